@@ -1,0 +1,15 @@
+// Registration of the subcommands of the `crowdrecon` program. Each group lives
+// in its own file and adds itself to the application; errors are thrown as
+// crowdrecon::InputError and reported by main().
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace crowdrecon::cli {
+
+void RegisterShapeCommands(CLI::App& app);  // shape, population
+void RegisterVenueCommands(CLI::App& app);  // venue check, venue import
+
+}  // namespace crowdrecon::cli

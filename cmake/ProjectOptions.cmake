@@ -1,0 +1,26 @@
+# Compiler settings for project targets: warnings as errors, no floating-point
+# contraction (results must not depend on whether the compiler fuses a*b+c),
+# optional sanitizers.
+add_library(crowdrecon_options INTERFACE)
+target_compile_options(crowdrecon_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
+  -Wnon-virtual-dtor -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion
+  -Werror
+  -ffp-contract=off)
+if(CROWDRECON_SANITIZE)
+  target_compile_options(crowdrecon_options INTERFACE
+    -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(crowdrecon_options INTERFACE -fsanitize=address,undefined)
+endif()
+
+# Mark a third-party target's include directories as system includes.
+function(crowdrecon_system_includes target)
+  get_target_property(aliased ${target} ALIASED_TARGET)
+  if(aliased)
+    set(target ${aliased})
+  endif()
+  get_target_property(dirs ${target} INTERFACE_INCLUDE_DIRECTORIES)
+  if(dirs)
+    set_target_properties(${target} PROPERTIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES "${dirs}")
+  endif()
+endfunction()

@@ -1,0 +1,27 @@
+// Errors of crowdrecon. Every error a user can cause is an InputError whose
+// message names where the problem is (file, JSON path or line, element), the
+// value found and what was expected. The command-line program prints the
+// message and exits non-zero.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace crowdrecon {
+
+// Bad input: a file, option or value the user gave.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Invalid geometry (a shape or venue that cannot be built as asked).
+class GeometryError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+// Formats a double compactly for messages ("0.05", "1e+05").
+std::string FormatNumber(double value);
+
+}  // namespace crowdrecon

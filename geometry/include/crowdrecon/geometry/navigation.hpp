@@ -1,0 +1,89 @@
+// Navigation field: the desired walking direction of every target at every
+// point of a venue.
+//
+// For an exit, the field is built from the geodesic distance T(x) to the exit
+// over the walkable area (shortest walking distance around obstacles), which
+// solves the eikonal equation |grad T| = 1 with T = 0 on the exit. T is computed
+// once, on a regular grid, by the fast marching method (Sethian 1996; first-
+// order upwind scheme), and the desired direction is e(x) = -grad T / |grad T|,
+// interpolated bilinearly between grid nodes. People therefore walk around
+// obstacles toward the exit rather than into them.
+//
+// For a fixed-direction target (periodic corridors) the field is constant.
+//
+// The grid is exposed as plain arrays so that the engine can sample it without
+// this module.
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string_view>
+#include <vector>
+
+#include "crowdrecon/common/vec2.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+
+namespace crowdrecon::geometry {
+
+struct NavigationOptions {
+  // Grid spacing of the fast marching grid (m). The error of T is of the order
+  // of the spacing near the exit and obstacle corners and falls off relative to
+  // the distance; 0.1 m is a fraction of a body width.
+  double grid_spacing_m = 0.1;
+
+  // Throws InputError naming the option if a value is out of range.
+  void Validate() const;
+};
+
+class NavigationField {
+ public:
+  // Geodesic field toward the exit `exit_id` (GeometryError if there is none).
+  static NavigationField ToExit(const Venue& venue, std::string_view exit_id,
+                                const NavigationOptions& options = {});
+  // Constant field.
+  static NavigationField Constant(Vec2 direction);
+  // The field of a target (see Venue::FindTarget): ToExit or Constant.
+  static NavigationField ForTarget(const Venue& venue, std::string_view target_id,
+                                   const NavigationOptions& options = {});
+
+  bool is_constant() const { return constant_; }
+
+  // Desired direction at p: a unit vector, or (0, 0) where the target cannot be
+  // reached (a disconnected part of the venue) or p is far outside the area.
+  Vec2 Direction(Vec2 p) const;
+  // Geodesic distance to the exit at p (m), bilinearly interpolated;
+  // +infinity where unreachable. For a constant field: 0.
+  double Distance(Vec2 p) const;
+
+  // --- the grid (empty for a constant field) ---------------------------------
+  // Node (i, j) is at origin + (i, j) * spacing, index j * nx + i.
+  Vec2 origin_m() const { return origin_m_; }
+  double spacing_m() const { return spacing_m_; }
+  std::size_t nx() const { return nx_; }
+  std::size_t ny() const { return ny_; }
+  // T at each node (m); +infinity at nodes outside the area or unreachable.
+  const std::vector<double>& distance_m() const { return distance_m_; }
+  // -grad T at each node, normalised; (0, 0) outside or unreachable.
+  const std::vector<Vec2>& direction() const { return direction_; }
+
+ private:
+  bool constant_ = true;
+  Vec2 constant_direction_;
+  Vec2 origin_m_;
+  double spacing_m_ = 0.0;
+  std::size_t nx_ = 0, ny_ = 0;
+  std::vector<double> distance_m_;
+  std::vector<Vec2> direction_;
+};
+
+// Fast marching on a grid, exposed for tests and reuse. `inside[k]` marks
+// the nodes of the domain; `source_distance_m[k]` is finite at source nodes (the
+// known distance there) and +infinity elsewhere. Returns T at every node
+// (+infinity outside or unreachable). Node k = j * nx + i, spacing h.
+std::vector<double> FastMarch(std::size_t nx, std::size_t ny, double spacing_m,
+                              const std::vector<char>& inside,
+                              const std::vector<double>& source_distance_m);
+
+inline constexpr double kUnreachable = std::numeric_limits<double>::infinity();
+
+}  // namespace crowdrecon::geometry
