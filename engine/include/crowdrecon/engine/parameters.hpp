@@ -1,0 +1,98 @@
+// ModelParameters: every physical parameter of the pedestrian model, with its
+// unit, the paper's value as default and its source (Table 1 and the text of
+// Alonso-Marroquin et al.; decisions on inconsistencies in docs/model.md).
+#pragma once
+
+#include <string>
+
+namespace crowdrecon::engine {
+
+// Which angle the motive torque (eq. 16) turns a person toward (ERRATA 5).
+enum class FacingTarget {
+  kVelocity,          // theta_D = angle of the walking velocity v_i (the paper's definition)
+  kDesiredDirection,  // theta_D = angle of the desired direction e_i
+};
+const char* ToString(FacingTarget t);
+bool FromString(const std::string& s, FacingTarget* t);
+
+// How the tangential damping rate gamma_t is set (ERRATA 2: the paper is silent).
+enum class TangentialDamping {
+  kFromRestitution,  // invert eq. (19) with kt instead of kn: same restitution for tangential oscillation
+  kEqualToNormal,    // gamma_t = gamma_n of the same contact
+  kFixed,            // gamma_t = tangential_damping_rate_per_s
+};
+const char* ToString(TangentialDamping t);
+bool FromString(const std::string& s, TangentialDamping* t);
+
+enum class Integrator {
+  kVelocityVerlet,  // second order, symplectic for conservative forces; default
+  kGear5,           // fifth-order Gear predictor-corrector, as in the paper's SPOLY code
+};
+const char* ToString(Integrator t);
+bool FromString(const std::string& s, Integrator* t);
+
+struct ModelParameters {
+  // --- Contact forces (eqs. 7-14, 19; Table 1) -------------------------
+  double normal_stiffness_n_per_m = 1e5;      // k_n, Table 1 (thorax deformation data [21])
+  double tangential_stiffness_n_per_m = 1e4;  // k_t, Table 1 ("k_6" in the text, ERRATA 3)
+  double friction_coefficient = 0.4;          // mu, Table 1 (cloth on cloth)
+  // epsilon, Table 1 says 0.4, the text 0.3 (ERRATA 1). We default to Table 1.
+  // gamma_n is derived per contact from epsilon and m_ij by inverting eq. (19) (ERRATA 2).
+  double restitution = 0.4;
+  double wall_restitution = 0.4;  // epsilon for person-wall contacts (same source)
+  TangentialDamping tangential_damping = TangentialDamping::kFromRestitution;
+  double tangential_damping_rate_per_s = 0.0;  // gamma_t when kFixed (1/s)
+  // Allow the linear dashpot to pull at the end of a contact (as in eq. 19's
+  // derivation); when false the normal force is clamped at zero.
+  bool allow_tensile_normal_force = true;
+
+  // --- Ground reaction forces (eqs. 3, 15) -----------------------------
+  // false: people are passive rigid bodies (no eqs. 3, 15, 16, 17 and no
+  // slope force), as needed by the verification scenes (collisions, momentum).
+  bool ground_reaction = true;
+  double relaxation_time_s = 2.0 / 3.0;  // tau, text: "tau = 2/3 s"
+  double desired_speed_min_m_per_s = 0.8;  // v0 ~ U(0.8, 1.2) m/s, text
+  double desired_speed_max_m_per_s = 1.2;
+  double back_force_gamma = 1.2;  // Gamma, Table 1 (fitted to footage)
+
+  // --- Torques (eqs. 16-17) --------------------------------------------
+  double torsion_stiffness_lambda = 27.0;  // lambda, Table 1 (fitted to footage)
+  // Relaxation time of rotation in eq. (17); the paper reuses the symbol tau
+  // (ERRATA 8), so it defaults to tau.
+  double rotation_relaxation_time_s = 2.0 / 3.0;
+  FacingTarget facing_target = FacingTarget::kVelocity;
+
+  // --- Bodies -----------------------------------------------------------
+  double surface_density_kg_per_m2 = 1000.0;  // rho, text (eq. 13)
+  double mass_min_kg = 40.0;                  // text: masses uniform in 40-70 kg
+  double mass_max_kg = 70.0;
+
+  // --- Floor --------------------------------------------------------------
+  double gravity_m_per_s2 = 9.81;  // for the optional floor slope body force
+
+  // --- Time integration ---------------------------------------------------
+  Integrator integrator = Integrator::kVelocityVerlet;
+  // Time step (s); 0 = chosen by the engine from the stiffest contact (see
+  // StableTimeStep). A user-given value above the stability limit is refused.
+  double time_step_s = 0.0;
+  // Fraction of the integrator's stability limit used when the engine chooses
+  // the step: h = safety * 2 / omega_max for velocity Verlet. Chosen for
+  // accuracy, not speed: at 0.04 the restitution of head-on collisions is
+  // within 3% of epsilon for epsilon in [0.1, 0.5] whatever the phase of the
+  // collision within a step, and within 2% at half that step
+  // (tests/unit/test_engine_physics.cpp; docs/model.md).
+  double time_step_safety = 0.04;
+
+  // Returns false and fills *error with "name: value, expected ..." if a value
+  // is out of its physical range.
+  bool IsValid(std::string* error) const;
+};
+
+// Normal damping rate gamma_n (1/s) that gives restitution epsilon for a
+// contact of stiffness k and effective mass m_ij, by inverting eq. (19):
+//   gamma = 2 L sqrt(k / m) / sqrt(pi^2 + L^2),  L = -ln(epsilon).
+double DampingRateFromRestitution(double restitution, double stiffness_n_per_m, double mass_kg);
+// Eq. (19) itself: restitution of a linear spring-dashpot contact.
+double RestitutionFromDampingRate(double gamma_per_s, double stiffness_n_per_m, double mass_kg);
+
+}  // namespace crowdrecon::engine

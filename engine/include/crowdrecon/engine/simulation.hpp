@@ -1,0 +1,161 @@
+// Simulation: Newton-Euler dynamics of spheropolygon pedestrians (paper,
+// eqs. 1-19). One Step() runs a fixed list of named stages, each timed into
+// the Profile (in the manner of Box2D v3):
+//
+//   1. update_pairs   Verlet neighbour list (cells + skin) when people moved
+//   2. place_shapes   body-frame vertices -> world frame
+//   3. collide        narrow phase + contact forces per pair (eqs. 7-14, 19), parallel
+//   4. gather         contact forces and torques onto bodies in a fixed order (eq. 18)
+//   5. drive          self-driven force (3), back force (15), torques (16-17), slope
+//   6. integrate      velocity Verlet or Gear 5th-order predictor-corrector
+//   7. check          non-finite state or overlap beyond the sum of radii -> SimulationError
+//
+// Forces read only the current state and every sum runs in a fixed order, so
+// results are identical whatever the number of threads.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/engine/world.hpp"
+
+namespace crowdrecon::engine {
+
+// A contact between person `a` and person `b`, or between person `a` and wall
+// segment `b` when `wall` is true. Forces are those acting on `a`; `b` feels
+// the opposite. Every contact of the step is kept (force network, injury risk).
+struct Contact {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  bool wall = false;
+  std::uint32_t feature = 0;      // owning vertex within (a, b), see narrow_phase.hpp
+  Vec2 point_m;                   // application point (in a's periodic image)
+  Vec2 normal;                    // unit, from b to a
+  double overlap_m = 0.0;         // delta_n
+  double normal_force_n = 0.0;    // along `normal` (elastic + viscous, eqs. 8, 11)
+  double tangential_force_n = 0.0;  // along Perp(normal) (eqs. 9, 12)
+  double tangential_spring_m = 0.0;  // delta_t, elastic tangential displacement (eqs. 9-10)
+  // The viscous parts of the two forces above (eqs. 11, 12), and the fractions
+  // of the half steps before and after this evaluation during which the
+  // contact existed (see "contact onset and end within a step" in docs/model.md).
+  double viscous_normal_n = 0.0;
+  double viscous_tangential_n = 0.0;
+  double trailing_fraction = 1.0;
+  double leading_fraction = 1.0;
+  Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
+};
+
+// Hot state, one entry per person (structure of arrays).
+struct BodyState {
+  std::vector<Vec2> position_m;
+  std::vector<double> angle_rad;
+  std::vector<Vec2> velocity_m_per_s;
+  std::vector<double> angular_velocity_rad_per_s;
+  std::vector<Vec2> force_n;         // total force of the last evaluation
+  std::vector<double> torque_n_m;    // total torque of the last evaluation
+  std::vector<Vec2> contact_force_n;  // sum of contact forces (eq. 2, third term)
+  std::vector<double> contact_torque_n_m;  // sum of contact torques (eq. 18, last term)
+  std::vector<Vec2> external_force_n;  // see Simulation::SetExternalForce
+  std::vector<double> mass_kg;
+  std::vector<double> inertia_kg_m2;
+  std::vector<std::uint32_t> shape;
+  std::vector<double> desired_speed_m_per_s;
+  std::vector<std::uint32_t> target;
+  std::vector<std::uint32_t> group;
+  std::vector<PersonState> state;
+  std::size_t size() const { return position_m.size(); }
+};
+
+struct Profile {
+  // Accumulated wall-clock seconds per stage since construction.
+  double update_pairs_s = 0, place_shapes_s = 0, collide_s = 0, gather_s = 0, drive_s = 0,
+         integrate_s = 0, check_s = 0;
+  std::uint64_t pair_rebuilds = 0;
+};
+
+// Time-step limits derived from the stiffest contact and the smallest body.
+struct TimeStepEstimate {
+  double omega_max_rad_per_s = 0.0;  // highest contact frequency (see docs/model.md)
+  double stability_limit_s = 0.0;    // integrator's stability bound
+  double chosen_s = 0.0;             // safety * limit (or the user's value)
+};
+
+// A run that went numerically wrong. The message names the people and the time.
+class SimulationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Simulation {
+ public:
+  // Validates the definition; throws InputError with a precise message.
+  explicit Simulation(WorldDef def);
+  ~Simulation();
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+
+  void Step();
+  // Steps until time() >= end_time_s.
+  void AdvanceTo(double end_time_s);
+
+  double time_s() const { return time_s_; }
+  std::uint64_t step_count() const { return step_count_; }
+  double time_step_s() const { return dt_s_; }
+  const TimeStepEstimate& time_step_estimate() const { return dt_estimate_; }
+  const WorldDef& definition() const { return def_; }
+  const BodyState& bodies() const { return bodies_; }
+  // Contacts of the last force evaluation, in a fixed order.
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const Profile& profile() const { return profile_; }
+
+  // A constant external force on a person (N), added to eq. (2) until changed;
+  // used by verification scenes and crash tests (pushing, pressing).
+  void SetExternalForce(std::uint32_t person, Vec2 force_n);
+
+  // Changes a person's state (a fall makes them an obstacle; removal takes them out).
+  void SetPersonState(std::uint32_t person, PersonState state);
+
+  // Diagnostics for tests and reports.
+  Vec2 LinearMomentum() const;
+  double AngularMomentum() const;  // about the origin (z component)
+  double KineticEnergy() const;    // translational + rotational
+  double ElasticEnergy() const;    // kn delta^2/2 + kt delta_t^2/2 over the contacts
+
+  // Minimum-image difference a - b under the periodic box.
+  Vec2 Separation(Vec2 a, Vec2 b) const;
+
+ private:
+  struct Internals;
+  void UpdatePairs();
+  void PlaceShapes();
+  void Collide();
+  void Gather();
+  void Drive();
+  void ComputeForces();
+  void VerletKickDrift();
+  void VerletKick();
+  void GearPredict();
+  void GearCorrect();
+  void Check();
+  void Wrap(Vec2& p) const;
+
+  WorldDef def_;
+  BodyState bodies_;
+  std::vector<Contact> contacts_;
+  std::unique_ptr<Internals> in_;
+  Profile profile_;
+  TimeStepEstimate dt_estimate_;
+  double dt_s_ = 0.0;
+  double time_s_ = 0.0;
+  std::uint64_t step_count_ = 0;
+  bool advance_springs_ = false;
+};
+
+// Time-step estimate for a world (used by the constructor; exposed for tests).
+TimeStepEstimate EstimateTimeStep(const WorldDef& def);
+
+}  // namespace crowdrecon::engine

@@ -1,0 +1,970 @@
+#include "crowdrecon/engine/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/narrow_phase.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace crowdrecon::engine {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::uint64_t kWallBit = std::uint64_t{1} << 63;
+// Pairs per work chunk. Chunks are fixed by the pair list, not by the thread
+// count, and their outputs are concatenated in order: determinism by construction.
+constexpr std::size_t kChunk = 64;
+// Below this many people the per-body stages run on one thread (the results
+// are the same either way; only the overhead differs).
+constexpr std::int64_t kParallelBodies = 512;
+
+using Clock = std::chrono::steady_clock;
+
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double& sink) : sink_(sink), start_(Clock::now()) {}
+  ~ScopedTimer() { sink_ += std::chrono::duration<double>(Clock::now() - start_).count(); }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  double& sink_;
+  Clock::time_point start_;
+};
+
+std::uint64_t PairKey(const Contact& c) {
+  return (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
+}
+
+double WrapAngle(double a) {
+  a = std::fmod(a + kPi, 2.0 * kPi);
+  if (a <= 0.0) a += 2.0 * kPi;
+  return a - kPi;  // (-pi, pi]
+}
+
+std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i); }
+
+}  // namespace
+
+struct Simulation::Internals {
+  // Geometry of every body in world frame, rebuilt each evaluation.
+  std::vector<std::uint32_t> vertex_offset;  // per body, into world_vertices
+  std::vector<Vec2> world_vertices;
+  std::vector<double> bound_m;  // core radius + sphero-radius per body
+  double skin_m = 0.1;
+
+  // Verlet lists.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;       // person pairs, a < b
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> wall_pairs;  // (person, wall)
+  std::vector<Vec2> position_at_build;
+  bool pairs_valid = false;
+
+  // Contact-law constants.
+  double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
+  double wall_restitution_factor = 0.0;  // same for walls
+
+  // Gear predictor-corrector: scaled derivatives r2..r5 for x, y, theta.
+  std::vector<std::array<Vec2, 4>> gear_xy;     // r2, r3, r4, r5
+  std::vector<std::array<double, 4>> gear_theta;
+  bool gear_initialised = false;
+
+  std::vector<std::vector<Contact>> chunk_contacts;
+  std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
+  std::vector<std::pair<Vec2, double>> wall_bounds;  // bounding circle of each wall
+  // Corrections of the dashpot impulse for contacts that began during the
+  // last half step (trailing) or end during the next (leading); see ContactLaw.
+  std::vector<Vec2> trailing_force, leading_force;
+  std::vector<double> trailing_torque, leading_torque;
+  // Verlet half-step velocities, or the Gear predicted r2 terms.
+  std::vector<Vec2> v_half;
+  std::vector<double> w_half;
+};
+
+// ---------------------------------------------------------------------------
+// Construction and validation
+
+TimeStepEstimate EstimateTimeStep(const WorldDef& def) {
+  // The stiffest mode: a contact at the farthest point of the lightest, most
+  // elongated body, against an equal body. Along the normal the effective
+  // inverse mass of one body is 1/m + l^2/I (translation plus the rotation
+  // that the lever arm l allows); two such bodies add. Two flat faces touch at
+  // up to four points (two vertices of each against the other's face),
+  // multiplying the stiffness by four. Hence
+  //   omega_max^2 = 4 k_n * 2 max_i (1/m_i + l_i^2 / I_i).
+  double w_max = 0.0;
+  for (const PersonDef& p : def.people) {
+    const BodyShape& s = def.shapes[p.shape];
+    double l = 0.0;
+    for (const Vec2& v : s.vertices) l = std::max(l, Length(v));
+    l += s.radius_m;
+    const double w = 1.0 / p.mass_kg + (p.inertia_kg_m2 > 0 ? l * l / p.inertia_kg_m2 : 0.0);
+    w_max = std::max(w_max, w);
+  }
+  TimeStepEstimate e;
+  if (w_max == 0.0) w_max = 1.0 / def.parameters.mass_min_kg;
+  e.omega_max_rad_per_s = std::sqrt(4.0 * def.parameters.normal_stiffness_n_per_m * 2.0 * w_max);
+  // Velocity Verlet is stable for omega dt < 2; the fifth-order Gear
+  // predictor-corrector only below about 0.2 for these damping ratios (ERRATA 12).
+  const double bound = def.parameters.integrator == Integrator::kVelocityVerlet ? 2.0 : 0.2;
+  e.stability_limit_s = bound / e.omega_max_rad_per_s;
+  e.chosen_s = def.parameters.time_step_s > 0.0 ? def.parameters.time_step_s
+                                                 : def.parameters.time_step_safety * e.stability_limit_s;
+  return e;
+}
+
+Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
+  std::string error;
+  if (!def_.parameters.IsValid(&error)) throw InputError("model parameters: " + error);
+  if (def_.threads < 1 || def_.threads > 1024)
+    throw InputError("threads = " + std::to_string(def_.threads) + ", expected 1..1024");
+  for (std::size_t s = 0; s < def_.shapes.size(); ++s) {
+    BodyShape& shape = def_.shapes[s];
+    if (shape.vertices.empty() || shape.vertices.size() >= 32768 || !(shape.radius_m > 0))
+      throw InputError("shape " + std::to_string(s) + ": needs 1..32767 vertices and a radius > 0");
+    shape.core_radius_m = 0.0;
+    for (const Vec2& v : shape.vertices) shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
+  }
+  const std::size_t n = def_.people.size();
+  if (n >= (std::size_t{1} << 31)) throw InputError("too many people");
+  for (std::size_t i = 0; i < n; ++i) {
+    const PersonDef& p = def_.people[i];
+    const std::string who = PersonText(static_cast<std::uint32_t>(i));
+    if (p.shape >= def_.shapes.size()) throw InputError(who + ": shape index out of range");
+    if (p.target >= def_.targets.size()) throw InputError(who + ": target index out of range");
+    if (!(p.mass_kg > 0) || !(p.inertia_kg_m2 > 0))
+      throw InputError(who + ": mass and moment of inertia must be > 0");
+    if (!std::isfinite(p.position_m.x) || !std::isfinite(p.position_m.y) || !std::isfinite(p.angle_rad))
+      throw InputError(who + ": position and angle must be finite");
+  }
+  for (std::size_t w = 0; w < def_.walls.size(); ++w) {
+    const Wall& wall = def_.walls[w];
+    if (wall.points.size() < 2 || (wall.closed && wall.points.size() < 3) || !(wall.radius_m >= 0.0))
+      throw InputError("wall " + std::to_string(w) + ": needs at least 2 points (3 if closed) and a radius >= 0");
+    for (std::size_t k = 0; k + 1 < wall.points.size(); ++k)
+      if (Length(wall.points[k + 1] - wall.points[k]) <= 0.0)
+        throw InputError("wall " + std::to_string(w) + ": points " + std::to_string(k) + " and " +
+                         std::to_string(k + 1) + " coincide");
+  }
+  const PeriodicBox& box = def_.periodic;
+  if ((box.x && !(box.max_m.x > box.min_m.x)) || (box.y && !(box.max_m.y > box.min_m.y)))
+    throw InputError("periodic box: max must exceed min along periodic axes");
+
+  // Bodies.
+  bodies_.position_m.resize(n);
+  bodies_.angle_rad.resize(n);
+  bodies_.velocity_m_per_s.resize(n);
+  bodies_.angular_velocity_rad_per_s.resize(n);
+  bodies_.force_n.assign(n, {});
+  bodies_.torque_n_m.assign(n, 0.0);
+  bodies_.contact_force_n.assign(n, {});
+  bodies_.external_force_n.assign(n, {});
+  bodies_.contact_torque_n_m.assign(n, 0.0);
+  bodies_.mass_kg.resize(n);
+  bodies_.inertia_kg_m2.resize(n);
+  bodies_.shape.resize(n);
+  bodies_.desired_speed_m_per_s.resize(n);
+  bodies_.target.resize(n);
+  bodies_.group.resize(n);
+  bodies_.state.resize(n);
+  in_->vertex_offset.resize(n + 1);
+  in_->bound_m.resize(n);
+  std::uint32_t offset = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const PersonDef& p = def_.people[i];
+    bodies_.position_m[i] = p.position_m;
+    bodies_.angle_rad[i] = p.angle_rad;
+    bodies_.velocity_m_per_s[i] = p.velocity_m_per_s;
+    bodies_.angular_velocity_rad_per_s[i] = p.angular_velocity_rad_per_s;
+    bodies_.mass_kg[i] = p.mass_kg;
+    bodies_.inertia_kg_m2[i] = p.inertia_kg_m2;
+    bodies_.shape[i] = p.shape;
+    bodies_.desired_speed_m_per_s[i] = p.desired_speed_m_per_s;
+    bodies_.target[i] = p.target;
+    bodies_.group[i] = p.group;
+    bodies_.state[i] = p.state;
+    in_->vertex_offset[i] = offset;
+    const BodyShape& s = def_.shapes[p.shape];
+    offset += static_cast<std::uint32_t>(s.vertices.size());
+    in_->bound_m[i] = s.core_radius_m + s.radius_m;
+    Wrap(bodies_.position_m[i]);
+  }
+  in_->vertex_offset[n] = offset;
+  in_->world_vertices.resize(offset);
+
+  // Walls crossing a periodic boundary are extended beyond it, so that a body
+  // straddling the seam meets a straight wall and never a wall's end cap.
+  double bound_max = 0.0;
+  for (double b : in_->bound_m) bound_max = std::max(bound_max, b);
+  const double reach = 2.0 * bound_max + 2.0 * in_->skin_m;
+  const auto extend = [&](Vec2& end, Vec2 other, bool axis_x) {
+    const double c = axis_x ? end.x : end.y;
+    const double lo = axis_x ? box.min_m.x : box.min_m.y, hi = axis_x ? box.max_m.x : box.max_m.y;
+    if (std::abs(c - lo) > 1e-9 && std::abs(c - hi) > 1e-9) return;
+    const Vec2 dir = Normalized(end - other);
+    const double along = std::abs(axis_x ? dir.x : dir.y);
+    if (along < 1e-6) return;  // runs along the boundary
+    end += dir * (reach / along);
+  };
+  for (Wall& wall : def_.walls) {
+    if (wall.closed) continue;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!(axis == 0 ? box.x : box.y)) continue;
+      extend(wall.points.front(), wall.points[1], axis == 0);
+      extend(wall.points.back(), wall.points[wall.points.size() - 2], axis == 0);
+    }
+  }
+  in_->wall_bounds.resize(def_.walls.size());
+  for (std::size_t w = 0; w < def_.walls.size(); ++w) {
+    // Bounding circle of the polyline, for the per-vertex cull of the narrow phase.
+    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+    for (const Vec2& p : def_.walls[w].points) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    const Vec2 centre = (lo + hi) / 2.0;
+    double radius = 0.0;
+    for (const Vec2& p : def_.walls[w].points) radius = std::max(radius, Length(p - centre));
+    in_->wall_bounds[w] = {centre, radius};
+  }
+
+  const auto factor = [](double eps) {
+    const double l = -std::log(eps);
+    return 2.0 * l / std::sqrt(kPi * kPi + l * l);
+  };
+  in_->restitution_factor = factor(def_.parameters.restitution);
+  in_->wall_restitution_factor = factor(def_.parameters.wall_restitution);
+
+  dt_estimate_ = EstimateTimeStep(def_);
+  if (def_.parameters.time_step_s > dt_estimate_.stability_limit_s)
+    throw InputError("time_step_s = " + FormatNumber(def_.parameters.time_step_s) +
+                     " s is above the stability limit of the " +
+                     ToString(def_.parameters.integrator) + " integrator, " +
+                     FormatNumber(dt_estimate_.stability_limit_s) +
+                     " s, for the stiffest contact (omega_max = " +
+                     FormatNumber(dt_estimate_.omega_max_rad_per_s) +
+                     " rad/s); use a smaller step or 0 for automatic");
+  dt_s_ = dt_estimate_.chosen_s;
+
+  ComputeForces();  // forces at t = 0 (no spring increment: contacts start unloaded)
+  in_->previous_contacts = contacts_;
+}
+
+Simulation::~Simulation() = default;
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+
+// ---------------------------------------------------------------------------
+// Periodic box
+
+void Simulation::Wrap(Vec2& p) const {
+  const PeriodicBox& box = def_.periodic;
+  if (box.x) {
+    const double l = box.max_m.x - box.min_m.x;
+    p.x = box.min_m.x + (p.x - box.min_m.x) - l * std::floor((p.x - box.min_m.x) / l);
+    if (p.x >= box.max_m.x) p.x -= l;
+  }
+  if (box.y) {
+    const double l = box.max_m.y - box.min_m.y;
+    p.y = box.min_m.y + (p.y - box.min_m.y) - l * std::floor((p.y - box.min_m.y) / l);
+    if (p.y >= box.max_m.y) p.y -= l;
+  }
+}
+
+Vec2 Simulation::Separation(Vec2 a, Vec2 b) const {
+  Vec2 d = a - b;
+  const PeriodicBox& box = def_.periodic;
+  if (box.x) {
+    const double l = box.max_m.x - box.min_m.x;
+    d.x -= l * std::nearbyint(d.x / l);
+  }
+  if (box.y) {
+    const double l = box.max_m.y - box.min_m.y;
+    d.y -= l * std::nearbyint(d.y / l);
+  }
+  return d;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 1: neighbour pairs (cells + Verlet skin)
+
+void Simulation::UpdatePairs() {
+  ScopedTimer timer(profile_.update_pairs_s);
+  Internals& in = *in_;
+  const std::size_t n = bodies_.size();
+  if (in.pairs_valid) {
+    // Rebuild only when someone moved more than half the skin since the last
+    // build (bounding circles are rotation invariant, so rotation never forces one).
+    const double limit2 = in.skin_m * in.skin_m / 4.0;
+    bool rebuild = false;
+    for (std::size_t i = 0; i < n && !rebuild; ++i)
+      rebuild = LengthSquared(Separation(bodies_.position_m[i], in.position_at_build[i])) > limit2;
+    if (!rebuild) return;
+  }
+  ++profile_.pair_rebuilds;
+  in.pairs_valid = true;
+  in.position_at_build = bodies_.position_m;
+  in.pairs.clear();
+  in.wall_pairs.clear();
+
+  std::vector<std::uint32_t> active;
+  double bound_max = 0.0;
+  Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (bodies_.state[i] == PersonState::kRemoved) continue;
+    active.push_back(i);
+    bound_max = std::max(bound_max, in.bound_m[i]);
+    const Vec2 p = bodies_.position_m[i];
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+  }
+  if (active.empty()) return;
+  const double cutoff = 2.0 * bound_max + in.skin_m;
+  const PeriodicBox& box = def_.periodic;
+  if (box.x) { lo.x = box.min_m.x; hi.x = box.max_m.x; }
+  if (box.y) { lo.y = box.min_m.y; hi.y = box.max_m.y; }
+  if ((box.x && box.max_m.x - box.min_m.x < 2.0 * cutoff) ||
+      (box.y && box.max_m.y - box.min_m.y < 2.0 * cutoff))
+    throw InputError("periodic box is shorter than twice the interaction range " +
+                     FormatNumber(cutoff) + " m; make it longer");
+  const auto cells_along = [&](double extent, bool periodic) {
+    const double count = std::floor(extent / cutoff);
+    return static_cast<std::int64_t>(std::clamp(count, 1.0, periodic ? 1e6 : 1e6));
+  };
+  const std::int64_t ncx = cells_along(hi.x - lo.x + (box.x ? 0.0 : 1e-9), box.x);
+  const std::int64_t ncy = cells_along(hi.y - lo.y + (box.y ? 0.0 : 1e-9), box.y);
+  const double cell_w = box.x ? (hi.x - lo.x) / double(ncx) : std::max(cutoff, (hi.x - lo.x) / double(ncx));
+  const double cell_h = box.y ? (hi.y - lo.y) / double(ncy) : std::max(cutoff, (hi.y - lo.y) / double(ncy));
+  const auto cell_of = [&](Vec2 p) {
+    std::int64_t cx = static_cast<std::int64_t>(std::floor((p.x - lo.x) / cell_w));
+    std::int64_t cy = static_cast<std::int64_t>(std::floor((p.y - lo.y) / cell_h));
+    cx = std::clamp<std::int64_t>(cx, 0, ncx - 1);
+    cy = std::clamp<std::int64_t>(cy, 0, ncy - 1);
+    return std::pair{cx, cy};
+  };
+  // Counting sort of bodies into cells.
+  const std::size_t ncells = static_cast<std::size_t>(ncx * ncy);
+  std::vector<std::uint32_t> cell_start(ncells + 1, 0), cell_items(active.size());
+  std::vector<std::size_t> body_cell(active.size());
+  for (std::size_t k = 0; k < active.size(); ++k) {
+    const auto [cx, cy] = cell_of(bodies_.position_m[active[k]]);
+    body_cell[k] = static_cast<std::size_t>(cy * ncx + cx);
+    ++cell_start[body_cell[k] + 1];
+  }
+  for (std::size_t c = 0; c < ncells; ++c) cell_start[c + 1] += cell_start[c];
+  {
+    std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t k = 0; k < active.size(); ++k) cell_items[fill[body_cell[k]]++] = active[k];
+  }
+  std::vector<std::uint32_t> candidates;
+  std::vector<std::size_t> neighbour_cells;
+  for (std::size_t k = 0; k < active.size(); ++k) {
+    const std::uint32_t i = active[k];
+    const Vec2 pi = bodies_.position_m[i];
+    const std::int64_t cx = static_cast<std::int64_t>(body_cell[k] % static_cast<std::size_t>(ncx));
+    const std::int64_t cy = static_cast<std::int64_t>(body_cell[k] / static_cast<std::size_t>(ncx));
+    neighbour_cells.clear();
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        std::int64_t x = cx + dx, y = cy + dy;
+        if (box.x) x = (x + ncx) % ncx;
+        if (box.y) y = (y + ncy) % ncy;
+        if (x < 0 || x >= ncx || y < 0 || y >= ncy) continue;
+        neighbour_cells.push_back(static_cast<std::size_t>(y * ncx + x));
+      }
+    std::sort(neighbour_cells.begin(), neighbour_cells.end());
+    neighbour_cells.erase(std::unique(neighbour_cells.begin(), neighbour_cells.end()), neighbour_cells.end());
+    candidates.clear();
+    for (std::size_t c : neighbour_cells)
+      for (std::uint32_t s = cell_start[c]; s < cell_start[c + 1]; ++s) {
+        const std::uint32_t j = cell_items[s];
+        if (j <= i) continue;
+        const double range = in.bound_m[i] + in.bound_m[j] + in.skin_m;
+        if (LengthSquared(Separation(pi, bodies_.position_m[j])) < range * range) candidates.push_back(j);
+      }
+    std::sort(candidates.begin(), candidates.end());
+    for (std::uint32_t j : candidates) in.pairs.emplace_back(i, j);
+    for (std::uint32_t w = 0; w < def_.walls.size(); ++w) {
+      const Wall& wall = def_.walls[w];
+      const double range = in.bound_m[i] + wall.radius_m + in.skin_m;
+      if (Length(pi - in.wall_bounds[w].first) > in.wall_bounds[w].second + range) continue;
+      const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
+      for (std::size_t seg = 0; seg < segments; ++seg)
+        if (DistanceToSegment(pi, wall.points[seg], wall.points[(seg + 1) % wall.points.size()]) < range) {
+          in.wall_pairs.emplace_back(i, w);
+          break;
+        }
+    }
+  }
+  std::sort(in.pairs.begin(), in.pairs.end());
+}
+
+// ---------------------------------------------------------------------------
+// Stage 2: shapes to world frame
+
+void Simulation::PlaceShapes() {
+  ScopedTimer timer(profile_.place_shapes_s);
+  Internals& in = *in_;
+  const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const BodyShape& s = def_.shapes[bodies_.shape[i]];
+    const double c = std::cos(bodies_.angle_rad[i]), sn = std::sin(bodies_.angle_rad[i]);
+    const Vec2 x = bodies_.position_m[i];
+    Vec2* out = &in.world_vertices[in.vertex_offset[i]];
+    for (std::size_t k = 0; k < s.vertices.size(); ++k) {
+      const Vec2 v = s.vertices[k];
+      out[k] = {x.x + c * v.x - sn * v.y, x.y + sn * v.x + c * v.y};
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Stage 3: narrow phase and contact forces (eqs. 7-14, 19)
+
+namespace {
+
+struct ContactLaw {
+  double kn, kt, mu, dt;
+  double damping_factor;  // 2L/sqrt(pi^2+L^2): gamma = factor * sqrt(k / m_ij)
+  TangentialDamping tangential_mode;
+  double tangential_rate;
+  bool tensile;
+  bool advance_springs;
+
+  // Fills the forces of contact c given the relative velocity at the contact
+  // point and the previous tangential displacement.
+  //
+  //
+  // Restitution per pair. A pair touching at several points (a flat face) acts
+  // as one spring of stiffness k_eff kn along the normal, and the pair's
+  // restitution should be epsilon whatever the number of points. The pair
+  // damping rate follows from eq. (19) with k_eff kn, and is shared among the
+  // points in proportion to their overlaps. k_eff = (sum delta)^2 / sum delta^2
+  // counts points weighted by overlap, so that a point that starts touching
+  // joins the sum continuously. `weight` = delta_i / sum delta; for a single
+  // point weight = k_eff = 1 and this is eq. (19) as written (docs/model.md).
+  void Apply(Contact& c, Vec2 relative_velocity, double effective_mass, const Contact* previous,
+             double weight, double k_eff) const {
+    const double previous_spring = previous ? previous->tangential_spring_m : 0.0;
+    const bool previous_spring_found = previous != nullptr;
+    const Vec2 t = Perp(c.normal);
+    const double vn = Dot(relative_velocity, c.normal);  // > 0: separating
+    const double vt = Dot(relative_velocity, t);
+    const double gamma_n = damping_factor * std::sqrt(k_eff * kn / effective_mass) * weight;  // eq. (19) inverted
+    double gamma_t = 0.0;
+    switch (tangential_mode) {
+      case TangentialDamping::kFromRestitution:
+        gamma_t = damping_factor * std::sqrt(k_eff * kt / effective_mass) * weight;
+        break;
+      case TangentialDamping::kEqualToNormal: gamma_t = gamma_n; break;
+      case TangentialDamping::kFixed: gamma_t = tangential_rate * weight; break;
+    }
+    const double elastic_n = kn * c.overlap_m;                      // eq. (8)
+    double fn = elastic_n - effective_mass * gamma_n * vn;           // + eq. (11)
+    if (!tensile && fn < 0.0) fn = 0.0;
+    // Tangential elastic displacement (eq. 9), accumulated while the contact
+    // persists and capped by Coulomb's condition on the elastic parts (eq. 10).
+    double spring = previous_spring + (advance_springs ? vt * dt : 0.0);
+    const double cap = mu * elastic_n;
+    if (kt * std::abs(spring) > cap) spring = std::copysign(cap / kt, spring);
+    c.tangential_spring_m = spring;
+    c.normal_force_n = fn;
+    c.viscous_normal_n = fn - elastic_n;
+    c.viscous_tangential_n = -effective_mass * gamma_t * vt;
+    c.tangential_force_n = -kt * spring + c.viscous_tangential_n;  // eqs. (9) + (12)
+    // Onset and end within a step. The dashpots jump at delta = 0 (eqs. 11-12),
+    // so a kick that applies them for a whole half step when the contact began
+    // or ends inside it biases the restitution by O(gamma h). The time since
+    // onset (new contact) and until the end (separating contact) are estimated
+    // from delta and v_n, and the dashpot impulse of the half kick is cut to it.
+    const bool is_new = previous_spring_found == false;
+    c.trailing_fraction = (is_new && vn < 0.0) ? std::min(1.0, 2.0 * c.overlap_m / (-vn * dt)) : 1.0;
+    c.leading_fraction = vn > 0.0 ? std::min(1.0, 2.0 * c.overlap_m / (vn * dt)) : 1.0;
+  }
+};
+
+// Sum of the overlaps of a pair's points and their overlap-weighted count
+// k_eff = (sum delta)^2 / sum delta^2 (see ContactLaw::Apply).
+std::pair<double, double> OverlapShares(const std::vector<ContactPoint>& points) {
+  double sum = 0.0, sum2 = 0.0;
+  for (const ContactPoint& p : points) {
+    sum += p.overlap_m;
+    sum2 += p.overlap_m * p.overlap_m;
+  }
+  return {sum, sum * sum / sum2};
+}
+
+const Contact* FindPrevious(const std::vector<Contact>& previous, std::uint64_t key, std::uint32_t feature) {
+  auto it = std::lower_bound(previous.begin(), previous.end(), std::pair{key, feature},
+                             [](const Contact& c, const std::pair<std::uint64_t, std::uint32_t>& k) {
+                               const std::uint64_t ck = PairKey(c);
+                               return ck < k.first || (ck == k.first && c.feature < k.second);
+                             });
+  if (it != previous.end() && PairKey(*it) == key && it->feature == feature) return &*it;
+  return nullptr;
+}
+
+}  // namespace
+
+void Simulation::Collide() {
+  ScopedTimer timer(profile_.collide_s);
+  Internals& in = *in_;
+  const ModelParameters& mp = def_.parameters;
+  // The first evaluation (at construction) does not advance the springs.
+  const ContactLaw law{mp.normal_stiffness_n_per_m, mp.tangential_stiffness_n_per_m, mp.friction_coefficient,
+                       dt_s_, in.restitution_factor, mp.tangential_damping, mp.tangential_damping_rate_per_s,
+                       mp.allow_tensile_normal_force, advance_springs_};
+  ContactLaw wall_law = law;
+  wall_law.damping_factor = in.wall_restitution_factor;
+
+  const std::size_t person_chunks = (in.pairs.size() + kChunk - 1) / kChunk;
+  const std::size_t wall_chunks = (in.wall_pairs.size() + kChunk - 1) / kChunk;
+  const std::size_t chunks = person_chunks + wall_chunks;
+  in.chunk_contacts.resize(chunks);
+
+  const auto placed = [&](std::uint32_t i, const Vec2* vertices) {
+    const BodyShape& s = def_.shapes[bodies_.shape[i]];
+    PlacedShape p;
+    p.vertices = vertices;
+    p.count = static_cast<std::uint32_t>(s.vertices.size());
+    p.closed = s.vertices.size() >= 3;
+    p.radius_m = s.radius_m;
+    p.core_radius_m = s.core_radius_m;
+    return p;
+  };
+  const auto velocity_at = [&](std::uint32_t i, Vec2 arm) {
+    if (bodies_.state[i] != PersonState::kWalking) return Vec2{};
+    return bodies_.velocity_m_per_s[i] + Perp(arm) * bodies_.angular_velocity_rad_per_s[i];
+  };
+  const auto effective_mass = [&](std::uint32_t a, std::uint32_t b) {
+    const bool fa = bodies_.state[a] != PersonState::kWalking, fb = bodies_.state[b] != PersonState::kWalking;
+    if (fa && fb) return 0.5 * (bodies_.mass_kg[a] + bodies_.mass_kg[b]);  // no dynamics; any positive value
+    if (fa) return bodies_.mass_kg[b];
+    if (fb) return bodies_.mass_kg[a];
+    return bodies_.mass_kg[a] * bodies_.mass_kg[b] / (bodies_.mass_kg[a] + bodies_.mass_kg[b]);  // eq. (14)
+  };
+
+  const std::int64_t total = static_cast<std::int64_t>(chunks);
+#pragma omp parallel num_threads(def_.threads) if (total >= 4)
+  {
+    std::vector<ContactPoint> points;
+    std::vector<Vec2> shifted;
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t ck = 0; ck < total; ++ck) {
+      const std::size_t chunk = static_cast<std::size_t>(ck);
+      std::vector<Contact>& out = in.chunk_contacts[chunk];
+      out.clear();
+      if (chunk < person_chunks) {
+        const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
+        for (std::size_t k = chunk * kChunk; k < end; ++k) {
+          const auto [a, b] = in.pairs[k];
+          if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
+          const Vec2 xa = bodies_.position_m[a];
+          const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
+          const Vec2 shift = xb_image - bodies_.position_m[b];
+          PlacedShape pa = placed(a, &in.world_vertices[in.vertex_offset[a]]);
+          pa.centre = xa;
+          const Vec2* vb = &in.world_vertices[in.vertex_offset[b]];
+          if (shift.x != 0.0 || shift.y != 0.0) {
+            const std::size_t count = in.vertex_offset[b + 1] - in.vertex_offset[b];
+            shifted.resize(count);
+            for (std::size_t v = 0; v < count; ++v) shifted[v] = vb[v] + shift;
+            vb = shifted.data();
+          }
+          PlacedShape pb = placed(b, vb);
+          pb.centre = xb_image;
+          points.clear();
+          CollideShapes(pa, pb, points);
+          if (points.empty()) continue;
+          const double m_ab = effective_mass(a, b);
+          const std::uint64_t key = (std::uint64_t{a} << 32) | b;
+          const auto [sum, k_eff] = OverlapShares(points);
+          for (const ContactPoint& p : points) {
+            Contact c;
+            c.a = a;
+            c.b = b;
+            c.feature = p.feature;
+            c.point_m = p.point;
+            c.normal = p.normal;
+            c.overlap_m = p.overlap_m;
+            const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
+            const Contact* prev = FindPrevious(in.previous_contacts, key, p.feature);
+            law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
+            out.push_back(c);
+          }
+        }
+      } else {
+        const std::size_t wchunk = chunk - person_chunks;
+        const std::size_t end = std::min(in.wall_pairs.size(), (wchunk + 1) * kChunk);
+        for (std::size_t k = wchunk * kChunk; k < end; ++k) {
+          const auto [a, w] = in.wall_pairs[k];
+          if (bodies_.state[a] == PersonState::kRemoved) continue;
+          const Vec2 xa = bodies_.position_m[a];
+          PlacedShape pa = placed(a, &in.world_vertices[in.vertex_offset[a]]);
+          pa.centre = xa;
+          const Wall& wall = def_.walls[w];
+          PlacedShape pw;
+          pw.vertices = wall.points.data();
+          pw.count = static_cast<std::uint32_t>(wall.points.size());
+          pw.closed = wall.closed;
+          pw.radius_m = wall.radius_m;
+          pw.centre = in.wall_bounds[w].first;
+          pw.core_radius_m = in.wall_bounds[w].second;
+          points.clear();
+          CollideShapes(pa, pw, points);
+          if (points.empty()) continue;
+          const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
+          const auto [sum, k_eff] = OverlapShares(points);
+          for (const ContactPoint& p : points) {
+            Contact c;
+            c.a = a;
+            c.b = w;
+            c.wall = true;
+            c.feature = p.feature;
+            c.point_m = p.point;
+            c.normal = p.normal;
+            c.overlap_m = p.overlap_m;
+            const Vec2 rel = velocity_at(a, p.point - xa);
+            const Contact* prev = FindPrevious(in.previous_contacts, key, p.feature);
+            wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
+            out.push_back(c);
+          }
+        }
+      }
+    }
+  }
+  contacts_.clear();
+  for (const auto& chunk : in.chunk_contacts) contacts_.insert(contacts_.end(), chunk.begin(), chunk.end());
+}
+
+// ---------------------------------------------------------------------------
+// Stage 4: contact forces onto bodies (eq. 2 third term, eq. 18 last term)
+
+void Simulation::Gather() {
+  ScopedTimer timer(profile_.gather_s);
+  Internals& in = *in_;
+  const std::size_t n = bodies_.size();
+  std::fill(bodies_.contact_force_n.begin(), bodies_.contact_force_n.end(), Vec2{});
+  std::fill(bodies_.contact_torque_n_m.begin(), bodies_.contact_torque_n_m.end(), 0.0);
+  in.trailing_force.assign(n, {});
+  in.trailing_torque.assign(n, 0.0);
+  in.leading_force.assign(n, {});
+  in.leading_torque.assign(n, 0.0);
+  // Serial, in contact order: every body's sum has a fixed order (ERRATA 11:
+  // each contact acts on both bodies, equal and opposite, each with its own branch vector).
+  for (const Contact& c : contacts_) {
+    const Vec2 f = c.Force();
+    const Vec2 viscous = c.normal * c.viscous_normal_n + Perp(c.normal) * c.viscous_tangential_n;
+    const Vec2 trailing = viscous * (c.trailing_fraction - 1.0);
+    const Vec2 leading = viscous * (c.leading_fraction - 1.0);
+    const Vec2 xa = bodies_.position_m[c.a];
+    const Vec2 arm_a = c.point_m - xa;
+    bodies_.contact_force_n[c.a] += f;
+    bodies_.contact_torque_n_m[c.a] += Cross(arm_a, f);
+    in.trailing_force[c.a] += trailing;
+    in.trailing_torque[c.a] += Cross(arm_a, trailing);
+    in.leading_force[c.a] += leading;
+    in.leading_torque[c.a] += Cross(arm_a, leading);
+    if (!c.wall) {
+      const Vec2 arm_b = c.point_m - (xa - Separation(xa, bodies_.position_m[c.b]));
+      bodies_.contact_force_n[c.b] -= f;
+      bodies_.contact_torque_n_m[c.b] -= Cross(arm_b, f);
+      in.trailing_force[c.b] -= trailing;
+      in.trailing_torque[c.b] -= Cross(arm_b, trailing);
+      in.leading_force[c.b] -= leading;
+      in.leading_torque[c.b] -= Cross(arm_b, leading);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Stage 5: ground reaction forces and torques (eqs. 3, 15, 16, 17), slope
+
+void Simulation::Drive() {
+  ScopedTimer timer(profile_.drive_s);
+  const ModelParameters& mp = def_.parameters;
+  const double tau = mp.relaxation_time_s;
+  const double slope_force_per_kg =
+      def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
+                                : 0.0;
+  const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    Vec2 force = bodies_.contact_force_n[i] + bodies_.external_force_n[i];
+    double torque = bodies_.contact_torque_n_m[i];
+    if (bodies_.state[i] == PersonState::kWalking && mp.ground_reaction) {
+      const double m = bodies_.mass_kg[i], inertia = bodies_.inertia_kg_m2[i];
+      const double v0 = bodies_.desired_speed_m_per_s[i];
+      const Vec2 v = bodies_.velocity_m_per_s[i];
+      const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i]);
+      force += (e * v0 - v) * (m / tau);  // eq. (3)
+      // Back force, eq. (15): only when pushed backwards (Theta(x) = 1 for x > 0
+      // only, ERRATA 9), along e plus e x k, which points to the person's right.
+      if (-Dot(e, v) > 0.0) force += (e + Vec2{e.y, -e.x}) * (mp.back_force_gamma * m * v0 / tau);
+      // Motive torque, eq. (16) with the restoring sign (ERRATA 4) and the angle
+      // difference wrapped to (-pi, pi].
+      const double speed = Length(v);
+      Vec2 facing = e;
+      if (mp.facing_target == FacingTarget::kVelocity) facing = speed > 0.0 ? v / speed : Vec2{};
+      if (facing.x != 0.0 || facing.y != 0.0) {
+        const double theta_d = std::atan2(facing.y, facing.x);
+        const double gain = v0 > 0.0 ? 1.0 - std::exp(-speed / v0) : 1.0;
+        torque += mp.torsion_stiffness_lambda * inertia / (tau * tau) * gain *
+                  WrapAngle(theta_d - bodies_.angle_rad[i]);
+      }
+      // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
+      torque -= inertia / mp.rotation_relaxation_time_s * bodies_.angular_velocity_rad_per_s[i];
+      force += def_.slope.downhill * (m * slope_force_per_kg);
+    }
+    bodies_.force_n[i] = force;
+    bodies_.torque_n_m[i] = torque;
+  }
+}
+
+void Simulation::ComputeForces() {
+  UpdatePairs();
+  PlaceShapes();
+  Collide();
+  Gather();
+  Drive();
+}
+
+// ---------------------------------------------------------------------------
+// Stage 6: integration
+
+void Simulation::VerletKickDrift() {
+  ScopedTimer timer(profile_.integrate_s);
+  const double h = dt_s_;
+  const std::size_t n = bodies_.size();
+  Internals& in = *in_;
+  std::vector<Vec2>& v = bodies_.velocity_m_per_s;
+  std::vector<double>& w = bodies_.angular_velocity_rad_per_s;
+  in.v_half.resize(n);
+  in.w_half.resize(n);
+  // Half kick with the forces of the last evaluation and drift. The velocity-
+  // dependent forces (dashpots, eqs. 11-12; eq. 3) at the new positions see the
+  // predicted velocity v + h a(t). (A second-order Adams-Bashforth predictor was
+  // tried: the restitution error is dominated by the timing of contact onset and
+  // end within a step, which ContactLaw corrects, not by the predictor.)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) {
+      v[i] = {};
+      w[i] = 0.0;
+      in.v_half[i] = {};
+      in.w_half[i] = 0.0;
+      continue;
+    }
+    const Vec2 a = bodies_.force_n[i] / bodies_.mass_kg[i];
+    const double alpha = bodies_.torque_n_m[i] / bodies_.inertia_kg_m2[i];
+    in.v_half[i] = v[i] + (bodies_.force_n[i] + in.leading_force[i]) / bodies_.mass_kg[i] * (h / 2.0);
+    in.w_half[i] = w[i] + (bodies_.torque_n_m[i] + in.leading_torque[i]) / bodies_.inertia_kg_m2[i] * (h / 2.0);
+    bodies_.position_m[i] += in.v_half[i] * h;
+    bodies_.angle_rad[i] += in.w_half[i] * h;
+    Wrap(bodies_.position_m[i]);
+    v[i] = in.v_half[i] + a * (h / 2.0);
+    w[i] = in.w_half[i] + alpha * (h / 2.0);
+  }
+}
+
+void Simulation::VerletKick() {
+  ScopedTimer timer(profile_.integrate_s);
+  const double h = dt_s_;
+  Internals& in = *in_;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) continue;
+    bodies_.velocity_m_per_s[i] =
+        in.v_half[i] + (bodies_.force_n[i] + in.trailing_force[i]) / bodies_.mass_kg[i] * (h / 2.0);
+    bodies_.angular_velocity_rad_per_s[i] =
+        in.w_half[i] + (bodies_.torque_n_m[i] + in.trailing_torque[i]) / bodies_.inertia_kg_m2[i] * (h / 2.0);
+  }
+}
+
+void Simulation::GearPredict() {
+  ScopedTimer timer(profile_.integrate_s);
+  // Fifth-order Gear predictor-corrector for second-order equations, in
+  // Nordsieck form r_k = h^k/k! d^k x/dt^k (Allen & Tildesley, Appendix E),
+  // with the corrector coefficients for velocity-dependent forces (c0 = 3/16).
+  const double h = dt_s_;
+  const std::size_t n = bodies_.size();
+  Internals& in = *in_;
+  if (!in.gear_initialised) {
+    in.gear_xy.assign(n, {});
+    in.gear_theta.assign(n, {});
+    for (std::size_t i = 0; i < n; ++i) {
+      if (bodies_.state[i] != PersonState::kWalking) continue;
+      in.gear_xy[i][0] = bodies_.force_n[i] / bodies_.mass_kg[i] * (h * h / 2.0);
+      in.gear_theta[i][0] = bodies_.torque_n_m[i] / bodies_.inertia_kg_m2[i] * (h * h / 2.0);
+    }
+    in.gear_initialised = true;
+  }
+  std::vector<Vec2>& predicted_r2 = in.v_half;
+  std::vector<double>& predicted_t2 = in.w_half;
+  predicted_r2.resize(n);
+  predicted_t2.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) {
+      bodies_.velocity_m_per_s[i] = {};
+      bodies_.angular_velocity_rad_per_s[i] = 0.0;
+      in.gear_xy[i] = {};
+      in.gear_theta[i] = {};
+      continue;
+    }
+    auto& r = in.gear_xy[i];
+    Vec2 r1 = bodies_.velocity_m_per_s[i] * h;
+    bodies_.position_m[i] += r1 + r[0] + r[1] + r[2] + r[3];
+    r1 += r[0] * 2.0 + r[1] * 3.0 + r[2] * 4.0 + r[3] * 5.0;
+    r[0] += r[1] * 3.0 + r[2] * 6.0 + r[3] * 10.0;
+    r[1] += r[2] * 4.0 + r[3] * 10.0;
+    r[2] += r[3] * 5.0;
+    bodies_.velocity_m_per_s[i] = r1 / h;
+    predicted_r2[i] = r[0];
+    auto& t = in.gear_theta[i];
+    double t1 = bodies_.angular_velocity_rad_per_s[i] * h;
+    bodies_.angle_rad[i] += t1 + t[0] + t[1] + t[2] + t[3];
+    t1 += t[0] * 2.0 + t[1] * 3.0 + t[2] * 4.0 + t[3] * 5.0;
+    t[0] += t[1] * 3.0 + t[2] * 6.0 + t[3] * 10.0;
+    t[1] += t[2] * 4.0 + t[3] * 10.0;
+    t[2] += t[3] * 5.0;
+    bodies_.angular_velocity_rad_per_s[i] = t1 / h;
+    predicted_t2[i] = t[0];
+    Wrap(bodies_.position_m[i]);
+  }
+}
+
+void Simulation::GearCorrect() {
+  ScopedTimer timer(profile_.integrate_s);
+  static constexpr double c[6] = {3.0 / 16.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0};
+  const double h = dt_s_;
+  Internals& in = *in_;
+  const std::vector<Vec2>& predicted_r2 = in.v_half;
+  const std::vector<double>& predicted_t2 = in.w_half;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) continue;
+    auto& r = in.gear_xy[i];
+    const Vec2 delta = bodies_.force_n[i] / bodies_.mass_kg[i] * (h * h / 2.0) - predicted_r2[i];
+    bodies_.position_m[i] += delta * c[0];
+    bodies_.velocity_m_per_s[i] += delta * (c[1] / h);
+    r[0] += delta * c[2];
+    r[1] += delta * c[3];
+    r[2] += delta * c[4];
+    r[3] += delta * c[5];
+    Wrap(bodies_.position_m[i]);
+    auto& t = in.gear_theta[i];
+    const double dt2 = bodies_.torque_n_m[i] / bodies_.inertia_kg_m2[i] * (h * h / 2.0) - predicted_t2[i];
+    bodies_.angle_rad[i] += dt2 * c[0];
+    bodies_.angular_velocity_rad_per_s[i] += dt2 * (c[1] / h);
+    t[0] += dt2 * c[2];
+    t[1] += dt2 * c[3];
+    t[2] += dt2 * c[4];
+    t[3] += dt2 * c[5];
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Stage 7: checks
+
+void Simulation::Check() {
+  ScopedTimer timer(profile_.check_s);
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(v.x) || !std::isfinite(v.y) ||
+        !std::isfinite(bodies_.angle_rad[i]) || !std::isfinite(bodies_.angular_velocity_rad_per_s[i]))
+      throw SimulationError("non-finite state of " + PersonText(i) + " at t = " + FormatNumber(time_s_) +
+                            " s (position " + FormatNumber(x.x) + ", " + FormatNumber(x.y) + "; velocity " +
+                            FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")");
+  }
+  for (const Contact& c : contacts_) {
+    const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
+    const double rb = c.wall ? def_.walls[c.b].radius_m : def_.shapes[bodies_.shape[c.b]].radius_m;
+    if (c.overlap_m > ra + rb) {
+      const std::string other = c.wall ? "wall " + std::to_string(c.b) : PersonText(c.b);
+      throw SimulationError("overlap of " + PersonText(c.a) + " and " + other + " is " +
+                            FormatNumber(c.overlap_m) + " m at t = " + FormatNumber(time_s_) +
+                            " s, beyond the sum of their sphero-radii " + FormatNumber(ra + rb) +
+                            " m: the cores interpenetrate (time step too large or forces too strong)");
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+
+void Simulation::Step() {
+  in_->previous_contacts.swap(contacts_);
+  advance_springs_ = true;
+  if (def_.parameters.integrator == Integrator::kVelocityVerlet) {
+    VerletKickDrift();
+    ComputeForces();
+    VerletKick();
+  } else {
+    GearPredict();
+    ComputeForces();
+    GearCorrect();
+  }
+  time_s_ = static_cast<double>(step_count_ + 1) * dt_s_;
+  ++step_count_;
+  Check();
+}
+
+void Simulation::AdvanceTo(double end_time_s) {
+  while (time_s_ < end_time_s - 1e-12) Step();
+}
+
+void Simulation::SetExternalForce(std::uint32_t person, Vec2 force_n) {
+  if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
+  bodies_.external_force_n[person] = force_n;
+  Drive();  // the force enters the current evaluation too
+}
+
+void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
+  if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
+  bodies_.state[person] = state;
+  if (state != PersonState::kWalking) {
+    bodies_.velocity_m_per_s[person] = {};
+    bodies_.angular_velocity_rad_per_s[person] = 0.0;
+  }
+  in_->pairs_valid = false;
+}
+
+Vec2 Simulation::LinearMomentum() const {
+  Vec2 p;
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.state[i] == PersonState::kWalking) p += bodies_.velocity_m_per_s[i] * bodies_.mass_kg[i];
+  return p;
+}
+
+double Simulation::AngularMomentum() const {
+  double l = 0.0;
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.state[i] == PersonState::kWalking)
+      l += bodies_.mass_kg[i] * Cross(bodies_.position_m[i], bodies_.velocity_m_per_s[i]) +
+           bodies_.inertia_kg_m2[i] * bodies_.angular_velocity_rad_per_s[i];
+  return l;
+}
+
+double Simulation::KineticEnergy() const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.state[i] == PersonState::kWalking)
+      e += 0.5 * bodies_.mass_kg[i] * LengthSquared(bodies_.velocity_m_per_s[i]) +
+           0.5 * bodies_.inertia_kg_m2[i] * bodies_.angular_velocity_rad_per_s[i] * bodies_.angular_velocity_rad_per_s[i];
+  return e;
+}
+
+double Simulation::ElasticEnergy() const {
+  const double kn = def_.parameters.normal_stiffness_n_per_m, kt = def_.parameters.tangential_stiffness_n_per_m;
+  double e = 0.0;
+  for (const Contact& c : contacts_)
+    e += 0.5 * kn * c.overlap_m * c.overlap_m + 0.5 * kt * c.tangential_spring_m * c.tangential_spring_m;
+  return e;
+}
+
+}  // namespace crowdrecon::engine

@@ -1,0 +1,73 @@
+// Small verification scenes for the engine tests.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/geometry/spheropolygon.hpp"
+
+namespace crowdrecon::engine::testing {
+
+// A thorax-like body: an 8-vertex rounded octagon 0.42 m wide and 0.24 m deep,
+// chest facing +x, centroid at the origin.
+inline BodyShape ThoraxLikeShape() {
+  BodyShape s;
+  s.radius_m = 0.05;
+  const double hx = 0.07, hy = 0.16;
+  s.vertices = {{hx, -hy * 0.55}, {hx, hy * 0.55}, {hx * 0.4, hy}, {-hx * 0.4, hy},
+                {-hx, hy * 0.55}, {-hx, -hy * 0.55}, {-hx * 0.4, -hy}, {hx * 0.4, -hy}};
+  return s;
+}
+
+inline BodyShape DiskShape(double radius_m) {
+  BodyShape s;
+  s.radius_m = radius_m;
+  s.vertices = {{0.0, 0.0}};
+  return s;
+}
+
+// Mass properties consistent with a shape at surface density rho.
+inline void SetMassFromShape(const BodyShape& shape, double rho, PersonDef& p) {
+  const auto sp = geometry::Spheropolygon::Create(shape.vertices, shape.radius_m);
+  p.mass_kg = rho * sp.area();
+  p.inertia_kg_m2 = rho * sp.polar_moment();
+}
+
+inline WorldDef PassiveWorld() {
+  WorldDef def;
+  def.parameters.ground_reaction = false;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  return def;
+}
+
+// N thorax-like bodies on a jittered lattice in [0, L]^2 with random
+// velocities and spins (no two overlapping at the start).
+inline WorldDef RandomGas(int per_side, double spacing_m, unsigned seed, bool periodic) {
+  WorldDef def = PassiveWorld();
+  def.shapes.push_back(ThoraxLikeShape());
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < per_side; ++i)
+    for (int j = 0; j < per_side; ++j) {
+      PersonDef p;
+      p.shape = 0;
+      SetMassFromShape(def.shapes[0], 1000.0, p);
+      p.mass_kg *= 1.0 + 0.2 * u(rng);
+      p.inertia_kg_m2 *= 1.0 + 0.2 * u(rng);
+      p.position_m = {(i + 0.5) * spacing_m + 0.02 * u(rng), (j + 0.5) * spacing_m + 0.02 * u(rng)};
+      p.angle_rad = std::numbers::pi * u(rng);
+      p.velocity_m_per_s = {1.5 * u(rng), 1.5 * u(rng)};
+      p.angular_velocity_rad_per_s = 2.0 * u(rng);
+      def.people.push_back(p);
+    }
+  if (periodic) {
+    def.periodic.x = def.periodic.y = true;
+    def.periodic.min_m = {0.0, 0.0};
+    def.periodic.max_m = {per_side * spacing_m, per_side * spacing_m};
+  }
+  return def;
+}
+
+}  // namespace crowdrecon::engine::testing
