@@ -9,7 +9,7 @@ class App;
 
 namespace crowdrecon::cli {
 
-void RegisterShapeCommands(CLI::App& app);  // shape, population
+void RegisterShapeCommands(CLI::App& app);  // shape, population, body reference
 void RegisterVenueCommands(CLI::App& app);  // venue check, venue import
 
 }  // namespace crowdrecon::cli

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <numbers>
+#include <type_traits>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
@@ -932,6 +934,143 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
   }
   in_->pairs_valid = false;
+}
+
+// ---------------------------------------------------------------------------
+// Checkpoints
+
+namespace {
+
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
+
+class StateWriter {
+ public:
+  template <typename T>
+  void Put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    out_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  template <typename T>
+  void PutVector(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    Put(static_cast<std::uint64_t>(values.size()));
+    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  std::string Finish() {
+    // FNV-1a checksum of everything written.
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : out_) h = (h ^ c) * 1099511628211ull;
+    Put(h);
+    return std::move(out_);
+  }
+
+ private:
+  std::string out_;
+};
+
+class StateReader {
+ public:
+  explicit StateReader(const std::string& data) : data_(data) {
+    if (data.size() < sizeof(kStateMagic) + 8 || std::memcmp(data.data(), kStateMagic, sizeof(kStateMagic)) != 0)
+      throw InputError("checkpoint: not a crowdrecon engine state (bad magic)");
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::size_t i = 0; i < data.size() - 8; ++i)
+      h = (h ^ static_cast<unsigned char>(data[i])) * 1099511628211ull;
+    std::uint64_t stored;
+    std::memcpy(&stored, data.data() + data.size() - 8, 8);
+    if (h != stored) throw InputError("checkpoint: checksum mismatch (the file is damaged or truncated)");
+    pos_ = sizeof(kStateMagic);
+    end_ = data.size() - 8;
+  }
+  template <typename T>
+  T Get() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (pos_ + sizeof(T) > end_) throw InputError("checkpoint: truncated state");
+    T value;
+    std::memcpy(&value, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  template <typename T>
+  void GetVector(std::vector<T>& values, std::size_t expected_size = SIZE_MAX) {
+    const auto n = Get<std::uint64_t>();
+    if (expected_size != SIZE_MAX && n != expected_size)
+      throw InputError("checkpoint: holds " + std::to_string(n) + " entries where this run has " +
+                       std::to_string(expected_size) + " (different scenario?)");
+    if (pos_ + n * sizeof(T) > end_) throw InputError("checkpoint: truncated state");
+    values.resize(n);
+    std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
+  }
+
+ private:
+  const std::string& data_;
+  std::size_t pos_ = 0, end_ = 0;
+};
+
+}  // namespace
+
+std::string Simulation::SaveState() const {
+  StateWriter w;
+  for (char c : kStateMagic) w.Put(c);
+  w.Put(static_cast<std::uint64_t>(bodies_.size()));
+  w.Put(step_count_);
+  w.Put(time_s_);
+  w.Put(dt_s_);
+  w.Put(advance_springs_);
+  w.PutVector(bodies_.position_m);
+  w.PutVector(bodies_.angle_rad);
+  w.PutVector(bodies_.velocity_m_per_s);
+  w.PutVector(bodies_.angular_velocity_rad_per_s);
+  w.PutVector(bodies_.force_n);
+  w.PutVector(bodies_.torque_n_m);
+  w.PutVector(bodies_.contact_force_n);
+  w.PutVector(bodies_.contact_torque_n_m);
+  w.PutVector(bodies_.external_force_n);
+  w.PutVector(bodies_.state);
+  w.PutVector(bodies_.target);
+  w.PutVector(bodies_.desired_speed_m_per_s);
+  w.PutVector(contacts_);
+  w.PutVector(in_->leading_force);
+  w.PutVector(in_->leading_torque);
+  w.Put(in_->gear_initialised);
+  w.PutVector(in_->gear_xy);
+  w.PutVector(in_->gear_theta);
+  return w.Finish();
+}
+
+void Simulation::LoadState(const std::string& data) {
+  StateReader r(data);
+  const auto n = r.Get<std::uint64_t>();
+  if (n != bodies_.size())
+    throw InputError("checkpoint: holds " + std::to_string(n) + " people where this run has " +
+                     std::to_string(bodies_.size()) + " (different scenario?)");
+  step_count_ = r.Get<std::uint64_t>();
+  time_s_ = r.Get<double>();
+  const double dt = r.Get<double>();
+  if (dt != dt_s_)
+    throw InputError("checkpoint: time step " + FormatNumber(dt) + " s differs from this run's " +
+                     FormatNumber(dt_s_) + " s (different scenario or parameters?)");
+  advance_springs_ = r.Get<bool>();
+  r.GetVector(bodies_.position_m, n);
+  r.GetVector(bodies_.angle_rad, n);
+  r.GetVector(bodies_.velocity_m_per_s, n);
+  r.GetVector(bodies_.angular_velocity_rad_per_s, n);
+  r.GetVector(bodies_.force_n, n);
+  r.GetVector(bodies_.torque_n_m, n);
+  r.GetVector(bodies_.contact_force_n, n);
+  r.GetVector(bodies_.contact_torque_n_m, n);
+  r.GetVector(bodies_.external_force_n, n);
+  r.GetVector(bodies_.state, n);
+  r.GetVector(bodies_.target, n);
+  r.GetVector(bodies_.desired_speed_m_per_s, n);
+  r.GetVector(contacts_);
+  r.GetVector(in_->leading_force);
+  r.GetVector(in_->leading_torque);
+  in_->gear_initialised = r.Get<bool>();
+  r.GetVector(in_->gear_xy);
+  r.GetVector(in_->gear_theta);
+  in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
 }
 
 Vec2 Simulation::LinearMomentum() const {

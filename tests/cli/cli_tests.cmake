@@ -1,2 +1,104 @@
 # Command-line tests (see expect.sh). Arguments may use @TMP@ for a scratch dir.
 crowdrecon_cli_test(help ok "shape" --help)
+
+# --- venues ------------------------------------------------------------------
+crowdrecon_cli_test(venue.check.hallway_periodic ok "periodic: along \\(1, 0\\), period 12 m"
+                    venue check venues/madrid-arena/hallway-periodic.json --picture @TMP@/hallway-periodic.png)
+crowdrecon_cli_test(venue.check.hallway_open ok "walkable area: 36.00 m2 in 1 part"
+                    venue check venues/madrid-arena/hallway-open.json --picture @TMP@/hallway-open.svg)
+crowdrecon_cli_test(venue.check.ground_floor ok "walkable area: 1925.00 m2"
+                    venue check venues/madrid-arena/ground-floor.json --picture @TMP@/ground-floor.png)
+crowdrecon_cli_test(venue.check.capacity ok "capacity: 183 persons at 4.7 /m2, 234 at 6.0 /m2"
+                    venue check tests/data/venues/room.json)
+crowdrecon_cli_test(venue.import.wkt ok "39.00 m2 walkable in 1 part\\(s\\), 1 obstacle"
+                    venue import tests/data/venues/room.wkt -o @TMP@/room.json)
+crowdrecon_cli_test(venue.import.wkt_multipolygon ok "20.00 m2 walkable in 2 part"
+                    venue import tests/data/venues/two-rooms.wkt -o @TMP@/two.json --name "two rooms")
+crowdrecon_cli_test(venue.import.dxf ok "39.00 m2 walkable in 1 part\\(s\\), 1 obstacle"
+                    venue import tests/data/venues/room.dxf -o @TMP@/room.json)
+crowdrecon_cli_test(venue.import.image ok "39.00 m2 walkable in 1 part\\(s\\), 1 obstacle"
+                    venue import tests/data/venues/room-50ppm.png -o @TMP@/room.json --pixels-per-metre 50
+                    --seed 3,1)
+
+# Invalid venues: each message names the file, the JSON path and the problem.
+foreach(case
+    "self-intersecting|/walkable_area/0: outer ring is self-intersecting"
+    "obstacle-outside|/obstacles/0/polygon: obstacle .kiosk. near .* lies outside the walkable area"
+    "overlapping-obstacles|/obstacles/1/polygon: obstacles .bar.* and .stage. overlap"
+    "obstacle-crosses-boundary|/obstacles/0/polygon: obstacle .pillar. meets the boundary"
+    "exit-outside|/exits/1/segment: exit point \\(30, 0\\) is 20 m outside the walkable area"
+    "unknown-key|: /: unknown key.s. .exitz."
+    "wrong-type|/periodic/0/period_m: expected a number .* found .ten."
+    "gradient|/slope/gradient: value -0.025 is out of range"
+    "empty-area|/walkable_area: the walkable area is empty"
+    "syntax|:3:9: invalid JSON"
+    "target|/targets/0/exit: target .leave. names exit .main., which does not exist"
+    "period|/periodic/0/period_m: period 12 m differs"
+    "duplicate-id|/exits/1/id: id .door. is used twice"
+    "zero-direction|/targets/0/direction: the direction .* has zero length")
+  string(REPLACE "|" ";" parts "${case}")
+  list(GET parts 0 name)
+  list(GET parts 1 regex)
+  crowdrecon_cli_test(venue.check.bad_${name} fail "bad-${name}.json.*${regex}"
+                      venue check tests/data/venues/bad-${name}.json)
+endforeach()
+crowdrecon_cli_test(venue.check.missing_file fail "no-such-venue.json: cannot open venue file"
+                    venue check tests/data/venues/no-such-venue.json)
+crowdrecon_cli_test(venue.import.bad_wkt_syntax fail "bad-syntax.wkt:2:33: invalid WKT: expected a number but found 'x'"
+                    venue import tests/data/venues/bad-syntax.wkt -o @TMP@/x.json)
+crowdrecon_cli_test(venue.import.bad_wkt_unclosed fail "bad-unclosed.wkt:1:10: invalid WKT: ring is not closed"
+                    venue import tests/data/venues/bad-unclosed.wkt -o @TMP@/x.json)
+crowdrecon_cli_test(venue.import.bad_dxf_open fail "bad-open.dxf: no closed region found"
+                    venue import tests/data/venues/bad-open.dxf -o @TMP@/x.json)
+crowdrecon_cli_test(venue.import.image_needs_scale fail "give --pixels-per-metre"
+                    venue import tests/data/venues/room-50ppm.png -o @TMP@/x.json)
+crowdrecon_cli_test(venue.import.bad_seed fail "--seed .3x1.: expected two numbers X,Y"
+                    venue import tests/data/venues/room-50ppm.png -o @TMP@/x.json --pixels-per-metre 50 --seed 3x1)
+crowdrecon_cli_test(venue.import.unknown_extension fail "cannot tell the format from the extension"
+                    venue import tests/data/venues/room.json -o @TMP@/x.json)
+
+# --- bodies (docs/bodies.md) ---------------------------------------------------
+crowdrecon_cli_test(shape.image ok "vertices: 18, sphero-radius 0.05 m"
+                    shape tests/data/bodies/ellipse-1000ppm.png --scale ppm:1000 -o @TMP@/ellipse.json
+                    --picture @TMP@/ellipse.png)
+crowdrecon_cli_test(shape.image_sternum ok "scale: sternum:0.2 "
+                    shape tests/data/bodies/ellipse-1000ppm.png -o @TMP@/ellipse.json --picture @TMP@/e.svg)
+crowdrecon_cli_test(shape.reference ok "Hausdorff distance outline - swept shape: 0.00"
+                    shape venues/bodies/thorax-reference.json --vertices 18 --radius 0.05 -o @TMP@/thorax.json)
+crowdrecon_cli_test(shape.light_region ok "note: the light region touches the image border"
+                    shape tests/data/bodies/blank.png --region light -o @TMP@/b.json)
+crowdrecon_cli_test(population.paper ok "mass: 4[0-9]\\.[0-9]+ \\.\\. [67][0-9]\\.[0-9]+ kg"
+                    population --mode paper --count 50 --seed 3 -o @TMP@/pop.json --picture @TMP@/pop.png)
+crowdrecon_cli_test(population.anthropometric ok "bodies built: [0-9]+ distinct"
+                    population --mode anthropometric --count 12 --seed 3 --female-fraction 0.5
+                    -o @TMP@/pop.json)
+crowdrecon_cli_test(population.circle ok "population: circle, 10 people"
+                    population --mode circle --count 10 --seed 3 -o @TMP@/pop.json)
+crowdrecon_cli_test(population.bad_mode fail "--mode: unknown population mode \"crowd\""
+                    population --mode crowd --count 10 -o @TMP@/pop.json)
+crowdrecon_cli_test(body.reference ok "wrote @TMP@/thorax-18.json|thorax-18.json"
+                    body reference --outline @TMP@/thorax-reference.json -o @TMP@/thorax-18.json)
+
+# Invalid outlines and options: each message names the file or option and the problem.
+foreach(case
+    "empty_image|tests/data/bodies/empty.png: not a readable image|tests/data/bodies/empty.png"
+    "no_region|blank.png: no dark region|tests/data/bodies/blank.png"
+    "too_few_points|two-points.csv: too few points \\(2 distinct\\)|tests/data/bodies/two-points.csv"
+    "self_intersecting|bowtie.json: the outline intersects itself \\(edge 0|tests/data/bodies/bowtie.json"
+    "too_thin|thin-strip.json: outline too thin for the sphero-radius|tests/data/bodies/thin-strip.json"
+    "missing_file|missing.json: cannot open file|tests/data/bodies/missing.json"
+    "bad_json|bad-syntax.json:2:1: invalid JSON|tests/data/bodies/bad-syntax.json")
+  string(REPLACE "|" ";" parts "${case}")
+  list(GET parts 0 name)
+  list(GET parts 1 regex)
+  list(GET parts 2 file)
+  crowdrecon_cli_test(shape.invalid.${name} fail "${regex}" shape ${file} -o @TMP@/body.json)
+endforeach()
+crowdrecon_cli_test(shape.invalid.vertices fail "vertex count \\(2\\) is too small.+expected at least 3"
+                    shape venues/bodies/thorax-reference.json --vertices 2 -o @TMP@/body.json)
+crowdrecon_cli_test(shape.invalid.radius fail "sphero-radius \\(-0.05 m\\) must be positive"
+                    shape venues/bodies/thorax-reference.json --radius -0.05 -o @TMP@/body.json)
+crowdrecon_cli_test(shape.invalid.scale fail "--scale: unknown scale rule \"width\""
+                    shape venues/bodies/thorax-reference.json --scale width:0.3 -o @TMP@/body.json)
+crowdrecon_cli_test(shape.invalid.front fail "--front: unknown front axis \"up\""
+                    shape venues/bodies/thorax-reference.json --front up -o @TMP@/body.json)

@@ -297,6 +297,33 @@ TEST(EnginePhysics, ResultsDoNotDependOnTheThreadCount) {
   }
 }
 
+TEST(EnginePhysics, RestoredCheckpointContinuesBitForBit) {
+  for (Integrator integrator : {Integrator::kVelocityVerlet, Integrator::kGear5}) {
+    WorldDef def = RandomGas(6, 0.42, 9, true);
+    def.parameters.ground_reaction = true;
+    def.parameters.integrator = integrator;
+    Simulation straight(def);
+    straight.AdvanceTo(0.4);
+    Simulation first(def);
+    first.AdvanceTo(0.2);
+    const std::string state = first.SaveState();
+    Simulation resumed(def);
+    resumed.LoadState(state);
+    resumed.AdvanceTo(0.4);
+    ASSERT_EQ(resumed.step_count(), straight.step_count());
+    const auto& a = straight.bodies();
+    const auto& b = resumed.bodies();
+    EXPECT_EQ(std::memcmp(a.position_m.data(), b.position_m.data(), a.size() * sizeof(Vec2)), 0);
+    EXPECT_EQ(std::memcmp(a.velocity_m_per_s.data(), b.velocity_m_per_s.data(), a.size() * sizeof(Vec2)), 0);
+    EXPECT_EQ(std::memcmp(a.angle_rad.data(), b.angle_rad.data(), a.size() * sizeof(double)), 0);
+    // A damaged state is refused.
+    std::string damaged = state;
+    damaged[damaged.size() / 2] ^= 1;
+    Simulation other(def);
+    EXPECT_THROW(other.LoadState(damaged), InputError);
+  }
+}
+
 TEST(EnginePhysics, UnstableTimeStepIsRefusedWithTheLimit) {
   WorldDef def = RandomGas(3, 0.5, 1, false);
   def.parameters.time_step_s = 0.05;

@@ -119,6 +119,14 @@ class Simulation {
   // Changes a person's state (a fall makes them an obstacle; removal takes them out).
   void SetPersonState(std::uint32_t person, PersonState state);
 
+  // Checkpoints: the complete dynamic state (bodies, contacts with their
+  // tangential springs, integrator history, time), so that a run restored from
+  // it continues bit for bit as if it had never stopped. The definition (world)
+  // is not included: restore into a Simulation built from the same WorldDef.
+  // LoadState throws InputError if the data is damaged or does not match.
+  std::string SaveState() const;
+  void LoadState(const std::string& data);
+
   // Diagnostics for tests and reports.
   Vec2 LinearMomentum() const;
   double AngularMomentum() const;  // about the origin (z component)

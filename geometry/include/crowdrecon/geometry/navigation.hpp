@@ -76,13 +76,23 @@ class NavigationField {
   std::vector<Vec2> direction_;
 };
 
-// Fast marching on a grid, exposed for tests and reuse. `inside[k]` marks
-// the nodes of the domain; `source_distance_m[k]` is finite at source nodes (the
-// known distance there) and +infinity elsewhere. Returns T at every node
-// (+infinity outside or unreachable). Node k = j * nx + i, spacing h.
-std::vector<double> FastMarch(std::size_t nx, std::size_t ny, double spacing_m,
-                              const std::vector<char>& inside,
-                              const std::vector<double>& source_distance_m);
+// A regular grid for fast marching: node (i, j) at origin + (i, j) * spacing,
+// index k = j * nx + i.
+struct MarchingGrid {
+  std::size_t nx = 0, ny = 0;
+  double spacing_m = 0.1;
+  std::vector<char> inside;         // per node: in the domain
+  // Per node, optional (empty: nothing blocked): the link to the node east
+  // (k + 1) or north (k + nx) is cut by a wall, so the front may not pass.
+  std::vector<char> blocked_east;
+  std::vector<char> blocked_north;
+};
+
+// Fast marching (first-order upwind): solves |grad T| = 1 on the grid's inside
+// nodes with T fixed at source nodes (`source_distance_m[k]` finite there,
+// +infinity elsewhere). Returns T at every node, +infinity outside the domain
+// or where the sources cannot be reached.
+std::vector<double> FastMarch(const MarchingGrid& grid, const std::vector<double>& source_distance_m);
 
 inline constexpr double kUnreachable = std::numeric_limits<double>::infinity();
 

@@ -1,0 +1,332 @@
+// DXF floor plans via dxflib. Curves are flattened into segments, pieces whose
+// endpoints meet are chained into rings, and the nesting of the rings decides
+// what is walkable (even depth) and what is an obstacle (odd depth), which is
+// how a plan drawn as "outline plus pillars" reads.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <dxflib/dl_creationadapter.h>
+#include <dxflib/dl_dxf.h>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+#include "venue_internal.hpp"
+
+namespace crowdrecon::geometry {
+
+namespace {
+
+struct Piece {
+  std::vector<Vec2> points;  // in file units
+  bool closed = false;
+};
+
+// Number of segments for an arc of radius r and sweep |angle| so that the
+// chord's distance to the arc (r (1 - cos(step/2))) stays below `tolerance`.
+std::size_t ArcSegments(double radius, double sweep_rad, double tolerance) {
+  const double ratio = std::clamp(1.0 - tolerance / radius, -1.0, 1.0);
+  const double max_step = std::max(2.0 * std::acos(ratio), 1e-3);
+  const auto n = static_cast<std::size_t>(std::ceil(std::abs(sweep_rad) / max_step));
+  return std::clamp<std::size_t>(n, 1, 10000);
+}
+
+// Points of an arc from start_rad sweeping sweep_rad (positive: counter-clockwise).
+std::vector<Vec2> ArcPoints(Vec2 centre, double radius, double start_rad, double sweep_rad, double tolerance,
+                            bool include_last) {
+  const std::size_t n = ArcSegments(radius, sweep_rad, tolerance);
+  std::vector<Vec2> points;
+  for (std::size_t k = 0; k <= n; ++k) {
+    if (k == n && !include_last) break;
+    const double a = start_rad + sweep_rad * static_cast<double>(k) / static_cast<double>(n);
+    points.push_back(centre + radius * Vec2{std::cos(a), std::sin(a)});
+  }
+  return points;
+}
+
+// Metres per unit for the DXF $INSUNITS codes a floor plan may use.
+double MetresPerInsUnit(int code) {
+  switch (code) {
+    case 1: return 0.0254;   // inches
+    case 2: return 0.3048;   // feet
+    case 4: return 0.001;    // millimetres
+    case 5: return 0.01;     // centimetres
+    case 6: return 1.0;      // metres
+    case 14: return 0.1;     // decimetres
+    default: return 1.0;     // unitless or unusual: take metres
+  }
+}
+
+class Collector : public DL_CreationAdapter {
+ public:
+  // The arc tolerance is in metres; the drawing unit is known once the header
+  // ($INSUNITS) has been read, which in a DXF file precedes the entities.
+  // Not copyable: dxflib's interface base owns a raw pointer.
+  Collector(std::string layer, double tolerance_m, double scale_override)
+      : layer_(std::move(layer)), tolerance_m_(tolerance_m), scale_override_(scale_override) {}
+  Collector(const Collector&) = delete;
+  Collector& operator=(const Collector&) = delete;
+
+  // Metres per drawing unit.
+  double Scale() const { return scale_override_ > 0.0 ? scale_override_ : MetresPerInsUnit(insunits_); }
+
+  void setVariableInt(const std::string& key, int value, int /*code*/) override {
+    if (key == "$INSUNITS") insunits_ = value;
+  }
+  void addBlock(const DL_BlockData&) override {
+    FinishPolyline();
+    in_block_ = true;  // block definitions are templates, not drawn geometry
+  }
+  void endBlock() override { in_block_ = false; }
+
+  void addLine(const DL_LineData& d) override {
+    FinishPolyline();
+    if (!Wanted()) return;
+    pieces_.push_back({{{d.x1, d.y1}, {d.x2, d.y2}}, false});
+  }
+  void addArc(const DL_ArcData& d) override {
+    FinishPolyline();
+    if (!Wanted() || d.radius <= 0.0) return;
+    double sweep_deg = std::fmod(d.angle2 - d.angle1, 360.0);
+    if (sweep_deg <= 0.0) sweep_deg += 360.0;  // DXF arcs run counter-clockwise
+    pieces_.push_back({ArcPoints({d.cx, d.cy}, d.radius, Radians(d.angle1), Radians(sweep_deg), Tolerance(), true),
+                       false});
+  }
+  void addCircle(const DL_CircleData& d) override {
+    FinishPolyline();
+    if (!Wanted() || d.radius <= 0.0) return;
+    std::vector<Vec2> ring = ArcPoints({d.cx, d.cy}, d.radius, 0.0, 2.0 * std::numbers::pi, Tolerance(), false);
+    // A circle needs at least a few vertices to be a ring of the right area.
+    if (ring.size() < 8) ring = ArcPoints({d.cx, d.cy}, d.radius, 0.0, 2.0 * std::numbers::pi, 0.0, false);
+    pieces_.push_back({ring, true});
+  }
+  void addPolyline(const DL_PolylineData& d) override {
+    FinishPolyline();
+    polyline_active_ = Wanted();
+    polyline_closed_ = (d.flags & 1) != 0;
+    vertices_.clear();
+    bulges_.clear();
+  }
+  void addVertex(const DL_VertexData& d) override {
+    if (!polyline_active_) return;
+    vertices_.push_back({d.x, d.y});
+    bulges_.push_back(d.bulge);
+  }
+  void endSequence() override { FinishPolyline(); }
+
+  // Completes a pending polyline (LWPOLYLINE has no end marker of its own).
+  void FinishPolyline() {
+    if (!polyline_active_) return;
+    polyline_active_ = false;
+    if (vertices_.size() < 2) return;
+    std::vector<Vec2> points;
+    const std::size_t n = vertices_.size();
+    const std::size_t edges = polyline_closed_ ? n : n - 1;
+    for (std::size_t i = 0; i < edges; ++i) {
+      const Vec2 p0 = vertices_[i], p1 = vertices_[(i + 1) % n];
+      points.push_back(p0);
+      const double bulge = bulges_[i];
+      const double chord = Length(p1 - p0);
+      if (std::abs(bulge) > 1e-12 && chord > 0.0) {
+        // Bulge = tan(theta / 4), theta the signed included angle of the arc
+        // from p0 to p1; the centre is off the chord's midpoint by
+        // (c / 2) cot(theta / 2) to the left of the chord.
+        const double theta = 4.0 * std::atan(bulge);
+        const Vec2 mid = 0.5 * (p0 + p1);
+        const Vec2 left = Perp(p1 - p0) / chord;
+        const Vec2 centre = mid + left * (0.5 * chord / std::tan(0.5 * theta));
+        const double radius = Length(p0 - centre);
+        const double start = std::atan2(p0.y - centre.y, p0.x - centre.x);
+        std::vector<Vec2> arc = ArcPoints(centre, radius, start, theta, Tolerance(), false);
+        points.insert(points.end(), arc.begin() + 1, arc.end());
+      }
+    }
+    if (!polyline_closed_) points.push_back(vertices_.back());
+    pieces_.push_back({std::move(points), polyline_closed_});
+  }
+
+  std::vector<Piece>& pieces() { return pieces_; }
+  std::size_t skipped_layers() const { return skipped_; }
+
+ private:
+  static double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+
+  bool Wanted() {
+    if (in_block_) return false;
+    if (!layer_.empty() && getAttributes().getLayer() != layer_) {
+      ++skipped_;
+      return false;
+    }
+    return true;
+  }
+
+  double Tolerance() const { return tolerance_m_ / Scale(); }
+
+  std::string layer_;
+  double tolerance_m_;
+  double scale_override_;
+  int insunits_ = 0;
+  bool in_block_ = false;
+  bool polyline_active_ = false;
+  bool polyline_closed_ = false;
+  std::vector<Vec2> vertices_;
+  std::vector<double> bulges_;
+  std::vector<Piece> pieces_;
+  std::size_t skipped_ = 0;
+};
+
+std::vector<Vec2> WithoutRepeats(const std::vector<Vec2>& points, double tolerance) {
+  std::vector<Vec2> out;
+  for (Vec2 p : points)
+    if (out.empty() || Length(p - out.back()) > tolerance) out.push_back(p);
+  return out;
+}
+
+// Joins open pieces whose endpoints meet into rings. Endpoints within
+// `tolerance` are one node; a connected set of pieces in which every node has
+// exactly two piece ends is a cycle and becomes a ring. Pieces of other sets
+// (T-junctions, dangling lines) stay open.
+void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
+  std::vector<Piece> open, done;
+  for (Piece& p : *pieces) (p.closed ? done : open).push_back(std::move(p));
+  // Cluster endpoints: node id per end (2 per piece), O(n^2) over ends, fine
+  // for the few thousand lines of a floor plan.
+  const std::size_t ends = 2 * open.size();
+  std::vector<Vec2> end_point(ends);
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    end_point[2 * i] = open[i].points.front();
+    end_point[2 * i + 1] = open[i].points.back();
+  }
+  std::vector<std::size_t> node(ends);
+  std::vector<Vec2> node_point;
+  for (std::size_t e = 0; e < ends; ++e) {
+    std::size_t found = node_point.size();
+    for (std::size_t k = 0; k < node_point.size(); ++k)
+      if (Length(node_point[k] - end_point[e]) <= tolerance) { found = k; break; }
+    if (found == node_point.size()) node_point.push_back(end_point[e]);
+    node[e] = found;
+  }
+  std::vector<std::vector<std::size_t>> ends_at(node_point.size());
+  for (std::size_t e = 0; e < ends; ++e) ends_at[node[e]].push_back(e);
+
+  std::vector<bool> used(open.size(), false);
+  for (std::size_t start = 0; start < open.size(); ++start) {
+    if (used[start]) continue;
+    // Collect the connected set of pieces.
+    std::vector<std::size_t> set{start}, stack{start};
+    std::vector<bool> seen(open.size(), false);
+    seen[start] = true;
+    while (!stack.empty()) {
+      const std::size_t piece = stack.back();
+      stack.pop_back();
+      for (std::size_t side = 0; side < 2; ++side)
+        for (std::size_t e : ends_at[node[2 * piece + side]])
+          if (!seen[e / 2]) { seen[e / 2] = true; set.push_back(e / 2); stack.push_back(e / 2); }
+    }
+    for (std::size_t piece : set) used[piece] = true;
+    const bool cycle = std::all_of(set.begin(), set.end(), [&](std::size_t piece) {
+      return ends_at[node[2 * piece]].size() == 2 && ends_at[node[2 * piece + 1]].size() == 2;
+    });
+    if (!cycle) {
+      for (std::size_t piece : set) done.push_back(std::move(open[piece]));
+      continue;
+    }
+    // Walk the cycle, appending each piece in the direction of travel.
+    Piece ring;
+    ring.closed = true;
+    std::size_t piece = start, entry_end = 2 * start;  // enter at its front
+    std::vector<bool> walked(open.size(), false);
+    while (!walked[piece]) {
+      walked[piece] = true;
+      std::vector<Vec2> pts = open[piece].points;
+      if (entry_end % 2 == 1) std::reverse(pts.begin(), pts.end());
+      ring.points.insert(ring.points.end(), pts.begin(), pts.end() - 1);  // the last point starts the next piece
+      const std::size_t exit_end = entry_end ^ 1u;
+      const auto& at = ends_at[node[exit_end]];
+      const std::size_t next_end = at[0] == exit_end ? at[1] : at[0];
+      piece = next_end / 2;
+      entry_end = next_end;
+    }
+    done.push_back(std::move(ring));
+  }
+  *pieces = std::move(done);
+}
+
+}  // namespace
+
+Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options) {
+  if (!std::ifstream(file)) throw InputError(file.string() + ": cannot open DXF file for reading");
+  Collector collector(options.dxf_layer, options.dxf_arc_tolerance_m, options.scale_m_per_unit);
+  DL_Dxf dxf;
+  if (!dxf.in(file.string(), &collector)) throw InputError(file.string() + ": cannot read the file as DXF");
+  collector.FinishPolyline();
+  const double scale = collector.Scale();
+
+  std::vector<Piece> pieces = std::move(collector.pieces());
+  const double join_units = options.dxf_join_tolerance_m / scale;
+  for (Piece& p : pieces) p.points = WithoutRepeats(p.points, join_units * 1e-3);
+  pieces.erase(std::remove_if(pieces.begin(), pieces.end(),
+                              [](const Piece& p) { return p.points.size() < (p.closed ? 3u : 2u); }),
+               pieces.end());
+  ChainPieces(&pieces, join_units);
+
+  std::vector<Ring> rings;
+  std::vector<std::vector<Vec2>> open_lines;
+  for (Piece& p : pieces) {
+    for (Vec2& q : p.points) q *= scale;
+    if (p.closed) rings.push_back(std::move(p.points));
+    else open_lines.push_back(std::move(p.points));
+  }
+  if (rings.empty()) {
+    std::string what = file.string() + ": no closed region found";
+    what += options.dxf_layer.empty() ? "" : " on layer \"" + options.dxf_layer + "\"";
+    what += " (" + std::to_string(open_lines.size()) + " open polyline(s) that do not close";
+    if (collector.skipped_layers() > 0)
+      what += ", " + std::to_string(collector.skipped_layers()) + " entities on other layers skipped";
+    what += "); expected the outline of the walkable area as a closed polyline, a circle, or lines whose "
+            "endpoints meet within " + FormatNumber(options.dxf_join_tolerance_m) + " m";
+    throw GeometryError(what);
+  }
+
+  // Nesting depth: the number of other rings containing a ring (tested at a
+  // vertex; rings of a valid plan do not touch, and validation reports it if
+  // they do). The innermost container of an odd ring is its outer ring.
+  const std::size_t n = rings.size();
+  std::vector<std::size_t> depth(n, 0);
+  std::vector<std::size_t> parent(n, n);
+  std::vector<double> area(n);
+  for (std::size_t i = 0; i < n; ++i) area[i] = std::abs(RingSignedArea_m2(rings[i]));
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      if (i != j && area[j] > area[i] && PointInRing(rings[j], rings[i][0])) {
+        ++depth[i];
+        if (parent[i] == n || area[j] < area[parent[i]]) parent[i] = j;
+      }
+  std::vector<internal::ImportedRegion> regions;
+  std::map<std::size_t, std::size_t> region_of_ring;
+  for (std::size_t i = 0; i < n; ++i)
+    if (depth[i] % 2 == 0) {
+      region_of_ring[i] = regions.size();
+      regions.push_back({rings[i], {}});
+    }
+  for (std::size_t i = 0; i < n; ++i)
+    if (depth[i] % 2 == 1) regions[region_of_ring.at(parent[i])].holes.push_back(rings[i]);
+
+  const std::string name = options.name.empty() ? file.stem().string() : options.name;
+  Venue venue = internal::VenueFromRegions(std::move(regions), name,
+                                           "imported from " + file.filename().string() + " (DXF)", file.string());
+  for (std::size_t i = 0; i < open_lines.size(); ++i) {
+    Wall wall;
+    wall.id = "line-" + std::to_string(i + 1);
+    wall.points = std::move(open_lines[i]);
+    venue.walls.push_back(std::move(wall));
+  }
+  ValidateVenue(venue);
+  return venue;
+}
+
+}  // namespace crowdrecon::geometry

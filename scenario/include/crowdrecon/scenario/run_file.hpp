@@ -1,0 +1,117 @@
+// RunFile: one SQLite file per run, readable by the field's tools.
+//
+// JuPedSim trajectory format, version 2 (what PedPy's
+// load_trajectory_from_jupedsim_sqlite and load_walkable_area_from_jupedsim_sqlite read):
+//   trajectory_data(frame INTEGER, id INTEGER, pos_x REAL, pos_y REAL, ori_x REAL, ori_y REAL)
+//   metadata(key TEXT PRIMARY KEY, value TEXT)   version = 2, fps, xmin, xmax, ymin, ymax
+//   geometry(hash INTEGER, wkt TEXT)             the walkable area as WKT
+//   frame_data(frame INTEGER, geometry_hash INTEGER)
+// plus crowdrecon's own tables in the same file:
+//   run(key TEXT PRIMARY KEY, value TEXT)        scenario JSON, seed, time step, status, ...
+//   shape(id INTEGER PRIMARY KEY, radius_m REAL, vertices TEXT)   body frame, JSON [[x,y],...]
+//   person(id INTEGER PRIMARY KEY, shape INTEGER, mass_kg REAL, inertia_kg_m2 REAL,
+//          desired_speed_m_per_s REAL, grp INTEGER, target TEXT)
+//   frame_time(frame INTEGER PRIMARY KEY, time_s REAL)
+//   person_state(frame, id, vel_x, vel_y, angle_rad, omega_rad_per_s, state, load_n)
+//   contact(frame, a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m,
+//           normal_force_n, tangential_force_n)   every contact of the frame; b is a
+//           person id, or a wall index when wall = 1; forces act on a along the
+//           normal and along Perp(normal) = (-normal_y, normal_x)
+//   event(frame, time_s, kind TEXT, person INTEGER, other INTEGER, detail TEXT)
+//   wall(id INTEGER PRIMARY KEY, closed INTEGER, radius_m REAL, points TEXT)
+// Person ids in every table are 1-based in trajectory_data/person (as PedPy
+// expects ids), i.e. engine index + 1; contact.a/b use the same ids.
+//
+// Each frame is one transaction: a run killed at any moment leaves a valid
+// file holding every frame committed so far.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/engine/simulation.hpp"
+
+namespace crowdrecon::scenario {
+
+// Identity of a run, written once.
+struct RunHeader {
+  std::string scenario_json;    // the scenario as given
+  std::string scenario_origin;  // its file
+  std::string walkable_wkt;     // POLYGON/MULTIPOLYGON of the walkable area
+  double output_fps = 10.0;
+  double time_step_s = 0.0;
+  std::uint64_t seed = 0;
+  std::vector<std::string> target_names;  // by target index
+};
+
+struct Event {
+  double time_s = 0.0;
+  std::string kind;          // e.g. "fall", "avalanche_start", "numerical_failure"
+  std::int64_t person = -1;  // engine index, -1 if none
+  std::int64_t other = -1;
+  std::string detail;
+};
+
+class RunFileWriter {
+ public:
+  // Creates (truncating) the file and writes the header, shapes, persons and walls.
+  static RunFileWriter Create(const std::filesystem::path& file, const RunHeader& header,
+                              const engine::Simulation& sim);
+  // Reopens an existing run to continue after a checkpoint: frames after
+  // `last_frame` are deleted (they will be written again identically).
+  static RunFileWriter Resume(const std::filesystem::path& file, std::int64_t last_frame);
+  RunFileWriter(RunFileWriter&&) noexcept;
+  RunFileWriter& operator=(RunFileWriter&&) noexcept;
+  ~RunFileWriter();
+
+  // Writes frame `frame` (trajectories, states, contacts if enabled, events) in one transaction.
+  void WriteFrame(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
+                  bool with_contacts);
+  // Records an event outside a frame (e.g. a failure), committed at once.
+  void WriteEvent(std::int64_t frame, const Event& event);
+  // run.status = "running" | "complete" | "interrupted" | "failed: ..."
+  void SetStatus(const std::string& status);
+  void SetRunValue(const std::string& key, const std::string& value);
+
+ private:
+  RunFileWriter();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Reading a run back (render, reports, tests).
+struct RunFrame {
+  std::int64_t frame = 0;
+  double time_s = 0.0;
+  std::vector<std::int64_t> ids;  // 1-based
+  std::vector<Vec2> position_m;
+  std::vector<Vec2> orientation;  // unit vector the chest faces
+  std::vector<engine::Contact> contacts;  // a, b as engine indices (id - 1) / wall index
+};
+
+class RunFileReader {
+ public:
+  explicit RunFileReader(const std::filesystem::path& file);
+  RunFileReader(RunFileReader&&) noexcept;
+  ~RunFileReader();
+
+  std::string RunValue(const std::string& key) const;  // "" if absent
+  double fps() const;
+  std::string walkable_wkt() const;
+  std::vector<std::int64_t> Frames() const;
+  RunFrame Frame(std::int64_t frame) const;
+  // Shapes (body frame) and each person's shape index.
+  std::vector<engine::BodyShape> Shapes() const;
+  std::vector<std::uint32_t> PersonShapes() const;
+  std::vector<std::uint32_t> PersonGroups() const;
+  std::vector<engine::Wall> Walls() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace crowdrecon::scenario

@@ -1,0 +1,442 @@
+#include "crowdrecon/scenario/run_file.hpp"
+
+#include <sqlite3.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::scenario {
+
+namespace {
+
+// Thin RAII wrappers over the SQLite C API; every failure names the file.
+class Database {
+ public:
+  Database(const std::filesystem::path& file, int flags) : file_(file.string()) {
+    if (sqlite3_open_v2(file_.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+      const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw InputError(file_ + ": cannot open run file: " + message);
+    }
+    sqlite3_busy_timeout(db_, 5000);
+  }
+  ~Database() {
+    if (db_) sqlite3_close(db_);
+  }
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+
+  void Exec(const std::string& sql) const {
+    char* error = nullptr;
+    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
+      const std::string message = error ? error : "unknown error";
+      sqlite3_free(error);
+      throw InputError(file_ + ": SQLite error: " + message + " (in: " + sql.substr(0, 80) + ")");
+    }
+  }
+  sqlite3* get() const { return db_; }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  sqlite3* db_ = nullptr;
+};
+
+class Statement {
+ public:
+  Statement(const Database& db, const std::string& sql) : db_(db) {
+    if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
+      throw InputError(db.file() + ": SQLite error: " + sqlite3_errmsg(db.get()) + " (in: " + sql.substr(0, 80) + ")");
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& Bind(int i, double v) { Check(sqlite3_bind_double(stmt_, i, v)); return *this; }
+  Statement& Bind(int i, std::int64_t v) { Check(sqlite3_bind_int64(stmt_, i, v)); return *this; }
+  Statement& Bind(int i, const std::string& v) {
+    Check(sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
+    return *this;
+  }
+  // Runs a statement that returns no rows, then resets it for reuse.
+  void Run() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc != SQLITE_DONE) Fail(rc);
+    sqlite3_reset(stmt_);
+  }
+  // Steps to the next row; false at the end.
+  bool Next() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc != SQLITE_DONE) Fail(rc);
+    return false;
+  }
+  double Double(int col) const { return sqlite3_column_double(stmt_, col); }
+  std::int64_t Int(int col) const { return sqlite3_column_int64(stmt_, col); }
+  std::string Text(int col) const {
+    const auto* t = sqlite3_column_text(stmt_, col);
+    return t ? reinterpret_cast<const char*>(t) : "";
+  }
+
+ private:
+  void Check(int rc) const {
+    if (rc != SQLITE_OK) Fail(rc);
+  }
+  [[noreturn]] void Fail(int) const {
+    throw InputError(db_.file() + ": SQLite error: " + sqlite3_errmsg(db_.get()));
+  }
+  const Database& db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+std::string NumberText(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+// 64-bit FNV-1a of the WKT, as the geometry hash (JuPedSim uses Python's hash;
+// any integer identifying the geometry will do for readers).
+std::int64_t GeometryHash(const std::string& wkt) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : wkt) h = (h ^ c) * 1099511628211ull;
+  return static_cast<std::int64_t>(h >> 1);
+}
+
+std::string PointsJson(const std::vector<Vec2>& points) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const Vec2& p : points) j.push_back({p.x, p.y});
+  return j.dump();
+}
+
+std::vector<Vec2> PointsFromJson(const std::string& text, const std::string& file) {
+  std::vector<Vec2> points;
+  try {
+    for (const auto& p : nlohmann::json::parse(text)) points.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+  } catch (const std::exception& e) {
+    throw InputError(file + ": malformed point list in run file: " + e.what());
+  }
+  return points;
+}
+
+constexpr const char* kSchema = R"SQL(
+CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL,
+  pos_y REAL NOT NULL, ori_x REAL NOT NULL, ori_y REAL NOT NULL);
+CREATE TABLE metadata(key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE geometry(hash INTEGER NOT NULL, wkt TEXT NOT NULL);
+CREATE TABLE frame_data(frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL);
+CREATE INDEX frame_id_idx ON trajectory_data(frame, id);
+CREATE TABLE run(key TEXT NOT NULL PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE shape(id INTEGER PRIMARY KEY, radius_m REAL NOT NULL, vertices TEXT NOT NULL);
+CREATE TABLE person(id INTEGER PRIMARY KEY, shape INTEGER NOT NULL, mass_kg REAL NOT NULL,
+  inertia_kg_m2 REAL NOT NULL, desired_speed_m_per_s REAL NOT NULL, grp INTEGER NOT NULL, target TEXT NOT NULL);
+CREATE TABLE wall(id INTEGER PRIMARY KEY, closed INTEGER NOT NULL, radius_m REAL NOT NULL, points TEXT NOT NULL);
+CREATE TABLE frame_time(frame INTEGER PRIMARY KEY, time_s REAL NOT NULL);
+CREATE TABLE person_state(frame INTEGER NOT NULL, id INTEGER NOT NULL, vel_x REAL NOT NULL, vel_y REAL NOT NULL,
+  angle_rad REAL NOT NULL, omega_rad_per_s REAL NOT NULL, state INTEGER NOT NULL, load_n REAL NOT NULL);
+CREATE INDEX person_state_idx ON person_state(frame, id);
+CREATE TABLE contact(frame INTEGER NOT NULL, a INTEGER NOT NULL, b INTEGER NOT NULL, wall INTEGER NOT NULL,
+  point_x REAL NOT NULL, point_y REAL NOT NULL, normal_x REAL NOT NULL, normal_y REAL NOT NULL,
+  overlap_m REAL NOT NULL, normal_force_n REAL NOT NULL, tangential_force_n REAL NOT NULL);
+CREATE INDEX contact_frame_idx ON contact(frame);
+CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT NULL, person INTEGER NOT NULL,
+  other INTEGER NOT NULL, detail TEXT NOT NULL);
+)SQL";
+
+}  // namespace
+
+struct RunFileWriter::Impl {
+  std::unique_ptr<Database> db;
+  std::int64_t geometry_hash = 0;
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
+  double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
+};
+
+RunFileWriter::RunFileWriter() : impl_(std::make_unique<Impl>()) {}
+RunFileWriter::RunFileWriter(RunFileWriter&&) noexcept = default;
+RunFileWriter& RunFileWriter::operator=(RunFileWriter&&) noexcept = default;
+RunFileWriter::~RunFileWriter() = default;
+
+RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
+                                    const engine::Simulation& sim) {
+  std::error_code ec;
+  std::filesystem::remove(file, ec);
+  for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
+  RunFileWriter w;
+  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+  Database& db = *w.impl_->db;
+  db.Exec("PRAGMA synchronous=NORMAL");
+  db.Exec("BEGIN");
+  db.Exec(kSchema);
+  w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
+  {
+    Statement meta(db, "INSERT INTO metadata VALUES(?, ?)");
+    meta.Bind(1, std::string("version")).Bind(2, std::string("2")).Run();
+    meta.Bind(1, std::string("fps")).Bind(2, NumberText(header.output_fps)).Run();
+    Statement geo(db, "INSERT INTO geometry VALUES(?, ?)");
+    geo.Bind(1, w.impl_->geometry_hash).Bind(2, header.walkable_wkt).Run();
+    Statement run(db, "INSERT INTO run VALUES(?, ?)");
+    const auto put = [&](const std::string& k, const std::string& v) { run.Bind(1, k).Bind(2, v).Run(); };
+    put("format", "crowdrecon-run");
+    put("format_version", "1");
+    put("scenario", header.scenario_json);
+    put("scenario_file", header.scenario_origin);
+    put("seed", std::to_string(header.seed));
+    put("time_step_s", NumberText(header.time_step_s));
+    put("output_fps", NumberText(header.output_fps));
+    put("status", "running");
+  }
+  const engine::WorldDef& def = sim.definition();
+  {
+    Statement shape(db, "INSERT INTO shape VALUES(?, ?, ?)");
+    for (std::size_t s = 0; s < def.shapes.size(); ++s)
+      shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, def.shapes[s].radius_m).Bind(3, PointsJson(def.shapes[s].vertices)).Run();
+    Statement person(db, "INSERT INTO person VALUES(?, ?, ?, ?, ?, ?, ?)");
+    const engine::BodyState& b = sim.bodies();
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      const std::uint32_t t = b.target[i];
+      person.Bind(1, static_cast<std::int64_t>(i + 1))
+          .Bind(2, static_cast<std::int64_t>(b.shape[i]))
+          .Bind(3, b.mass_kg[i])
+          .Bind(4, b.inertia_kg_m2[i])
+          .Bind(5, b.desired_speed_m_per_s[i])
+          .Bind(6, static_cast<std::int64_t>(b.group[i]))
+          .Bind(7, t < header.target_names.size() ? header.target_names[t] : std::to_string(t))
+          .Run();
+    }
+    Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
+    for (std::size_t k = 0; k < def.walls.size(); ++k)
+      wall.Bind(1, static_cast<std::int64_t>(k))
+          .Bind(2, static_cast<std::int64_t>(def.walls[k].closed))
+          .Bind(3, def.walls[k].radius_m)
+          .Bind(4, PointsJson(def.walls[k].points))
+          .Run();
+  }
+  db.Exec("COMMIT");
+  return w;
+}
+
+RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int64_t last_frame) {
+  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": run file to resume does not exist");
+  RunFileWriter w;
+  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE);
+  Database& db = *w.impl_->db;
+  db.Exec("PRAGMA synchronous=NORMAL");
+  db.Exec("BEGIN");
+  const std::string after = std::to_string(last_frame);
+  for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
+    db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
+  {
+    Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
+    if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
+    w.impl_->geometry_hash = geo.Int(0);
+    Statement bounds(db, "SELECT MIN(pos_x), MAX(pos_x), MIN(pos_y), MAX(pos_y), COUNT(*) FROM trajectory_data");
+    if (bounds.Next() && bounds.Int(4) > 0) {
+      w.impl_->xmin = bounds.Double(0);
+      w.impl_->xmax = bounds.Double(1);
+      w.impl_->ymin = bounds.Double(2);
+      w.impl_->ymax = bounds.Double(3);
+    }
+  }
+  db.Exec("INSERT OR REPLACE INTO run VALUES('status', 'running')");
+  db.Exec("COMMIT");
+  return w;
+}
+
+void RunFileWriter::WriteFrame(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
+                               bool with_contacts) {
+  Database& db = *impl_->db;
+  const engine::BodyState& b = sim.bodies();
+  db.Exec("BEGIN");
+  {
+    // Per-person load: the sum of the magnitudes of the contact forces on the
+    // person (the quantity compared with the 400 N threshold).
+    std::vector<double> load(b.size(), 0.0);
+    for (const engine::Contact& c : sim.contacts()) {
+      const double f = Length(c.Force());
+      load[c.a] += f;
+      if (!c.wall) load[c.b] += f;
+    }
+    Statement traj(db, "INSERT INTO trajectory_data VALUES(?, ?, ?, ?, ?, ?)");
+    Statement state(db, "INSERT INTO person_state VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (b.state[i] == engine::PersonState::kRemoved) continue;
+      const Vec2 x = b.position_m[i];
+      const double angle = b.angle_rad[i];
+      traj.Bind(1, frame).Bind(2, static_cast<std::int64_t>(i + 1)).Bind(3, x.x).Bind(4, x.y)
+          .Bind(5, std::cos(angle)).Bind(6, std::sin(angle)).Run();
+      state.Bind(1, frame).Bind(2, static_cast<std::int64_t>(i + 1))
+          .Bind(3, b.velocity_m_per_s[i].x).Bind(4, b.velocity_m_per_s[i].y)
+          .Bind(5, angle).Bind(6, b.angular_velocity_rad_per_s[i])
+          .Bind(7, static_cast<std::int64_t>(b.state[i])).Bind(8, load[i]).Run();
+      impl_->xmin = std::min(impl_->xmin, x.x);
+      impl_->xmax = std::max(impl_->xmax, x.x);
+      impl_->ymin = std::min(impl_->ymin, x.y);
+      impl_->ymax = std::max(impl_->ymax, x.y);
+    }
+    if (with_contacts) {
+      Statement contact(db, "INSERT INTO contact VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      for (const engine::Contact& c : sim.contacts())
+        contact.Bind(1, frame).Bind(2, static_cast<std::int64_t>(c.a + 1))
+            .Bind(3, static_cast<std::int64_t>(c.wall ? c.b : c.b + 1))
+            .Bind(4, static_cast<std::int64_t>(c.wall))
+            .Bind(5, c.point_m.x).Bind(6, c.point_m.y).Bind(7, c.normal.x).Bind(8, c.normal.y)
+            .Bind(9, c.overlap_m).Bind(10, c.normal_force_n).Bind(11, c.tangential_force_n).Run();
+    }
+    Statement ft(db, "INSERT INTO frame_time VALUES(?, ?)");
+    ft.Bind(1, frame).Bind(2, sim.time_s()).Run();
+    Statement fd(db, "INSERT INTO frame_data VALUES(?, ?)");
+    fd.Bind(1, frame).Bind(2, impl_->geometry_hash).Run();
+    Statement ev(db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
+    for (const Event& e : events)
+      ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
+          .Bind(4, e.person >= 0 ? e.person + 1 : std::int64_t{0})
+          .Bind(5, e.other >= 0 ? e.other + 1 : std::int64_t{0}).Bind(6, e.detail).Run();
+    Statement meta(db, "INSERT OR REPLACE INTO metadata VALUES(?, ?)");
+    if (std::isfinite(impl_->xmin)) {
+      meta.Bind(1, std::string("xmin")).Bind(2, NumberText(impl_->xmin)).Run();
+      meta.Bind(1, std::string("xmax")).Bind(2, NumberText(impl_->xmax)).Run();
+      meta.Bind(1, std::string("ymin")).Bind(2, NumberText(impl_->ymin)).Run();
+      meta.Bind(1, std::string("ymax")).Bind(2, NumberText(impl_->ymax)).Run();
+    }
+  }
+  db.Exec("COMMIT");
+}
+
+void RunFileWriter::WriteEvent(std::int64_t frame, const Event& e) {
+  Statement ev(*impl_->db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
+  ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
+      .Bind(4, e.person >= 0 ? e.person + 1 : std::int64_t{0})
+      .Bind(5, e.other >= 0 ? e.other + 1 : std::int64_t{0}).Bind(6, e.detail).Run();
+}
+
+void RunFileWriter::SetStatus(const std::string& status) { SetRunValue("status", status); }
+
+void RunFileWriter::SetRunValue(const std::string& key, const std::string& value) {
+  Statement s(*impl_->db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
+  s.Bind(1, key).Bind(2, value).Run();
+}
+
+// ---------------------------------------------------------------------------
+
+struct RunFileReader::Impl {
+  std::unique_ptr<Database> db;
+  std::string file;
+};
+
+RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
+  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": run file does not exist");
+  impl_->file = file.string();
+  impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READONLY);
+  Statement check(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE name IN ('trajectory_data', 'run', 'person')");
+  if (!check.Next() || check.Int(0) != 3)
+    throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
+}
+RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
+RunFileReader::~RunFileReader() = default;
+
+std::string RunFileReader::RunValue(const std::string& key) const {
+  Statement s(*impl_->db, "SELECT value FROM run WHERE key = ?");
+  s.Bind(1, key);
+  return s.Next() ? s.Text(0) : "";
+}
+
+double RunFileReader::fps() const {
+  Statement s(*impl_->db, "SELECT value FROM metadata WHERE key = 'fps'");
+  if (!s.Next()) throw InputError(impl_->file + ": run file has no fps in metadata");
+  return std::stod(s.Text(0));
+}
+
+std::string RunFileReader::walkable_wkt() const {
+  Statement s(*impl_->db, "SELECT wkt FROM geometry LIMIT 1");
+  return s.Next() ? s.Text(0) : "";
+}
+
+std::vector<std::int64_t> RunFileReader::Frames() const {
+  std::vector<std::int64_t> frames;
+  Statement s(*impl_->db, "SELECT frame FROM frame_time ORDER BY frame");
+  while (s.Next()) frames.push_back(s.Int(0));
+  return frames;
+}
+
+RunFrame RunFileReader::Frame(std::int64_t frame) const {
+  RunFrame f;
+  f.frame = frame;
+  {
+    Statement t(*impl_->db, "SELECT time_s FROM frame_time WHERE frame = ?");
+    t.Bind(1, frame);
+    if (!t.Next()) throw InputError(impl_->file + ": no frame " + std::to_string(frame));
+    f.time_s = t.Double(0);
+  }
+  Statement s(*impl_->db, "SELECT id, pos_x, pos_y, ori_x, ori_y FROM trajectory_data WHERE frame = ? ORDER BY id");
+  s.Bind(1, frame);
+  while (s.Next()) {
+    f.ids.push_back(s.Int(0));
+    f.position_m.push_back({s.Double(1), s.Double(2)});
+    f.orientation.push_back({s.Double(3), s.Double(4)});
+  }
+  Statement c(*impl_->db,
+              "SELECT a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m, normal_force_n, "
+              "tangential_force_n FROM contact WHERE frame = ? ORDER BY rowid");
+  c.Bind(1, frame);
+  while (c.Next()) {
+    engine::Contact k;
+    k.a = static_cast<std::uint32_t>(c.Int(0) - 1);
+    k.wall = c.Int(2) != 0;
+    k.b = static_cast<std::uint32_t>(k.wall ? c.Int(1) : c.Int(1) - 1);
+    k.point_m = {c.Double(3), c.Double(4)};
+    k.normal = {c.Double(5), c.Double(6)};
+    k.overlap_m = c.Double(7);
+    k.normal_force_n = c.Double(8);
+    k.tangential_force_n = c.Double(9);
+    f.contacts.push_back(k);
+  }
+  return f;
+}
+
+std::vector<engine::BodyShape> RunFileReader::Shapes() const {
+  std::vector<engine::BodyShape> shapes;
+  Statement s(*impl_->db, "SELECT radius_m, vertices FROM shape ORDER BY id");
+  while (s.Next()) {
+    engine::BodyShape shape;
+    shape.radius_m = s.Double(0);
+    shape.vertices = PointsFromJson(s.Text(1), impl_->file);
+    shapes.push_back(std::move(shape));
+  }
+  return shapes;
+}
+
+std::vector<std::uint32_t> RunFileReader::PersonShapes() const {
+  std::vector<std::uint32_t> out;
+  Statement s(*impl_->db, "SELECT shape FROM person ORDER BY id");
+  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Int(0)));
+  return out;
+}
+
+std::vector<std::uint32_t> RunFileReader::PersonGroups() const {
+  std::vector<std::uint32_t> out;
+  Statement s(*impl_->db, "SELECT grp FROM person ORDER BY id");
+  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Int(0)));
+  return out;
+}
+
+std::vector<engine::Wall> RunFileReader::Walls() const {
+  std::vector<engine::Wall> walls;
+  Statement s(*impl_->db, "SELECT closed, radius_m, points FROM wall ORDER BY id");
+  while (s.Next()) {
+    engine::Wall w;
+    w.closed = s.Int(0) != 0;
+    w.radius_m = s.Double(1);
+    w.points = PointsFromJson(s.Text(2), impl_->file);
+    walls.push_back(std::move(w));
+  }
+  return walls;
+}
+
+}  // namespace crowdrecon::scenario
