@@ -11,5 +11,7 @@ namespace crowdrecon::cli {
 
 void RegisterShapeCommands(CLI::App& app);  // shape, population, body reference
 void RegisterVenueCommands(CLI::App& app);  // venue check, venue import
+void RegisterSimulateCommand(CLI::App& app);  // simulate
+void RegisterRenderCommand(CLI::App& app);  // render (pictures and video of a run)
 
 }  // namespace crowdrecon::cli

@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "crowdrecon 0.1.0");
   crowdrecon::cli::RegisterShapeCommands(app);
   crowdrecon::cli::RegisterVenueCommands(app);
+  crowdrecon::cli::RegisterSimulateCommand(app);
+  crowdrecon::cli::RegisterRenderCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

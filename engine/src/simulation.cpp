@@ -920,6 +920,12 @@ void Simulation::AdvanceTo(double end_time_s) {
   while (time_s_ < end_time_s - 1e-12) Step();
 }
 
+void Simulation::Quench() {
+  std::fill(bodies_.velocity_m_per_s.begin(), bodies_.velocity_m_per_s.end(), Vec2{});
+  std::fill(bodies_.angular_velocity_rad_per_s.begin(), bodies_.angular_velocity_rad_per_s.end(), 0.0);
+  in_->gear_initialised = false;
+}
+
 void Simulation::SetExternalForce(std::uint32_t person, Vec2 force_n) {
   if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
   bodies_.external_force_n[person] = force_n;

@@ -191,6 +191,12 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
     put("time_step_s", NumberText(header.time_step_s));
     put("output_fps", NumberText(header.output_fps));
     put("status", "running");
+    const engine::PeriodicBox& box = sim.definition().periodic;
+    if (box.x || box.y) {
+      nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
+                          {"max_m", {box.max_m.x, box.max_m.y}}};
+      put("periodic_box", j.dump());
+    }
   }
   const engine::WorldDef& def = sim.definition();
   {

@@ -102,3 +102,47 @@ crowdrecon_cli_test(shape.invalid.scale fail "--scale: unknown scale rule \"widt
                     shape venues/bodies/thorax-reference.json --scale width:0.3 -o @TMP@/body.json)
 crowdrecon_cli_test(shape.invalid.front fail "--front: unknown front axis \"up\""
                     shape venues/bodies/thorax-reference.json --front up -o @TMP@/body.json)
+
+# --- render (viz/render_run.hpp) ----------------------------------------------
+# Run files written by crowdrecon_make_test_run (tests/tools) before these
+# tests run (fixture render_data): run.sqlite, 12 people in counter-flow with
+# the 18-vertex thorax, 21 frames (0-2 s) with contacts; empty.sqlite, no frame.
+set(render_data ${CMAKE_CURRENT_BINARY_DIR}/render-data)
+add_test(NAME cli.render.make_data
+         COMMAND crowdrecon_make_test_run ${render_data} ${PROJECT_SOURCE_DIR}/venues/bodies/thorax-18.json)
+set_tests_properties(cli.render.make_data PROPERTIES FIXTURES_SETUP render_data)
+crowdrecon_cli_test(render.first_last ok "video: .*run\\.avi \\(MJPG, 10 fps\\)"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames first,last --width 960
+                    --video @TMP@/run.avi --svg)
+crowdrecon_cli_test(render.first_last_size ok "rendered 2 frame\\(s\\), 0 to 20, 960 x [0-9]+ px"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames first,last --width 960)
+crowdrecon_cli_test(render.every ok "rendered 5 frame\\(s\\), 0 to 20"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames every:5 --force-scale 20)
+crowdrecon_cli_test(render.time_range ok "rendered 6 frame\\(s\\), 5 to 10"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames 0.5:1)
+crowdrecon_cli_test(render.mp4 ok "video: .*run\\.(mp4 \\(mp4v|avi \\(MJPG), 5 fps\\)"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames every:2 --video @TMP@/run.mp4)
+crowdrecon_cli_test(render.missing_file fail "no-such-run.sqlite: run file does not exist"
+                    render ${render_data}/no-such-run.sqlite -o @TMP@/frames)
+crowdrecon_cli_test(render.not_a_run fail "thorax-18.json: not a crowdrecon run file"
+                    render venues/bodies/thorax-18.json -o @TMP@/frames)
+crowdrecon_cli_test(render.empty_run fail "empty.sqlite: the run has no frames to draw"
+                    render ${render_data}/empty.sqlite -o @TMP@/frames)
+crowdrecon_cli_test(render.frame_not_in_run fail "--frames \"0,99\": frame 99 is not in the run \\(the run has 21 frames, 0 to 20\\)"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames 0,99)
+crowdrecon_cli_test(render.bad_every fail "--frames \"every:0\": every:N needs a whole number N >= 1"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames every:0)
+crowdrecon_cli_test(render.bad_time_range fail "--frames \"2:1\": the time range ends \\(1 s\\) before it starts \\(2 s\\)"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames 2:1)
+crowdrecon_cli_test(render.empty_time_range fail "no frame lies between 5 s and 6 s \\(the run covers 0 s to 2(\\.[0-9]+)? s\\)"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames 5:6)
+crowdrecon_cli_test(render.unwritable_output fail "expect.sh/frames: cannot create the output folder"
+                    render ${render_data}/run.sqlite -o tests/cli/expect.sh/frames)
+crowdrecon_cli_test(render.bad_video fail "--video .*run.gif: unknown video format \".gif\", expected .mp4 or .avi"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --video @TMP@/run.gif)
+crowdrecon_cli_test(render.bad_width fail "--width: 100 px, expected 320 .. 8000"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --width 100)
+get_property(render_tests DIRECTORY PROPERTY TESTS)
+list(FILTER render_tests INCLUDE REGEX "^cli\\.render\\.")
+list(REMOVE_ITEM render_tests cli.render.make_data)
+set_tests_properties(${render_tests} PROPERTIES FIXTURES_REQUIRED render_data)

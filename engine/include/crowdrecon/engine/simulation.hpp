@@ -112,6 +112,10 @@ class Simulation {
   const std::vector<Contact>& contacts() const { return contacts_; }
   const Profile& profile() const { return profile_; }
 
+  // Sets every velocity and angular velocity to zero and forgets the
+  // integrator's history (used to relax an initial placement).
+  void Quench();
+
   // A constant external force on a person (N), added to eq. (2) until changed;
   // used by verification scenes and crash tests (pushing, pressing).
   void SetExternalForce(std::uint32_t person, Vec2 force_n);

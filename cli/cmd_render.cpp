@@ -1,0 +1,76 @@
+// `crowdrecon render`: pictures (and a video) of a run's frames with the
+// contact force network of the paper's Figure 6 (viz/render_run.hpp).
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/viz/render_run.hpp"
+
+namespace crowdrecon::cli {
+
+namespace {
+
+struct RenderArgs {
+  std::string run_file;
+  std::string output_dir;
+  std::string frames = "all";
+  std::string video;
+  double fps = 0.0;
+  int width_px = 1280;
+  double force_n_per_px = 0.0;
+  bool svg = false;
+};
+
+void RunRender(const RenderArgs& args) {
+  viz::RenderOptions options;
+  options.output_dir = args.output_dir;
+  options.frames = viz::ParseFrameSelection(args.frames);
+  options.video = args.video;
+  options.video_fps = args.fps;
+  options.width_px = args.width_px;
+  options.force_n_per_px = args.force_n_per_px;
+  options.svg = args.svg;
+  // A progress line only for a person watching: logs and pipes stay clean.
+  const bool terminal = isatty(fileno(stderr)) != 0;
+  if (terminal)
+    options.progress = [](const viz::RenderProgress& p) {
+      std::fprintf(stderr, "\rrender: frame %lld (t = %.2f s), %zu of %zu", static_cast<long long>(p.frame),
+                   p.time_s, p.done, p.total);
+      if (p.done == p.total) std::fprintf(stderr, "\n");
+      std::fflush(stderr);
+    };
+  const viz::RenderSummary summary = viz::RenderRun(args.run_file, options);
+  std::printf("%s", summary.BriefReport().c_str());
+  std::printf("pictures: %s (frame_%06lld.png ...)\n", args.output_dir.c_str(),
+              static_cast<long long>(summary.first_frame));
+}
+
+}  // namespace
+
+void RegisterRenderCommand(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* render = app.add_subcommand(
+      "render", "Draw a run's frames: bodies, walls and the contact force network (paper, Figure 6)");
+  render->add_option("RUN", args->run_file, "run file (.sqlite) written by `crowdrecon simulate`")->required();
+  render->add_option("-o,--output", args->output_dir, "folder for frame_NNNNNN.png (created if missing)")
+      ->required();
+  render->add_option("--frames", args->frames,
+                     "which frames: all (default), a list such as first,last or 0,50,last, every:N, or a time "
+                     "range T1:T2 in seconds");
+  render->add_option("--video", args->video,
+                     "also write a video: .mp4 (MPEG-4; falls back to .avi if unsupported) or .avi (Motion-JPEG)");
+  render->add_option("--fps", args->fps, "frames per second of the video (default: real time)");
+  render->add_option("--width", args->width_px, "picture width in pixels (default 1280)");
+  render->add_option("--force-scale", args->force_n_per_px,
+                     "newtons per pixel of force-line width (default: the largest force ~0.12 m wide)");
+  render->add_flag("--svg", args->svg, "also write frame_NNNNNN.svg");
+  render->callback([args] { RunRender(*args); });
+}
+
+}  // namespace crowdrecon::cli

@@ -1,0 +1,46 @@
+// Running a scenario: builds the world, writes the run file frame by frame,
+// writes checkpoints, survives interruption (Ctrl-C, SIGTERM: a checkpoint is
+// written before stopping; a killed run resumes from its last checkpoint), and
+// stops with a clear message and its state saved when the run goes
+// numerically wrong. Progress (simulated time, real-time factor, time left) is
+// shown on a terminal only.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "crowdrecon/scenario/scenario.hpp"
+
+namespace crowdrecon::scenario {
+
+struct RunOptions {
+  std::filesystem::path output;  // RUN.sqlite
+  int threads = 1;
+  bool resume = false;           // continue from output + ".checkpoint"
+  bool show_progress = false;    // a progress line on stderr
+  // Stop (as if interrupted) once the simulated time reaches this; < 0 never.
+  // For tests of interruption and resume.
+  double stop_after_s = -1.0;
+};
+
+struct RunSummary {
+  std::string status;           // "complete" or "interrupted"
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+  double time_step_s = 0.0;
+  std::size_t people = 0;
+  std::int64_t frames = 0;      // frames in the run file
+  double real_time_factor = 0.0;  // simulated / wall seconds (this invocation)
+};
+
+// Path of the checkpoint that belongs to a run file.
+std::filesystem::path CheckpointPath(const std::filesystem::path& run_file);
+
+// Installs SIGINT/SIGTERM handlers that ask running scenarios to stop at the
+// next step (after writing a checkpoint).
+void InstallInterruptHandlers();
+
+RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
+
+}  // namespace crowdrecon::scenario

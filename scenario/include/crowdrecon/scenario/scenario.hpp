@@ -1,0 +1,81 @@
+// Scenario: what to simulate, read from a JSON file (docs/scenarios.md).
+//
+//   {
+//     "format": "crowdrecon-scenario", "version": 1,
+//     "name": "Madrid Arena hallway, 5 /m2, 30 % counter-flow",
+//     "venue": "../venues/madrid-arena/hallway-periodic.json",   (relative to this file)
+//     "population": {
+//       "density_per_m2": 5.0,            (or "count": 180)
+//       "counter_flow_fraction": 0.3,
+//       "target": "to_exit", "counter_target": "to_court",
+//       "body": {"mode": "paper", "reference": "../venues/bodies/thorax-18.json"},
+//       "desired_speed_m_per_s": [0.8, 1.2],
+//       "placement": {"region": "walkable", "max_overlap_m": 0.003},
+//       "seed": 2012
+//     },
+//     "model": { "restitution": 0.4, "back_force_gamma": 1.2, ... },   (engine::ModelParameters)
+//     "run": {"duration_s": 60, "output_fps": 10, "checkpoint_interval_s": 10, "contacts": true}
+//   }
+//
+// Unknown keys and out-of-range values are errors naming the file, the JSON
+// path and the allowed range.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "crowdrecon/engine/parameters.hpp"
+#include "crowdrecon/geometry/population.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+
+namespace crowdrecon::scenario {
+
+struct PopulationSpec {
+  std::optional<std::size_t> count;       // exactly one of count and density
+  std::optional<double> density_per_m2;   // persons per m^2 of the placement region
+  double counter_flow_fraction = 0.0;     // share of people walking to counter_target
+  std::string target;                     // venue target of the main flow
+  std::string counter_target;             // venue target of the counter-flow
+  geometry::PopulationMode body_mode = geometry::PopulationMode::kPaper;
+  std::filesystem::path reference_body;   // body JSON (paper and circle modes)
+  std::filesystem::path anthropometry;    // ANSUR II extract (anthropometric mode)
+  double female_fraction = 0.5;
+  std::size_t vertex_count = 18;          // anthropometric bodies
+  double desired_speed_min_m_per_s = 0.8;  // v0 ~ U(min, max), paper
+  double desired_speed_max_m_per_s = 1.2;
+  std::string placement_region = "walkable";  // "walkable" or "entries"
+  double max_initial_overlap_m = 0.003;       // after relaxation of the placement
+  std::uint64_t seed = 1;
+};
+
+struct RunSpec {
+  double duration_s = 60.0;
+  double output_fps = 10.0;
+  double checkpoint_interval_s = 10.0;  // 0 = none
+  bool write_contacts = true;
+};
+
+struct Scenario {
+  std::string name;
+  std::filesystem::path file;  // where it was read from ("" if from text)
+  std::string json_text;       // as given (kept in the run file)
+  std::filesystem::path venue_file;
+  geometry::Venue venue;
+  PopulationSpec population;
+  engine::ModelParameters model;
+  RunSpec run;
+};
+
+Scenario LoadScenario(const std::filesystem::path& file);
+// `base_dir` resolves relative paths; `origin` names the text in messages.
+Scenario ParseScenario(const std::string& json_text, const std::string& origin,
+                       const std::filesystem::path& base_dir);
+
+// The project's root (where venues/ lives) for default reference files: the
+// CROWDRECON_DATA_DIR environment variable, or the source tree the program was
+// built from.
+std::filesystem::path DataDirectory();
+
+}  // namespace crowdrecon::scenario

@@ -1,0 +1,223 @@
+#include "crowdrecon/scenario/runner.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/world_builder.hpp"
+
+namespace crowdrecon::scenario {
+
+namespace {
+
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void OnInterrupt(int) { g_stop_requested.store(true); }
+
+// FNV-1a of the scenario text and thread-independent settings: a checkpoint
+// only resumes the run it was written for.
+std::uint64_t ScenarioFingerprint(const Scenario& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s.json_text) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+constexpr char kCheckpointMagic[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '1'};
+
+void WriteCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint, std::int64_t last_frame,
+                     const engine::Simulation& sim) {
+  const std::string state = sim.SaveState();
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(tmp.string() + ": cannot write checkpoint");
+    out.write(kCheckpointMagic, sizeof kCheckpointMagic);
+    out.write(reinterpret_cast<const char*>(&fingerprint), sizeof fingerprint);
+    out.write(reinterpret_cast<const char*>(&last_frame), sizeof last_frame);
+    out.write(state.data(), static_cast<std::streamsize>(state.size()));
+    out.flush();
+    if (!out) throw InputError(tmp.string() + ": cannot write checkpoint (disk full?)");
+  }
+  std::filesystem::rename(tmp, file);  // atomic: a crash never leaves a half-written checkpoint
+}
+
+struct Checkpoint {
+  std::int64_t last_frame = -1;
+  std::string state;
+};
+
+Checkpoint ReadCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": no checkpoint to resume from (was the run started with this output file?)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string data = buffer.str();
+  const std::size_t header = sizeof kCheckpointMagic + 16;
+  if (data.size() < header || data.compare(0, sizeof kCheckpointMagic, kCheckpointMagic, sizeof kCheckpointMagic) != 0)
+    throw InputError(file.string() + ": not a crowdrecon checkpoint");
+  std::uint64_t stored;
+  Checkpoint c;
+  std::memcpy(&stored, data.data() + 8, 8);
+  std::memcpy(&c.last_frame, data.data() + 16, 8);
+  if (stored != fingerprint)
+    throw InputError(file.string() + ": the checkpoint belongs to a different scenario (the scenario file changed?)");
+  c.state = data.substr(header);
+  return c;
+}
+
+std::string Duration(double s) {
+  char buffer[32];
+  if (!std::isfinite(s)) return "?";
+  const long total = std::lround(s);
+  if (total >= 3600) std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, (total / 60) % 60);
+  else if (total >= 60) std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
+  else std::snprintf(buffer, sizeof buffer, "%lds", total);
+  return buffer;
+}
+
+}  // namespace
+
+std::filesystem::path CheckpointPath(const std::filesystem::path& run_file) {
+  return run_file.string() + ".checkpoint";
+}
+
+void InstallInterruptHandlers() {
+  std::signal(SIGINT, OnInterrupt);
+  std::signal(SIGTERM, OnInterrupt);
+}
+
+RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const auto say = [&](const std::string& line) {
+    if (options.show_progress) std::fprintf(stderr, "%s\n", line.c_str());
+  };
+  g_stop_requested.store(false);
+  BuiltWorld built = BuildWorld(scenario, options.threads, say);
+
+  // An integer number of steps per output frame, so that frames are exactly
+  // 1/fps apart (the frame rate JuPedSim's format declares): the chosen step
+  // is shortened, never lengthened.
+  const double frame_dt = 1.0 / scenario.run.output_fps;
+  {
+    const engine::TimeStepEstimate estimate = engine::EstimateTimeStep(built.world);
+    if (scenario.model.time_step_s > estimate.stability_limit_s)
+      throw InputError(scenario.file.string() + ": /model/time_step_s: " + FormatNumber(scenario.model.time_step_s) +
+                       " s is above the stability limit of the " + engine::ToString(scenario.model.integrator) +
+                       " integrator for these bodies, " + FormatNumber(estimate.stability_limit_s) +
+                       " s (stiffest contact omega_max = " + FormatNumber(estimate.omega_max_rad_per_s) +
+                       " rad/s); give a smaller step, or 0 to let the engine choose");
+    const double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
+    built.world.parameters.time_step_s = frame_dt / steps;
+  }
+  const auto steps_per_frame = static_cast<std::int64_t>(std::llround(frame_dt / built.world.parameters.time_step_s));
+  engine::Simulation sim(built.world);
+
+  RunHeader header;
+  header.scenario_json = scenario.json_text;
+  header.scenario_origin = scenario.file.string();
+  header.walkable_wkt = built.walkable_wkt;
+  header.output_fps = scenario.run.output_fps;
+  header.time_step_s = sim.time_step_s();
+  header.seed = scenario.population.seed;
+  header.target_names = built.target_names;
+
+  const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
+  const std::filesystem::path checkpoint = CheckpointPath(options.output);
+  std::int64_t last_frame = -1;
+  RunFileWriter writer = [&] {
+    if (!options.resume) {
+      std::error_code ec;
+      std::filesystem::remove(checkpoint, ec);
+      return RunFileWriter::Create(options.output, header, sim);
+    }
+    const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
+    sim.LoadState(c.state);
+    last_frame = c.last_frame;
+    say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
+    return RunFileWriter::Resume(options.output, last_frame);
+  }();
+  writer.SetRunValue("people", std::to_string(sim.bodies().size()));
+  writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));
+
+  const std::int64_t total_frames = static_cast<std::int64_t>(std::floor(scenario.run.duration_s * scenario.run.output_fps + 1e-9));
+  const std::int64_t checkpoint_every =
+      scenario.run.checkpoint_interval_s > 0
+          ? std::max<std::int64_t>(1, std::llround(scenario.run.checkpoint_interval_s * scenario.run.output_fps))
+          : 0;
+  RunSummary summary;
+  summary.people = sim.bodies().size();
+  summary.time_step_s = sim.time_step_s();
+  const auto start = Clock::now();
+  const double start_sim = sim.time_s();
+  auto last_print = start;
+
+  const auto write_frame = [&](std::int64_t frame) {
+    writer.WriteFrame(frame, sim, {}, scenario.run.write_contacts);
+    last_frame = frame;
+  };
+  if (last_frame < 0) write_frame(0);
+
+  std::string status = "complete";
+  try {
+    while (last_frame < total_frames) {
+      for (std::int64_t k = 0; k < steps_per_frame; ++k) {
+        sim.Step();
+      }
+      write_frame(last_frame + 1);
+      if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) WriteCheckpoint(checkpoint, fingerprint, last_frame, sim);
+      const bool stop = g_stop_requested.load() || (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);
+      const auto now = Clock::now();
+      if (options.show_progress && (now - last_print > std::chrono::milliseconds(500) || stop || last_frame == total_frames)) {
+        last_print = now;
+        const double wall = std::chrono::duration<double>(now - start).count();
+        const double rtf = wall > 0 ? (sim.time_s() - start_sim) / wall : 0.0;
+        const double left = rtf > 0 ? (scenario.run.duration_s - sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
+        std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", sim.time_s(),
+                     scenario.run.duration_s, rtf, Duration(left).c_str());
+        std::fflush(stderr);
+      }
+      if (stop && last_frame < total_frames) {
+        WriteCheckpoint(checkpoint, fingerprint, last_frame, sim);
+        status = "interrupted";
+        break;
+      }
+    }
+  } catch (const engine::SimulationError& e) {
+    // Save the state in which the run failed, next to the run file, and say so.
+    const std::filesystem::path failed = options.output.string() + ".failed-state";
+    WriteCheckpoint(failed, fingerprint, last_frame, sim);
+    Event event;
+    event.time_s = sim.time_s();
+    event.kind = "numerical_failure";
+    event.detail = e.what();
+    writer.WriteEvent(last_frame, event);
+    writer.SetStatus(std::string("failed: ") + e.what());
+    if (options.show_progress) std::fprintf(stderr, "\n");
+    throw InputError(options.output.string() + ": the run went numerically wrong: " + e.what() +
+                     "; frames up to " + std::to_string(last_frame) + " are in the run file and the state is saved in " +
+                     failed.string());
+  }
+  if (options.show_progress) std::fprintf(stderr, "\n");
+  writer.SetStatus(status);
+  if (status == "complete") {
+    std::error_code ec;
+    std::filesystem::remove(checkpoint, ec);
+  }
+  summary.status = status;
+  summary.simulated_s = sim.time_s();
+  summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.real_time_factor = summary.wall_s > 0 ? (sim.time_s() - start_sim) / summary.wall_s : 0.0;
+  summary.frames = last_frame + 1;
+  return summary;
+}
+
+}  // namespace crowdrecon::scenario

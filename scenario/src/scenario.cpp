@@ -1,0 +1,161 @@
+#include "crowdrecon/scenario/scenario.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/json_reader.hpp"
+
+namespace crowdrecon::scenario {
+
+std::filesystem::path DataDirectory() {
+  if (const char* dir = std::getenv("CROWDRECON_DATA_DIR"); dir && *dir) return dir;
+  return CROWDRECON_SOURCE_DIR;
+}
+
+namespace {
+
+std::filesystem::path Resolve(const std::filesystem::path& base, const std::string& path) {
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? p : (base / p).lexically_normal();
+}
+
+// Reads every ModelParameters field present in `model`, range-checked.
+void ReadModel(const JsonReader& model, engine::ModelParameters& m) {
+  m.normal_stiffness_n_per_m = model.Number("normal_stiffness_n_per_m", m.normal_stiffness_n_per_m, 1.0, 1e9);
+  m.tangential_stiffness_n_per_m =
+      model.Number("tangential_stiffness_n_per_m", m.tangential_stiffness_n_per_m, 1.0, 1e9);
+  m.friction_coefficient = model.Number("friction_coefficient", m.friction_coefficient, 0.0, 5.0);
+  m.restitution = model.Number("restitution", m.restitution, 0.01, 1.0);
+  m.wall_restitution = model.Number("wall_restitution", m.restitution, 0.01, 1.0);
+  {
+    const std::string mode = model.Choice("tangential_damping", engine::ToString(m.tangential_damping),
+                                          {"from_restitution", "equal_to_normal", "fixed"});
+    engine::FromString(mode, &m.tangential_damping);
+  }
+  m.tangential_damping_rate_per_s =
+      model.Number("tangential_damping_rate_per_s", m.tangential_damping_rate_per_s, 0.0, 1e6);
+  m.allow_tensile_normal_force = model.Bool("allow_tensile_normal_force", m.allow_tensile_normal_force);
+  m.ground_reaction = model.Bool("ground_reaction", m.ground_reaction);
+  m.relaxation_time_s = model.Number("relaxation_time_s", m.relaxation_time_s, 0.01, 100.0);
+  m.back_force_gamma = model.Number("back_force_gamma", m.back_force_gamma, 0.0, 100.0);
+  m.torsion_stiffness_lambda = model.Number("torsion_stiffness_lambda", m.torsion_stiffness_lambda, 0.0, 1e4);
+  m.rotation_relaxation_time_s =
+      model.Number("rotation_relaxation_time_s", m.relaxation_time_s, 0.01, 100.0);
+  {
+    const std::string facing =
+        model.Choice("facing_target", engine::ToString(m.facing_target), {"velocity", "desired_direction"});
+    engine::FromString(facing, &m.facing_target);
+  }
+  m.gravity_m_per_s2 = model.Number("gravity_m_per_s2", m.gravity_m_per_s2, 0.0, 100.0);
+  {
+    const std::string integrator =
+        model.Choice("integrator", engine::ToString(m.integrator), {"velocity_verlet", "gear5"});
+    engine::FromString(integrator, &m.integrator);
+  }
+  m.time_step_s = model.Number("time_step_s", m.time_step_s, 0.0, 0.1);
+  m.time_step_safety = model.Number("time_step_safety", m.time_step_safety, 1e-4, 1.0);
+  model.Finish();
+}
+
+}  // namespace
+
+Scenario ParseScenario(const std::string& json_text, const std::string& origin,
+                       const std::filesystem::path& base_dir) {
+  const JsonDocument doc = JsonDocument::Parse(json_text, origin);
+  const JsonReader root = doc.Root();
+  if (!root.IsObject()) root.Fail("expected a scenario object {...}");
+  Scenario s;
+  s.json_text = json_text;
+  s.file = origin;
+  const std::string format = root.String("format", "crowdrecon-scenario");
+  if (format != "crowdrecon-scenario")
+    root.At("format").Fail("\"" + format + "\" is not a scenario; expected \"crowdrecon-scenario\"");
+  root.Integer("version", 1, 1, 1);
+  s.name = root.String("name", std::filesystem::path(origin).stem().string());
+
+  {
+    const JsonReader venue = root.At("venue");
+    s.venue_file = Resolve(base_dir, venue.AsString());
+    try {
+      s.venue = geometry::LoadVenue(s.venue_file);
+    } catch (const InputError& e) {
+      venue.Fail(std::string("cannot use the venue: ") + e.what());
+    }
+  }
+
+  {
+    const JsonReader pop = root.At("population");
+    PopulationSpec& p = s.population;
+    if (pop.Has("count") == pop.Has("density_per_m2"))
+      pop.Fail("give exactly one of \"count\" and \"density_per_m2\"");
+    if (pop.Has("count")) p.count = static_cast<std::size_t>(pop.Integer("count", 1, 1000000));
+    if (pop.Has("density_per_m2")) p.density_per_m2 = pop.Number("density_per_m2", 0.01, 12.0);
+    p.counter_flow_fraction = pop.Number("counter_flow_fraction", 0.0, 0.0, 1.0);
+    p.target = pop.String("target");
+    if (!s.venue.FindTarget(p.target))
+      pop.At("target").Fail("the venue " + s.venue_file.string() + " has no target or exit \"" + p.target + "\"");
+    p.counter_target = pop.String("counter_target", "");
+    if (p.counter_flow_fraction > 0.0) {
+      if (p.counter_target.empty()) pop.Fail("counter_flow_fraction > 0 needs a \"counter_target\"");
+      if (!s.venue.FindTarget(p.counter_target))
+        pop.At("counter_target").Fail("the venue has no target or exit \"" + p.counter_target + "\"");
+    }
+    if (auto body = pop.Find("body")) {
+      p.body_mode = geometry::PopulationModeFromString(
+          body->Choice("mode", "paper", {"paper", "anthropometric", "circle"}), body->Where() + "/mode");
+      if (auto ref = body->Find("reference")) p.reference_body = Resolve(base_dir, ref->AsString());
+      if (auto ansur = body->Find("anthropometry")) p.anthropometry = Resolve(base_dir, ansur->AsString());
+      p.female_fraction = body->Number("female_fraction", p.female_fraction, 0.0, 1.0);
+      p.vertex_count = static_cast<std::size_t>(body->Integer("vertices", 18, 3, 200));
+      body->Finish();
+    }
+    if (p.reference_body.empty()) p.reference_body = DataDirectory() / "venues/bodies/thorax-18.json";
+    if (p.anthropometry.empty()) p.anthropometry = DataDirectory() / "venues/bodies/ansur2-thorax.csv";
+    if (auto speed = pop.Find("desired_speed_m_per_s")) {
+      if (speed->Size() != 2) speed->Fail("expected [min, max] in m/s");
+      p.desired_speed_min_m_per_s = speed->Element(0).AsNumber(0.0, 10.0);
+      p.desired_speed_max_m_per_s = speed->Element(1).AsNumber(p.desired_speed_min_m_per_s, 10.0);
+    }
+    if (auto placement = pop.Find("placement")) {
+      p.placement_region = placement->Choice("region", "walkable", {"walkable", "entries"});
+      p.max_initial_overlap_m = placement->Number("max_overlap_m", p.max_initial_overlap_m, 1e-5, 0.05);
+      placement->Finish();
+    }
+    if (p.placement_region == "entries" && s.venue.entries.empty())
+      pop.At("placement").Fail("region \"entries\" but the venue has no entry zones");
+    p.seed = static_cast<std::uint64_t>(pop.Integer("seed", 1, 0, std::int64_t{1} << 62));
+    pop.Finish();
+  }
+
+  if (auto model = root.Find("model")) ReadModel(*model, s.model);
+  s.model.desired_speed_min_m_per_s = s.population.desired_speed_min_m_per_s;
+  s.model.desired_speed_max_m_per_s = s.population.desired_speed_max_m_per_s;
+  {
+    std::string error;
+    if (!s.model.IsValid(&error)) root.At("model").Fail(error);
+  }
+
+  if (auto run = root.Find("run")) {
+    s.run.duration_s = run->Number("duration_s", s.run.duration_s, 0.0, 1e6);
+    s.run.output_fps = run->Number("output_fps", s.run.output_fps, 0.01, 1000.0);
+    s.run.checkpoint_interval_s = run->Number("checkpoint_interval_s", s.run.checkpoint_interval_s, 0.0, 1e6);
+    s.run.write_contacts = run->Bool("contacts", s.run.write_contacts);
+    run->Finish();
+  }
+  root.Finish();
+  return s;
+}
+
+Scenario LoadScenario(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open scenario file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  Scenario s = ParseScenario(buffer.str(), file.string(), file.parent_path());
+  s.file = file;
+  return s;
+}
+
+}  // namespace crowdrecon::scenario

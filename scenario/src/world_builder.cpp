@@ -1,0 +1,356 @@
+#include "crowdrecon/scenario/world_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/narrow_phase.hpp"
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/geometry/anthropometry.hpp"
+#include "crowdrecon/geometry/body.hpp"
+#include "crowdrecon/geometry/navigation.hpp"
+#include "crowdrecon/geometry/triangulation.hpp"
+
+namespace crowdrecon::scenario {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double Uniform(std::mt19937_64& rng) { return geometry::UniformUnit(rng()); }
+
+std::string RingWkt(const geometry::Ring& ring, bool ccw) {
+  geometry::Ring r = ring;
+  if ((geometry::RingSignedArea_m2(r) > 0) != ccw) std::reverse(r.begin(), r.end());
+  std::string s = "(";
+  char buffer[64];
+  for (std::size_t i = 0; i <= r.size(); ++i) {
+    const Vec2 p = r[i % r.size()];
+    std::snprintf(buffer, sizeof buffer, "%s%.17g %.17g", i ? ", " : "", p.x, p.y);
+    s += buffer;
+  }
+  return s + ")";
+}
+
+engine::BodyShape ToBodyShape(const geometry::Spheropolygon& shape, double scale) {
+  engine::BodyShape b;
+  for (const Vec2& v : shape.vertices()) b.vertices.push_back(v * scale);
+  b.radius_m = shape.radius() * scale;
+  return b;
+}
+
+double MaxOverlap(const engine::Simulation& sim) {
+  double worst = 0.0;
+  for (const engine::Contact& c : sim.contacts()) worst = std::max(worst, c.overlap_m);
+  return worst;
+}
+
+}  // namespace
+
+std::vector<engine::Wall> VenueWalls(const geometry::Venue& venue) {
+  std::vector<engine::Wall> walls;
+  for (const geometry::WallSegment& s : geometry::WallSegments(venue)) {
+    if (!walls.empty()) {
+      engine::Wall& last = walls.back();
+      if (last.radius_m == s.radius_m && Length(last.points.back() - s.a) < 1e-12) {
+        if (Length(last.points.front() - s.b) < 1e-12 && last.points.size() >= 3) {
+          last.closed = true;  // the chain came back to its start
+        } else {
+          last.points.push_back(s.b);
+        }
+        continue;
+      }
+    }
+    walls.push_back({{s.a, s.b}, false, s.radius_m});
+  }
+  return walls;
+}
+
+std::string WalkableAreaWkt(const geometry::Venue& venue) {
+  std::vector<std::string> polygons;
+  for (const geometry::Ring& outer : venue.walkable_area) {
+    std::string p = "(" + RingWkt(outer, true);
+    for (const geometry::Obstacle& o : venue.obstacles)
+      if (!o.polygon.empty() && geometry::PointInRing(outer, o.polygon.front())) p += ", " + RingWkt(o.polygon, false);
+    polygons.push_back(p + ")");
+  }
+  if (polygons.size() == 1) return "POLYGON " + polygons.front();
+  std::string wkt = "MULTIPOLYGON (";
+  for (std::size_t i = 0; i < polygons.size(); ++i) wkt += (i ? ", " : "") + polygons[i];
+  return wkt + ")";
+}
+
+BuiltWorld BuildWorld(const Scenario& scenario, int threads,
+                      const std::function<void(const std::string&)>& progress) {
+  const auto say = [&](const std::string& line) {
+    if (progress) progress(line);
+  };
+  const geometry::Venue& venue = scenario.venue;
+  const PopulationSpec& spec = scenario.population;
+  BuiltWorld built;
+  engine::WorldDef& def = built.world;
+  def.parameters = scenario.model;
+  def.threads = threads;
+
+  // Placement region and head count.
+  std::vector<geometry::AreaTriangulation> regions;
+  if (spec.placement_region == "entries") {
+    for (std::size_t e = 0; e < venue.entries.size(); ++e)
+      regions.push_back(geometry::AreaTriangulation::OfEntryZone(venue, e));
+  } else {
+    regions.push_back(geometry::AreaTriangulation::OfWalkableArea(venue));
+  }
+  for (const auto& r : regions) built.placement_area_m2 += r.area_m2();
+  const std::size_t count = spec.count ? *spec.count
+                                       : static_cast<std::size_t>(std::llround(*spec.density_per_m2 * built.placement_area_m2));
+  if (count == 0) throw InputError(scenario.file.string() + ": /population: the density gives 0 people in " +
+                                   FormatNumber(built.placement_area_m2) + " m^2");
+
+  // Targets: the main flow first, the counter-flow second.
+  built.target_names.push_back(spec.target);
+  def.targets.push_back(geometry::NavigationField::ForTarget(venue, spec.target));
+  if (spec.counter_flow_fraction > 0.0) {
+    built.target_names.push_back(spec.counter_target);
+    def.targets.push_back(geometry::NavigationField::ForTarget(venue, spec.counter_target));
+  }
+
+  // Bodies.
+  say("building " + std::to_string(count) + " " + geometry::ToString(spec.body_mode) + " bodies");
+  geometry::PopulationOptions options;
+  options.mode = spec.body_mode;
+  options.count = count;
+  options.seed = spec.seed;
+  options.mass_min_kg = scenario.model.mass_min_kg;
+  options.mass_max_kg = scenario.model.mass_max_kg;
+  options.density_kg_m2 = scenario.model.surface_density_kg_per_m2;
+  options.female_fraction = spec.female_fraction;
+  options.vertex_count = spec.vertex_count;
+  const geometry::Body reference = geometry::ReadBodyJson(spec.reference_body);
+  std::vector<geometry::AnsurRecord> records;
+  if (spec.body_mode == geometry::PopulationMode::kAnthropometric) records = geometry::ReadAnsurExtract(spec.anthropometry);
+  const geometry::Population population = geometry::MakePopulation(options, reference.shape, records);
+
+  // Groups, desired speeds: a second generator stream so that they do not
+  // depend on how many draws the body modes consumed.
+  std::mt19937_64 rng(spec.seed ^ 0x9e3779b97f4a7c15ull);
+  const std::size_t counter = static_cast<std::size_t>(std::llround(spec.counter_flow_fraction * double(count)));
+  std::vector<std::uint32_t> group(count, 0);
+  for (std::size_t i = 0; i < counter; ++i) group[i] = 1;
+  for (std::size_t i = count - 1; i > 0; --i) {  // Fisher-Yates with explicit draws
+    const std::size_t j = static_cast<std::size_t>(Uniform(rng) * double(i + 1));
+    std::swap(group[i], group[std::min(j, i)]);
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    const geometry::Person& person = population.people[i];
+    engine::PersonDef p;
+    p.shape = static_cast<std::uint32_t>(def.shapes.size());
+    def.shapes.push_back(ToBodyShape(person.shape, 1.0));
+    p.mass_kg = person.mass_kg;
+    p.inertia_kg_m2 = person.moment_of_inertia_kgm2;
+    p.desired_speed_m_per_s =
+        spec.desired_speed_min_m_per_s + (spec.desired_speed_max_m_per_s - spec.desired_speed_min_m_per_s) * Uniform(rng);
+    p.group = group[i];
+    p.target = group[i];
+    def.people.push_back(p);
+  }
+
+  // Walls, periodic box, slope.
+  def.walls = VenueWalls(venue);
+  Vec2 lo, hi;
+  geometry::WalkableBounds(venue, &lo, &hi);
+  for (const geometry::PeriodicDirection& d : venue.periodic) {
+    if (std::abs(std::abs(d.direction.x) - 1.0) < 1e-9) {
+      def.periodic.x = true;
+      def.periodic.min_m.x = lo.x;
+      def.periodic.max_m.x = lo.x + d.period_m;
+    } else if (std::abs(std::abs(d.direction.y) - 1.0) < 1e-9) {
+      def.periodic.y = true;
+      def.periodic.min_m.y = lo.y;
+      def.periodic.max_m.y = lo.y + d.period_m;
+    } else {
+      throw InputError(venue.origin + ": periodic direction (" + FormatNumber(d.direction.x) + ", " +
+                       FormatNumber(d.direction.y) + ") is not along x or y; the engine supports axis-aligned periods");
+    }
+  }
+  if (venue.slope && venue.slope->enabled) def.slope = {venue.slope->direction, venue.slope->gradient};
+  built.walkable_wkt = WalkableAreaWkt(venue);
+
+  // --- Placement --------------------------------------------------------
+  double body_area = 0.0, max_bound = 0.0;
+  for (const geometry::Person& person : population.people) {
+    body_area += person.shape.area();
+    double bound = 0.0;
+    for (const Vec2& v : person.shape.vertices()) bound = std::max(bound, Length(v));
+    max_bound = std::max(max_bound, bound + person.shape.radius());
+  }
+  const double fraction = body_area / built.placement_area_m2;
+  double scale = std::min(1.0, std::sqrt(0.25 / fraction));
+  say("placing at area fraction " + FormatNumber(fraction) + ", initial size x" + FormatNumber(scale));
+
+  // Random sequential placement at the reduced size, checked with the engine's
+  // narrow phase against people already placed (cell grid) and walls.
+  std::vector<Vec2> world;
+  std::vector<Vec2> position(count);
+  std::vector<double> angle(count);
+  const double cell = 2.0 * max_bound * scale + 1e-9;
+  std::vector<std::vector<std::uint32_t>> grid;
+  Vec2 grid_lo = lo - Vec2{cell, cell};
+  const auto gx = static_cast<std::size_t>(std::ceil((hi.x - lo.x) / cell)) + 3;
+  const auto gy = static_cast<std::size_t>(std::ceil((hi.y - lo.y) / cell)) + 3;
+  grid.assign(gx * gy, {});
+  const auto cell_of = [&](Vec2 p) {
+    const auto cx = static_cast<std::size_t>(std::clamp((p.x - grid_lo.x) / cell, 0.0, double(gx - 1)));
+    const auto cy = static_cast<std::size_t>(std::clamp((p.y - grid_lo.y) / cell, 0.0, double(gy - 1)));
+    return std::pair{cx, cy};
+  };
+  const auto placed_shape = [&](std::size_t i, Vec2 at, double theta, std::vector<Vec2>& out) {
+    const engine::BodyShape& s = def.shapes[def.people[i].shape];
+    out.clear();
+    double core = 0.0;
+    for (const Vec2& v : s.vertices) {
+      out.push_back(at + Rotated(v * scale, theta));
+      core = std::max(core, Length(v) * scale);
+    }
+    engine::PlacedShape p;
+    p.vertices = out.data();
+    p.count = static_cast<std::uint32_t>(out.size());
+    p.closed = out.size() >= 3;
+    p.radius_m = s.radius_m * scale;
+    p.centre = at;
+    p.core_radius_m = core;
+    return p;
+  };
+  std::vector<Vec2> mine, theirs;
+  std::vector<engine::ContactPoint> hits;
+  const auto periodic_image = [&](Vec2 d) {
+    if (def.periodic.x) d.x -= (def.periodic.max_m.x - def.periodic.min_m.x) * std::nearbyint(d.x / (def.periodic.max_m.x - def.periodic.min_m.x));
+    if (def.periodic.y) d.y -= (def.periodic.max_m.y - def.periodic.min_m.y) * std::nearbyint(d.y / (def.periodic.max_m.y - def.periodic.min_m.y));
+    return d;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 4000 && !placed; ++attempt) {
+      // Region chosen in proportion to its area.
+      double u = Uniform(rng) * built.placement_area_m2;
+      std::size_t r = 0;
+      while (r + 1 < regions.size() && u > regions[r].area_m2()) u -= regions[r++].area_m2();
+      const Vec2 at = regions[r].Sample(rng);
+      const Vec2 e = def.targets[def.people[i].target].Direction(at);
+      const double theta = (e.x != 0.0 || e.y != 0.0 ? std::atan2(e.y, e.x) : 2.0 * kPi * Uniform(rng)) +
+                           0.3 * (Uniform(rng) - 0.5);
+      const engine::PlacedShape me = placed_shape(i, at, theta, mine);
+      bool free = true;
+      for (const engine::Wall& w : def.walls) {
+        engine::PlacedShape ws;
+        ws.vertices = w.points.data();
+        ws.count = static_cast<std::uint32_t>(w.points.size());
+        ws.closed = w.closed;
+        ws.radius_m = w.radius_m;
+        Vec2 wl{1e300, 1e300}, wh{-1e300, -1e300};
+        for (const Vec2& q : w.points) { wl = {std::min(wl.x, q.x), std::min(wl.y, q.y)}; wh = {std::max(wh.x, q.x), std::max(wh.y, q.y)}; }
+        ws.centre = (wl + wh) / 2.0;
+        ws.core_radius_m = Length(wh - wl) / 2.0 + 1e-9;
+        hits.clear();
+        engine::CollideShapes(me, ws, hits);
+        if (!hits.empty()) { free = false; break; }
+      }
+      const auto [cx, cy] = cell_of(at);
+      for (std::size_t dy = 0; dy < 3 && free; ++dy)
+        for (std::size_t dx = 0; dx < 3 && free; ++dx) {
+          const std::size_t x = cx + dx - 1, y = cy + dy - 1;
+          if (x >= gx || y >= gy) continue;
+          for (std::uint32_t j : grid[y * gx + x]) {
+            hits.clear();
+            engine::CollideShapes(me, placed_shape(j, position[j], angle[j], theirs), hits);
+            if (!hits.empty()) { free = false; break; }
+          }
+        }
+      // Across a periodic seam, compare with the nearest images too.
+      if (free && (def.periodic.x || def.periodic.y))
+        for (std::size_t j = 0; j < i && free; ++j) {
+          const Vec2 d = periodic_image(position[j] - at);
+          if (Length(d) > 2.0 * max_bound * scale || Length(position[j] - at - d) < 1e-9) continue;
+          hits.clear();
+          engine::CollideShapes(me, placed_shape(j, at + d, angle[j], theirs), hits);
+          if (!hits.empty()) free = false;
+        }
+      if (!free) continue;
+      position[i] = at;
+      angle[i] = theta;
+      grid[cy * gx + cx].push_back(static_cast<std::uint32_t>(i));
+      placed = true;
+    }
+    if (!placed)
+      throw InputError(scenario.file.string() + ": /population: cannot place person " + std::to_string(i + 1) +
+                       " of " + std::to_string(count) + " in " + FormatNumber(built.placement_area_m2) +
+                       " m^2 even at " + FormatNumber(scale) + " of full size; the density is too high");
+  }
+
+  // Grow to full size in stages with a passive, quenched relaxation after each.
+  const double tolerance = spec.max_initial_overlap_m;
+  const int stages = scale < 1.0 ? 8 : 1;
+  const double s0 = scale;
+  double residual = 0.0;
+  for (int stage = 1; stage <= stages; ++stage) {
+    scale = stages == 1 ? 1.0 : s0 + (1.0 - s0) * stage / stages;
+    engine::WorldDef relax = def;
+    relax.parameters.ground_reaction = false;
+    relax.parameters.restitution = relax.parameters.wall_restitution = 0.05;
+    relax.parameters.time_step_s = 0.0;
+    for (engine::BodyShape& s : relax.shapes) {
+      for (Vec2& v : s.vertices) v *= scale;
+      s.radius_m *= scale;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      relax.people[i].position_m = position[i];
+      relax.people[i].angle_rad = angle[i];
+    }
+    engine::Simulation sim(relax);
+    const bool last = stage == stages;
+    const double goal = last ? tolerance : std::max(tolerance, 0.02 * scale);
+    const int budget = last ? 20000 : 3000;
+    int steps = 0;
+    residual = MaxOverlap(sim);
+    // Quenched relaxation; give up early once the largest overlap stops
+    // falling (a jammed packing), judged over windows of 1000 steps.
+    double window_start = residual;
+    while (residual > goal && steps < budget) {
+      for (int k = 0; k < 20; ++k) sim.Step();
+      steps += 20;
+      sim.Quench();
+      residual = MaxOverlap(sim);
+      if (steps % 1000 == 0) {
+        if (residual > 0.95 * window_start) break;
+        window_start = residual;
+      }
+    }
+    built.relaxation_steps += static_cast<std::size_t>(steps);
+    for (std::size_t i = 0; i < count; ++i) {
+      position[i] = sim.bodies().position_m[i];
+      angle[i] = sim.bodies().angle_rad[i];
+    }
+    say("placement stage " + std::to_string(stage) + "/" + std::to_string(stages) + ": size x" +
+        FormatNumber(scale) + ", largest overlap " + FormatNumber(residual) + " m after " + std::to_string(steps) +
+        " relaxation steps");
+  }
+  if (residual > tolerance)
+    throw InputError(scenario.file.string() + ": /population: " + std::to_string(count) + " people (" +
+                     FormatNumber(double(count) / built.placement_area_m2) + " /m^2) cannot be placed: after relaxation the largest overlap is " +
+                     FormatNumber(residual) + " m, above the tolerance " + FormatNumber(tolerance) +
+                     " m (/population/placement/max_overlap_m); the crowd is jammed at this density");
+  for (const geometry::Exit& exit : venue.exits) (void)exit;
+  for (std::size_t i = 0; i < count; ++i) {
+    def.people[i].position_m = position[i];
+    def.people[i].angle_rad = angle[i];
+    if (!def.periodic.x && !def.periodic.y && !geometry::IsWalkable(venue, position[i]))
+      throw InputError(scenario.file.string() + ": /population: person " + std::to_string(i + 1) +
+                       " was pushed out of the walkable area while relaxing the placement; lower the density");
+  }
+  built.max_initial_overlap_m = residual;
+  return built;
+}
+
+}  // namespace crowdrecon::scenario

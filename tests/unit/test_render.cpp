@@ -1,0 +1,254 @@
+// Pictures of runs (viz/render_run.hpp): frame selection, and a small engine
+// run written to a run file and rendered, checked pixel by pixel.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/viz/render_run.hpp"
+#include "render_scene.hpp"
+
+namespace crowdrecon::viz {
+namespace {
+
+using engine::testing::CorridorScene;
+
+// A scratch folder per test, removed afterwards.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("crowdrecon-render-" + name + "-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Writes the counter-flow corridor (12 thorax-like bodies, periodic along x,
+// walls along both sides) with `frames` frames at 10 fps.
+std::filesystem::path WriteRun(const std::filesystem::path& dir, int frames, bool record_periodic_box = true) {
+  const CorridorScene scene;
+  engine::Simulation sim(engine::testing::CounterFlowCorridor(engine::testing::ThoraxLikeShape(), scene));
+  const std::filesystem::path file = dir / "run.sqlite";
+  engine::testing::WriteCorridorRun(file, sim, scene, frames, 10.0, record_periodic_box);
+  return file;
+}
+
+std::string MessageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(RenderFrameSelection, ParsesEveryForm) {
+  EXPECT_EQ(ParseFrameSelection("all").kind, FrameSelection::Kind::kAll);
+  const FrameSelection list = ParseFrameSelection("first, 7,last");
+  ASSERT_EQ(list.kind, FrameSelection::Kind::kList);
+  EXPECT_EQ(list.list, (std::vector<std::int64_t>{FrameSelection::kFirst, 7, FrameSelection::kLast}));
+  const FrameSelection every = ParseFrameSelection("every:5");
+  EXPECT_EQ(every.kind, FrameSelection::Kind::kEvery);
+  EXPECT_EQ(every.stride, 5);
+  const FrameSelection range = ParseFrameSelection("0.5:1.5");
+  EXPECT_EQ(range.kind, FrameSelection::Kind::kTimeRange);
+  EXPECT_DOUBLE_EQ(range.from_s, 0.5);
+  EXPECT_DOUBLE_EQ(range.to_s, 1.5);
+  EXPECT_TRUE(std::isinf(ParseFrameSelection(":3").from_s));
+  EXPECT_TRUE(std::isinf(ParseFrameSelection("3:").to_s));
+}
+
+TEST(RenderFrameSelection, RejectsMalformedSelections) {
+  for (const char* bad : {"", "every:0", "every:x", "5:2", ":", "a:b", "1,,2", "first,middle", "-3", "1.5"}) {
+    const std::string message = MessageOf([&] { ParseFrameSelection(bad); });
+    EXPECT_NE(message.find("--frames \"" + std::string(bad) + "\""), std::string::npos) << message;
+    EXPECT_NE(message.find("expected all"), std::string::npos) << message;
+  }
+}
+
+TEST(RenderFrameSelection, SelectsFramesOfTheRun) {
+  const std::vector<std::int64_t> frames{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  const auto time_of = [](std::int64_t f) { return 0.1 * static_cast<double>(f); };  // 10 fps, inexact sums
+  EXPECT_EQ(SelectFrames(ParseFrameSelection("all"), frames, time_of), frames);
+  EXPECT_EQ(SelectFrames(ParseFrameSelection("last,first,last"), frames, time_of),
+            (std::vector<std::int64_t>{0, 10}));
+  EXPECT_EQ(SelectFrames(ParseFrameSelection("every:4"), frames, time_of), (std::vector<std::int64_t>{0, 4, 8}));
+  EXPECT_EQ(SelectFrames(ParseFrameSelection("0.3:0.6"), frames, time_of),
+            (std::vector<std::int64_t>{3, 4, 5, 6}));
+  EXPECT_EQ(SelectFrames(ParseFrameSelection("0.95:"), frames, time_of), (std::vector<std::int64_t>{10}));
+  EXPECT_NE(MessageOf([&] { SelectFrames(ParseFrameSelection("3,11"), frames, time_of); })
+                .find("frame 11 is not in the run (the run has 11 frames, 0 to 10)"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([&] { SelectFrames(ParseFrameSelection("2:3"), frames, time_of); })
+                .find("no frame lies between 2 s and 3 s (the run covers 0 s to 1 s)"),
+            std::string::npos);
+}
+
+TEST(RenderRun, DrawsBodiesWallsAndForcesIntoPngFramesAndAVideo) {
+  const ScratchDir dir("draw");
+  const std::filesystem::path run = WriteRun(dir.path(), 21);
+
+  RenderOptions options;
+  options.output_dir = dir.path() / "frames";
+  options.width_px = 800;
+  options.svg = true;
+  options.video = dir.path() / "run.avi";
+  std::size_t progress_calls = 0;
+  options.progress = [&](const RenderProgress& p) {
+    ++progress_calls;
+    EXPECT_EQ(p.total, 21u);
+  };
+  const RenderSummary summary = RenderRun(run, options);
+
+  EXPECT_EQ(summary.frames_written, 21u);
+  EXPECT_EQ(progress_calls, 21u);
+  EXPECT_EQ(summary.first_frame, 0);
+  EXPECT_EQ(summary.last_frame, 20);
+  EXPECT_EQ(summary.width_px, 800);
+  // Head-on collisions of the counter-flow: there are contact forces to draw,
+  // and with the periodic box recorded every branch across the seam is drawn.
+  EXPECT_GT(summary.max_contact_force_n, 10.0);
+  EXPECT_GT(summary.force_n_per_px, 0.0);
+  EXPECT_EQ(summary.branches_left_out, 0u);
+  EXPECT_EQ(summary.video_written, dir.path() / "run.avi");
+  {
+    // The video holds every frame at the picture size (padded to even sizes)
+    // and plays at the run's 10 frames per second.
+    cv::VideoCapture video((dir.path() / "run.avi").string());
+    ASSERT_TRUE(video.isOpened());
+    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_COUNT), 21.0);
+    EXPECT_EQ(video.get(cv::CAP_PROP_FPS), 10.0);
+    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_WIDTH), double(summary.width_px + summary.width_px % 2));
+    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_HEIGHT), double(summary.height_px + summary.height_px % 2));
+  }
+
+  for (std::int64_t f = 0; f <= 20; ++f) {
+    const std::filesystem::path png = FramePicturePath(options.output_dir, f, ".png");
+    ASSERT_TRUE(std::filesystem::exists(png)) << png;
+    EXPECT_TRUE(std::filesystem::exists(FramePicturePath(options.output_dir, f, ".svg")));
+    const cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+    ASSERT_FALSE(image.empty()) << png;
+    EXPECT_EQ(image.cols, summary.width_px);
+    EXPECT_EQ(image.rows, summary.height_px);
+  }
+
+  // Frame 0 has no contacts yet (people stand on a lattice): a point inside
+  // each body, between centroid and back, shows its group's colour -- blue
+  // (group 0) or orange (group 1) -- and not the floor or the background.
+  scenario::RunFileReader reader(run);
+  const scenario::RunFrame frame0 = reader.Frame(0);
+  ASSERT_TRUE(frame0.contacts.empty());
+  const std::vector<std::uint32_t> groups = reader.PersonGroups();
+  const cv::Mat image = cv::imread(FramePicturePath(options.output_dir, 0, ".png").string(), cv::IMREAD_COLOR);
+  for (std::size_t i = 0; i < frame0.ids.size(); ++i) {
+    const Vec2 inside = frame0.position_m[i] - frame0.orientation[i] * 0.06;
+    const Vec2 px = summary.PixelOf(inside);
+    const cv::Vec3b bgr = image.at<cv::Vec3b>(static_cast<int>(px.y), static_cast<int>(px.x));
+    const int blue = bgr[0], red = bgr[2];
+    const bool group0 = groups[static_cast<std::size_t>(frame0.ids[i] - 1)] == 0;
+    EXPECT_FALSE(bgr[0] > 230 && bgr[1] > 225 && bgr[2] > 225) << "background at person " << frame0.ids[i];
+    if (group0) EXPECT_GT(blue, red + 20) << "person " << frame0.ids[i];
+    else EXPECT_GT(red, blue + 20) << "person " << frame0.ids[i];
+  }
+  // Far from every body, inside the corridor: the floor colour.
+  const Vec2 floor_px = summary.PixelOf({1.5, 0.02});
+  const cv::Vec3b floor = image.at<cv::Vec3b>(static_cast<int>(floor_px.y), static_cast<int>(floor_px.x));
+  EXPECT_GT(floor[2], 220);
+  EXPECT_LT(std::abs(int(floor[2]) - int(floor[0])), 20);
+}
+
+TEST(RenderRun, StrongerForcesDrawThickerLines) {
+  // With a fixed scale, the darkest (force-coloured) pixel count grows with the
+  // force scale's inverse: the same frame at 5 N/px has more force pixels than at 50 N/px.
+  const ScratchDir dir("thickness");
+  const std::filesystem::path run = WriteRun(dir.path(), 11);
+  const auto force_pixels = [&](double n_per_px, const std::string& sub) {
+    RenderOptions options;
+    options.output_dir = dir.path() / sub;
+    options.frames = ParseFrameSelection("last");
+    options.force_n_per_px = n_per_px;
+    const RenderSummary summary = RenderRun(run, options);
+    EXPECT_DOUBLE_EQ(summary.force_n_per_px, n_per_px);
+    const cv::Mat image = cv::imread(summary.first_picture.string(), cv::IMREAD_COLOR);
+    int count = 0;
+    for (int y = 0; y < image.rows - static_cast<int>(summary.margin_px); ++y)  // leave out the legend's sample lines
+      for (int x = 0; x < image.cols; ++x) {
+        const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+        if (p[2] > 100 && p[2] < 190 && p[1] < 60 && p[0] < 60) ++count;  // dark red
+      }
+    return count;
+  };
+  const int thin = force_pixels(50.0, "thin"), thick = force_pixels(5.0, "thick");
+  EXPECT_GT(thin, 0);
+  EXPECT_GT(thick, 2 * thin);
+}
+
+TEST(RenderRun, WithoutAPeriodicBoxLeavesOutBranchesAcrossTheSeam) {
+  const ScratchDir dir("seam");
+  const std::filesystem::path run = WriteRun(dir.path(), 11, /*record_periodic_box=*/false);
+  RenderOptions options;
+  options.output_dir = dir.path() / "frames";
+  const RenderSummary summary = RenderRun(run, options);
+  EXPECT_EQ(summary.frames_written, 11u);
+  // The corridor's people meet across x = 0 (columns at 0.375 and 2.625 m).
+  EXPECT_GT(summary.branches_left_out, 0u);
+  EXPECT_NE(summary.BriefReport().find("left out"), std::string::npos);
+}
+
+TEST(RenderRun, ReportsUserErrorsClearly) {
+  const ScratchDir dir("errors");
+  RenderOptions options;
+  options.output_dir = dir.path() / "out";
+
+  EXPECT_NE(MessageOf([&] { RenderRun(dir.path() / "missing.sqlite", options); })
+                .find("missing.sqlite: run file does not exist"),
+            std::string::npos);
+
+  const std::filesystem::path text = dir.path() / "notes.txt";
+  std::ofstream(text) << "not a database, just text that is long enough to have a header page\n";
+  EXPECT_NE(MessageOf([&] { RenderRun(text, options); }).find("notes.txt: not a crowdrecon run file"),
+            std::string::npos);
+
+  const std::filesystem::path empty = dir.path() / "empty";
+  std::filesystem::create_directories(empty);
+  const std::filesystem::path empty_run = WriteRun(empty, 0);
+  EXPECT_NE(MessageOf([&] { RenderRun(empty_run, options); }).find("the run has no frames to draw (status: complete)"),
+            std::string::npos);
+
+  const std::filesystem::path run = WriteRun(dir.path(), 3);
+  RenderOptions bad_frames = options;
+  bad_frames.frames = ParseFrameSelection("0,9");
+  EXPECT_NE(MessageOf([&] { RenderRun(run, bad_frames); }).find("frame 9 is not in the run"), std::string::npos);
+
+  RenderOptions under_a_file = options;
+  under_a_file.output_dir = text / "frames";
+  EXPECT_NE(MessageOf([&] { RenderRun(run, under_a_file); }).find("cannot create the output folder"),
+            std::string::npos);
+
+  RenderOptions bad_video = options;
+  bad_video.video = dir.path() / "run.gif";
+  EXPECT_NE(MessageOf([&] { RenderRun(run, bad_video); }).find("unknown video format \".gif\""), std::string::npos);
+
+  RenderOptions narrow = options;
+  narrow.width_px = 10;
+  EXPECT_NE(MessageOf([&] { RenderRun(run, narrow); }).find("--width: 10 px"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace crowdrecon::viz

@@ -1,0 +1,819 @@
+#include "crowdrecon/viz/render_run.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/viz/canvas.hpp"
+
+namespace crowdrecon::viz {
+
+namespace {
+
+// --- frame selection -----------------------------------------------------------
+
+[[noreturn]] void FailSelection(const std::string& text, const std::string& why) {
+  throw InputError("--frames \"" + text + "\": " + why +
+                   "; expected all, a list such as first,last or 0,50,last, every:N, or a time range T1:T2 in "
+                   "seconds");
+}
+
+std::string Trimmed(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t") - begin + 1);
+}
+
+std::optional<std::int64_t> ParseInteger(const std::string& s) {
+  std::int64_t value = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+  return value;
+}
+
+std::optional<double> ParseSeconds(const std::string& s) {
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+std::string Fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+// Times in messages: six significant digits hide the time-step residue of
+// frame times (2.000149 s for a frame written at the step after 2 s).
+std::string Seconds(double t_s) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.6g", t_s);
+  return buffer;
+}
+
+// --- the scene: what does not change from frame to frame ---------------------
+
+struct ShapeInfo {
+  std::vector<Vec2> vertices;  // body frame, chest toward +x
+  double radius_m = 0.0;
+  double reach_m = 0.0;  // farthest point of the swept shape from the centroid
+  double front_m = 0.0;  // farthest point along +x (the chest)
+};
+
+struct WallPiece {
+  Vec2 a, b;
+  double radius_m = 0.0;
+};
+
+struct Scene {
+  std::vector<std::vector<Vec2>> floor_rings;  // outer rings and holes, filled even-odd
+  std::vector<WallPiece> walls;  // wall segments as drawn (see ClipToPeriodicBox)
+  std::vector<ShapeInfo> shapes;
+  std::vector<std::uint32_t> person_shape;  // by engine index (id - 1)
+  std::vector<std::uint32_t> person_group;
+  std::optional<engine::PeriodicBox> periodic;
+  std::string floor_note;  // why the walkable area is not drawn, if it is not
+
+  const ShapeInfo& ShapeOf(std::size_t person) const {
+    const std::uint32_t s = person < person_shape.size() ? person_shape[person] : 0;
+    return shapes[s < shapes.size() ? s : 0];
+  }
+  std::uint32_t GroupOf(std::size_t person) const {
+    return person < person_group.size() ? person_group[person] : 0;
+  }
+  // Minimum-image form of a difference under the periodic box (identity without one).
+  Vec2 MinimumImage(Vec2 d) const {
+    if (!periodic) return d;
+    if (periodic->x) {
+      const double l = periodic->max_m.x - periodic->min_m.x;
+      d.x -= l * std::round(d.x / l);
+    }
+    if (periodic->y) {
+      const double l = periodic->max_m.y - periodic->min_m.y;
+      d.y -= l * std::round(d.y / l);
+    }
+    return d;
+  }
+};
+
+// The run's periodic box, if its run table records one as
+//   run.periodic_box = {"x": true, "y": false, "min_m": [x, y], "max_m": [x, y]}.
+// Run files do not have to: without it, seams are handled by leaving out
+// contact lines that would span the box (see DrawForceNetwork).
+std::optional<engine::PeriodicBox> ReadPeriodicBox(const scenario::RunFileReader& run, const std::string& file) {
+  const std::string text = run.RunValue("periodic_box");
+  if (text.empty()) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    engine::PeriodicBox box;
+    box.x = j.value("x", false);
+    box.y = j.value("y", false);
+    box.min_m = {j.at("min_m").at(0).get<double>(), j.at("min_m").at(1).get<double>()};
+    box.max_m = {j.at("max_m").at(0).get<double>(), j.at("max_m").at(1).get<double>()};
+    if ((box.x && !(box.max_m.x > box.min_m.x)) || (box.y && !(box.max_m.y > box.min_m.y)))
+      throw std::runtime_error("max must exceed min along periodic axes");
+    if (!box.x && !box.y) return std::nullopt;
+    return box;
+  } catch (const std::exception& e) {
+    throw InputError(file + ": run value periodic_box is malformed (" + e.what() + "): " + text);
+  }
+}
+
+// Clips the segment [a, b] to the periodic box widened by `margin_m` along its
+// periodic axes (Liang-Barsky); false if nothing is left.
+bool ClipToPeriodicBox(const engine::PeriodicBox& box, double margin_m, Vec2* a, Vec2* b) {
+  double t0 = 0.0, t1 = 1.0;
+  const Vec2 d = *b - *a;
+  const auto clip = [&](double p, double q) {  // keeps the part where p t <= q
+    if (p == 0.0) return q >= 0.0;
+    const double t = q / p;
+    if (p < 0.0) t0 = std::max(t0, t); else t1 = std::min(t1, t);
+    return t0 <= t1;
+  };
+  if (box.x && !(clip(-d.x, a->x - (box.min_m.x - margin_m)) && clip(d.x, box.max_m.x + margin_m - a->x)))
+    return false;
+  if (box.y && !(clip(-d.y, a->y - (box.min_m.y - margin_m)) && clip(d.y, box.max_m.y + margin_m - a->y)))
+    return false;
+  const Vec2 start = *a + d * t0, end = *a + d * t1;
+  *a = start;
+  *b = end;
+  return true;
+}
+
+Scene LoadScene(const scenario::RunFileReader& run, const std::string& file) {
+  Scene scene;
+  for (const engine::BodyShape& s : run.Shapes()) {
+    ShapeInfo info;
+    info.vertices = s.vertices;
+    info.radius_m = s.radius_m;
+    info.front_m = -std::numeric_limits<double>::infinity();
+    for (Vec2 v : s.vertices) {
+      info.reach_m = std::max(info.reach_m, Length(v) + s.radius_m);
+      info.front_m = std::max(info.front_m, v.x + s.radius_m);
+    }
+    if (s.vertices.empty()) throw InputError(file + ": run file has a body shape without vertices");
+    scene.shapes.push_back(std::move(info));
+  }
+  if (scene.shapes.empty()) throw InputError(file + ": run file has no body shapes (table shape is empty)");
+  scene.person_shape = run.PersonShapes();
+  scene.person_group = run.PersonGroups();
+  scene.periodic = ReadPeriodicBox(run, file);
+  // The engine extends walls that cross a periodic seam beyond it (so that a
+  // body straddling the seam meets a straight wall) and the run stores them so;
+  // drawn, they are cut back to the box and the bodies' images across the seam.
+  double max_reach_m = 0.0;
+  for (const ShapeInfo& shape : scene.shapes) max_reach_m = std::max(max_reach_m, shape.reach_m);
+  for (const engine::Wall& w : run.Walls()) {
+    const std::size_t n = w.points.size();
+    for (std::size_t k = 0; k + 1 < n + (w.closed ? 1 : 0); ++k) {
+      WallPiece piece{w.points[k], w.points[(k + 1) % n], w.radius_m};
+      if (scene.periodic && !ClipToPeriodicBox(*scene.periodic, max_reach_m, &piece.a, &piece.b)) continue;
+      scene.walls.push_back(piece);
+    }
+  }
+
+  // The walkable area as drawn by PedPy: outer rings with the obstacles as holes.
+  // A WKT the venue importer refuses only costs the floor, not the picture.
+  const std::string wkt = run.walkable_wkt();
+  if (!wkt.empty()) {
+    try {
+      const geometry::Venue area = geometry::ParseWkt(wkt, file + " (geometry)");
+      scene.floor_rings = area.walkable_area;
+      for (const geometry::Obstacle& o : area.obstacles) scene.floor_rings.push_back(o.polygon);
+    } catch (const InputError& e) {
+      scene.floor_note = std::string("walkable area not drawn: ") + e.what();
+    }
+  }
+  return scene;
+}
+
+// --- layout: world window and pixel scale, the same for every frame -----------
+
+// Canvas margin: holds the legend (top) and the scales (bottom).
+constexpr double kMargin_px = 52.0;
+// Width of the thickest force line when the scale is chosen automatically (m):
+// a quarter of a chest depth, thick enough to rank forces by eye, thin enough
+// not to hide two bodies pressed chest to chest (centroids ~0.3 m apart).
+constexpr double kAutoMaxLineWidth_m = 0.06;
+
+struct Layout {
+  Vec2 lo, hi;        // world window (m)
+  double ppm = 1.0;   // pixels per metre
+  int width_px = 0, height_px = 0;
+
+  // World point at a device position (pixels from the top-left corner).
+  Vec2 World(double x_px, double y_px) const {
+    return {lo.x + (x_px - kMargin_px) / ppm, hi.y - (y_px - kMargin_px) / ppm};
+  }
+};
+
+// A round force (1, 2 or 5 times a power of ten) not above `force_n`.
+double NiceFloor(double force_n) {
+  const double power = std::pow(10.0, std::floor(std::log10(force_n)));
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * power <= force_n * (1.0 + 1e-9)) return m * power;
+  return power;
+}
+
+// A round length near a fifth of `extent_m`, for the scale bar.
+double NiceLength(double extent_m) { return NiceFloor(extent_m / 5.0); }
+
+// --- drawing ------------------------------------------------------------------
+
+// Group colours: group 0 (toward the exit) blue, group 1 (counter-flow)
+// orange, more groups from a qualitative palette (Tableau 10).
+Color GroupColor(std::uint32_t group) {
+  static const unsigned kPalette[] = {0x4e79a7, 0xf28e2b, 0x59a14f, 0xb07aa1, 0xe15759, 0x76b7b2, 0xedc948};
+  return Color::Hex(kPalette[group % (sizeof kPalette / sizeof kPalette[0])]);
+}
+Color Lighter(Color c, double toward_white) {
+  return {c.r + (1 - c.r) * toward_white, c.g + (1 - c.g) * toward_white, c.b + (1 - c.b) * toward_white, c.a};
+}
+Color Darker(Color c, double factor) { return {c.r * factor, c.g * factor, c.b * factor, c.a}; }
+
+const Color kFloor = Color::Hex(0xeeebe4);
+const Color kWall = Color::Hex(0x303030);
+const Color kForce = Color{0.55, 0.05, 0.05, 0.85};
+const Color kText = Color::Hex(0x202020);
+const Color kSubtleText = Color::Hex(0x505050);
+
+// Offsets of the periodic images of a body at `p` that reach into the box:
+// {0} plus one per seam the body straddles (and the corner image).
+std::vector<Vec2> ImageOffsets(const Scene& scene, Vec2 p, double reach_m) {
+  std::vector<Vec2> offsets{{0.0, 0.0}};
+  if (!scene.periodic) return offsets;
+  const engine::PeriodicBox& box = *scene.periodic;
+  std::vector<double> dx{0.0}, dy{0.0};
+  if (box.x) {
+    const double l = box.max_m.x - box.min_m.x;
+    if (p.x - reach_m < box.min_m.x) dx.push_back(l);
+    if (p.x + reach_m > box.max_m.x) dx.push_back(-l);
+  }
+  if (box.y) {
+    const double l = box.max_m.y - box.min_m.y;
+    if (p.y - reach_m < box.min_m.y) dy.push_back(l);
+    if (p.y + reach_m > box.max_m.y) dy.push_back(-l);
+  }
+  for (double x : dx)
+    for (double y : dy)
+      if (x != 0.0 || y != 0.0) offsets.push_back({x, y});
+  return offsets;
+}
+
+// One body: the swept outline (core polygon dilated by the sphero-radius) is
+// drawn as the core polygon stroked 2r wide with round joins, on top of a
+// slightly wider stroke in a darker colour that becomes its outline; then a
+// triangle on the chest shows where the person faces.
+void DrawBody(Canvas& canvas, const Layout& layout, const ShapeInfo& shape, Vec2 position, Vec2 facing,
+              Color color) {
+  const double angle = std::atan2(facing.y, facing.x);
+  const Color fill = Lighter(color, 0.45), outline = Darker(color, 0.6);
+  const double outline_px = std::clamp(0.012 * layout.ppm, 0.8, 2.0);
+  if (shape.vertices.size() == 1) {  // a disk: Cairo draws nothing for a closed one-point path
+    canvas.Circle(position + Rotated(shape.vertices[0], angle), shape.radius_m, fill, outline, outline_px);
+  } else {
+    std::vector<Vec2> core;
+    core.reserve(shape.vertices.size());
+    for (Vec2 v : shape.vertices) core.push_back(position + Rotated(v, angle));
+    const double sweep_px = 2.0 * shape.radius_m * layout.ppm;
+    canvas.StrokePolygon(core, outline, sweep_px + 2.0 * outline_px);
+    canvas.FillPolygon(core, fill);
+    canvas.StrokePolygon(core, fill, sweep_px);
+  }
+  // Chest mark: a triangle just inside the front of the body, sized to it.
+  const Vec2 ahead = Rotated(Vec2{1.0, 0.0}, angle), side = Perp(ahead);
+  const Vec2 tip = position + ahead * (0.9 * shape.front_m);
+  const Vec2 base = position + ahead * (0.9 * shape.front_m - 0.4 * shape.front_m);
+  const double half_width_m = 0.22 * shape.front_m;
+  canvas.FillPolygon({tip, base + side * half_width_m, base - side * half_width_m}, outline);
+}
+
+// A force line: a band of `width_px` from a to b with square ends (a stroked
+// line would get Canvas's round caps, which pile up into blobs at a centroid
+// with several contacts).
+void ForceLine(Canvas& canvas, const Layout& layout, Vec2 a, Vec2 b, double width_px) {
+  const double length = Length(b - a);
+  if (length <= 0.0) return;
+  const Vec2 half = Perp(b - a) * (0.5 * width_px / layout.ppm / length);
+  canvas.FillPolygon({a + half, b + half, b - half, a - half}, kForce);
+}
+
+struct FrameStats {
+  std::size_t contacts = 0, wall_contacts = 0;
+  double max_force_n = 0.0;
+  std::size_t branches_left_out = 0;
+};
+
+// Figure 6's contact network: for each contact, a line from the centroid of
+// each person in it to the contact point, as wide as the force is strong
+// (|F| = |fn n + ft Perp(n)|, the force on a; b feels the opposite).
+// The contact point lies in a's periodic image, so across a seam it may be
+// far from b's stored (wrapped) position: with a known periodic box the branch
+// is unwrapped to the nearest image and drawn at both sides of the seam;
+// without one, a branch longer than the body could reach is left out.
+void DrawForceNetwork(Canvas& canvas, const Layout& layout, const Scene& scene, const scenario::RunFrame& frame,
+                      const std::vector<std::int64_t>& slot_of_person, double force_n_per_px,
+                      FrameStats* stats) {
+  const auto branch = [&](std::size_t person, Vec2 point, double width_px) {
+    const std::int64_t slot = person < slot_of_person.size() ? slot_of_person[person] : -1;
+    if (slot < 0) {  // person not in this frame (removed): nothing to attach to
+      ++stats->branches_left_out;
+      return;
+    }
+    const Vec2 centre = frame.position_m[static_cast<std::size_t>(slot)];
+    const Vec2 d = scene.MinimumImage(point - centre);
+    // 1.5 x the reach: contact points lie on the swept surface, overlapped a little.
+    if (Length(d) > 1.5 * scene.ShapeOf(person).reach_m) {
+      ++stats->branches_left_out;
+      return;
+    }
+    // Drawn from every image of the body that is drawn, and from the image
+    // next to the point (which lies in a's image, maybe across the seam from
+    // this body's stored position).
+    std::vector<Vec2> offsets = ImageOffsets(scene, centre, scene.ShapeOf(person).reach_m);
+    const Vec2 to_point_image = point - d - centre;
+    if (std::none_of(offsets.begin(), offsets.end(), [&](Vec2 o) { return Length(o - to_point_image) < 1e-6; }))
+      offsets.push_back(to_point_image);
+    for (Vec2 o : offsets) ForceLine(canvas, layout, centre + o, centre + o + d, width_px);
+  };
+  for (const engine::Contact& c : frame.contacts) {
+    const double force_n = Length(c.Force());
+    stats->max_force_n = std::max(stats->max_force_n, force_n);
+    ++stats->contacts;
+    if (c.wall) ++stats->wall_contacts;
+    const double width_px = std::max(force_n / force_n_per_px, kMinForceLineWidth_px);
+    branch(c.a, c.point_m, width_px);
+    if (!c.wall) branch(c.b, c.point_m, width_px);
+  }
+}
+
+struct FrameLegend {
+  std::int64_t frame = 0;
+  double time_s = 0.0;
+  std::size_t people = 0;
+  std::vector<std::uint32_t> groups_present;
+};
+
+void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend, const FrameStats& stats,
+                double force_n_per_px, double max_force_all_n) {
+  const double w = canvas.width_px(), h = canvas.height_px();
+  const std::string line1 = "t = " + Fixed(legend.time_s, 2) + " s    frame " + std::to_string(legend.frame) +
+                            "    people " + std::to_string(legend.people) + "    contacts " +
+                            std::to_string(stats.contacts) + " (" + std::to_string(stats.wall_contacts) +
+                            " with walls)    max contact force " + Fixed(stats.max_force_n, 0) + " N";
+  canvas.TextPx(kMargin_px, 22.0, line1, 15, kText);
+
+  // Groups: a swatch and a name each.
+  double x = kMargin_px;
+  for (std::uint32_t g : legend.groups_present) {
+    const Color c = GroupColor(g);
+    const Vec2 a = layout.World(x, 32.0), b = layout.World(x + 11.0, 43.0);
+    canvas.FillPolygon({a, {b.x, a.y}, b, {a.x, b.y}}, Lighter(c, 0.45));
+    canvas.StrokePolygon({a, {b.x, a.y}, b, {a.x, b.y}}, Darker(c, 0.6), 1.0);
+    const std::string name = "group " + std::to_string(g) + (g == 1 ? " (counter-flow)" : "");
+    canvas.TextPx(x + 16.0, 42.0, name, 12, kSubtleText);
+    x += 16.0 + 7.0 * static_cast<double>(name.size()) + 18.0;
+  }
+  canvas.TextPx(x, 42.0, "triangle: chest    lines: contact forces (centroid to contact point)", 12, kSubtleText);
+
+  // Scale bar (lower left) and force scale (lower right): sample lines of
+  // round forces up to the largest force of the selected frames.
+  canvas.ScaleBar(NiceLength(layout.hi.x - layout.lo.x));
+  const double y = h - 0.35 * kMargin_px;
+  std::vector<double> samples;
+  if (max_force_all_n > 0.0) {
+    const double top = NiceFloor(max_force_all_n);
+    for (double f : {top / 5.0, top / 2.0, top})
+      if (f / force_n_per_px >= kMinForceLineWidth_px) samples.push_back(f);
+  }
+  const std::string title = "force scale " + FormatNumber(std::round(force_n_per_px * 100.0) / 100.0) + " N/px:";
+  double right = w - kMargin_px;
+  std::vector<std::pair<double, std::string>> items;  // x of each sample, label
+  double needed = 0.0;
+  for (double f : samples) needed += 30.0 + 8.0 + 7.0 * static_cast<double>(FormatNumber(f).size() + 2) + 14.0;
+  double sx = right - needed;
+  canvas.TextPx(sx - 6.5 * static_cast<double>(title.size()) - 6.0, y + 4.0, title, 12, kSubtleText);
+  for (double f : samples) {
+    const std::string label = FormatNumber(f) + " N";
+    ForceLine(canvas, layout, layout.World(sx, y), layout.World(sx + 30.0, y), f / force_n_per_px);
+    canvas.TextPx(sx + 38.0, y + 4.0, label, 12, kSubtleText);
+    sx += 30.0 + 8.0 + 7.0 * static_cast<double>(label.size()) + 14.0;
+  }
+}
+
+// --- video --------------------------------------------------------------------
+
+// OpenCV's writer, chosen by the video's extension. Debian's OpenCV writes
+// Motion-JPEG AVI with its built-in encoder (no FFmpeg needed); MPEG-4 part 2
+// ("mp4v") in .mp4 needs its FFmpeg backend, so that one may fall back to AVI.
+class VideoOut {
+ public:
+  VideoOut(const std::filesystem::path& requested, double fps, int width_px, int height_px,
+           RenderSummary* summary)
+      : size_(width_px + width_px % 2, height_px + height_px % 2) {  // even sizes: codecs want them
+    std::string ext = requested.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::filesystem::path path = requested;
+    std::string codec = ext == ".mp4" ? "mp4v" : "MJPG";
+    Open(path, codec, fps);
+    if (!writer_.isOpened() && ext == ".mp4") {
+      const std::filesystem::path fallback = std::filesystem::path(requested).replace_extension(".avi");
+      summary->notes.push_back(requested.string() + ": OpenCV cannot write MPEG-4 (mp4v) here; wrote " +
+                            fallback.string() + " (Motion-JPEG) instead");
+      path = fallback;
+      codec = "MJPG";
+      Open(path, codec, fps);
+    }
+    if (!writer_.isOpened())
+      throw InputError(path.string() + ": cannot write video (" + codec + " at " + FormatNumber(fps) +
+                       " fps); check that the folder exists and is writable");
+    summary->video_written = path;
+    summary->video_codec = codec;
+    summary->video_fps = fps;
+  }
+
+  // Appends a PNG written for this frame. Frames are padded with white to the
+  // video's size (all frames share one layout, so this only adds the odd row).
+  void Append(const std::filesystem::path& png) {
+    cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+    if (image.empty()) throw InputError(png.string() + ": cannot read back the frame for the video");
+    if (image.cols > size_.width || image.rows > size_.height) {
+      cv::resize(image, image, size_, 0, 0, cv::INTER_AREA);
+    } else if (image.cols != size_.width || image.rows != size_.height) {
+      cv::copyMakeBorder(image, image, 0, size_.height - image.rows, 0, size_.width - image.cols,
+                         cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
+    }
+    writer_.write(image);
+  }
+  void Close() { writer_.release(); }
+
+ private:
+  void Open(const std::filesystem::path& path, const std::string& codec, double fps) {
+    // OpenCV may print backend warnings on failure; the fallback above reports the outcome.
+    writer_.open(path.string(), cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps, size_, true);
+  }
+  cv::VideoWriter writer_;
+  cv::Size size_;
+};
+
+}  // namespace
+
+// --- public API ---------------------------------------------------------------------
+
+FrameSelection ParseFrameSelection(const std::string& raw) {
+  FrameSelection s;
+  s.text = raw;
+  const std::string text = Trimmed(raw);
+  if (text.empty()) FailSelection(raw, "empty selection");
+  if (text == "all") return s;
+  if (text.rfind("every:", 0) == 0) {
+    const auto n = ParseInteger(Trimmed(text.substr(6)));
+    if (!n || *n < 1) FailSelection(raw, "every:N needs a whole number N >= 1");
+    s.kind = FrameSelection::Kind::kEvery;
+    s.stride = *n;
+    return s;
+  }
+  const auto colon = text.find(':');
+  if (colon != std::string::npos) {
+    const std::string a = Trimmed(text.substr(0, colon)), b = Trimmed(text.substr(colon + 1));
+    if (a.empty() && b.empty()) FailSelection(raw, "a time range needs at least one of T1, T2");
+    s.kind = FrameSelection::Kind::kTimeRange;
+    if (!a.empty()) {
+      const auto t = ParseSeconds(a);
+      if (!t) FailSelection(raw, "T1 \"" + a + "\" is not a number of seconds");
+      s.from_s = *t;
+    }
+    if (!b.empty()) {
+      const auto t = ParseSeconds(b);
+      if (!t) FailSelection(raw, "T2 \"" + b + "\" is not a number of seconds");
+      s.to_s = *t;
+    }
+    if (s.from_s > s.to_s)
+      FailSelection(raw, "the time range ends (" + FormatNumber(s.to_s) + " s) before it starts (" +
+                             FormatNumber(s.from_s) + " s)");
+    return s;
+  }
+  s.kind = FrameSelection::Kind::kList;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    const std::string item = Trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (item == "first") {
+      s.list.push_back(FrameSelection::kFirst);
+    } else if (item == "last") {
+      s.list.push_back(FrameSelection::kLast);
+    } else {
+      const auto n = ParseInteger(item);
+      if (!n || *n < 0)
+        FailSelection(raw, item.empty() ? std::string("empty item in the list")
+                                        : "\"" + item + "\" is not a frame number, first or last");
+      s.list.push_back(*n);
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return s;
+}
+
+std::vector<std::int64_t> SelectFrames(const FrameSelection& selection, const std::vector<std::int64_t>& frames,
+                                       const std::function<double(std::int64_t)>& time_of_frame_s,
+                                       double tolerance_s) {
+  if (frames.empty()) throw InputError("--frames \"" + selection.text + "\": the run has no frames");
+  const std::string range = " (the run has " + std::to_string(frames.size()) + " frames, " +
+                            std::to_string(frames.front()) + " to " + std::to_string(frames.back()) + ")";
+  std::vector<std::int64_t> out;
+  switch (selection.kind) {
+    case FrameSelection::Kind::kAll:
+      out = frames;
+      break;
+    case FrameSelection::Kind::kEvery:
+      for (std::size_t i = 0; i < frames.size(); i += static_cast<std::size_t>(selection.stride))
+        out.push_back(frames[i]);
+      break;
+    case FrameSelection::Kind::kList:
+      for (std::int64_t f : selection.list) {
+        if (f == FrameSelection::kFirst) f = frames.front();
+        if (f == FrameSelection::kLast) f = frames.back();
+        if (!std::binary_search(frames.begin(), frames.end(), f))
+          throw InputError("--frames \"" + selection.text + "\": frame " + std::to_string(f) +
+                           " is not in the run" + range);
+        out.push_back(f);
+      }
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+      break;
+    case FrameSelection::Kind::kTimeRange: {
+      // Times grow with frame numbers: two binary searches over the frames.
+      const auto first_at_or_after = [&](double t, bool inclusive) {
+        std::size_t lo = 0, hi = frames.size();
+        while (lo < hi) {
+          const std::size_t mid = lo + (hi - lo) / 2;
+          const double tm = time_of_frame_s(frames[mid]);
+          if (inclusive ? tm < t : tm <= t) lo = mid + 1; else hi = mid;
+        }
+        return lo;
+      };
+      const std::size_t begin = first_at_or_after(selection.from_s - tolerance_s, true);
+      const std::size_t end = first_at_or_after(selection.to_s + tolerance_s, false);
+      for (std::size_t i = begin; i < end; ++i) out.push_back(frames[i]);
+      if (out.empty())
+        throw InputError("--frames \"" + selection.text + "\": no frame lies between " +
+                         FormatNumber(selection.from_s) + " s and " + FormatNumber(selection.to_s) +
+                         " s (the run covers " + Seconds(time_of_frame_s(frames.front())) + " s to " +
+                         Seconds(time_of_frame_s(frames.back())) + " s)");
+      break;
+    }
+  }
+  return out;
+}
+
+bool RenderOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (output_dir.empty()) return fail("output folder: none given");
+  if (width_px < 320 || width_px > 8000)
+    return fail("--width: " + std::to_string(width_px) + " px, expected 320 .. 8000");
+  if (!(video_fps >= 0.0 && video_fps <= 1000.0))
+    return fail("--fps: " + FormatNumber(video_fps) + ", expected 0 (the run's rate) or up to 1000");
+  if (!(force_n_per_px >= 0.0 && std::isfinite(force_n_per_px)))
+    return fail("--force-scale: " + FormatNumber(force_n_per_px) + " N/px, expected a positive number (0: automatic)");
+  if (!video.empty()) {
+    std::string ext = video.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext != ".mp4" && ext != ".avi")
+      return fail("--video " + video.string() + ": unknown video format \"" + ext + "\", expected .mp4 or .avi");
+  }
+  return true;
+}
+
+std::filesystem::path FramePicturePath(const std::filesystem::path& dir, std::int64_t frame,
+                                       const std::string& extension) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%06lld%s", static_cast<long long>(frame), extension.c_str());
+  return dir / name;
+}
+
+std::string RenderSummary::BriefReport() const {
+  std::string s = "rendered " + std::to_string(frames_written) + " frame(s), " + std::to_string(first_frame) +
+                  " to " + std::to_string(last_frame) + ", " + std::to_string(width_px) + " x " +
+                  std::to_string(height_px) + " px\n";
+  s += "contact force: max " + Fixed(max_contact_force_n, 1) + " N, drawn at " +
+       FormatNumber(std::round(force_n_per_px * 1000.0) / 1000.0) + " N per px of line width\n";
+  if (branches_left_out > 0)
+    s += "note: " + std::to_string(branches_left_out) +
+         " contact line(s) across a periodic seam left out (the run file records no periodic box)\n";
+  for (const std::string& note : notes) s += "note: " + note + "\n";
+  if (!video_written.empty())
+    s += "video: " + video_written.string() + " (" + video_codec + ", " + FormatNumber(video_fps) + " fps)\n";
+  return s;
+}
+
+RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  const std::string file = run_file.string();
+
+  // 1. Open the run. SQLite opens any file lazily and fails on the first query,
+  //    so a foreign file surfaces as "file is not a database": say what it means.
+  if (!std::filesystem::exists(run_file)) throw InputError(file + ": run file does not exist");
+  if (std::filesystem::is_directory(run_file)) throw InputError(file + ": is a folder, not a run file");
+  std::optional<scenario::RunFileReader> reader;
+  try {
+    reader.emplace(run_file);
+  } catch (const InputError& e) {
+    std::string why = e.what();
+    if (why.rfind(file + ": ", 0) == 0) why = why.substr(file.size() + 2);
+    if (why.find("not a crowdrecon run file") != std::string::npos) throw InputError(file + ": " + why);
+    throw InputError(file + ": not a crowdrecon run file (" + why + ")");
+  }
+  const scenario::RunFileReader& run = *reader;
+  const std::vector<std::int64_t> all_frames = run.Frames();
+  if (all_frames.empty()) {
+    const std::string status = run.RunValue("status");
+    throw InputError(file + ": the run has no frames to draw" + (status.empty() ? "" : " (status: " + status + ")"));
+  }
+  // Frame times exceed their nominal times by less than one time step.
+  double time_step_s = 0.0;
+  try {
+    time_step_s = std::stod(run.RunValue("time_step_s"));
+  } catch (const std::exception&) {
+    // absent or unreadable: exact times assumed
+  }
+  const std::vector<std::int64_t> frames =
+      SelectFrames(options.frames, all_frames, [&](std::int64_t f) { return run.Frame(f).time_s; },
+                   std::max(1e-6, std::isfinite(time_step_s) ? time_step_s : 0.0));
+  const Scene scene = LoadScene(run, file);
+
+  // 2. The output folder.
+  std::error_code ec;
+  std::filesystem::create_directories(options.output_dir, ec);
+  if (ec || !std::filesystem::is_directory(options.output_dir))
+    throw InputError(options.output_dir.string() + ": cannot create the output folder" +
+                     (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
+
+  // 3. First pass over the selected frames: the region people occupy and the
+  //    largest force, so that every frame shares one layout and one force scale.
+  RenderSummary summary;
+  if (!scene.floor_note.empty()) summary.notes.push_back(scene.floor_note);
+  Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec2 hi = -lo;
+  const auto include = [&](Vec2 p, double pad) {
+    lo = {std::min(lo.x, p.x - pad), std::min(lo.y, p.y - pad)};
+    hi = {std::max(hi.x, p.x + pad), std::max(hi.y, p.y + pad)};
+  };
+  for (const auto& ring : scene.floor_rings)
+    for (Vec2 p : ring) include(p, 0.0);
+  for (const WallPiece& w : scene.walls) {
+    include(w.a, w.radius_m);
+    include(w.b, w.radius_m);
+  }
+  if (scene.periodic) {
+    include(scene.periodic->min_m, 0.0);
+    include(scene.periodic->max_m, 0.0);
+  }
+  for (std::int64_t f : frames) {
+    const scenario::RunFrame frame = run.Frame(f);
+    // Ids are 1-based (PedPy's convention); anything else would index out of range below.
+    for (std::int64_t id : frame.ids)
+      if (id < 1 || id > (std::int64_t{1} << 31))
+        throw InputError(file + ": frame " + std::to_string(f) + " has person id " + std::to_string(id) +
+                         "; expected ids from 1 (trajectory_data.id)");
+    for (std::size_t i = 0; i < frame.position_m.size(); ++i)
+      include(frame.position_m[i], scene.ShapeOf(static_cast<std::size_t>(frame.ids[i] - 1)).reach_m);
+    for (const engine::Contact& c : frame.contacts)
+      summary.max_contact_force_n = std::max(summary.max_contact_force_n, Length(c.Force()));
+  }
+  if (!(lo.x < hi.x && lo.y < hi.y)) {  // a lone person and no venue: a square around them
+    lo -= Vec2{1.0, 1.0};
+    hi += Vec2{1.0, 1.0};
+  }
+  const double pad_m = 0.02 * std::max(hi.x - lo.x, hi.y - lo.y);
+  lo -= Vec2{pad_m, pad_m};
+  hi += Vec2{pad_m, pad_m};
+  Layout layout;
+  layout.lo = lo;
+  layout.hi = hi;
+  // A hair below the exact scale, so that Canvas's ceil() lands on width_px.
+  layout.ppm = (options.width_px - 2.0 * kMargin_px) / (hi.x - lo.x) * (1.0 - 1e-9);
+  layout.width_px = static_cast<int>(std::ceil((hi.x - lo.x) * layout.ppm + 2.0 * kMargin_px));
+  layout.height_px = static_cast<int>(std::ceil((hi.y - lo.y) * layout.ppm + 2.0 * kMargin_px));
+  if (layout.height_px > 20000)
+    throw InputError(file + ": the drawn region is " + Fixed(hi.x - lo.x, 1) + " m x " + Fixed(hi.y - lo.y, 1) +
+                     " m; at --width " + std::to_string(options.width_px) + " the pictures would be " +
+                     std::to_string(layout.height_px) + " px tall (at most 20000): give a larger --width");
+  summary.world_min_m = layout.lo;
+  summary.world_max_m = layout.hi;
+  summary.pixels_per_metre = layout.ppm;
+  summary.margin_px = kMargin_px;
+  summary.force_n_per_px =
+      options.force_n_per_px > 0.0 ? options.force_n_per_px
+      : summary.max_contact_force_n > 0.0
+          ? summary.max_contact_force_n / std::max(4.0, kAutoMaxLineWidth_m * layout.ppm)
+          : 100.0;  // no contact anywhere: any scale will do; 100 N/px puts the paper's 400 N at 4 px
+
+  // 4. The video, opened before any drawing so that a bad path fails early.
+  std::optional<VideoOut> video;
+  if (!options.video.empty()) {
+    double fps = options.video_fps;
+    if (fps <= 0.0) {
+      double run_fps = 10.0;
+      try {
+        run_fps = run.fps();
+      } catch (const InputError&) {
+        // A run without metadata.fps: 10 frames per second, JuPedSim's default.
+      }
+      const double stride = options.frames.kind == FrameSelection::Kind::kEvery
+                                ? static_cast<double>(options.frames.stride) : 1.0;
+      fps = std::max(run_fps / stride, 1.0);
+    }
+    video.emplace(options.video, fps, layout.width_px, layout.height_px, &summary);
+  }
+
+  // 5. Draw each frame: floor, walls, bodies (and their images across seams),
+  //    force network on top, legend in the margins.
+  std::vector<std::int64_t> slot_of_person;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const scenario::RunFrame frame = run.Frame(frames[k]);
+    slot_of_person.assign(scene.person_shape.size(), -1);
+    FrameLegend legend;
+    legend.frame = frame.frame;
+    legend.time_s = frame.time_s;
+    legend.people = frame.ids.size();
+    for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+      const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
+      if (person >= slot_of_person.size()) slot_of_person.resize(person + 1, -1);
+      slot_of_person[person] = static_cast<std::int64_t>(i);
+      const std::uint32_t g = scene.GroupOf(person);
+      if (std::find(legend.groups_present.begin(), legend.groups_present.end(), g) == legend.groups_present.end())
+        legend.groups_present.push_back(g);
+    }
+    std::sort(legend.groups_present.begin(), legend.groups_present.end());
+
+    FrameStats stats;
+    const auto draw = [&](const std::filesystem::path& path) {
+      Canvas canvas(path, layout.lo, layout.hi, layout.ppm, kMargin_px);
+      if (!scene.floor_rings.empty()) canvas.FillRings(scene.floor_rings, kFloor);
+      for (const WallPiece& w : scene.walls)
+        canvas.Line(w.a, w.b, kWall, std::max(3.0, 2.0 * w.radius_m * layout.ppm));
+      // Periodic seams: dashed grey lines across the box where it wraps.
+      if (scene.periodic) {
+        const engine::PeriodicBox& box = *scene.periodic;
+        const Color seam = Color::Hex(0x777777);
+        if (box.x)
+          for (double x : {box.min_m.x, box.max_m.x})
+            canvas.StrokePolyline({{x, layout.lo.y}, {x, layout.hi.y}}, seam, 1.5, /*dashed=*/true);
+        if (box.y)
+          for (double y : {box.min_m.y, box.max_m.y})
+            canvas.StrokePolyline({{layout.lo.x, y}, {layout.hi.x, y}}, seam, 1.5, /*dashed=*/true);
+      }
+      for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+        const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
+        const ShapeInfo& shape = scene.ShapeOf(person);
+        for (Vec2 offset : ImageOffsets(scene, frame.position_m[i], shape.reach_m))
+          DrawBody(canvas, layout, shape, frame.position_m[i] + offset, frame.orientation[i],
+                   GroupColor(scene.GroupOf(person)));
+      }
+      stats = FrameStats{};
+      DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, &stats);
+      for (Vec2 p : frame.position_m) canvas.Dot(p, std::clamp(0.02 * layout.ppm, 1.0, 2.5), kForce);
+      DrawLegend(canvas, layout, legend, stats, summary.force_n_per_px, summary.max_contact_force_n);
+      canvas.Finish();
+      return std::pair<double, double>{canvas.width_px(), canvas.height_px()};
+    };
+    const std::filesystem::path png = FramePicturePath(options.output_dir, frame.frame, ".png");
+    const auto [w, h] = draw(png);
+    if (options.svg) draw(FramePicturePath(options.output_dir, frame.frame, ".svg"));
+    if (video) video->Append(png);
+
+    if (k == 0) {
+      summary.first_picture = png;
+      summary.first_frame = frame.frame;
+      summary.width_px = static_cast<int>(w);
+      summary.height_px = static_cast<int>(h);
+    }
+    summary.last_frame = frame.frame;
+    summary.branches_left_out += stats.branches_left_out;
+    ++summary.frames_written;
+    if (options.progress) options.progress({k + 1, frames.size(), frame.frame, frame.time_s});
+  }
+  if (video) video->Close();
+  return summary;
+}
+
+}  // namespace crowdrecon::viz
