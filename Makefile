@@ -6,7 +6,7 @@ BUILD  := build/$(PRESET)
 JOBS   ?= $(shell nproc)
 CROWDRECON := $(BUILD)/cli/crowdrecon
 
-.PHONY: all deps build test demo clean sanitize
+.PHONY: all deps build test test-long demo clean sanitize
 
 all: build
 
@@ -18,7 +18,11 @@ build: deps
 	@cmake --build --preset $(PRESET) -j $(JOBS)
 
 test: build
-	@ctest --preset $(PRESET) -j $(JOBS)
+	@ctest --preset $(PRESET) -j $(JOBS) --label-exclude long
+
+# Long measurements (convergence in time step and vertex count), not in CI.
+test-long: build
+	@ctest --preset $(PRESET) --label-regex long --output-on-failure
 
 demo: build
 	@bash scripts/demo.sh $(CROWDRECON) out

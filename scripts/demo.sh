@@ -1,29 +1,32 @@
 #!/usr/bin/env bash
 # The main job on the embedded default, the Madrid Arena case (called by `make demo`).
 #   scripts/demo.sh CROWDRECON OUTDIR
-# At this stage: the geometry of the reconstruction. Venues of the Madrid Arena
-# (hallway periodic and open, ground floor) are validated and drawn, the
-# reference thorax body is built from its outline, and a body population is drawn.
 set -euo pipefail
 exe=${1:?usage: demo.sh CROWDRECON OUTDIR}
 out=${2:?usage: demo.sh CROWDRECON OUTDIR}
-mkdir -p "$out/venues" "$out/bodies"
+mkdir -p "$out/venues" "$out/bodies" "$out/hallway"
 
 echo "== Madrid Arena venues"
 for venue in venues/madrid-arena/*.json; do
   name=$(basename "$venue" .json)
-  "$exe" venue check "$venue" --picture "$out/venues/$name.png" | tee "$out/venues/$name.txt"
+  "$exe" venue check "$venue" --picture "$out/venues/$name.png" > "$out/venues/$name.txt"
   "$exe" venue check "$venue" --picture "$out/venues/$name.svg" >/dev/null
+  head -n 3 "$out/venues/$name.txt"
 done
 
 echo "== Reference thorax body (18 vertices, sphero-radius 0.05 m)"
 "$exe" shape venues/bodies/thorax-reference.json --vertices 18 --radius 0.05 \
-  -o "$out/bodies/thorax-18.json" --picture "$out/bodies/thorax-18.png" | tee "$out/bodies/thorax-18.txt"
-
-echo "== Body populations (paper, anthropometric, circle)"
+  -o "$out/bodies/thorax-18.json" --picture "$out/bodies/thorax-18.png" > "$out/bodies/thorax-18.txt"
 for mode in paper anthropometric circle; do
   "$exe" population --mode "$mode" --count 400 --seed 2012 \
-    -o "$out/bodies/population-$mode.json" --picture "$out/bodies/population-$mode.png"
+    -o "$out/bodies/population-$mode.json" --picture "$out/bodies/population-$mode.png" >/dev/null
 done
 
-echo "Outputs written under $out/"
+echo "== Madrid Arena hallway: periodic, 5 persons/m2, 30 % counter-flow, 60 s"
+"$exe" simulate venues/madrid-arena/scenarios/hallway-5pm2-30cf.json -o "$out/hallway/run.sqlite" \
+  | tee "$out/hallway/summary.txt"
+echo "== Rendering the hallway run (frames every second and a video)"
+"$exe" render "$out/hallway/run.sqlite" -o "$out/hallway/frames" --frames every:10 \
+  --video "$out/hallway/hallway.mp4" --width 1600 | tee -a "$out/hallway/summary.txt"
+
+echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy)"

@@ -51,7 +51,8 @@ double WrapAngle(double a) {
   return a - kPi;  // (-pi, pi]
 }
 
-std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i); }
+// People are named by id = index + 1, as in run files.
+std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i + 1); }
 
 }  // namespace
 
@@ -882,7 +883,8 @@ void Simulation::Check() {
         !std::isfinite(bodies_.angle_rad[i]) || !std::isfinite(bodies_.angular_velocity_rad_per_s[i]))
       throw SimulationError("non-finite state of " + PersonText(i) + " at t = " + FormatNumber(time_s_) +
                             " s (position " + FormatNumber(x.x) + ", " + FormatNumber(x.y) + "; velocity " +
-                            FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")");
+                            FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")",
+                            i, -1, time_s_);
   }
   for (const Contact& c : contacts_) {
     const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
@@ -892,7 +894,8 @@ void Simulation::Check() {
       throw SimulationError("overlap of " + PersonText(c.a) + " and " + other + " is " +
                             FormatNumber(c.overlap_m) + " m at t = " + FormatNumber(time_s_) +
                             " s, beyond the sum of their sphero-radii " + FormatNumber(ra + rb) +
-                            " m: the cores interpenetrate (time step too large or forces too strong)");
+                            " m: the cores interpenetrate (time step too large or forces too strong)",
+                            c.a, c.wall ? -1 : std::int64_t{c.b}, time_s_);
     }
   }
 }

@@ -198,6 +198,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     Event event;
     event.time_s = sim.time_s();
     event.kind = "numerical_failure";
+    event.person = e.person();
+    event.other = e.other();
     event.detail = e.what();
     writer.WriteEvent(last_frame, event);
     writer.SetStatus(std::string("failed: ") + e.what());

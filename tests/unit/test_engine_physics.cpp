@@ -324,6 +324,34 @@ TEST(EnginePhysics, RestoredCheckpointContinuesBitForBit) {
   }
 }
 
+TEST(EnginePhysics, InterpenetrationStopsWithTheNamesAndTheTime) {
+  // Two chests meeting at 60 m/s: the contact cannot stop them before the
+  // cores pass into each other; the run must stop and say who and when.
+  WorldDef def = PassiveWorld();
+  def.shapes.push_back(ThoraxLikeShape());
+  PersonDef a, b;
+  SetMassFromShape(def.shapes[0], 1000.0, a);
+  SetMassFromShape(def.shapes[0], 1000.0, b);
+  a.position_m = {-0.5, 0.0};
+  b.position_m = {0.5, 0.0};
+  b.angle_rad = std::numbers::pi;
+  a.velocity_m_per_s = {30.0, 0.0};
+  b.velocity_m_per_s = {-30.0, 0.0};
+  def.people = {a, b};
+  Simulation sim(def);
+  try {
+    sim.AdvanceTo(1.0);
+    FAIL() << "expected a SimulationError";
+  } catch (const SimulationError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("overlap of person 1 and person 2"), std::string::npos) << what;
+    EXPECT_NE(what.find("at t = "), std::string::npos) << what;
+    EXPECT_EQ(e.person(), 0);
+    EXPECT_EQ(e.other(), 1);
+    EXPECT_GT(e.time_s(), 0.0);
+  }
+}
+
 TEST(EnginePhysics, UnstableTimeStepIsRefusedWithTheLimit) {
   WorldDef def = RandomGas(3, 0.5, 1, false);
   def.parameters.time_step_s = 0.05;

@@ -84,10 +84,19 @@ struct TimeStepEstimate {
   double chosen_s = 0.0;             // safety * limit (or the user's value)
 };
 
-// A run that went numerically wrong. The message names the people and the time.
+// A run that went numerically wrong. The message names the people (by id =
+// index + 1, as in run files) and the time.
 class SimulationError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  SimulationError(const std::string& message, std::int64_t person, std::int64_t other, double time_s)
+      : std::runtime_error(message), person_(person), other_(other), time_s_(time_s) {}
+  std::int64_t person() const { return person_; }  // engine index, -1 if none
+  std::int64_t other() const { return other_; }    // engine index of the other person, -1 if none or a wall
+  double time_s() const { return time_s_; }
+
+ private:
+  std::int64_t person_, other_;
+  double time_s_;
 };
 
 class Simulation {
