@@ -66,9 +66,14 @@ void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, 
                      std::vector<ContactPoint>& out) {
   const double reach = from.radius_m + to.radius_m;
   const double cull = to.core_radius_m + reach;
+  const Vec2 lo = to.box_min - Vec2{reach, reach}, hi = to.box_max + Vec2{reach, reach};
   for (std::uint32_t i = 0; i < from.count; ++i) {
     const Vec2 p = from.vertices[i];
-    if (LengthSquared(p - to.centre) >= cull * cull) continue;
+    const Vec2 d = p - to.centre;
+    if (LengthSquared(d) >= cull * cull) continue;
+    const double lx = to.cos_angle * d.x + to.sin_angle * d.y;
+    const double ly = -to.sin_angle * d.x + to.cos_angle * d.y;
+    if (lx < lo.x || lx > hi.x || ly < lo.y || ly > hi.y) continue;
     const Closest c = ClosestOnCore(p, to);
     if (c.distance >= reach) continue;
     Vec2 normal;

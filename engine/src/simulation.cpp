@@ -81,6 +81,8 @@ struct Simulation::Internals {
   std::vector<std::vector<Contact>> chunk_contacts;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
   std::vector<std::pair<Vec2, double>> wall_bounds;  // bounding circle of each wall
+  std::vector<std::pair<Vec2, Vec2>> wall_boxes;     // its bounding box, relative to the circle's centre
+  std::vector<double> cos_angle, sin_angle;          // per body, set by PlaceShapes
   // Corrections of the dashpot impulse for contacts that began during the
   // last half step (trailing) or end during the next (leading); see ContactLaw.
   std::vector<Vec2> trailing_force, leading_force;
@@ -132,7 +134,12 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     if (shape.vertices.empty() || shape.vertices.size() >= 32768 || !(shape.radius_m > 0))
       throw InputError("shape " + std::to_string(s) + ": needs 1..32767 vertices and a radius > 0");
     shape.core_radius_m = 0.0;
-    for (const Vec2& v : shape.vertices) shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
+    shape.box_min_m = shape.box_max_m = shape.vertices.front();
+    for (const Vec2& v : shape.vertices) {
+      shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
+      shape.box_min_m = {std::min(shape.box_min_m.x, v.x), std::min(shape.box_min_m.y, v.y)};
+      shape.box_max_m = {std::max(shape.box_max_m.x, v.x), std::max(shape.box_max_m.y, v.y)};
+    }
   }
   const std::size_t n = def_.people.size();
   if (n >= (std::size_t{1} << 31)) throw InputError("too many people");
@@ -200,6 +207,8 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   }
   in_->vertex_offset[n] = offset;
   in_->world_vertices.resize(offset);
+  in_->cos_angle.assign(n, 1.0);
+  in_->sin_angle.assign(n, 0.0);
 
   // Walls crossing a periodic boundary are extended beyond it, so that a body
   // straddling the seam meets a straight wall and never a wall's end cap.
@@ -235,6 +244,7 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     double radius = 0.0;
     for (const Vec2& p : def_.walls[w].points) radius = std::max(radius, Length(p - centre));
     in_->wall_bounds[w] = {centre, radius};
+    in_->wall_boxes.push_back({lo - centre, hi - centre});
   }
 
   const auto factor = [](double eps) {
@@ -420,6 +430,8 @@ void Simulation::PlaceShapes() {
     const std::size_t i = static_cast<std::size_t>(ii);
     const BodyShape& s = def_.shapes[bodies_.shape[i]];
     const double c = std::cos(bodies_.angle_rad[i]), sn = std::sin(bodies_.angle_rad[i]);
+    in.cos_angle[i] = c;
+    in.sin_angle[i] = sn;
     const Vec2 x = bodies_.position_m[i];
     Vec2* out = &in.world_vertices[in.vertex_offset[i]];
     for (std::size_t k = 0; k < s.vertices.size(); ++k) {
@@ -541,6 +553,10 @@ void Simulation::Collide() {
     p.closed = s.vertices.size() >= 3;
     p.radius_m = s.radius_m;
     p.core_radius_m = s.core_radius_m;
+    p.box_min = s.box_min_m;
+    p.box_max = s.box_max_m;
+    p.cos_angle = in.cos_angle[i];
+    p.sin_angle = in.sin_angle[i];
     return p;
   };
   const auto velocity_at = [&](std::uint32_t i, Vec2 arm) {
@@ -621,6 +637,8 @@ void Simulation::Collide() {
           pw.radius_m = wall.radius_m;
           pw.centre = in.wall_bounds[w].first;
           pw.core_radius_m = in.wall_bounds[w].second;
+          pw.box_min = in.wall_boxes[w].first;
+          pw.box_max = in.wall_boxes[w].second;
           points.clear();
           CollideShapes(pa, pw, points);
           if (points.empty()) continue;

@@ -219,6 +219,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   summary.real_time_factor = summary.wall_s > 0 ? (sim.time_s() - start_sim) / summary.wall_s : 0.0;
   summary.frames = last_frame + 1;
+  summary.profile = sim.profile();
   return summary;
 }
 

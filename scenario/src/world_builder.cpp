@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include "crowdrecon/common/error.hpp"
@@ -308,7 +309,13 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
       relax.people[i].position_m = position[i];
       relax.people[i].angle_rad = angle[i];
     }
-    engine::Simulation sim(relax);
+    std::optional<engine::Simulation> relaxing;
+    try {
+      relaxing.emplace(relax);
+    } catch (const engine::SimulationError& e) {
+      throw InputError(scenario.file.string() + ": /population: placement failed while relaxing: " + e.what());
+    }
+    engine::Simulation& sim = *relaxing;
     const bool last = stage == stages;
     const double goal = last ? tolerance : std::max(tolerance, 0.02 * scale);
     const int budget = last ? 20000 : 3000;
@@ -318,7 +325,12 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     // falling (a jammed packing), judged over windows of 1000 steps.
     double window_start = residual;
     while (residual > goal && steps < budget) {
-      for (int k = 0; k < 20; ++k) sim.Step();
+      try {
+        for (int k = 0; k < 20; ++k) sim.Step();
+      } catch (const engine::SimulationError& e) {
+        throw InputError(scenario.file.string() + ": /population: placement failed while relaxing (the density may be too high): " +
+                         e.what());
+      }
       steps += 20;
       sim.Quench();
       residual = MaxOverlap(sim);

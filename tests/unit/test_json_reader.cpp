@@ -1,19 +1,13 @@
 #include <gtest/gtest.h>
 
+#include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 
 namespace crowdrecon {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing_util::ErrorOf;
 
 TEST(JsonReader, SyntaxErrorNamesLineAndColumn) {
   const std::string msg = ErrorOf([] { JsonDocument::Parse("{\n  \"a\": 1,\n  \"b\": ]\n}", "x.json"); });

@@ -9,12 +9,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/body.hpp"
 #include "crowdrecon/geometry/outline.hpp"
 
 namespace crowdrecon::geometry {
 namespace {
+
+using testing_util::ErrorOf;
 
 const std::string kData = std::string(CROWDRECON_SOURCE_DIR) + "/tests/data/bodies/";
 constexpr double kA = 0.25, kB = 0.15;  // semi-axes, m: across the shoulders, front-back
@@ -46,16 +49,6 @@ Outline EllipsePoints(double a = kA, double b = kB, int n = 720) {
     outline.points.push_back({a * std::cos(t), b * std::sin(t)});
   }
   return outline;
-}
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 TEST(Outline, ImageOfEllipseBecomesFaithfulBody) {

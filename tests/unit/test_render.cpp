@@ -11,12 +11,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 #include "render_scene.hpp"
 
 namespace crowdrecon::viz {
 namespace {
+
+using testing_util::ErrorOf;
 
 using engine::testing::CorridorScene;
 
@@ -49,15 +52,6 @@ std::filesystem::path WriteRun(const std::filesystem::path& dir, int frames, boo
   return file;
 }
 
-std::string MessageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
-
 TEST(RenderFrameSelection, ParsesEveryForm) {
   EXPECT_EQ(ParseFrameSelection("all").kind, FrameSelection::Kind::kAll);
   const FrameSelection list = ParseFrameSelection("first, 7,last");
@@ -76,7 +70,7 @@ TEST(RenderFrameSelection, ParsesEveryForm) {
 
 TEST(RenderFrameSelection, RejectsMalformedSelections) {
   for (const char* bad : {"", "every:0", "every:x", "5:2", ":", "a:b", "1,,2", "first,middle", "-3", "1.5"}) {
-    const std::string message = MessageOf([&] { ParseFrameSelection(bad); });
+    const std::string message = ErrorOf([&] { ParseFrameSelection(bad); });
     EXPECT_NE(message.find("--frames \"" + std::string(bad) + "\""), std::string::npos) << message;
     EXPECT_NE(message.find("expected all"), std::string::npos) << message;
   }
@@ -92,10 +86,10 @@ TEST(RenderFrameSelection, SelectsFramesOfTheRun) {
   EXPECT_EQ(SelectFrames(ParseFrameSelection("0.3:0.6"), frames, time_of),
             (std::vector<std::int64_t>{3, 4, 5, 6}));
   EXPECT_EQ(SelectFrames(ParseFrameSelection("0.95:"), frames, time_of), (std::vector<std::int64_t>{10}));
-  EXPECT_NE(MessageOf([&] { SelectFrames(ParseFrameSelection("3,11"), frames, time_of); })
+  EXPECT_NE(ErrorOf([&] { SelectFrames(ParseFrameSelection("3,11"), frames, time_of); })
                 .find("frame 11 is not in the run (the run has 11 frames, 0 to 10)"),
             std::string::npos);
-  EXPECT_NE(MessageOf([&] { SelectFrames(ParseFrameSelection("2:3"), frames, time_of); })
+  EXPECT_NE(ErrorOf([&] { SelectFrames(ParseFrameSelection("2:3"), frames, time_of); })
                 .find("no frame lies between 2 s and 3 s (the run covers 0 s to 1 s)"),
             std::string::npos);
 }
@@ -216,38 +210,38 @@ TEST(RenderRun, ReportsUserErrorsClearly) {
   RenderOptions options;
   options.output_dir = dir.path() / "out";
 
-  EXPECT_NE(MessageOf([&] { RenderRun(dir.path() / "missing.sqlite", options); })
+  EXPECT_NE(ErrorOf([&] { RenderRun(dir.path() / "missing.sqlite", options); })
                 .find("missing.sqlite: run file does not exist"),
             std::string::npos);
 
   const std::filesystem::path text = dir.path() / "notes.txt";
   std::ofstream(text) << "not a database, just text that is long enough to have a header page\n";
-  EXPECT_NE(MessageOf([&] { RenderRun(text, options); }).find("notes.txt: not a crowdrecon run file"),
+  EXPECT_NE(ErrorOf([&] { RenderRun(text, options); }).find("notes.txt: not a crowdrecon run file"),
             std::string::npos);
 
   const std::filesystem::path empty = dir.path() / "empty";
   std::filesystem::create_directories(empty);
   const std::filesystem::path empty_run = WriteRun(empty, 0);
-  EXPECT_NE(MessageOf([&] { RenderRun(empty_run, options); }).find("the run has no frames to draw (status: complete)"),
+  EXPECT_NE(ErrorOf([&] { RenderRun(empty_run, options); }).find("the run has no frames to draw (status: complete)"),
             std::string::npos);
 
   const std::filesystem::path run = WriteRun(dir.path(), 3);
   RenderOptions bad_frames = options;
   bad_frames.frames = ParseFrameSelection("0,9");
-  EXPECT_NE(MessageOf([&] { RenderRun(run, bad_frames); }).find("frame 9 is not in the run"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, bad_frames); }).find("frame 9 is not in the run"), std::string::npos);
 
   RenderOptions under_a_file = options;
   under_a_file.output_dir = text / "frames";
-  EXPECT_NE(MessageOf([&] { RenderRun(run, under_a_file); }).find("cannot create the output folder"),
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, under_a_file); }).find("cannot create the output folder"),
             std::string::npos);
 
   RenderOptions bad_video = options;
   bad_video.video = dir.path() / "run.gif";
-  EXPECT_NE(MessageOf([&] { RenderRun(run, bad_video); }).find("unknown video format \".gif\""), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, bad_video); }).find("unknown video format \".gif\""), std::string::npos);
 
   RenderOptions narrow = options;
   narrow.width_px = 10;
-  EXPECT_NE(MessageOf([&] { RenderRun(run, narrow); }).find("--width: 10 px"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, narrow); }).find("--width: 10 px"), std::string::npos);
 }
 
 }  // namespace

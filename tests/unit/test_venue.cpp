@@ -6,25 +6,17 @@
 #include <ostream>
 #include <string>
 
+#include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 
 namespace crowdrecon::geometry {
 namespace {
 
+using testing_util::ErrorOf;
+
 const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
 const std::filesystem::path kVenues = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "venues/madrid-arena";
-
-// The message of the InputError (or GeometryError) thrown by `f`, or "" if none.
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 constexpr const char* kRoom = R"("walkable_area": [[[0, 0], [10, 0], [10, 4], [0, 4]]])";
 

@@ -13,23 +13,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 
 namespace crowdrecon::geometry {
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
+using testing_util::ErrorOf;
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
 
 std::filesystem::path TempFile(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / "crowdrecon_test_venue_import";

@@ -36,6 +36,12 @@ struct PlacedShape {
   double radius_m = 0.0;
   Vec2 centre;                 // centroid (for the cheap per-vertex cull)
   double core_radius_m = 0.0;  // max distance of a vertex from `centre`
+  // Bounding box of the core in the shape's own frame (rotation `angle` about
+  // `centre`): a vertex farther than r_a + r_b outside it cannot touch, which
+  // culls most vertex tests of elongated bodies exactly.
+  // Default: unbounded (no cull).
+  Vec2 box_min{-1e300, -1e300}, box_max{1e300, 1e300};  // relative to centre, rotated frame
+  double cos_angle = 1.0, sin_angle = 0.0;
 };
 
 struct ContactPoint {

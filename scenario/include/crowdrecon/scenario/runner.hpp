@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 
+#include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/scenario/scenario.hpp"
 
 namespace crowdrecon::scenario {
@@ -32,6 +33,7 @@ struct RunSummary {
   std::size_t people = 0;
   std::int64_t frames = 0;      // frames in the run file
   double real_time_factor = 0.0;  // simulated / wall seconds (this invocation)
+  engine::Profile profile;         // time per engine stage (this invocation)
 };
 
 // Path of the checkpoint that belongs to a run file.
