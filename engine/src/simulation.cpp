@@ -981,7 +981,7 @@ class StateWriter {
   void PutVector(const std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     Put(static_cast<std::uint64_t>(values.size()));
-    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    if (!values.empty()) out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
   }
   std::string Finish() {
     // FNV-1a checksum of everything written.
@@ -1026,7 +1026,7 @@ class StateReader {
                        std::to_string(expected_size) + " (different scenario?)");
     if (pos_ + n * sizeof(T) > end_) throw InputError("checkpoint: truncated state");
     values.resize(n);
-    std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));
+    if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));
     pos_ += n * sizeof(T);
   }
 

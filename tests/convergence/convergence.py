@@ -16,6 +16,7 @@ usage: convergence.py CROWDRECON OUTDIR [--seeds N] [--duration S] [--transient 
 Exit status 1 if a change exceeds the tolerance. Prints 'N passed, N failed'.
 """
 import argparse
+import concurrent.futures
 import json
 import math
 import os
@@ -78,7 +79,8 @@ def main():
     p.add_argument("--duration", type=float, default=20.0)
     p.add_argument("--transient", type=float, default=5.0)
     p.add_argument("--tolerance", type=float, default=0.05)
-    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--threads", type=int, default=1, help="threads per run")
+    p.add_argument("--jobs", type=int, default=2, help="runs at a time")
     p.add_argument("--density", type=float, default=5.0)
     p.add_argument("--counter-flow", type=float, default=0.3)
     p.add_argument("--configs", default="base,half_dt,vertices36")
@@ -95,8 +97,7 @@ def main():
     for name, cfg in configs.items():
         if name not in wanted:
             continue
-        speeds, forces, dts = [], [], []
-        for seed in range(1, args.seeds + 1):
+        def one(seed):
             sc = os.path.join(args.outdir, f"{name}-{seed}.json")
             run = os.path.join(args.outdir, f"{name}-{seed}.sqlite")
             with open(sc, "w") as f:
@@ -104,10 +105,12 @@ def main():
                           f, indent=1)
             subprocess.run([args.exe, "simulate", sc, "-o", run, "-q", "--threads", str(args.threads)], check=True,
                            stdout=subprocess.DEVNULL)
-            s, fo, dt = measure(run, args.transient)
-            speeds.append(s)
-            forces.append(fo)
-            dts.append(dt)
+            return measure(run, args.transient)
+        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            measured = list(pool.map(one, range(1, args.seeds + 1)))
+        speeds = [m[0] for m in measured]
+        forces = [m[1] for m in measured]
+        dts = [m[2] for m in measured]
         results[name] = (mean_and_sem(speeds), mean_and_sem(forces), dts[0], speeds, forces)
         (ms, es), (mf, ef) = results[name][0], results[name][1]
         print(f"{name:11s} dt {dts[0]:.3e} s  mean speed {ms:.4f} +- {es:.4f} m/s ({100 * es / ms:.1f} %)  "
