@@ -13,5 +13,6 @@ void RegisterShapeCommands(CLI::App& app);  // shape, population, body reference
 void RegisterVenueCommands(CLI::App& app);  // venue check, venue import
 void RegisterSimulateCommand(CLI::App& app);  // simulate
 void RegisterRenderCommand(CLI::App& app);  // render (pictures and video of a run)
+void RegisterAnalyzeCommand(CLI::App& app);  // analyze (metrics and regime of a run)
 
 }  // namespace crowdrecon::cli

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterVenueCommands(app);
   crowdrecon::cli::RegisterSimulateCommand(app);
   crowdrecon::cli::RegisterRenderCommand(app);
+  crowdrecon::cli::RegisterAnalyzeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -146,3 +146,25 @@ get_property(render_tests DIRECTORY PROPERTY TESTS)
 list(FILTER render_tests INCLUDE REGEX "^cli\\.render\\.")
 list(REMOVE_ITEM render_tests cli.render.make_data)
 set_tests_properties(${render_tests} PROPERTIES FIXTURES_REQUIRED render_data)
+
+# --- analyze (analysis/run_analysis.hpp) ---------------------------------------
+# The 2 s counter-flow run of the render tests: too short for a regime.
+crowdrecon_cli_test(analyze.short_run ok "regime: unclassified \\(run too short: 2.0 s"
+                    analyze ${render_data}/run.sqlite --json @TMP@/a.json)
+crowdrecon_cli_test(analyze.full_report ok "measurement line: middle of the walkable area, across group 0's direction \\(1.5, 0\\) - \\(1.5, 1.5\\), forward \\(1, 0\\)"
+                    analyze ${render_data}/run.sqlite --full --transient 0)
+crowdrecon_cli_test(analyze.missing_file fail "no-such-run.sqlite: run file does not exist"
+                    analyze ${render_data}/no-such-run.sqlite)
+crowdrecon_cli_test(analyze.not_a_run fail "thorax-18.json: not a crowdrecon run file"
+                    analyze venues/bodies/thorax-18.json)
+crowdrecon_cli_test(analyze.empty_run fail "empty.sqlite: the run has 0 frame\\(s\\). the analysis needs at least 2"
+                    analyze ${render_data}/empty.sqlite)
+crowdrecon_cli_test(analyze.bad_line fail "--line \"1,2,3\": expected four numbers X1,Y1,X2,Y2"
+                    analyze ${render_data}/run.sqlite --line 1,2,3)
+set_tests_properties(cli.analyze.short_run cli.analyze.full_report cli.analyze.missing_file cli.analyze.empty_run
+                     cli.analyze.bad_line PROPERTIES FIXTURES_REQUIRED render_data)
+# --write stores the results in (a copy of) the run file.
+add_test(NAME cli.analyze.write
+         COMMAND bash -c "d=$(mktemp -d) && cp \"$1\" \"$d/r.sqlite\" && \"$0\" analyze \"$d/r.sqlite\" --write >/dev/null && sqlite3 \"$d/r.sqlite\" \"SELECT value FROM run WHERE key = 'regime'\" | grep -qx unclassified && test $(sqlite3 \"$d/r.sqlite\" 'SELECT COUNT(*) FROM metric_summary') -gt 20; rc=$?; rm -rf \"$d\"; exit $rc"
+                 $<TARGET_FILE:crowdrecon> ${render_data}/run.sqlite)
+set_tests_properties(cli.analyze.write PROPERTIES FIXTURES_REQUIRED render_data)

@@ -1,0 +1,127 @@
+// Regime of a hallway run (paper, Results: "three different regimes are
+// observed ... i) lane formation ... ii) avalanches ... characterized by
+// temporal clogging of the pedestrian flow, followed by a sudden release ...
+// iii) clogging, characterized by a frozen stage"), decided from the time
+// series of the crowd's mean speed along the desired direction.
+//
+// The criteria were fixed from these physical descriptions before any phase
+// diagram was computed; every threshold is in RegimeOptions with its unit and
+// reason, and docs/analysis.md states the definitions in full.
+//
+//   stop       the mean speed V(t) stays below stop_speed_m_per_s for at least
+//              min_stop_duration_s (a stop that begins at the first frame is
+//              the initial rest of a placed crowd, not a stop of a flow);
+//   avalanche  after a stop, V rises above burst_speed_m_per_s; it starts at
+//              the last upward crossing of stop_speed_m_per_s before that and
+//              ends at the next downward crossing (or at the end of the run);
+//   frozen     the mean of V over the last frozen_window_s is below
+//              frozen_speed_m_per_s.
+//
+//   clogging     frozen at the end;
+//   avalanches   not frozen, and at least min_avalanches avalanches start in
+//                the stationary stage (after transient_s);
+//   lanes        neither, the flow stopped at most max_stopped_fraction_for_lanes
+//                of the stationary stage, and (if min_lane_order_for_lanes > 0)
+//                the mean lane order reaches it;
+//   unclassified anything else (e.g. one long stop and one release), or a run
+//                too short to tell (stationary stage < frozen_window_s).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace crowdrecon::analysis {
+
+enum class Regime {
+  kLanes,         // free flow (lane formation at the stationary stage)
+  kAvalanches,    // recurring stop-and-go: stops released by bursts of motion
+  kClogging,      // frozen at the end of the run
+  kUnclassified,  // none of the above clearly, or too short a run
+};
+const char* ToString(Regime regime);  // "lanes", "avalanches", "clogging", "unclassified"
+bool FromString(const std::string& text, Regime* regime);
+
+struct RegimeOptions {
+  // Mean speed along the desired direction below which the flow counts as
+  // stopped (m/s): a tenth of the mean desired speed (v0 ~ U(0.8, 1.2) m/s,
+  // paper); at it a crowd advances one body depth (~0.3 m) in 3 s.
+  double stop_speed_m_per_s = 0.1;
+  // Mean speed that makes a release a burst (m/s): three times the stop
+  // threshold, so that noise around the stop threshold is not an avalanche
+  // (hysteresis), and 30 % of the desired speed: the crowd as a whole advances
+  // a body depth per second.
+  double burst_speed_m_per_s = 0.3;
+  // Shortest stop (s): three relaxation times of the model (tau = 2/3 s,
+  // paper): a person re-accelerates to their desired speed within ~tau, so a
+  // dip shorter than this is a hesitation, not a stop.
+  double min_stop_duration_s = 2.0;
+  // Mean speed over the final window below which the flow is frozen (m/s):
+  // half the stop threshold, i.e. the crowd advances less than two body depths
+  // in the 10 s window: clogged "indefinitely" (paper) as far as a run can tell.
+  double frozen_speed_m_per_s = 0.05;
+  // Final window over which frozen-ness is judged (s): five minimal stops, and
+  // longer than any stop that avalanches release.
+  double frozen_window_s = 10.0;
+  // Start-up stage left out of stationary averages (s): people are placed at
+  // rest in random order; lanes need about the time to walk the 12 m corridor
+  // once at ~1 m/s to form.
+  double transient_s = 10.0;
+  // Avalanches needed in the stationary stage for the avalanche regime: the
+  // paper's regime is a recurring "temporal clogging followed by a sudden
+  // release"; one stop-and-release may be a single rearrangement, two is the
+  // least that recurs.
+  int min_avalanches = 2;
+  // Largest fraction of the stationary stage with the flow stopped that still
+  // counts as free flow (lanes): lanes are a moving stationary state.
+  double max_stopped_fraction_for_lanes = 0.1;
+  // Lane order the stationary stage must reach for "lanes" (0 = not required).
+  // Off by default: with little counter-flow free flow needs no lanes, and a
+  // threshold here would be a fitted number.
+  double min_lane_order_for_lanes = 0.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct Avalanche {
+  std::size_t start_index = 0;  // sample where V rose above the stop speed
+  std::size_t end_index = 0;    // sample where V fell back below it, or the last sample
+  double start_time_s = 0.0;
+  double end_time_s = 0.0;
+  double duration_s = 0.0;
+  double stopped_before_s = 0.0;  // from the start of the stop that preceded it
+  double peak_speed_m_per_s = 0.0;
+  // Mean distance travelled along the desired direction, the integral of V
+  // over the avalanche (trapezoidal rule), m.
+  double distance_m = 0.0;
+  bool complete = true;         // false if the run ended during it
+  bool stationary = false;      // starts after the transient
+  // People who advanced at least AnalysisOptions::avalanche_move_m along their
+  // desired direction during it; -1 where unknown (series without positions).
+  int people_moved = -1;
+};
+
+// Avalanches in a mean-speed series (`time_s` increasing, same length).
+std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const std::vector<double>& speed_m_per_s,
+                                      const RegimeOptions& options);
+
+struct RegimeResult {
+  Regime regime = Regime::kUnclassified;
+  std::string reason;  // one sentence with the numbers that decided it
+  std::vector<Avalanche> avalanches;  // all of them, transient included
+  int stationary_avalanches = 0;
+  double stationary_start_s = 0.0;      // time the stationary stage begins
+  double stopped_time_fraction = 0.0;   // stationary samples with V < stop speed
+  double end_mean_speed_m_per_s = 0.0;  // mean V over the final window
+  bool frozen_at_end = false;
+  double mean_lane_order = 0.0;  // over the stationary stage; NaN if no lane order given
+  bool long_enough = false;      // stationary stage at least frozen_window_s long
+};
+
+// Classifies a run from its mean speed along the desired direction and
+// (optionally, may be empty) its lane order series. Throws InputError if the
+// options are invalid or the series differ in length.
+RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector<double>& mean_speed_m_per_s,
+                            const std::vector<double>& lane_order, const RegimeOptions& options);
+
+}  // namespace crowdrecon::analysis

@@ -1,0 +1,226 @@
+#include "crowdrecon/analysis/regime.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::analysis {
+
+namespace {
+
+// Frame times exceed their nominal times by less than a time step (the engine
+// stops at the first step past the frame time); comparisons of times with
+// window edges allow for it.
+constexpr double kTimeTolerance_s = 1e-6;
+
+std::string Fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+bool CheckRange(double value, double lo, double hi, const char* name, const char* unit, std::string* error) {
+  if (value >= lo && value <= hi) return true;
+  *error = std::string("regime ") + name + " = " + FormatNumber(value) + (*unit ? " " : "") + unit +
+           ", expected [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+  return false;
+}
+
+}  // namespace
+
+const char* ToString(Regime regime) {
+  switch (regime) {
+    case Regime::kLanes: return "lanes";
+    case Regime::kAvalanches: return "avalanches";
+    case Regime::kClogging: return "clogging";
+    case Regime::kUnclassified: return "unclassified";
+  }
+  return "unclassified";
+}
+
+bool FromString(const std::string& text, Regime* regime) {
+  for (Regime r : {Regime::kLanes, Regime::kAvalanches, Regime::kClogging, Regime::kUnclassified})
+    if (text == ToString(r)) {
+      *regime = r;
+      return true;
+    }
+  return false;
+}
+
+bool RegimeOptions::IsValid(std::string* error) const {
+  if (!CheckRange(stop_speed_m_per_s, 1e-4, 2.0, "stop_speed_m_per_s", "m/s", error)) return false;
+  if (!CheckRange(burst_speed_m_per_s, 1e-4, 5.0, "burst_speed_m_per_s", "m/s", error)) return false;
+  if (!(burst_speed_m_per_s > stop_speed_m_per_s)) {
+    *error = "regime burst_speed_m_per_s (" + FormatNumber(burst_speed_m_per_s) +
+             " m/s) must exceed stop_speed_m_per_s (" + FormatNumber(stop_speed_m_per_s) + " m/s)";
+    return false;
+  }
+  if (!CheckRange(min_stop_duration_s, 0.0, 600.0, "min_stop_duration_s", "s", error)) return false;
+  if (!CheckRange(frozen_speed_m_per_s, 0.0, 2.0, "frozen_speed_m_per_s", "m/s", error)) return false;
+  if (!CheckRange(frozen_window_s, 0.1, 3600.0, "frozen_window_s", "s", error)) return false;
+  if (!CheckRange(transient_s, 0.0, 3600.0, "transient_s", "s", error)) return false;
+  if (min_avalanches < 1) {
+    *error = "regime min_avalanches = " + std::to_string(min_avalanches) + ", expected at least 1";
+    return false;
+  }
+  if (!CheckRange(max_stopped_fraction_for_lanes, 0.0, 1.0, "max_stopped_fraction_for_lanes", "", error)) return false;
+  if (!CheckRange(min_lane_order_for_lanes, 0.0, 1.0, "min_lane_order_for_lanes", "", error)) return false;
+  return true;
+}
+
+// A Schmitt trigger with a dwell time on V(t): "stopped" is entered when V has
+// stayed below the stop speed for min_stop_duration_s, "moving" when V exceeds
+// the burst speed; every passage stopped -> moving is an avalanche. Sub-burst
+// excursions between the two thresholds neither end a stop nor count as a
+// release: they are creeping, not the "sudden release" of the paper.
+std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const std::vector<double>& speed_m_per_s,
+                                      const RegimeOptions& options) {
+  if (time_s.size() != speed_m_per_s.size())
+    throw InputError("FindAvalanches: the time and speed series differ in length");
+  const std::size_t n = time_s.size();
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::vector<Avalanche> avalanches;
+  if (n == 0) return avalanches;
+  const double stationary_start_s = time_s.front() + options.transient_s - kTimeTolerance_s;
+  bool armed = false;
+  std::size_t below_start = kNone;   // first sample of the current run below the stop speed
+  std::size_t armed_stop_start = 0;  // first sample of the stop that armed the trigger
+  std::size_t last_rise = 0;         // last sample that rose above the stop speed
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = speed_m_per_s[i];
+    if (v < options.stop_speed_m_per_s) {
+      if (below_start == kNone) below_start = i;
+      // A run below the stop speed that includes the first sample is the
+      // initial rest of a crowd placed standing, not a stop of a flow.
+      if (!armed && below_start != 0 &&
+          time_s[i] - time_s[below_start] >= options.min_stop_duration_s - kTimeTolerance_s) {
+        armed = true;
+        armed_stop_start = below_start;
+      }
+      continue;
+    }
+    if (below_start != kNone || i == 0) last_rise = i;
+    below_start = kNone;
+    if (!armed || v < options.burst_speed_m_per_s) continue;
+    // The burst: the avalanche began at the last rise and lasts until V falls
+    // back below the stop speed.
+    Avalanche a;
+    a.start_index = last_rise;
+    std::size_t end = i;
+    while (end < n && speed_m_per_s[end] >= options.stop_speed_m_per_s) ++end;
+    a.complete = end < n;
+    a.end_index = a.complete ? end : n - 1;
+    a.start_time_s = time_s[a.start_index];
+    a.end_time_s = time_s[a.end_index];
+    a.duration_s = a.end_time_s - a.start_time_s;
+    a.stopped_before_s = a.start_time_s - time_s[armed_stop_start];
+    for (std::size_t k = a.start_index; k <= a.end_index; ++k) {
+      a.peak_speed_m_per_s = std::max(a.peak_speed_m_per_s, speed_m_per_s[k]);
+      if (k > a.start_index)
+        a.distance_m += 0.5 * (speed_m_per_s[k] + speed_m_per_s[k - 1]) * (time_s[k] - time_s[k - 1]);
+    }
+    a.stationary = a.start_time_s >= stationary_start_s;
+    avalanches.push_back(a);
+    armed = false;
+    if (!a.complete) break;
+    // Continue at the sample that fell back below the stop speed: it may begin
+    // the next stop.
+    i = a.end_index - 1;
+  }
+  return avalanches;
+}
+
+RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector<double>& mean_speed_m_per_s,
+                            const std::vector<double>& lane_order, const RegimeOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  if (time_s.size() != mean_speed_m_per_s.size() || (!lane_order.empty() && lane_order.size() != time_s.size()))
+    throw InputError("ClassifyRegime: the time, speed and lane order series differ in length");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  RegimeResult r;
+  r.mean_lane_order = nan;
+  if (time_s.empty()) {
+    r.reason = "no frames";
+    return r;
+  }
+  const std::size_t n = time_s.size();
+  const double t_first = time_s.front(), t_last = time_s.back();
+  r.stationary_start_s = t_first + options.transient_s;
+  r.long_enough = t_last - r.stationary_start_s >= options.frozen_window_s - kTimeTolerance_s;
+
+  // Stationary stage: fraction of samples stopped, mean lane order. A run
+  // that ends before the transient does is averaged whole (and is too short
+  // to classify anyway).
+  const double from_s = t_last >= r.stationary_start_s - kTimeTolerance_s ? r.stationary_start_s : t_first;
+  std::size_t stationary = 0, stopped = 0, lane_samples = 0;
+  double lane_sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (time_s[i] < from_s - kTimeTolerance_s) continue;
+    ++stationary;
+    if (mean_speed_m_per_s[i] < options.stop_speed_m_per_s) ++stopped;
+    if (!lane_order.empty() && std::isfinite(lane_order[i])) {
+      lane_sum += lane_order[i];
+      ++lane_samples;
+    }
+  }
+  r.stopped_time_fraction = stationary > 0 ? static_cast<double>(stopped) / static_cast<double>(stationary) : 0.0;
+  if (lane_samples > 0) r.mean_lane_order = lane_sum / static_cast<double>(lane_samples);
+
+  // Final window: mean speed, frozen or not.
+  std::size_t end_samples = 0;
+  double end_sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (time_s[i] >= t_last - options.frozen_window_s - kTimeTolerance_s) {
+      end_sum += mean_speed_m_per_s[i];
+      ++end_samples;
+    }
+  r.end_mean_speed_m_per_s = end_sum / static_cast<double>(end_samples);
+  r.frozen_at_end = r.end_mean_speed_m_per_s < options.frozen_speed_m_per_s;
+
+  r.avalanches = FindAvalanches(time_s, mean_speed_m_per_s, options);
+  for (const Avalanche& a : r.avalanches) r.stationary_avalanches += a.stationary ? 1 : 0;
+
+  // The decision, in the order of regime.hpp.
+  const std::string speed_text = "mean speed along the desired direction over the last " +
+                                 FormatNumber(options.frozen_window_s) + " s " +
+                                 Fixed(r.end_mean_speed_m_per_s, 3) + " m/s";
+  if (!r.long_enough) {
+    r.regime = Regime::kUnclassified;
+    r.reason = "run too short: " + Fixed(t_last - t_first, 1) + " s, the classifier needs the transient (" +
+               FormatNumber(options.transient_s) + " s) plus a final window of " +
+               FormatNumber(options.frozen_window_s) + " s";
+  } else if (r.frozen_at_end) {
+    r.regime = Regime::kClogging;
+    r.reason = "frozen at the end: " + speed_text + " < " + FormatNumber(options.frozen_speed_m_per_s) + " m/s";
+  } else if (r.stationary_avalanches >= options.min_avalanches) {
+    r.regime = Regime::kAvalanches;
+    r.reason = std::to_string(r.stationary_avalanches) + " avalanches (stop >= " +
+               FormatNumber(options.min_stop_duration_s) + " s below " + FormatNumber(options.stop_speed_m_per_s) +
+               " m/s, then a burst above " + FormatNumber(options.burst_speed_m_per_s) +
+               " m/s) in the stationary stage, at least " + std::to_string(options.min_avalanches) +
+               ", and not frozen (" + speed_text + ")";
+  } else if (r.stopped_time_fraction <= options.max_stopped_fraction_for_lanes &&
+             (options.min_lane_order_for_lanes <= 0.0 ||
+              (std::isfinite(r.mean_lane_order) && r.mean_lane_order >= options.min_lane_order_for_lanes))) {
+    r.regime = Regime::kLanes;
+    r.reason = "free flow: stopped " + Fixed(100.0 * r.stopped_time_fraction, 1) +
+               " % of the stationary stage (at most " +
+               FormatNumber(100.0 * options.max_stopped_fraction_for_lanes) + " %), " +
+               std::to_string(r.stationary_avalanches) + " avalanche(s)";
+    if (std::isfinite(r.mean_lane_order)) r.reason += ", mean lane order " + Fixed(r.mean_lane_order, 2);
+  } else if (r.stopped_time_fraction <= options.max_stopped_fraction_for_lanes) {
+    r.regime = Regime::kUnclassified;
+    r.reason = "free flow without lanes: mean lane order " + Fixed(r.mean_lane_order, 2) + " below " +
+               FormatNumber(options.min_lane_order_for_lanes);
+  } else {
+    r.regime = Regime::kUnclassified;
+    r.reason = "intermittent: stopped " + Fixed(100.0 * r.stopped_time_fraction, 1) +
+               " % of the stationary stage with " + std::to_string(r.stationary_avalanches) +
+               " avalanche(s) (fewer than " + std::to_string(options.min_avalanches) + "), not frozen";
+  }
+  return r;
+}
+
+}  // namespace crowdrecon::analysis
