@@ -6,14 +6,14 @@
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
-#include "sqlite_util.hpp"
+#include "crowdrecon/scenario/sqlite.hpp"
 
 namespace crowdrecon::analysis {
 
 namespace {
 
-using detail::Database;
-using detail::Statement;
+using sqlite::Database;
+using sqlite::Statement;
 
 std::string Printf(const char* format, double value) {
   char buffer[64];

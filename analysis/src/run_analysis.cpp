@@ -16,14 +16,14 @@
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/scenario/run_file.hpp"
 #include "crowdrecon/scenario/scenario.hpp"
-#include "sqlite_util.hpp"
+#include "crowdrecon/scenario/sqlite.hpp"
 
 namespace crowdrecon::analysis {
 
 namespace {
 
-using detail::Database;
-using detail::Statement;
+using sqlite::Database;
+using sqlite::Statement;
 namespace fs = std::filesystem;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -195,19 +195,9 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
   if (!options.IsValid(&error)) throw InputError("analysis options: " + error);
   const std::string file = run_file.string();
 
-  // 1. Open. SQLite opens any file lazily and fails on the first query, so a
-  //    foreign file surfaces as "file is not a database": say what it means.
-  if (!fs::exists(run_file)) throw InputError(file + ": run file does not exist");
-  if (fs::is_directory(run_file)) throw InputError(file + ": is a folder, not a run file");
+  // 1. Open (RunFileReader names missing, foreign and non-run files).
   std::optional<scenario::RunFileReader> reader;
-  try {
-    reader.emplace(run_file);
-  } catch (const InputError& e) {
-    std::string why = e.what();
-    if (why.rfind(file + ": ", 0) == 0) why = why.substr(file.size() + 2);
-    if (why.find("not a crowdrecon run file") != std::string::npos) throw InputError(file + ": " + why);
-    throw InputError(file + ": not a crowdrecon run file (" + why + ")");
-  }
+  reader.emplace(run_file);
   const scenario::RunFileReader& run = *reader;
   RunAnalysis out;
   out.run_file = file;

@@ -1,7 +1,5 @@
 #include "crowdrecon/scenario/run_file.hpp"
 
-#include <sqlite3.h>
-
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -9,91 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/scenario/sqlite.hpp"
 
 namespace crowdrecon::scenario {
 
 namespace {
 
-// Thin RAII wrappers over the SQLite C API; every failure names the file.
-class Database {
- public:
-  Database(const std::filesystem::path& file, int flags) : file_(file.string()) {
-    if (sqlite3_open_v2(file_.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
-      const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
-      sqlite3_close(db_);
-      db_ = nullptr;
-      throw InputError(file_ + ": cannot open run file: " + message);
-    }
-    sqlite3_busy_timeout(db_, 5000);
-  }
-  ~Database() {
-    if (db_) sqlite3_close(db_);
-  }
-  Database(const Database&) = delete;
-  Database& operator=(const Database&) = delete;
-
-  void Exec(const std::string& sql) const {
-    char* error = nullptr;
-    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
-      const std::string message = error ? error : "unknown error";
-      sqlite3_free(error);
-      throw InputError(file_ + ": SQLite error: " + message + " (in: " + sql.substr(0, 80) + ")");
-    }
-  }
-  sqlite3* get() const { return db_; }
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  sqlite3* db_ = nullptr;
-};
-
-class Statement {
- public:
-  Statement(const Database& db, const std::string& sql) : db_(db) {
-    if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
-      throw InputError(db.file() + ": SQLite error: " + sqlite3_errmsg(db.get()) + " (in: " + sql.substr(0, 80) + ")");
-  }
-  ~Statement() { sqlite3_finalize(stmt_); }
-  Statement(const Statement&) = delete;
-  Statement& operator=(const Statement&) = delete;
-
-  Statement& Bind(int i, double v) { Check(sqlite3_bind_double(stmt_, i, v)); return *this; }
-  Statement& Bind(int i, std::int64_t v) { Check(sqlite3_bind_int64(stmt_, i, v)); return *this; }
-  Statement& Bind(int i, const std::string& v) {
-    Check(sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
-    return *this;
-  }
-  // Runs a statement that returns no rows, then resets it for reuse.
-  void Run() {
-    const int rc = sqlite3_step(stmt_);
-    if (rc != SQLITE_DONE) Fail(rc);
-    sqlite3_reset(stmt_);
-  }
-  // Steps to the next row; false at the end.
-  bool Next() {
-    const int rc = sqlite3_step(stmt_);
-    if (rc == SQLITE_ROW) return true;
-    if (rc != SQLITE_DONE) Fail(rc);
-    return false;
-  }
-  double Double(int col) const { return sqlite3_column_double(stmt_, col); }
-  std::int64_t Int(int col) const { return sqlite3_column_int64(stmt_, col); }
-  std::string Text(int col) const {
-    const auto* t = sqlite3_column_text(stmt_, col);
-    return t ? reinterpret_cast<const char*>(t) : "";
-  }
-
- private:
-  void Check(int rc) const {
-    if (rc != SQLITE_OK) Fail(rc);
-  }
-  [[noreturn]] void Fail(int) const {
-    throw InputError(db_.file() + ": SQLite error: " + sqlite3_errmsg(db_.get()));
-  }
-  const Database& db_;
-  sqlite3_stmt* stmt_ = nullptr;
-};
+using sqlite::Database;
+using sqlite::Statement;
 
 std::string NumberText(double v) {
   char buffer[40];
@@ -337,12 +258,22 @@ struct RunFileReader::Impl {
 };
 
 RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
-  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": run file does not exist");
   impl_->file = file.string();
+  if (!std::filesystem::exists(file)) throw InputError(impl_->file + ": run file does not exist");
+  if (std::filesystem::is_directory(file)) throw InputError(impl_->file + ": is a folder, not a run file");
   impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READONLY);
-  Statement check(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE name IN ('trajectory_data', 'run', 'person')");
-  if (!check.Next() || check.Int(0) != 3)
-    throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
+  // SQLite opens any file lazily and fails on the first query, so a foreign
+  // file surfaces here as "file is not a database": say what that means.
+  bool ok = false;
+  try {
+    Statement check(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE name IN ('trajectory_data', 'run', 'person')");
+    ok = check.Next() && check.Int(0) == 3;
+  } catch (const InputError& e) {
+    std::string why = e.what();
+    if (why.rfind(impl_->file + ": ", 0) == 0) why = why.substr(impl_->file.size() + 2);
+    throw InputError(impl_->file + ": not a crowdrecon run file (" + why + ")");
+  }
+  if (!ok) throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
 }
 RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
 RunFileReader::~RunFileReader() = default;

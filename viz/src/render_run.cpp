@@ -629,19 +629,9 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
   if (!options.IsValid(&error)) throw InputError(error);
   const std::string file = run_file.string();
 
-  // 1. Open the run. SQLite opens any file lazily and fails on the first query,
-  //    so a foreign file surfaces as "file is not a database": say what it means.
-  if (!std::filesystem::exists(run_file)) throw InputError(file + ": run file does not exist");
-  if (std::filesystem::is_directory(run_file)) throw InputError(file + ": is a folder, not a run file");
+  // 1. Open the run (RunFileReader names missing, foreign and non-run files).
   std::optional<scenario::RunFileReader> reader;
-  try {
-    reader.emplace(run_file);
-  } catch (const InputError& e) {
-    std::string why = e.what();
-    if (why.rfind(file + ": ", 0) == 0) why = why.substr(file.size() + 2);
-    if (why.find("not a crowdrecon run file") != std::string::npos) throw InputError(file + ": " + why);
-    throw InputError(file + ": not a crowdrecon run file (" + why + ")");
-  }
+  reader.emplace(run_file);
   const scenario::RunFileReader& run = *reader;
   const std::vector<std::int64_t> all_frames = run.Frames();
   if (all_frames.empty()) {

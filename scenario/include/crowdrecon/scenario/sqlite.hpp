@@ -1,6 +1,6 @@
-// Thin RAII wrappers over the SQLite C API for the analysis (internal). The
-// run-file reader of crowdrecon_scenario does not expose velocities or loads,
-// so the analysis queries person_state itself; every failure names the file.
+// Thin RAII wrappers over the SQLite C API, shared by the run-file writer and
+// reader and by the analysis: every failure is an InputError naming the file.
+// (SQLite's own header is light; nothing heavy leaks through here.)
 #pragma once
 
 #include <sqlite3.h>
@@ -11,7 +11,7 @@
 
 #include "crowdrecon/common/error.hpp"
 
-namespace crowdrecon::analysis::detail {
+namespace crowdrecon::sqlite {
 
 class Database {
  public:
@@ -22,8 +22,8 @@ class Database {
       db_ = nullptr;
       throw InputError(file_ + ": cannot open run file: " + message);
     }
-    // A run being simulated commits a frame at a time; wait for it rather
-    // than fail.
+    // A run being simulated commits a frame at a time; readers wait for the
+    // writer's transaction rather than fail.
     sqlite3_busy_timeout(db_, 10000);
   }
   ~Database() {
@@ -102,4 +102,4 @@ class Statement {
   sqlite3_stmt* stmt_ = nullptr;
 };
 
-}  // namespace crowdrecon::analysis::detail
+}  // namespace crowdrecon::sqlite
