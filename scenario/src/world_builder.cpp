@@ -301,6 +301,9 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     relax.parameters.ground_reaction = false;
     relax.parameters.restitution = relax.parameters.wall_restitution = 0.05;
     relax.parameters.time_step_s = 0.0;
+    // The placement is not part of the dynamics: relax with velocity Verlet
+    // whatever the run's integrator (Gear's step is ten times shorter).
+    relax.parameters.integrator = engine::Integrator::kVelocityVerlet;
     for (engine::BodyShape& s : relax.shapes) {
       for (Vec2& v : s.vertices) v *= scale;
       s.radius_m *= scale;
