@@ -54,6 +54,33 @@ double WrapAngle(double a) {
 // People are named by id = index + 1, as in run files.
 std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i + 1); }
 
+// Gear predictor for one coordinate (a Vec2 position or an angle): Pascal
+// triangle on the Nordsieck vector (x, h v, r2..r5). Returns the predicted r2.
+template <typename T>
+T GearPredictOne(T& x, T& v, std::array<T, 4>& r, double h) {
+  T r1 = v * h;
+  x += r1 + r[0] + r[1] + r[2] + r[3];
+  r1 += r[0] * 2.0 + r[1] * 3.0 + r[2] * 4.0 + r[3] * 5.0;
+  r[0] += r[1] * 3.0 + r[2] * 6.0 + r[3] * 10.0;
+  r[1] += r[2] * 4.0 + r[3] * 10.0;
+  r[2] += r[3] * 5.0;
+  v = r1 / h;
+  return r[0];
+}
+
+// Gear corrector for one coordinate, `delta` = h^2/2 a(computed) - r2(predicted),
+// with the coefficients for velocity-dependent forces (c0 = 3/16).
+template <typename T>
+void GearCorrectOne(T& x, T& v, std::array<T, 4>& r, T delta, double h) {
+  static constexpr double c[6] = {3.0 / 16.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0};
+  x += delta * c[0];
+  v += delta * (c[1] / h);
+  r[0] += delta * c[2];
+  r[1] += delta * c[3];
+  r[2] += delta * c[4];
+  r[3] += delta * c[5];
+}
+
 }  // namespace
 
 struct Simulation::Internals {
@@ -839,54 +866,25 @@ void Simulation::GearPredict() {
       in.gear_theta[i] = {};
       continue;
     }
-    auto& r = in.gear_xy[i];
-    Vec2 r1 = bodies_.velocity_m_per_s[i] * h;
-    bodies_.position_m[i] += r1 + r[0] + r[1] + r[2] + r[3];
-    r1 += r[0] * 2.0 + r[1] * 3.0 + r[2] * 4.0 + r[3] * 5.0;
-    r[0] += r[1] * 3.0 + r[2] * 6.0 + r[3] * 10.0;
-    r[1] += r[2] * 4.0 + r[3] * 10.0;
-    r[2] += r[3] * 5.0;
-    bodies_.velocity_m_per_s[i] = r1 / h;
-    predicted_r2[i] = r[0];
-    auto& t = in.gear_theta[i];
-    double t1 = bodies_.angular_velocity_rad_per_s[i] * h;
-    bodies_.angle_rad[i] += t1 + t[0] + t[1] + t[2] + t[3];
-    t1 += t[0] * 2.0 + t[1] * 3.0 + t[2] * 4.0 + t[3] * 5.0;
-    t[0] += t[1] * 3.0 + t[2] * 6.0 + t[3] * 10.0;
-    t[1] += t[2] * 4.0 + t[3] * 10.0;
-    t[2] += t[3] * 5.0;
-    bodies_.angular_velocity_rad_per_s[i] = t1 / h;
-    predicted_t2[i] = t[0];
+    predicted_r2[i] = GearPredictOne(bodies_.position_m[i], bodies_.velocity_m_per_s[i], in.gear_xy[i], h);
+    predicted_t2[i] = GearPredictOne(bodies_.angle_rad[i], bodies_.angular_velocity_rad_per_s[i], in.gear_theta[i], h);
     Wrap(bodies_.position_m[i]);
   }
 }
 
 void Simulation::GearCorrect() {
   ScopedTimer timer(profile_.integrate_s);
-  static constexpr double c[6] = {3.0 / 16.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0};
   const double h = dt_s_;
   Internals& in = *in_;
   const std::vector<Vec2>& predicted_r2 = in.v_half;
   const std::vector<double>& predicted_t2 = in.w_half;
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_.state[i] != PersonState::kWalking) continue;
-    auto& r = in.gear_xy[i];
-    const Vec2 delta = bodies_.force_n[i] / bodies_.mass_kg[i] * (h * h / 2.0) - predicted_r2[i];
-    bodies_.position_m[i] += delta * c[0];
-    bodies_.velocity_m_per_s[i] += delta * (c[1] / h);
-    r[0] += delta * c[2];
-    r[1] += delta * c[3];
-    r[2] += delta * c[4];
-    r[3] += delta * c[5];
+    GearCorrectOne(bodies_.position_m[i], bodies_.velocity_m_per_s[i], in.gear_xy[i],
+                   bodies_.force_n[i] / bodies_.mass_kg[i] * (h * h / 2.0) - predicted_r2[i], h);
     Wrap(bodies_.position_m[i]);
-    auto& t = in.gear_theta[i];
-    const double dt2 = bodies_.torque_n_m[i] / bodies_.inertia_kg_m2[i] * (h * h / 2.0) - predicted_t2[i];
-    bodies_.angle_rad[i] += dt2 * c[0];
-    bodies_.angular_velocity_rad_per_s[i] += dt2 * (c[1] / h);
-    t[0] += dt2 * c[2];
-    t[1] += dt2 * c[3];
-    t[2] += dt2 * c[4];
-    t[3] += dt2 * c[5];
+    GearCorrectOne(bodies_.angle_rad[i], bodies_.angular_velocity_rad_per_s[i], in.gear_theta[i],
+                   bodies_.torque_n_m[i] / bodies_.inertia_kg_m2[i] * (h * h / 2.0) - predicted_t2[i], h);
   }
 }
 
