@@ -445,6 +445,13 @@ void Simulation::UpdatePairs() {
   std::sort(in.pairs.begin(), in.pairs.end());
 }
 
+void Simulation::RebuildNeighbourList() {
+  in_->pairs_valid = false;
+  UpdatePairs();
+}
+
+std::size_t Simulation::neighbour_pair_count() const { return in_->pairs.size(); }
+
 // ---------------------------------------------------------------------------
 // Stage 2: shapes to world frame
 

@@ -140,6 +140,11 @@ class Simulation {
   std::string SaveState() const;
   void LoadState(const std::string& data);
 
+  // Rebuilds the neighbour (Verlet) list now; normally the engine decides.
+  // Results do not depend on when it is rebuilt. For benchmarks and tests.
+  void RebuildNeighbourList();
+  std::size_t neighbour_pair_count() const;  // person-person pairs in the list
+
   // Diagnostics for tests and reports.
   Vec2 LinearMomentum() const;
   double AngularMomentum() const;  // about the origin (z component)
