@@ -84,9 +84,10 @@ void GearCorrectOne(T& x, T& v, std::array<T, 4>& r, T delta, double h) {
 }  // namespace
 
 struct Simulation::Internals {
-  // Geometry of every body in world frame, rebuilt each evaluation.
-  std::vector<std::uint32_t> vertex_offset;  // per body, into world_vertices
-  std::vector<Vec2> world_vertices;
+  // Geometry of every shape and wall in its own frame (narrow_phase.hpp).
+  std::vector<ShapeGeometry> shape_geometry;
+  std::vector<ShapeGeometry> wall_geometry;
+  std::vector<Vec2> wall_origin;  // world position of each wall's frame
   std::vector<double> bound_m;  // core radius + sphero-radius per body
   double skin_m = 0.1;
 
@@ -107,8 +108,6 @@ struct Simulation::Internals {
 
   std::vector<std::vector<Contact>> chunk_contacts;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
-  std::vector<std::pair<Vec2, double>> wall_bounds;  // bounding circle of each wall
-  std::vector<std::pair<Vec2, Vec2>> wall_boxes;     // its bounding box, relative to the circle's centre
   std::vector<double> cos_angle, sin_angle;          // per body, set by PlaceShapes
   // Corrections of the dashpot impulse for contacts that began during the
   // last half step (trailing) or end during the next (leading); see ContactLaw.
@@ -210,9 +209,7 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   bodies_.target.resize(n);
   bodies_.group.resize(n);
   bodies_.state.resize(n);
-  in_->vertex_offset.resize(n + 1);
   in_->bound_m.resize(n);
-  std::uint32_t offset = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const PersonDef& p = def_.people[i];
     bodies_.position_m[i] = p.position_m;
@@ -226,14 +223,12 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     bodies_.target[i] = p.target;
     bodies_.group[i] = p.group;
     bodies_.state[i] = p.state;
-    in_->vertex_offset[i] = offset;
     const BodyShape& s = def_.shapes[p.shape];
-    offset += static_cast<std::uint32_t>(s.vertices.size());
     in_->bound_m[i] = s.core_radius_m + s.radius_m;
     Wrap(bodies_.position_m[i]);
   }
-  in_->vertex_offset[n] = offset;
-  in_->world_vertices.resize(offset);
+  for (const BodyShape& shape : def_.shapes)
+    in_->shape_geometry.push_back(ShapeGeometry::Make(shape.vertices, shape.vertices.size() >= 3, shape.radius_m));
   in_->cos_angle.assign(n, 1.0);
   in_->sin_angle.assign(n, 0.0);
 
@@ -259,19 +254,10 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
       extend(wall.points.back(), wall.points[wall.points.size() - 2], axis == 0);
     }
   }
-  in_->wall_bounds.resize(def_.walls.size());
+  in_->wall_origin.resize(def_.walls.size());
   for (std::size_t w = 0; w < def_.walls.size(); ++w) {
-    // Bounding circle of the polyline, for the per-vertex cull of the narrow phase.
-    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
-    for (const Vec2& p : def_.walls[w].points) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
-    }
-    const Vec2 centre = (lo + hi) / 2.0;
-    double radius = 0.0;
-    for (const Vec2& p : def_.walls[w].points) radius = std::max(radius, Length(p - centre));
-    in_->wall_bounds[w] = {centre, radius};
-    in_->wall_boxes.push_back({lo - centre, hi - centre});
+    const Wall& wall = def_.walls[w];
+    in_->wall_geometry.push_back(ShapeGeometry::FromWorld(wall.points, wall.closed, wall.radius_m, in_->wall_origin[w]));
   }
 
   const auto factor = [](double eps) {
@@ -433,7 +419,7 @@ void Simulation::UpdatePairs() {
     for (std::uint32_t w = 0; w < def_.walls.size(); ++w) {
       const Wall& wall = def_.walls[w];
       const double range = in.bound_m[i] + wall.radius_m + in.skin_m;
-      if (Length(pi - in.wall_bounds[w].first) > in.wall_bounds[w].second + range) continue;
+      if (Length(pi - in.wall_origin[w]) > in.wall_geometry[w].core_radius_m + range) continue;
       const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
       for (std::size_t seg = 0; seg < segments; ++seg)
         if (DistanceToSegment(pi, wall.points[seg], wall.points[(seg + 1) % wall.points.size()]) < range) {
@@ -462,16 +448,8 @@ void Simulation::PlaceShapes() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
-    const BodyShape& s = def_.shapes[bodies_.shape[i]];
-    const double c = std::cos(bodies_.angle_rad[i]), sn = std::sin(bodies_.angle_rad[i]);
-    in.cos_angle[i] = c;
-    in.sin_angle[i] = sn;
-    const Vec2 x = bodies_.position_m[i];
-    Vec2* out = &in.world_vertices[in.vertex_offset[i]];
-    for (std::size_t k = 0; k < s.vertices.size(); ++k) {
-      const Vec2 v = s.vertices[k];
-      out[k] = {x.x + c * v.x - sn * v.y, x.y + sn * v.x + c * v.y};
-    }
+    in.cos_angle[i] = std::cos(bodies_.angle_rad[i]);
+    in.sin_angle[i] = std::sin(bodies_.angle_rad[i]);
   }
 }
 
@@ -579,16 +557,10 @@ void Simulation::Collide() {
   const std::size_t chunks = person_chunks + wall_chunks;
   in.chunk_contacts.resize(chunks);
 
-  const auto placed = [&](std::uint32_t i, const Vec2* vertices) {
-    const BodyShape& s = def_.shapes[bodies_.shape[i]];
+  const auto placed = [&](std::uint32_t i, Vec2 position) {
     PlacedShape p;
-    p.vertices = vertices;
-    p.count = static_cast<std::uint32_t>(s.vertices.size());
-    p.closed = s.vertices.size() >= 3;
-    p.radius_m = s.radius_m;
-    p.core_radius_m = s.core_radius_m;
-    p.box_min = s.box_min_m;
-    p.box_max = s.box_max_m;
+    p.geometry = &in.shape_geometry[bodies_.shape[i]];
+    p.position = position;
     p.cos_angle = in.cos_angle[i];
     p.sin_angle = in.sin_angle[i];
     return p;
@@ -609,7 +581,6 @@ void Simulation::Collide() {
 #pragma omp parallel num_threads(def_.threads) if (total >= 4)
   {
     std::vector<ContactPoint> points;
-    std::vector<Vec2> shifted;
 #pragma omp for schedule(dynamic, 1)
     for (std::int64_t ck = 0; ck < total; ++ck) {
       const std::size_t chunk = static_cast<std::size_t>(ck);
@@ -622,18 +593,7 @@ void Simulation::Collide() {
           if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
-          const Vec2 shift = xb_image - bodies_.position_m[b];
-          PlacedShape pa = placed(a, &in.world_vertices[in.vertex_offset[a]]);
-          pa.centre = xa;
-          const Vec2* vb = &in.world_vertices[in.vertex_offset[b]];
-          if (shift.x != 0.0 || shift.y != 0.0) {
-            const std::size_t count = in.vertex_offset[b + 1] - in.vertex_offset[b];
-            shifted.resize(count);
-            for (std::size_t v = 0; v < count; ++v) shifted[v] = vb[v] + shift;
-            vb = shifted.data();
-          }
-          PlacedShape pb = placed(b, vb);
-          pb.centre = xb_image;
+          const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
           points.clear();
           CollideShapes(pa, pb, points);
           if (points.empty()) continue;
@@ -661,18 +621,10 @@ void Simulation::Collide() {
           const auto [a, w] = in.wall_pairs[k];
           if (bodies_.state[a] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
-          PlacedShape pa = placed(a, &in.world_vertices[in.vertex_offset[a]]);
-          pa.centre = xa;
-          const Wall& wall = def_.walls[w];
+          const PlacedShape pa = placed(a, xa);
           PlacedShape pw;
-          pw.vertices = wall.points.data();
-          pw.count = static_cast<std::uint32_t>(wall.points.size());
-          pw.closed = wall.closed;
-          pw.radius_m = wall.radius_m;
-          pw.centre = in.wall_bounds[w].first;
-          pw.core_radius_m = in.wall_bounds[w].second;
-          pw.box_min = in.wall_boxes[w].first;
-          pw.box_max = in.wall_boxes[w].second;
+          pw.geometry = &in.wall_geometry[w];
+          pw.position = in.wall_origin[w];
           points.clear();
           CollideShapes(pa, pw, points);
           if (points.empty()) continue;

@@ -174,7 +174,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
       }
       write_frame(last_frame + 1);
       if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) WriteCheckpoint(checkpoint, fingerprint, last_frame, sim);
-      const bool stop = g_stop_requested.load() || (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);
+      const bool stop = g_stop_requested.load() || (options.stop_flag && options.stop_flag->load()) ||
+                        (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);
       const auto now = Clock::now();
       if (options.show_progress && (now - last_print > std::chrono::milliseconds(500) || stop || last_frame == total_frames)) {
         last_print = now;

@@ -207,24 +207,26 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     const auto cy = static_cast<std::size_t>(std::clamp((p.y - grid_lo.y) / cell, 0.0, double(gy - 1)));
     return std::pair{cx, cy};
   };
-  const auto placed_shape = [&](std::size_t i, Vec2 at, double theta, std::vector<Vec2>& out) {
-    const engine::BodyShape& s = def.shapes[def.people[i].shape];
-    out.clear();
-    double core = 0.0;
-    for (const Vec2& v : s.vertices) {
-      out.push_back(at + Rotated(v * scale, theta));
-      core = std::max(core, Length(v) * scale);
-    }
+  // Shapes at this growth stage's scale, and the walls, in their own frames.
+  std::vector<engine::ShapeGeometry> scaled_shapes;
+  for (const engine::BodyShape& s : def.shapes) {
+    std::vector<Vec2> vertices;
+    for (const Vec2& v : s.vertices) vertices.push_back(v * scale);
+    scaled_shapes.push_back(engine::ShapeGeometry::Make(std::move(vertices), s.vertices.size() >= 3, s.radius_m * scale));
+  }
+  std::vector<engine::ShapeGeometry> wall_shapes;
+  std::vector<Vec2> wall_origins(def.walls.size());
+  for (std::size_t w = 0; w < def.walls.size(); ++w)
+    wall_shapes.push_back(engine::ShapeGeometry::FromWorld(def.walls[w].points, def.walls[w].closed,
+                                                           def.walls[w].radius_m, wall_origins[w]));
+  const auto placed_shape = [&](std::size_t i, Vec2 at, double theta) {
     engine::PlacedShape p;
-    p.vertices = out.data();
-    p.count = static_cast<std::uint32_t>(out.size());
-    p.closed = out.size() >= 3;
-    p.radius_m = s.radius_m * scale;
-    p.centre = at;
-    p.core_radius_m = core;
+    p.geometry = &scaled_shapes[def.people[i].shape];
+    p.position = at;
+    p.cos_angle = std::cos(theta);
+    p.sin_angle = std::sin(theta);
     return p;
   };
-  std::vector<Vec2> mine, theirs;
   std::vector<engine::ContactPoint> hits;
   const auto periodic_image = [&](Vec2 d) {
     if (def.periodic.x) d.x -= (def.periodic.max_m.x - def.periodic.min_m.x) * std::nearbyint(d.x / (def.periodic.max_m.x - def.periodic.min_m.x));
@@ -242,18 +244,12 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
       const Vec2 e = def.targets[def.people[i].target].Direction(at);
       const double theta = (e.x != 0.0 || e.y != 0.0 ? std::atan2(e.y, e.x) : 2.0 * kPi * Uniform(rng)) +
                            0.3 * (Uniform(rng) - 0.5);
-      const engine::PlacedShape me = placed_shape(i, at, theta, mine);
+      const engine::PlacedShape me = placed_shape(i, at, theta);
       bool free = true;
-      for (const engine::Wall& w : def.walls) {
+      for (std::size_t w = 0; w < def.walls.size(); ++w) {
         engine::PlacedShape ws;
-        ws.vertices = w.points.data();
-        ws.count = static_cast<std::uint32_t>(w.points.size());
-        ws.closed = w.closed;
-        ws.radius_m = w.radius_m;
-        Vec2 wl{1e300, 1e300}, wh{-1e300, -1e300};
-        for (const Vec2& q : w.points) { wl = {std::min(wl.x, q.x), std::min(wl.y, q.y)}; wh = {std::max(wh.x, q.x), std::max(wh.y, q.y)}; }
-        ws.centre = (wl + wh) / 2.0;
-        ws.core_radius_m = Length(wh - wl) / 2.0 + 1e-9;
+        ws.geometry = &wall_shapes[w];
+        ws.position = wall_origins[w];
         hits.clear();
         engine::CollideShapes(me, ws, hits);
         if (!hits.empty()) { free = false; break; }
@@ -265,7 +261,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
           if (x >= gx || y >= gy) continue;
           for (std::uint32_t j : grid[y * gx + x]) {
             hits.clear();
-            engine::CollideShapes(me, placed_shape(j, position[j], angle[j], theirs), hits);
+            engine::CollideShapes(me, placed_shape(j, position[j], angle[j]), hits);
             if (!hits.empty()) { free = false; break; }
           }
         }
@@ -275,7 +271,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
           const Vec2 d = periodic_image(position[j] - at);
           if (Length(d) > 2.0 * max_bound * scale || Length(position[j] - at - d) < 1e-9) continue;
           hits.clear();
-          engine::CollideShapes(me, placed_shape(j, at + d, angle[j], theirs), hits);
+          engine::CollideShapes(me, placed_shape(j, at + d, angle[j]), hits);
           if (!hits.empty()) free = false;
         }
       if (!free) continue;

@@ -1,4 +1,4 @@
-// Narrow phase: contact points between two spheropolygons in world frame.
+// Narrow phase: contact points between two spheropolygons.
 //
 // Overlaps come from vertex-to-edge distances in both directions (paper,
 // eqs. 8-9; Alonso-Marroquin 2008): every vertex of A interacts with the
@@ -16,6 +16,16 @@
 // disk's own vertex is counted (a disk-disk contact is one spring k_n).
 // Elsewhere, a corner touching a corner is counted from both sides (two
 // springs), a flat face touching a face at up to four points (docs/model.md).
+//
+// How it is computed. A shape is kept in its own frame (ShapeGeometry, built
+// once: vertices, edges with their inverse squared lengths, reflex corners,
+// bounding box and circle) and placed by a pose (PlacedShape). For a pair,
+// the two bounding boxes, each grown by half the reach r_A + r_B, are tested
+// for overlap (separating axes); then each vertex of A is carried into B's
+// frame by one rotation and translation, tested against B's grown box, and
+// only the survivors are measured against B's edges, in B's frame. The world
+// vertices are never formed. Both culls are exact: they drop only vertices
+// that are farther than the reach from B's core.
 #pragma once
 
 #include <cstdint>
@@ -25,28 +35,47 @@
 
 namespace crowdrecon::engine {
 
-// A shape placed in the world: vertices in world coordinates. count 1 = disk;
-// closed with count >= 3 = polygon (counter-clockwise); open = polyline
-// (count - 1 edges; a capsule is an open polyline of 2 vertices; walls are
-// open or closed polylines).
-struct PlacedShape {
-  const Vec2* vertices = nullptr;
-  std::uint32_t count = 0;
+// One edge of a core: start vertex, edge vector, 1 / |edge|^2.
+struct CoreEdge {
+  Vec2 start;
+  Vec2 direction;
+  double inverse_length2 = 0.0;
+};
+
+// A core polygon, polyline or point in its own frame, with what the narrow
+// phase needs precomputed. count 1 = disk; closed with count >= 3 = polygon
+// (counter-clockwise); open = polyline (count - 1 edges; a capsule is an open
+// polyline of 2 vertices; walls are open or closed polylines).
+struct ShapeGeometry {
+  std::vector<Vec2> vertices;
+  std::vector<CoreEdge> edges;
+  std::vector<std::uint8_t> reflex;  // per vertex of a closed polygon: 1 if reflex
   bool closed = true;
   double radius_m = 0.0;
-  Vec2 centre;                 // centroid (for the cheap per-vertex cull)
-  double core_radius_m = 0.0;  // max distance of a vertex from `centre`
-  // Bounding box of the core in the shape's own frame (rotation `angle` about
-  // `centre`): a vertex farther than r_a + r_b outside it cannot touch, which
-  // culls most vertex tests of elongated bodies exactly.
-  // Default: unbounded (no cull).
-  Vec2 box_min{-1e300, -1e300}, box_max{1e300, 1e300};  // relative to centre, rotated frame
+  double core_radius_m = 0.0;  // max distance of a vertex from the frame's origin
+  Vec2 box_min, box_max;       // bounding box of the core in the shape's frame
+
+  // Builds the geometry of a core given in its own frame (a body: centroid at
+  // the origin). Vertex counts must be 1..32767.
+  static ShapeGeometry Make(std::vector<Vec2> vertices, bool closed, double radius_m);
+  // A core given in world coordinates (a wall): the frame's origin is put at
+  // the centre of its bounding box; `origin` receives that point, which is
+  // the position of the shape's pose (angle 0).
+  static ShapeGeometry FromWorld(const std::vector<Vec2>& points, bool closed, double radius_m, Vec2& origin);
+  std::uint32_t count() const { return static_cast<std::uint32_t>(vertices.size()); }
+};
+
+// A shape placed in the world: its geometry and a pose (the world position
+// of its frame's origin, and the rotation of the frame).
+struct PlacedShape {
+  const ShapeGeometry* geometry = nullptr;
+  Vec2 position;
   double cos_angle = 1.0, sin_angle = 0.0;
 };
 
 struct ContactPoint {
-  Vec2 point;            // application point: middle of the overlap
-  Vec2 normal;           // unit normal from B to A (a repulsive force on A is +normal)
+  Vec2 point;            // application point (world): middle of the overlap
+  Vec2 normal;           // unit normal (world) from B to A (a repulsive force on A is +normal)
   double overlap_m = 0;  // delta_n = r_A + r_B - distance (> 0 when touching)
   // The vertex that owns the contact: bit 15 clear = vertex of A, set = vertex of B.
   std::uint32_t feature = 0;
@@ -55,7 +84,7 @@ struct ContactPoint {
 inline constexpr std::uint32_t kVertexOfB = 1u << 15;
 
 // Appends the contacts between A and B to `out` (nothing if they do not touch),
-// vertices of A first, each side in vertex order. Vertex counts must be below 32768.
+// vertices of A first, each side in vertex order.
 void CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out);
 
 }  // namespace crowdrecon::engine

@@ -6,6 +6,7 @@
 // shown on a terminal only.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -23,6 +24,11 @@ struct RunOptions {
   // Stop (as if interrupted) once the simulated time reaches this; < 0 never.
   // For tests of interruption and resume.
   double stop_after_s = -1.0;
+  // Also stop (as if interrupted: a checkpoint is written) once this flag is
+  // true; may be null. For callers that run several scenarios at once (a
+  // sweep): the flag of InstallInterruptHandlers is cleared by every
+  // RunScenario that starts, so it cannot stop concurrent runs reliably.
+  const std::atomic<bool>* stop_flag = nullptr;
 };
 
 struct RunSummary {
