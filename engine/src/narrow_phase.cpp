@@ -59,18 +59,19 @@ struct Closest {
   double distance = std::numeric_limits<double>::infinity();
 };
 
-Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) {
+// Searches the edges edge_index[0..m) (all edges when edge_index is null).
+Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g, const std::uint16_t* edge_index, std::size_t m) {
   Closest best;
   if (g.edges.empty()) {
     best.point = g.vertices[0];
     best.distance = Length(p - g.vertices[0]);
     return best;
   }
-  const std::size_t edges = g.edges.size();
   double best_d2 = std::numeric_limits<double>::infinity();
   std::size_t best_edge = 0;
   double best_t = 0.0;
-  for (std::size_t j = 0; j < edges; ++j) {
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::size_t j = edge_index ? edge_index[k] : k;
     const CoreEdge& e = g.edges[j];
     double t = Dot(p - e.start, e.direction) * e.inverse_length2;
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
@@ -101,27 +102,46 @@ Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) {
   return best;
 }
 
+Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) { return ClosestOnCore(p, g, nullptr, g.edges.size()); }
+
 // Contacts of the vertices of `from` against the core of `to`; `flip` makes
-// normals point from B to A when `from` is B. Works in `to`'s frame.
+// normals point from B to A when `from` is B. Works in `to`'s unscaled frame
+// (its geometry's own units).
 void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, std::uint32_t tag,
                      std::vector<ContactPoint>& out) {
   const ShapeGeometry& f = *from.geometry;
   const ShapeGeometry& g = *to.geometry;
-  const double reach = f.radius_m + g.radius_m;
-  // from-frame -> to-frame: rotation by (theta_from - theta_to), then the
-  // offset of from's origin seen in to's frame.
-  const double c = from.cos_angle * to.cos_angle + from.sin_angle * to.sin_angle;
-  const double s = from.sin_angle * to.cos_angle - from.cos_angle * to.sin_angle;
+  const double reach = f.radius_m * from.scale + g.radius_m * to.scale;  // metres
+  const double unit = to.scale;  // metres per unit of g
+  const double reach_g = reach / unit;
+  // from's geometry -> g's units and frame: rotation by (theta_from - theta_to)
+  // with the ratio of scales, then the offset of from's origin seen in to's frame.
+  const double ratio = from.scale / unit;
+  const double c = (from.cos_angle * to.cos_angle + from.sin_angle * to.sin_angle) * ratio;
+  const double s = (from.sin_angle * to.cos_angle - from.cos_angle * to.sin_angle) * ratio;
   const Vec2 d = from.position - to.position;
-  const Vec2 o{to.cos_angle * d.x + to.sin_angle * d.y, -to.sin_angle * d.x + to.cos_angle * d.y};
-  const Vec2 lo = g.box_min - Vec2{reach, reach}, hi = g.box_max + Vec2{reach, reach};
+  const Vec2 o = Vec2{to.cos_angle * d.x + to.sin_angle * d.y, -to.sin_angle * d.x + to.cos_angle * d.y} / unit;
+  const Vec2 lo = g.box_min - Vec2{reach_g, reach_g}, hi = g.box_max + Vec2{reach_g, reach_g};
+  const bool use_grid = !g.cell_start.empty() && reach_g <= g.grid_reach_m;
+  const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
   const std::uint32_t n = f.count();
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec2 v = f.vertices[i];
     const Vec2 p{c * v.x - s * v.y + o.x, s * v.x + c * v.y + o.y};
     if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) continue;
-    const Closest cl = ClosestOnCore(p, g);
-    if (cl.distance >= reach) continue;
+    Closest cl;
+    if (use_grid) {
+      const double fx = (p.x - g.grid_origin.x) * inverse_cell, fy = (p.y - g.grid_origin.y) * inverse_cell;
+      const std::uint32_t cx = fx <= 0.0 ? 0 : std::min(g.grid_nx - 1, static_cast<std::uint32_t>(fx));
+      const std::uint32_t cy = fy <= 0.0 ? 0 : std::min(g.grid_ny - 1, static_cast<std::uint32_t>(fy));
+      const std::uint32_t cell = cy * g.grid_nx + cx;
+      const std::uint32_t first = g.cell_start[cell], last = g.cell_start[cell + 1];
+      if (first == last) continue;  // farther than the reach from the core
+      cl = ClosestOnCore(p, g, &g.cell_edges[first], last - first);
+    } else {
+      cl = ClosestOnCore(p, g);
+    }
+    if (cl.distance >= reach_g) continue;
     Vec2 normal;
     if (cl.distance > 0.0) {
       normal = (p - cl.point) / cl.distance;
@@ -131,8 +151,8 @@ void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, 
       continue;  // exactly on the core boundary: no direction (measure zero)
     }
     ContactPoint cp;
-    cp.overlap_m = reach - cl.distance;
-    const Vec2 local = cl.point + normal * (g.radius_m - cp.overlap_m / 2.0);
+    cp.overlap_m = reach - cl.distance * unit;
+    const Vec2 local = cl.point * unit + normal * (g.radius_m * unit - cp.overlap_m / 2.0);  // metres, to's frame
     cp.point = to.position + Vec2{to.cos_angle * local.x - to.sin_angle * local.y,
                                   to.sin_angle * local.x + to.cos_angle * local.y};
     const Vec2 world_normal{to.cos_angle * normal.x - to.sin_angle * normal.y,
@@ -150,9 +170,9 @@ bool BoxesApart(const PlacedShape& a, const PlacedShape& b, double reach) {
   const ShapeGeometry& ga = *a.geometry;
   const ShapeGeometry& gb = *b.geometry;
   const double grow = reach / 2.0;
-  const Vec2 ha = (ga.box_max - ga.box_min) / 2.0 + Vec2{grow, grow};
-  const Vec2 hb = (gb.box_max - gb.box_min) / 2.0 + Vec2{grow, grow};
-  const Vec2 ma = (ga.box_max + ga.box_min) / 2.0, mb = (gb.box_max + gb.box_min) / 2.0;
+  const Vec2 ha = (ga.box_max - ga.box_min) * (a.scale / 2.0) + Vec2{grow, grow};
+  const Vec2 hb = (gb.box_max - gb.box_min) * (b.scale / 2.0) + Vec2{grow, grow};
+  const Vec2 ma = (ga.box_max + ga.box_min) * (a.scale / 2.0), mb = (gb.box_max + gb.box_min) * (b.scale / 2.0);
   const Vec2 ua{a.cos_angle, a.sin_angle}, va{-a.sin_angle, a.cos_angle};
   const Vec2 ub{b.cos_angle, b.sin_angle}, vb{-b.sin_angle, b.cos_angle};
   const Vec2 ca = a.position + ua * ma.x + va * ma.y;
@@ -169,11 +189,59 @@ bool BoxesApart(const PlacedShape& a, const PlacedShape& b, double reach) {
 
 }  // namespace
 
+void ShapeGeometry::BuildEdgeGrid(double reach_m) {
+  cell_start.clear();
+  cell_edges.clear();
+  grid_nx = grid_ny = 0;
+  grid_reach_m = 0.0;
+  if (edges.size() < 6 || !(reach_m > 0.0) || edges.size() > 65535) return;
+  const Vec2 lo = box_min - Vec2{reach_m, reach_m}, hi = box_max + Vec2{reach_m, reach_m};
+  // About 24 cells along the longer side: a cell is small next to a body, so
+  // few edges are candidates, and the grid stays a few kilobytes.
+  const double cell = std::max(hi.x - lo.x, hi.y - lo.y) / 24.0;
+  const auto nx = static_cast<std::uint32_t>(std::ceil((hi.x - lo.x) / cell));
+  const auto ny = static_cast<std::uint32_t>(std::ceil((hi.y - lo.y) / cell));
+  const double half_diagonal = cell * std::sqrt(0.5);
+  const double slack = 1e-9 * (1.0 + core_radius_m + reach_m);  // round-off of the distances below
+  std::vector<double> distance(edges.size());
+  cell_start.assign(std::size_t{nx} * ny + 1, 0);
+  for (std::uint32_t cy = 0; cy < ny; ++cy)
+    for (std::uint32_t cx = 0; cx < nx; ++cx) {
+      const Vec2 centre = lo + Vec2{(cx + 0.5) * cell, (cy + 0.5) * cell};
+      double least = std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < edges.size(); ++j) {
+        const CoreEdge& e = edges[j];
+        const double t = std::clamp(Dot(centre - e.start, e.direction) * e.inverse_length2, 0.0, 1.0);
+        distance[j] = Length(centre - (e.start + e.direction * t));
+        least = std::min(least, distance[j]);
+      }
+      const bool inside = ClosestOnCore(centre, *this).distance < 0.0;
+      const std::size_t index = std::size_t{cy} * nx + cx;
+      // Outside and farther than reach + half a diagonal: no point of the cell
+      // can touch. Inside cells keep their candidates (a vertex there is deep
+      // in the core, which the engine reports as an error).
+      if (!inside && least - half_diagonal > reach_m + slack) {
+        cell_start[index + 1] = static_cast<std::uint32_t>(cell_edges.size());
+        continue;
+      }
+      // Any point p of the cell: its closest edge e* has |p e*| <= |p e_least|
+      // <= least + h, so |centre e*| <= least + 2h.
+      for (std::size_t j = 0; j < edges.size(); ++j)
+        if (distance[j] <= least + 2.0 * half_diagonal + slack) cell_edges.push_back(static_cast<std::uint16_t>(j));
+      cell_start[index + 1] = static_cast<std::uint32_t>(cell_edges.size());
+    }
+  grid_origin = lo;
+  grid_cell_m = cell;
+  grid_nx = nx;
+  grid_ny = ny;
+  grid_reach_m = reach_m;
+}
+
 void CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out) {
   const ShapeGeometry& ga = *a.geometry;
   const ShapeGeometry& gb = *b.geometry;
-  const double reach = ga.radius_m + gb.radius_m;
-  const double bound = ga.core_radius_m + gb.core_radius_m + reach;
+  const double reach = ga.radius_m * a.scale + gb.radius_m * b.scale;
+  const double bound = ga.core_radius_m * a.scale + gb.core_radius_m * b.scale + reach;
   if (LengthSquared(a.position - b.position) >= bound * bound) return;
   if (BoxesApart(a, b, reach)) return;
   // With a disk on either side, the disk's vertex alone gives the exact overlap.

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numbers>
 #include <type_traits>
+#include <unordered_map>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
@@ -45,12 +46,6 @@ std::uint64_t PairKey(const Contact& c) {
   return (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
 }
 
-double WrapAngle(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a <= 0.0) a += 2.0 * kPi;
-  return a - kPi;  // (-pi, pi]
-}
-
 // People are named by id = index + 1, as in run files.
 std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i + 1); }
 
@@ -84,8 +79,13 @@ void GearCorrectOne(T& x, T& v, std::array<T, 4>& r, T delta, double h) {
 }  // namespace
 
 struct Simulation::Internals {
-  // Geometry of every shape and wall in its own frame (narrow_phase.hpp).
-  std::vector<ShapeGeometry> shape_geometry;
+  // Geometry of every shape family and wall in its own frame (narrow_phase.hpp).
+  // Shapes that are uniform scalings of one another share a family geometry
+  // in units of their sphero-radius: shape k is family shape_family[k] scaled
+  // by shape_scale[k].
+  std::vector<ShapeGeometry> family_geometry;
+  std::vector<std::uint32_t> shape_family;
+  std::vector<double> shape_scale;
   std::vector<ShapeGeometry> wall_geometry;
   std::vector<Vec2> wall_origin;  // world position of each wall's frame
   std::vector<double> bound_m;  // core radius + sphero-radius per body
@@ -107,6 +107,9 @@ struct Simulation::Internals {
   bool gear_initialised = false;
 
   std::vector<std::vector<Contact>> chunk_contacts;
+  std::vector<std::size_t> chunk_offset;  // start of each chunk in contacts_
+  // Contacts of each body (indices into contacts_, in contact order): CSR.
+  std::vector<std::uint32_t> body_contact_start, body_contact_items, body_contact_fill;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
   std::vector<double> cos_angle, sin_angle;          // per body, set by PlaceShapes
   // Corrections of the dashpot impulse for contacts that began during the
@@ -227,8 +230,55 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     in_->bound_m[i] = s.core_radius_m + s.radius_m;
     Wrap(bodies_.position_m[i]);
   }
-  for (const BodyShape& shape : def_.shapes)
-    in_->shape_geometry.push_back(ShapeGeometry::Make(shape.vertices, shape.vertices.size() >= 3, shape.radius_m));
+  // Shape families (see Internals), each with a grid of candidate edges for
+  // the largest reach it can meet: its member's radius plus the largest
+  // radius of any shape or wall, over its smallest member. A shape joins a
+  // family when its vertices over its radius match the family's to 1e-9
+  // relative (a scaled copy, up to round-off); it is then simulated as the
+  // family's outline at its own scale, a difference of the order of 1e-10 m.
+  double radius_max = 0.0;
+  for (const BodyShape& shape : def_.shapes) radius_max = std::max(radius_max, shape.radius_m);
+  for (const Wall& wall : def_.walls) radius_max = std::max(radius_max, wall.radius_m);
+  {
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets;
+    std::vector<double> smallest;
+    std::vector<Vec2> unit;
+    for (const BodyShape& shape : def_.shapes) {
+      const double r = shape.radius_m;
+      unit.clear();
+      double extent = 0.0;
+      for (const Vec2& v : shape.vertices) {
+        unit.push_back(v / r);
+        extent = std::max(extent, Length(unit.back()));
+      }
+      std::uint64_t key = 1469598103934665603ull ^ unit.size();
+      for (const Vec2& u : unit)
+        for (double x : {u.x, u.y}) key = (key ^ static_cast<std::uint64_t>(std::llround(x * 1e6))) * 1099511628211ull;
+      const double tolerance = 1e-9 * (1.0 + extent);
+      std::uint32_t family = UINT32_MAX;
+      for (std::uint32_t f : buckets[key]) {
+        const std::vector<Vec2>& fv = in_->family_geometry[f].vertices;
+        if (fv.size() != unit.size()) continue;
+        bool same = true;
+        for (std::size_t k = 0; k < unit.size() && same; ++k) same = Length(unit[k] - fv[k]) <= tolerance;
+        if (same) {
+          family = f;
+          break;
+        }
+      }
+      if (family == UINT32_MAX) {
+        family = static_cast<std::uint32_t>(in_->family_geometry.size());
+        in_->family_geometry.push_back(ShapeGeometry::Make(unit, unit.size() >= 3, 1.0));
+        smallest.push_back(r);
+        buckets[key].push_back(family);
+      }
+      smallest[family] = std::min(smallest[family], r);
+      in_->shape_family.push_back(family);
+      in_->shape_scale.push_back(r);
+    }
+    for (std::size_t f = 0; f < in_->family_geometry.size(); ++f)
+      in_->family_geometry[f].BuildEdgeGrid(1.0 + radius_max / smallest[f]);
+  }
   in_->cos_angle.assign(n, 1.0);
   in_->sin_angle.assign(n, 0.0);
 
@@ -291,6 +341,9 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 
 void Simulation::Wrap(Vec2& p) const {
   const PeriodicBox& box = def_.periodic;
+  // Fast path: already inside (the common case; a step moves far less than a period).
+  if ((!box.x || (p.x >= box.min_m.x && p.x < box.max_m.x)) && (!box.y || (p.y >= box.min_m.y && p.y < box.max_m.y)))
+    return;
   if (box.x) {
     const double l = box.max_m.x - box.min_m.x;
     p.x = box.min_m.x + (p.x - box.min_m.x) - l * std::floor((p.x - box.min_m.x) / l);
@@ -306,13 +359,15 @@ void Simulation::Wrap(Vec2& p) const {
 Vec2 Simulation::Separation(Vec2 a, Vec2 b) const {
   Vec2 d = a - b;
   const PeriodicBox& box = def_.periodic;
+  // Rounding (a library call without SSE4.1) only when the difference is
+  // longer than half a period: the same result, far fewer calls.
   if (box.x) {
     const double l = box.max_m.x - box.min_m.x;
-    d.x -= l * std::nearbyint(d.x / l);
+    if (std::abs(d.x) > l / 2.0) d.x -= l * std::nearbyint(d.x / l);
   }
   if (box.y) {
     const double l = box.max_m.y - box.min_m.y;
-    d.y -= l * std::nearbyint(d.y / l);
+    if (std::abs(d.y) > l / 2.0) d.y -= l * std::nearbyint(d.y / l);
   }
   return d;
 }
@@ -328,9 +383,12 @@ void Simulation::UpdatePairs() {
     // Rebuild only when someone moved more than half the skin since the last
     // build (bounding circles are rotation invariant, so rotation never forces one).
     const double limit2 = in.skin_m * in.skin_m / 4.0;
+    const std::int64_t count = static_cast<std::int64_t>(n);
     bool rebuild = false;
-    for (std::size_t i = 0; i < n && !rebuild; ++i)
-      rebuild = LengthSquared(Separation(bodies_.position_m[i], in.position_at_build[i])) > limit2;
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies) reduction(|| : rebuild)
+    for (std::int64_t i = 0; i < count; ++i)
+      rebuild = rebuild || LengthSquared(Separation(bodies_.position_m[static_cast<std::size_t>(i)],
+                                                    in.position_at_build[static_cast<std::size_t>(i)])) > limit2;
     if (!rebuild) return;
   }
   ++profile_.pair_rebuilds;
@@ -529,15 +587,40 @@ std::pair<double, double> OverlapShares(const std::vector<ContactPoint>& points)
   return {sum, sum * sum / sum2};
 }
 
-const Contact* FindPrevious(const std::vector<Contact>& previous, std::uint64_t key, std::uint32_t feature) {
-  auto it = std::lower_bound(previous.begin(), previous.end(), std::pair{key, feature},
-                             [](const Contact& c, const std::pair<std::uint64_t, std::uint32_t>& k) {
-                               const std::uint64_t ck = PairKey(c);
-                               return ck < k.first || (ck == k.first && c.feature < k.second);
-                             });
-  if (it != previous.end() && PairKey(*it) == key && it->feature == feature) return &*it;
-  return nullptr;
-}
+// The previous evaluation's contact with a given (pair key, feature), for its
+// tangential spring. The lookups of one work chunk come in increasing order
+// (pairs sorted, features increasing within a pair), so a cursor that moves
+// forward replaces a binary search per contact; a lookup out of order falls
+// back to the binary search.
+class PreviousContacts {
+ public:
+  explicit PreviousContacts(const std::vector<Contact>& previous) : previous_(previous) {}
+
+  const Contact* Find(std::uint64_t key, std::uint32_t feature) {
+    const auto before = [&](const Contact& c) {
+      const std::uint64_t ck = PairKey(c);
+      return ck < key || (ck == key && c.feature < feature);
+    };
+    if (!started_ || key < last_key_ || (key == last_key_ && feature < last_feature_)) {
+      pos_ = static_cast<std::size_t>(std::partition_point(previous_.begin(), previous_.end(), before) - previous_.begin());
+      started_ = true;
+    } else {
+      while (pos_ < previous_.size() && before(previous_[pos_])) ++pos_;
+    }
+    last_key_ = key;
+    last_feature_ = feature;
+    if (pos_ < previous_.size() && PairKey(previous_[pos_]) == key && previous_[pos_].feature == feature)
+      return &previous_[pos_];
+    return nullptr;
+  }
+
+ private:
+  const std::vector<Contact>& previous_;
+  std::size_t pos_ = 0;
+  bool started_ = false;
+  std::uint64_t last_key_ = 0;
+  std::uint32_t last_feature_ = 0;
+};
 
 }  // namespace
 
@@ -559,7 +642,9 @@ void Simulation::Collide() {
 
   const auto placed = [&](std::uint32_t i, Vec2 position) {
     PlacedShape p;
-    p.geometry = &in.shape_geometry[bodies_.shape[i]];
+    const std::uint32_t shape = bodies_.shape[i];
+    p.geometry = &in.family_geometry[in.shape_family[shape]];
+    p.scale = in.shape_scale[shape];
     p.position = position;
     p.cos_angle = in.cos_angle[i];
     p.sin_angle = in.sin_angle[i];
@@ -586,6 +671,7 @@ void Simulation::Collide() {
       const std::size_t chunk = static_cast<std::size_t>(ck);
       std::vector<Contact>& out = in.chunk_contacts[chunk];
       out.clear();
+      PreviousContacts previous(in.previous_contacts);
       if (chunk < person_chunks) {
         const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
         for (std::size_t k = chunk * kChunk; k < end; ++k) {
@@ -609,7 +695,7 @@ void Simulation::Collide() {
             c.normal = p.normal;
             c.overlap_m = p.overlap_m;
             const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
-            const Contact* prev = FindPrevious(in.previous_contacts, key, p.feature);
+            const Contact* prev = previous.Find(key, p.feature);
             law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
             out.push_back(c);
           }
@@ -640,7 +726,7 @@ void Simulation::Collide() {
             c.normal = p.normal;
             c.overlap_m = p.overlap_m;
             const Vec2 rel = velocity_at(a, p.point - xa);
-            const Contact* prev = FindPrevious(in.previous_contacts, key, p.feature);
+            const Contact* prev = previous.Find(key, p.feature);
             wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
             out.push_back(c);
           }
@@ -648,8 +734,15 @@ void Simulation::Collide() {
       }
     }
   }
-  contacts_.clear();
-  for (const auto& chunk : in.chunk_contacts) contacts_.insert(contacts_.end(), chunk.begin(), chunk.end());
+  // Concatenate the chunks in order (each copied by whichever thread).
+  in.chunk_offset.assign(chunks + 1, 0);
+  for (std::size_t k = 0; k < chunks; ++k) in.chunk_offset[k + 1] = in.chunk_offset[k] + in.chunk_contacts[k].size();
+  contacts_.resize(in.chunk_offset[chunks]);
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (total >= 64)
+  for (std::int64_t ck = 0; ck < total; ++ck) {
+    const std::size_t k = static_cast<std::size_t>(ck);
+    std::copy(in.chunk_contacts[k].begin(), in.chunk_contacts[k].end(), contacts_.begin() + static_cast<std::ptrdiff_t>(in.chunk_offset[k]));
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -659,36 +752,69 @@ void Simulation::Gather() {
   ScopedTimer timer(profile_.gather_s);
   Internals& in = *in_;
   const std::size_t n = bodies_.size();
-  std::fill(bodies_.contact_force_n.begin(), bodies_.contact_force_n.end(), Vec2{});
-  std::fill(bodies_.contact_torque_n_m.begin(), bodies_.contact_torque_n_m.end(), 0.0);
-  in.trailing_force.assign(n, {});
-  in.trailing_torque.assign(n, 0.0);
-  in.leading_force.assign(n, {});
-  in.leading_torque.assign(n, 0.0);
-  // Serial, in contact order: every body's sum has a fixed order (ERRATA 11:
-  // each contact acts on both bodies, equal and opposite, each with its own branch vector).
+  in.trailing_force.resize(n);
+  in.trailing_torque.resize(n);
+  in.leading_force.resize(n);
+  in.leading_torque.resize(n);
+  // Each body's contacts in contact order (counting sort), so that every
+  // body's sums run in a fixed order whichever thread computes them (ERRATA
+  // 11: each contact acts on both bodies, equal and opposite, each with its
+  // own branch vector).
+  std::vector<std::uint32_t>& start = in.body_contact_start;
+  std::vector<std::uint32_t>& items = in.body_contact_items;
+  start.assign(n + 1, 0);
   for (const Contact& c : contacts_) {
-    const Vec2 f = c.Force();
-    const Vec2 viscous = c.normal * c.viscous_normal_n + Perp(c.normal) * c.viscous_tangential_n;
-    const Vec2 trailing = viscous * (c.trailing_fraction - 1.0);
-    const Vec2 leading = viscous * (c.leading_fraction - 1.0);
-    const Vec2 xa = bodies_.position_m[c.a];
-    const Vec2 arm_a = c.point_m - xa;
-    bodies_.contact_force_n[c.a] += f;
-    bodies_.contact_torque_n_m[c.a] += Cross(arm_a, f);
-    in.trailing_force[c.a] += trailing;
-    in.trailing_torque[c.a] += Cross(arm_a, trailing);
-    in.leading_force[c.a] += leading;
-    in.leading_torque[c.a] += Cross(arm_a, leading);
-    if (!c.wall) {
-      const Vec2 arm_b = c.point_m - (xa - Separation(xa, bodies_.position_m[c.b]));
-      bodies_.contact_force_n[c.b] -= f;
-      bodies_.contact_torque_n_m[c.b] -= Cross(arm_b, f);
-      in.trailing_force[c.b] -= trailing;
-      in.trailing_torque[c.b] -= Cross(arm_b, trailing);
-      in.leading_force[c.b] -= leading;
-      in.leading_torque[c.b] -= Cross(arm_b, leading);
+    ++start[c.a + 1];
+    if (!c.wall) ++start[c.b + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  items.resize(start[n]);
+  {
+    std::vector<std::uint32_t>& fill = in.body_contact_fill;
+    fill.assign(start.begin(), start.end() - 1);
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      const Contact& c = contacts_[k];
+      items[fill[c.a]++] = static_cast<std::uint32_t>(k);
+      if (!c.wall) items[fill[c.b]++] = static_cast<std::uint32_t>(k);
     }
+  }
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < count; ++ii) {
+    const std::uint32_t i = static_cast<std::uint32_t>(ii);
+    Vec2 force, trailing_force, leading_force;
+    double torque = 0.0, trailing_torque = 0.0, leading_torque = 0.0;
+    for (std::uint32_t s = start[i]; s < start[i + 1]; ++s) {
+      const Contact& c = contacts_[items[s]];
+      const Vec2 f = c.Force();
+      const Vec2 viscous = c.normal * c.viscous_normal_n + Perp(c.normal) * c.viscous_tangential_n;
+      const Vec2 trailing = viscous * (c.trailing_fraction - 1.0);
+      const Vec2 leading = viscous * (c.leading_fraction - 1.0);
+      const Vec2 xa = bodies_.position_m[c.a];
+      if (c.a == i) {
+        const Vec2 arm = c.point_m - xa;
+        force += f;
+        torque += Cross(arm, f);
+        trailing_force += trailing;
+        trailing_torque += Cross(arm, trailing);
+        leading_force += leading;
+        leading_torque += Cross(arm, leading);
+      } else {
+        const Vec2 arm = c.point_m - (xa - Separation(xa, bodies_.position_m[c.b]));
+        force -= f;
+        torque -= Cross(arm, f);
+        trailing_force -= trailing;
+        trailing_torque -= Cross(arm, trailing);
+        leading_force -= leading;
+        leading_torque -= Cross(arm, leading);
+      }
+    }
+    bodies_.contact_force_n[i] = force;
+    bodies_.contact_torque_n_m[i] = torque;
+    in.trailing_force[i] = trailing_force;
+    in.trailing_torque[i] = trailing_torque;
+    in.leading_force[i] = leading_force;
+    in.leading_torque[i] = leading_torque;
   }
 }
 
@@ -697,6 +823,7 @@ void Simulation::Gather() {
 
 void Simulation::Drive() {
   ScopedTimer timer(profile_.drive_s);
+  const Internals& in = *in_;
   const ModelParameters& mp = def_.parameters;
   const double tau = mp.relaxation_time_s;
   const double slope_force_per_kg =
@@ -723,10 +850,12 @@ void Simulation::Drive() {
       Vec2 facing = e;
       if (mp.facing_target == FacingTarget::kVelocity) facing = speed > 0.0 ? v / speed : Vec2{};
       if (facing.x != 0.0 || facing.y != 0.0) {
-        const double theta_d = std::atan2(facing.y, facing.x);
+        // theta_D - theta wrapped to (-pi, pi], as the angle from the body's
+        // orientation (cos, sin from PlaceShapes) to the facing direction.
+        const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
+        const double angle_to_target = std::atan2(Cross(orientation, facing), Dot(orientation, facing));
         const double gain = v0 > 0.0 ? 1.0 - std::exp(-speed / v0) : 1.0;
-        torque += mp.torsion_stiffness_lambda * inertia / (tau * tau) * gain *
-                  WrapAngle(theta_d - bodies_.angle_rad[i]);
+        torque += mp.torsion_stiffness_lambda * inertia / (tau * tau) * gain * angle_to_target;
       }
       // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
       torque -= inertia / mp.rotation_relaxation_time_s * bodies_.angular_velocity_rad_per_s[i];
@@ -762,7 +891,10 @@ void Simulation::VerletKickDrift() {
   // predicted velocity v + h a(t). (A second-order Adams-Bashforth predictor was
   // tried: the restitution error is dominated by the timing of contact onset and
   // end within a step, which ContactLaw corrects, not by the predictor.)
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < count; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
     if (bodies_.state[i] != PersonState::kWalking) {
       v[i] = {};
       w[i] = 0.0;
@@ -786,7 +918,10 @@ void Simulation::VerletKick() {
   ScopedTimer timer(profile_.integrate_s);
   const double h = dt_s_;
   Internals& in = *in_;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  const std::int64_t count = static_cast<std::int64_t>(bodies_.size());
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < count; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
     if (bodies_.state[i] != PersonState::kWalking) continue;
     bodies_.velocity_m_per_s[i] =
         in.v_half[i] + (bodies_.force_n[i] + in.trailing_force[i]) / bodies_.mass_kg[i] * (h / 2.0);
@@ -817,7 +952,10 @@ void Simulation::GearPredict() {
   std::vector<double>& predicted_t2 = in.w_half;
   predicted_r2.resize(n);
   predicted_t2.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < count; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
     if (bodies_.state[i] != PersonState::kWalking) {
       bodies_.velocity_m_per_s[i] = {};
       bodies_.angular_velocity_rad_per_s[i] = 0.0;
@@ -837,7 +975,10 @@ void Simulation::GearCorrect() {
   Internals& in = *in_;
   const std::vector<Vec2>& predicted_r2 = in.v_half;
   const std::vector<double>& predicted_t2 = in.w_half;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+  const std::int64_t count = static_cast<std::int64_t>(bodies_.size());
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
+  for (std::int64_t ii = 0; ii < count; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
     if (bodies_.state[i] != PersonState::kWalking) continue;
     GearCorrectOne(bodies_.position_m[i], bodies_.velocity_m_per_s[i], in.gear_xy[i],
                    bodies_.force_n[i] / bodies_.mass_kg[i] * (h * h / 2.0) - predicted_r2[i], h);
@@ -852,6 +993,25 @@ void Simulation::GearCorrect() {
 
 void Simulation::Check() {
   ScopedTimer timer(profile_.check_s);
+  // Find the first bad body and contact in parallel; report them as the serial scan would.
+  const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
+  const std::int64_t m = static_cast<std::int64_t>(contacts_.size());
+  std::int64_t first_body = n, first_contact = m;
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies) reduction(min : first_body)
+  for (std::int64_t ii = 0; ii < n; ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
+    if (!std::isfinite(x.x + x.y + v.x + v.y + bodies_.angle_rad[i] + bodies_.angular_velocity_rad_per_s[i]))
+      first_body = std::min(first_body, ii);
+  }
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (m >= kParallelBodies) reduction(min : first_contact)
+  for (std::int64_t k = 0; k < m; ++k) {
+    const Contact& c = contacts_[static_cast<std::size_t>(k)];
+    const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
+    const double rb = c.wall ? def_.walls[c.b].radius_m : def_.shapes[bodies_.shape[c.b]].radius_m;
+    if (!(c.overlap_m <= ra + rb)) first_contact = std::min(first_contact, k);
+  }
+  if (first_body == n && first_contact == m) return;
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(v.x) || !std::isfinite(v.y) ||
@@ -864,7 +1024,7 @@ void Simulation::Check() {
   for (const Contact& c : contacts_) {
     const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
     const double rb = c.wall ? def_.walls[c.b].radius_m : def_.shapes[bodies_.shape[c.b]].radius_m;
-    if (c.overlap_m > ra + rb) {
+    if (!(c.overlap_m <= ra + rb)) {
       const std::string other = c.wall ? "wall " + std::to_string(c.b) : PersonText(c.b);
       throw SimulationError("overlap of " + PersonText(c.a) + " and " + other + " is " +
                             FormatNumber(c.overlap_m) + " m at t = " + FormatNumber(time_s_) +
@@ -1055,6 +1215,7 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
+  PlaceShapes();  // orientations of the restored angles (Drive reads them)
 }
 
 Vec2 Simulation::LinearMomentum() const {

@@ -23,9 +23,12 @@
 // the two bounding boxes, each grown by half the reach r_A + r_B, are tested
 // for overlap (separating axes); then each vertex of A is carried into B's
 // frame by one rotation and translation, tested against B's grown box, and
-// only the survivors are measured against B's edges, in B's frame. The world
-// vertices are never formed. Both culls are exact: they drop only vertices
-// that are farther than the reach from B's core.
+// only the survivors are measured against B's edges, in B's frame, through a
+// grid of candidate edges per cell (BuildEdgeGrid). The world vertices are
+// never formed. Every cull is exact: it drops only vertices that are farther
+// than the reach from B's core, and only edges that cannot be the closest.
+// Shapes that are scaled copies of one outline (the paper's population)
+// share one geometry placed with a scale, so that it stays in cache.
 #pragma once
 
 #include <cstdint>
@@ -55,6 +58,18 @@ struct ShapeGeometry {
   double core_radius_m = 0.0;  // max distance of a vertex from the frame's origin
   Vec2 box_min, box_max;       // bounding box of the core in the shape's frame
 
+  // Optional grid over the box grown by grid_reach_m (BuildEdgeGrid): for each
+  // cell, the edges that can be the closest to a point of the cell, in edge
+  // order; none where every point of the cell lies outside the core and
+  // farther than grid_reach_m from it. Exact: the closest edge is always a
+  // candidate, and ties resolve as in the full search.
+  double grid_reach_m = 0.0;
+  Vec2 grid_origin;
+  double grid_cell_m = 0.0;
+  std::uint32_t grid_nx = 0, grid_ny = 0;
+  std::vector<std::uint32_t> cell_start;  // grid_nx * grid_ny + 1
+  std::vector<std::uint16_t> cell_edges;
+
   // Builds the geometry of a core given in its own frame (a body: centroid at
   // the origin). Vertex counts must be 1..32767.
   static ShapeGeometry Make(std::vector<Vec2> vertices, bool closed, double radius_m);
@@ -62,15 +77,21 @@ struct ShapeGeometry {
   // the centre of its bounding box; `origin` receives that point, which is
   // the position of the shape's pose (angle 0).
   static ShapeGeometry FromWorld(const std::vector<Vec2>& points, bool closed, double radius_m, Vec2& origin);
+  // Builds the grid for contacts whose reach r_A + r_B is at most reach_m
+  // (shapes with fewer than 6 edges get none: the full search is as cheap).
+  void BuildEdgeGrid(double reach_m);
   std::uint32_t count() const { return static_cast<std::uint32_t>(vertices.size()); }
 };
 
-// A shape placed in the world: its geometry and a pose (the world position
-// of its frame's origin, and the rotation of the frame).
+// A shape placed in the world: its geometry, uniformly scaled by `scale`
+// (vertices and radius), and a pose (the world position of its frame's
+// origin, and the rotation of the frame). Scaling lets bodies that are scaled
+// copies of one outline share one geometry, which then stays in cache.
 struct PlacedShape {
   const ShapeGeometry* geometry = nullptr;
   Vec2 position;
   double cos_angle = 1.0, sin_angle = 0.0;
+  double scale = 1.0;
 };
 
 struct ContactPoint {
