@@ -14,5 +14,7 @@ void RegisterVenueCommands(CLI::App& app);  // venue check, venue import
 void RegisterSimulateCommand(CLI::App& app);  // simulate
 void RegisterRenderCommand(CLI::App& app);  // render (pictures and video of a run)
 void RegisterAnalyzeCommand(CLI::App& app);  // analyze (metrics and regime of a run)
+void RegisterSweepCommand(CLI::App& app);  // sweep (grids of runs, local or MPI)
+void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat maps of a sweep)
 
 }  // namespace crowdrecon::cli

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterSimulateCommand(app);
   crowdrecon::cli::RegisterRenderCommand(app);
   crowdrecon::cli::RegisterAnalyzeCommand(app);
+  crowdrecon::cli::RegisterSweepCommand(app);
+  crowdrecon::cli::RegisterPhaseCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

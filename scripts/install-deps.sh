@@ -19,8 +19,10 @@ packages=(
   libcairo2-dev
   # configuration, command line, floor plans, run files
   nlohmann-json3-dev libcli11-dev libdxflib-dev libsqlite3-dev sqlite3
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # sweeps spread over several machines (crowdrecon sweep under mpirun)
+  libopenmpi-dev openmpi-bin
+  # tests and benchmarks (GNU time: peak memory in bench/run_benchmarks.py)
+  libgtest-dev libgmock-dev libbenchmark-dev time
 )
 
 missing=()

@@ -182,6 +182,24 @@ void Canvas::TextPx(double x_px, double y_px, const std::string& text, double si
   cairo_new_path(cr);
 }
 
+void Canvas::TextPxAligned(double x_px, double y_px, const std::string& text, double size_px, double align_x,
+                           double align_y, Color color, double angle_rad, bool bold) {
+  cairo_t* cr = impl_->cr;
+  cairo_save(cr);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size_px);
+  cairo_text_extents_t e;
+  cairo_text_extents(cr, text.c_str(), &e);
+  cairo_translate(cr, x_px, y_px);
+  cairo_rotate(cr, -angle_rad);  // device y points down: counter-clockwise on the page
+  impl_->SetColor(color);
+  cairo_move_to(cr, -(e.x_bearing + e.width * align_x), -(e.y_bearing + e.height * align_y));
+  cairo_show_text(cr, text.c_str());
+  cairo_new_path(cr);
+  cairo_restore(cr);
+}
+
 void Canvas::ScaleBar(double length_m) {
   const double x0 = impl_->margin, y0 = impl_->height - impl_->margin * 0.35;
   cairo_t* cr = impl_->cr;

@@ -88,6 +88,10 @@ class Statement {
   }
   double Double(int col) const { return sqlite3_column_double(stmt_, col); }
   std::int64_t Int(int col) const { return sqlite3_column_int64(stmt_, col); }
+  // SQLITE_INTEGER, SQLITE_FLOAT, SQLITE_TEXT, SQLITE_BLOB or SQLITE_NULL.
+  int Type(int col) const { return sqlite3_column_type(stmt_, col); }
+  int ColumnCount() const { return sqlite3_column_count(stmt_); }
+  std::string ColumnName(int col) const { return sqlite3_column_name(stmt_, col); }
   std::string Text(int col) const {
     const auto* t = sqlite3_column_text(stmt_, col);
     return t ? reinterpret_cast<const char*>(t) : "";

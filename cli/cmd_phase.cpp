@@ -1,0 +1,45 @@
+// `crowdrecon phase DIR`: phase diagrams (the paper's Figure 5) and metric heat
+// maps of a sweep's results (sweep/phase_diagram.hpp, docs/sweeps.md).
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "crowdrecon/sweep/phase_diagram.hpp"
+
+namespace crowdrecon::cli {
+
+namespace {
+
+struct PhaseArgs {
+  std::string results;
+  std::string output;
+  bool no_heat_maps = false;
+};
+
+void RunPhase(const PhaseArgs& args) {
+  sweep::PhaseOptions options;
+  options.results = args.results;
+  options.output_dir = args.output;
+  options.heat_maps = !args.no_heat_maps;
+  const sweep::PhaseSummary s = sweep::DrawPhaseDiagrams(options);
+  std::printf("%s", s.BriefReport().c_str());
+}
+
+}  // namespace
+
+void RegisterPhaseCommand(CLI::App& app) {
+  auto args = std::make_shared<PhaseArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "phase",
+      "Draw a sweep's phase diagrams (regime per grid point, majority over seeds, disagreement shown, as the paper's "
+      "Figure 5) and heat maps of its metrics, as PNG and SVG with an index.html");
+  cmd->add_option("DIR", args->results, "Sweep output folder (or its results.sqlite)")->required();
+  cmd->add_option("-o,--output", args->output, "Folder for the pictures (default: DIR/phase)");
+  cmd->add_flag("--no-heat-maps", args->no_heat_maps, "Phase diagrams only");
+  cmd->callback([args] { RunPhase(*args); });
+}
+
+}  // namespace crowdrecon::cli

@@ -1,0 +1,63 @@
+// `crowdrecon sweep SWEEP.json -o DIR`: a grid of runs over scenario
+// parameters, on the local cores or spread over MPI ranks (sweep/, docs/sweeps.md).
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "crowdrecon/sweep/sweep_runner.hpp"
+
+namespace crowdrecon::cli {
+
+namespace {
+
+struct SweepArgs {
+  std::string sweep_file;
+  std::string output;
+  int jobs = 0;
+  bool quiet = false;
+  long long stop_after_runs = -1;
+};
+
+int RunSweepCommand(const SweepArgs& args) {
+  sweep::SweepOptions options;
+  options.sweep_file = args.sweep_file;
+  options.output_dir = args.output;
+  options.jobs = args.jobs;
+  options.show_progress = !args.quiet && isatty(STDERR_FILENO);
+  options.stop_after_runs = args.stop_after_runs;
+  const sweep::SweepSummary s = sweep::RunSweep(options);
+  if (!s.coordinator) return s.exit_code;  // MPI ranks other than 0 say nothing
+  std::printf("%s", s.BriefReport().c_str());
+  return s.interrupted ? 130 : 0;
+}
+
+}  // namespace
+
+void RegisterSweepCommand(CLI::App& app) {
+  auto args = std::make_shared<SweepArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "sweep",
+      "Run a grid of scenarios (density, counter-flow, body shape, model parameters, seeds, ...) and tabulate each "
+      "run's metrics and regime in DIR/results.sqlite and DIR/results.csv; run again to continue an interrupted "
+      "sweep; under mpirun the runs are spread over the ranks (docs/sweeps.md)");
+  cmd->add_option("SWEEP", args->sweep_file, "Sweep file (JSON, docs/sweeps.md)")->required();
+  cmd->add_option("-o,--output", args->output, "Output folder DIR (results.sqlite, results.csv, runs/)")->required();
+  cmd->add_option("--jobs", args->jobs,
+                  "Runs at a time (default: all cores; under MPI: 1 per rank); results do not depend on it")
+      ->check(CLI::Range(0, 4096));
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
+  cmd->add_option("--stop-after-runs", args->stop_after_runs,
+                  "Stop as if interrupted once this many runs have been written (for testing resumption)")
+      ->check(CLI::Range(0LL, 1LL << 40));
+  cmd->callback([args] {
+    const int rc = RunSweepCommand(*args);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace crowdrecon::cli

@@ -1,0 +1,47 @@
+// Phase diagrams of a sweep, like the paper's Figure 5 ("Phase diagram of the
+// simulations of counter-flow in the corridor ... lane formation (disks),
+// avalanches (crosses) and clogging (squares)"), and heat maps of the run
+// metrics, drawn from DIR/results.sqlite (results.hpp).
+//
+// One diagram per variant (and per value of any axis besides the diagram's
+// two): x and y are the sweep's "diagram" axes (density and counter-flow
+// fraction for the hallway). At each grid point the marker is the regime of
+// the majority of the seeds; where the seeds disagree a ring around it shows
+// every seed's regime, one segment per seed; where no regime has a majority
+// (a tie) the ring is drawn with a "?" in place of the marker.
+//
+// Heat maps (mean over the seeds of each point, failed runs left out): mean
+// speed along the desired direction, fraction of people stopped, fraction of
+// the time the flow is stopped, lane order, avalanches per minute of the
+// stationary stage, maximum load, fraction of person-frames above 400 N.
+//
+// Every picture is written as PNG and SVG; FIGDIR/index.html shows them all.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace crowdrecon::sweep {
+
+struct PhaseOptions {
+  std::filesystem::path results;     // DIR, or DIR/results.sqlite
+  std::filesystem::path output_dir;  // FIGDIR; "" = DIR/phase
+  bool heat_maps = true;
+};
+
+struct PhaseSummary {
+  std::vector<std::filesystem::path> pictures;  // PNG and SVG files written
+  std::filesystem::path index;                  // FIGDIR/index.html
+  std::size_t diagrams = 0;                     // phase diagrams (PNG + SVG each)
+  std::size_t heat_maps = 0;
+  std::size_t runs = 0;                         // rows read
+  std::vector<std::string> notes;               // e.g. runs that failed, points without runs
+  std::string BriefReport() const;
+};
+
+// Throws InputError if the results are missing or not a sweep's, or the sweep
+// has fewer than two axes (no diagram).
+PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options);
+
+}  // namespace crowdrecon::sweep

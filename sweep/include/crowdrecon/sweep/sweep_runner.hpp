@@ -1,0 +1,77 @@
+// Running a sweep: every run of a sweep file (sweep_file.hpp) simulated
+// (scenario::RunScenario, one engine thread per run), analysed
+// (analysis::AnalyzeRun) and written as one row of DIR/results.* (results.hpp).
+//
+// Local: `jobs` runs at a time on worker threads of this process; a progress
+// line (runs done / total, elapsed, time left) on a terminal.
+//
+// MPI: when started by mpirun (or srun) as an MPI rank, the runs are spread
+// over the ranks. Rank 0 coordinates: it hands out run indices one at a time
+// to whichever rank asks (each rank runs `jobs` runs at a time, rank 0
+// included), receives the rows and alone writes DIR/results.*. Other ranks
+// write only their runs' files in DIR/runs/. A run's row depends on its
+// parameters only, so the tables equal the local run's.
+//
+// Resume: a row is committed once its run has been analysed. Started again
+// on the same DIR, the sweep checks that DIR belongs to the same sweep and
+// skips the runs that have rows. A run that was interrupted (Ctrl-C,
+// SIGTERM: its checkpoint is written) continues from its checkpoint; one that
+// was killed outright starts over.
+//
+// Interruption: SIGINT / SIGTERM (and SweepOptions::stop_after_runs) stop the
+// runs in progress at their next frame, without rows; the summary says how
+// many runs are left.
+//
+// Thread safety of what the workers call: RunScenario and AnalyzeRun keep no
+// shared state (each opens its own SQLite connection; SQLite is built
+// thread-safe), and the engine's OpenMP regions run with one thread. The one
+// process-wide state, the interrupt flag of scenario::InstallInterruptHandlers,
+// is cleared by every RunScenario that starts, so a sweep installs its own
+// handlers and hands each run its flag (RunOptions::stop_flag).
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace crowdrecon::sweep {
+
+struct SweepOptions {
+  std::filesystem::path sweep_file;
+  std::filesystem::path output_dir;  // DIR: results.sqlite, results.csv, runs/
+  // Runs at a time in this process; 0 = the number of cores (locally) or 1
+  // (per MPI rank: mpirun starts one rank per core).
+  int jobs = 0;
+  bool show_progress = false;  // a progress line on stderr (rank 0)
+  // For tests of resumption: stop as if interrupted once this many rows have
+  // been written by this invocation (< 0: never).
+  long long stop_after_runs = -1;
+};
+
+struct SweepSummary {
+  std::string name;
+  std::size_t total = 0;         // runs in the sweep
+  std::size_t already_done = 0;  // rows found at the start (resumed sweep)
+  std::size_t completed = 0;     // rows written now (failed runs included)
+  std::size_t failed = 0;        // of those, runs whose status is "failed: ..."
+  std::size_t remaining = 0;     // runs without a row at the end
+  bool interrupted = false;
+  double wall_s = 0.0;
+  int ranks = 1;   // MPI ranks (1 = local)
+  int jobs = 1;    // runs at a time per rank
+  std::vector<std::size_t> runs_per_rank;  // rows computed by each rank in this invocation (rank 0 only)
+  bool coordinator = true;  // false on MPI ranks other than 0 (which print nothing)
+  int exit_code = 0;        // of a rank other than 0: 2 if the sweep could not start
+  std::filesystem::path results_sqlite, results_csv;
+
+  std::string BriefReport() const;
+};
+
+// Runs (or continues) the sweep. Throws InputError for a bad sweep file, a
+// run whose overrides make the scenario invalid (before any run starts), or
+// a DIR that holds another sweep. A run that cannot be placed or goes
+// numerically wrong is a row with status "failed: ...", not an error.
+SweepSummary RunSweep(const SweepOptions& options);
+
+}  // namespace crowdrecon::sweep

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Sweeps (sweep/, docs/sweeps.md): the results table does not depend on how
+# the runs were spread, nor on interruptions.
+#   run_sweep_tests.sh CROWDRECON SWEEP OUT local
+#       OUT/j1 with --jobs 1 (the reference), OUT/j2 with --jobs 2, and OUT/resume:
+#       stopped after 3 runs (--stop-after-runs 3, exit 130, runs in progress
+#       interrupted with their checkpoints), resumed, then run once more (nothing
+#       left to do); every results.csv equal to the reference but for wall_s.
+#       Also: the same DIR with another sweep file is refused.
+#   run_sweep_tests.sh CROWDRECON SWEEP OUT mpi
+#       OUT/mpi under `mpirun -np 2 --oversubscribe`, compared with OUT/j1
+#       (exit 77 = skipped if mpirun is absent).
+set -euo pipefail
+exe=$1; sweep=$2; out=$3; mode=$4
+mkdir -p "$out"
+
+# results.csv without its last column (wall_s, the only one that may differ).
+strip() { [[ $(head -1 "$1") == *,wall_s ]] || { echo "FAIL: $1 does not end with wall_s"; exit 1; }; sed 's/,[^,]*$//' "$1"; }
+same() {  # same REFERENCE_DIR DIR WHAT
+  if ! diff <(strip "$1/results.csv") <(strip "$2/results.csv") >"$out/diff.txt"; then
+    echo "FAIL: $3: results differ from $1"; head -20 "$out/diff.txt"; exit 1
+  fi
+  echo "$3: $(($(wc -l <"$2/results.csv") - 1)) rows, identical to the reference"
+}
+
+if [[ $mode == local ]]; then
+  rm -rf "$out/j1" "$out/j2" "$out/resume"
+  "$exe" sweep "$sweep" -o "$out/j1" --jobs 1 -q
+  rows=$(($(wc -l <"$out/j1/results.csv") - 1))
+  [[ $rows -ge 8 ]] || { echo "FAIL: only $rows rows"; exit 1; }
+  [[ -z $(ls "$out/j1/runs") ]] || { echo "FAIL: run files left in $out/j1/runs"; exit 1; }
+  "$exe" sweep "$sweep" -o "$out/j2" --jobs 2 -q >/dev/null
+  same "$out/j1" "$out/j2" "--jobs 2"
+
+  set +e
+  "$exe" sweep "$sweep" -o "$out/resume" --jobs 2 -q --stop-after-runs 3 >"$out/stop.txt" 2>&1
+  rc=$?
+  set -e
+  [[ $rc -eq 130 ]] || { echo "FAIL: stopped sweep exited $rc, expected 130"; cat "$out/stop.txt"; exit 1; }
+  grep -q "run the same command again to continue" "$out/stop.txt" || { echo "FAIL: no resume hint"; cat "$out/stop.txt"; exit 1; }
+  done=$(sqlite3 "$out/resume/results.sqlite" "SELECT COUNT(*) FROM runs")
+  [[ $done -ge 3 && $done -lt $rows ]] || { echo "FAIL: $done rows after stopping at 3"; exit 1; }
+  echo "stopped after $done rows ($(ls "$out/resume/runs" | wc -l) file(s) of interrupted runs left)"
+  "$exe" sweep "$sweep" -o "$out/resume" --jobs 1 -q >"$out/resume.txt"
+  grep -q "$done done before" "$out/resume.txt" || { echo "FAIL: resumed sweep redid runs"; cat "$out/resume.txt"; exit 1; }
+  same "$out/j1" "$out/resume" "stopped and resumed"
+  "$exe" sweep "$sweep" -o "$out/resume" -q >"$out/again.txt"
+  grep -q "$rows done before, 0 now" "$out/again.txt" || { echo "FAIL: a finished sweep ran again"; cat "$out/again.txt"; exit 1; }
+  [[ -z $(ls "$out/resume/runs") ]] || { echo "FAIL: run files left after resuming"; exit 1; }
+
+  # Another sweep into the same folder is refused.
+  sed 's/"count": 2}/"count": 3}/' "$sweep" >"$out/other.json"
+  sed -i "s#\"\\.\\./scenarios/#\"$(cd "$(dirname "$sweep")" && pwd)/../scenarios/#" "$out/other.json"
+  if "$exe" sweep "$out/other.json" -o "$out/j1" -q >"$out/other.txt" 2>&1; then
+    echo "FAIL: a different sweep was run into an existing folder"; exit 1
+  fi
+  grep -q "holds the results of a different sweep (the sweep file changed" "$out/other.txt" ||
+    { echo "FAIL: unclear message"; cat "$out/other.txt"; exit 1; }
+  echo "sweeps, local: OK"
+elif [[ $mode == mpi ]]; then
+  command -v mpirun >/dev/null || { echo "mpirun not found: skipped"; exit 77; }
+  [[ -s "$out/j1/results.csv" ]] || { echo "FAIL: no reference $out/j1 (run the local test first)"; exit 1; }
+  rm -rf "$out/mpi"
+  # Containers run as root; one machine: shared memory between the ranks.
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader OMPI_MCA_rmaps_base_oversubscribe=1
+  mpirun -np 2 --oversubscribe "$exe" sweep "$sweep" -o "$out/mpi" -q >"$out/mpi.txt" 2>&1 ||
+    { echo "FAIL: mpirun exited $?"; cat "$out/mpi.txt"; exit 1; }
+  cat "$out/mpi.txt"
+  grep -q "on each of 2 MPI ranks" "$out/mpi.txt" || { echo "FAIL: the sweep did not run on 2 ranks"; exit 1; }
+  same "$out/j1" "$out/mpi" "mpirun -np 2"
+  echo "sweeps, MPI: OK"
+else
+  echo "usage: run_sweep_tests.sh CROWDRECON SWEEP OUT local|mpi"; exit 2
+fi

@@ -1,0 +1,239 @@
+// Sweep files (sweep/sweep_file.hpp): parsing, errors that name the file, the
+// JSON path, the value and what was expected; the grid of runs and its fixed
+// order; the overrides as the scenario parser sees them; result rows.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/sweep/results.hpp"
+#include "crowdrecon/sweep/sweep_file.hpp"
+
+namespace crowdrecon::sweep {
+namespace {
+
+const std::filesystem::path kSweepDir = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/sweeps";
+
+SweepSpec Parse(const std::string& text) { return ParseSweep(text, "test.json", kSweepDir); }
+
+// The error message of parsing `text` ("" if it parses).
+std::string ErrorOf(const std::string& text) {
+  try {
+    Parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kHead = R"("format": "crowdrecon-sweep", "version": 1, "scenario": "../scenarios/sweep-tiny.json")";
+
+TEST(SweepFile, GridOrderIdsAndValues) {
+  const SweepSpec s = Parse("{" + kHead + R"(,
+    "axes": [{"path": "population.density_per_m2", "from": 3, "to": 7, "count": 9},
+             {"path": "population.counter_flow_fraction", "values": [0, 0.25, 0.5]}],
+    "seeds": {"first": 4, "count": 3},
+    "variants": [{"name": "thorax", "set": {"population.body.mode": "paper"}},
+                 {"name": "circle", "set": {"population.body.mode": "circle"}}]})");
+  ASSERT_EQ(s.axes.size(), 2u);
+  ASSERT_EQ(s.axes[0].numbers.size(), 9u);
+  EXPECT_EQ(s.axes[0].numbers.front(), 3.0);
+  EXPECT_EQ(s.axes[0].numbers[1], 3.5);
+  EXPECT_EQ(s.axes[0].numbers.back(), 7.0);  // the end exactly as given
+  EXPECT_EQ(s.seeds, (std::vector<std::uint64_t>{4, 5, 6}));
+  EXPECT_EQ(s.diagram_x, "population.density_per_m2");  // default: the first two axes
+  EXPECT_EQ(s.diagram_y, "population.counter_flow_fraction");
+  EXPECT_EQ(s.RunCount(), 2u * 9u * 3u * 3u);
+
+  const std::vector<RunPlan> runs = ExpandRuns(s);
+  ASSERT_EQ(runs.size(), s.RunCount());
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, i);
+  // Variants outermost, then the first axis, the second, seeds innermost.
+  EXPECT_EQ(runs[0].id, "0000-thorax-density_per_m2=3-counter_flow_fraction=0-seed4");
+  EXPECT_EQ(runs[1].seed, 5u);
+  EXPECT_EQ(runs[3].axis_value, (std::vector<std::size_t>{0, 1}));
+  EXPECT_EQ(runs[9].axis_value, (std::vector<std::size_t>{1, 0}));
+  EXPECT_EQ(runs[81].variant, 1u);
+  EXPECT_EQ(runs[81].id, "0081-circle-density_per_m2=3-counter_flow_fraction=0-seed4");
+  EXPECT_EQ(runs.back().id, "0161-circle-density_per_m2=7-counter_flow_fraction=0.5-seed6");
+  EXPECT_EQ(runs[3].description,
+            "variant thorax, population.density_per_m2 = 3, population.counter_flow_fraction = 0.25, seed 4");
+  // The same file always gives the same runs.
+  const std::vector<RunPlan> again = ExpandRuns(Parse("{" + kHead + R"(,
+    "axes": [{"path": "population.density_per_m2", "from": 3, "to": 7, "count": 9},
+             {"path": "population.counter_flow_fraction", "values": [0, 0.25, 0.5]}],
+    "seeds": {"first": 4, "count": 3},
+    "variants": [{"name": "thorax", "set": {"population.body.mode": "paper"}},
+                 {"name": "circle", "set": {"population.body.mode": "circle"}}]})"));
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(again[i].id, runs[i].id);
+}
+
+TEST(SweepFile, DefaultsWithoutAxesVariantsOrSeeds) {
+  const SweepSpec s = Parse("{" + kHead + "}");
+  EXPECT_EQ(s.variants.size(), 1u);
+  EXPECT_EQ(s.variants[0].name, "base");
+  EXPECT_EQ(s.seeds, (std::vector<std::uint64_t>{1}));  // the scenario's own seed
+  EXPECT_EQ(s.RunCount(), 1u);
+  EXPECT_EQ(ExpandRuns(s).size(), 1u);
+  EXPECT_EQ(s.diagram_x, "");
+}
+
+TEST(SweepFile, IntegerRangesStayIntegers) {
+  const SweepSpec s = Parse("{" + kHead + R"(, "axes": [{"path": "population.count", "from": 10, "to": 30, "count": 3}]})");
+  EXPECT_EQ(s.axes[0].values, (std::vector<std::string>{"10", "20", "30"}));
+}
+
+TEST(SweepFile, OverridesAppliedInOrderAndReadByTheScenarioParser) {
+  const SweepSpec s = Parse("{" + kHead + R"(,
+    "set": {"run.duration_s": 2, "model.back_force_gamma": 0.6},
+    "axes": [{"path": "model.back_force_gamma", "values": [2.4]}],
+    "variants": [{"name": "v", "set": {"model.back_force_gamma": 1.0, "model.torsion_stiffness_lambda": 13.5,
+                                       "population.body": {"mode": "circle"}}}],
+    "seeds": [7]})");
+  const RunPlan run = ExpandRuns(s).at(0);
+  const scenario::Scenario sc = RunScenarioOf(s, run);
+  EXPECT_EQ(sc.model.back_force_gamma, 2.4);  // the axis wins over the variant and "set"
+  EXPECT_EQ(sc.model.torsion_stiffness_lambda, 13.5);
+  EXPECT_EQ(sc.run.duration_s, 2.0);
+  EXPECT_EQ(sc.population.seed, 7u);
+  EXPECT_EQ(sc.population.body_mode, geometry::PopulationMode::kCircle);
+  // Relative paths of the base scenario still resolve against its folder.
+  EXPECT_TRUE(std::filesystem::exists(sc.venue_file)) << sc.venue_file;
+  EXPECT_EQ(sc.file, s.scenario_file);
+}
+
+TEST(SweepFile, FilePathsInOverridesAreRelativeToTheSweepFile) {
+  const SweepSpec s = Parse("{" + kHead + R"(,
+    "set": {"population.body": {"mode": "paper", "reference": "../../../venues/bodies/thorax-18.json"}}})");
+  const scenario::Scenario sc = RunScenarioOf(s, ExpandRuns(s).at(0));
+  EXPECT_TRUE(std::filesystem::exists(sc.population.reference_body)) << sc.population.reference_body;
+  EXPECT_EQ(sc.population.reference_body.filename(), "thorax-18.json");
+}
+
+TEST(SweepFile, UnknownScenarioPathNamesTheRun) {
+  const SweepSpec s = Parse("{" + kHead + R"(, "axes": [{"path": "population.densty", "values": [1, 2]}]})");
+  const std::vector<RunPlan> runs = ExpandRuns(s);
+  try {
+    ValidateRuns(s, runs);
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("test.json: run 0 (variant base, population.densty = 1, seed 1)"), std::string::npos) << m;
+    EXPECT_NE(m.find("sweep-tiny.json: /population: unknown key(s) \"densty\""), std::string::npos) << m;
+  }
+}
+
+TEST(SweepFile, OverrideOutOfRangeNamesTheRunAndTheRange) {
+  const SweepSpec s = Parse("{" + kHead + R"(, "axes": [{"path": "population.counter_flow_fraction", "values": [0.5, 1.5]}]})");
+  try {
+    ValidateRuns(s, ExpandRuns(s));
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("run 1 (variant base, population.counter_flow_fraction = 1.5, seed 1)"), std::string::npos) << m;
+    EXPECT_NE(m.find("/population/counter_flow_fraction: value 1.5 is out of range"), std::string::npos) << m;
+  }
+}
+
+TEST(SweepFile, OverrideThroughANonObject) {
+  const SweepSpec s = Parse("{" + kHead + R"(, "set": {"population.seed.x": 1}, "seeds": [1]})");
+  try {
+    (void)RunScenarioJson(s, ExpandRuns(s).at(0));
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("test.json: run 0 (variant base, seed 1): cannot set \"population.seed.x\": "
+                                         "\"population.seed\" is 1 in the scenario, not an object"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
+  const struct {
+    std::string body;
+    std::string expected;
+  } cases[] = {
+      {R"("axs": [])", "test.json: /: unknown key(s) \"axs\""},
+      {R"("format": "crowdrecon-scenario")", "test.json: /format: \"crowdrecon-scenario\" is not a sweep"},
+      {R"("version": 2)", "test.json: /version: value 2 is out of range; expected an integer in [1, 1]"},
+      {R"("axes": [{"path": "population.density_per_m2"}])",
+       "test.json: /axes/0: give either \"values\": [...] or \"from\", \"to\" and \"count\""},
+      {R"("axes": [{"path": "population.density_per_m2", "values": [1], "from": 1}])", "/axes/0: give either"},
+      {R"("axes": [{"path": "population.density_per_m2", "from": 1, "to": 2, "count": 0}])",
+       "/axes/0/count: value 0 is out of range; expected an integer in [1, 100000]"},
+      {R"("axes": [{"path": "population.density_per_m2", "values": []}])",
+       "/axes/0/values: expected at least one value"},
+      {R"("axes": [{"path": "population.density_per_m2", "values": [1, 1]}])", "value 1 appears twice"},
+      {R"("axes": [{"path": "population..seed", "values": [1]}])",
+       "/axes/0/path: \"population..seed\" is not a scenario path"},
+      {R"("axes": [{"path": "population.seed", "values": [1]}])",
+       "/axes/0/path: the seed is not an axis; give the seeds with \"seeds\""},
+      {R"("axes": [{"path": "model.restitution", "values": [0.3]}, {"path": "model.restitution", "values": [0.4]}])",
+       "/axes/1/path: axis \"model.restitution\" is given twice"},
+      {R"("axes": [{"path": "model.restitution", "values": [0.3], "step": 1}])", "/axes/0: unknown key(s) \"step\""},
+      {R"("seeds": [1, 2, 1])", "/seeds: seed 1 appears twice"},
+      {R"("seeds": [1.5])", "/seeds/0: expected a whole number in [0, 2^62], found 1.5"},
+      {R"("seeds": [-1])", "/seeds/0: expected a whole number in [0, 2^62], found -1"},
+      {R"("seeds": {"count": 3, "last": 4})", "/seeds: unknown key(s) \"last\""},
+      {R"("seeds": "three")", "/seeds: expected a list of seeds"},
+      {R"("variants": [])", "/variants: expected at least one variant"},
+      {R"("variants": [{"name": "a b"}])", "/variants/0/name: \"a b\" is not a variant name"},
+      {R"("variants": [{"name": "a"}, {"name": "a"}])", "/variants/1/name: variant \"a\" is given twice"},
+      {R"("variants": [{"name": "a", "sett": {}}])", "/variants/0: unknown key(s) \"sett\""},
+      {R"("set": [1])", "/set: expected an object"},
+      {R"("set": {".x": 1})", "/set/.x: \".x\" is not a scenario path"},
+      {R"("axes": [{"path": "model.restitution", "values": [0.3]}], "diagram": {"x": "model.restitution", "y": "population.density_per_m2"})",
+       "/diagram/y: \"population.density_per_m2\" is not an axis of this sweep; expected one of \"model.restitution\""},
+      {R"("keep_runs": "yes")", "/keep_runs: expected true or false, found \"yes\""},
+  };
+  for (const auto& c : cases) {
+    const std::string m = ErrorOf("{" + kHead + ", " + c.body + "}");
+    EXPECT_NE(m.find(c.expected), std::string::npos) << c.body << "\n  gave: " << m;
+  }
+  EXPECT_NE(ErrorOf(R"({"format": "crowdrecon-sweep", "scenario": "nope.json"})")
+                .find("test.json: /scenario: cannot open the scenario file"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(R"({"format": "crowdrecon-sweep", )").find("test.json:1:"), std::string::npos);
+  EXPECT_NE(ErrorOf(R"({"format": "crowdrecon-sweep"})").find("test.json: /: missing required key \"scenario\""),
+            std::string::npos);
+}
+
+TEST(SweepFile, ExactNumbers) {
+  EXPECT_EQ(ExactNumber(0.1), "0.1");
+  EXPECT_EQ(ExactNumber(3.0), "3");
+  EXPECT_EQ(ExactNumber(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(ExactNumber(std::numeric_limits<double>::quiet_NaN()), "");
+  EXPECT_EQ(std::stod(ExactNumber(1.0 / 3.0)), 1.0 / 3.0);
+}
+
+TEST(SweepResults, ColumnsAndRowRoundTrip) {
+  const std::vector<std::string>& c = MetricColumns();
+  EXPECT_EQ(c.front(), "duration_s");
+  EXPECT_NE(std::find(c.begin(), c.end(), "mean_speed_g0_m_per_s"), c.end());
+  EXPECT_NE(std::find(c.begin(), c.end(), "mean_speed_g1_m_per_s"), c.end());
+  EXPECT_EQ(c.back(), "regime_code");
+
+  ResultRow row;
+  row.run_index = 42;
+  row.status = "complete";
+  row.regime = "avalanches";
+  row.regime_reason = "3 avalanches, \"stop-and-go\"";
+  row.metrics = {1.0 / 3.0, std::numeric_limits<double>::quiet_NaN(), -0.0, 1e300};
+  row.wall_s = 12.5;
+  const ResultRow back = DeserializeRow(SerializeRow(row));
+  EXPECT_EQ(back.run_index, 42u);
+  EXPECT_EQ(back.status, row.status);
+  EXPECT_EQ(back.regime, row.regime);
+  EXPECT_EQ(back.regime_reason, row.regime_reason);
+  ASSERT_EQ(back.metrics.size(), 4u);
+  EXPECT_EQ(back.metrics[0], 1.0 / 3.0);
+  EXPECT_TRUE(std::isnan(back.metrics[1]));
+  EXPECT_TRUE(std::signbit(back.metrics[2]));
+  EXPECT_EQ(back.metrics[3], 1e300);
+  EXPECT_EQ(back.wall_s, 12.5);
+}
+
+}  // namespace
+}  // namespace crowdrecon::sweep
