@@ -274,8 +274,9 @@ void DrawAxes(Page& page, const Layout& L, bool grid_lines) {
 }
 
 void DrawTitle(Page& page, const Layout& L, const std::string& title, const std::string& subtitle) {
-  page.canvas.TextPxAligned(L.left, 30, title, 18, 0.0, 0.5, Color::Black(), 0.0, true);
-  page.canvas.TextPxAligned(L.left, 58, subtitle, 14, 0.0, 0.5, Color::Hex(0x333333));
+  const double room = L.width - L.left - 12.0;  // long sweep names shrink to fit the page
+  page.canvas.TextPxAligned(L.left, 30, title, 18, 0.0, 0.5, Color::Black(), 0.0, true, room);
+  page.canvas.TextPxAligned(L.left, 58, subtitle, 14, 0.0, 0.5, Color::Hex(0x333333), 0.0, false, room);
 }
 
 std::string PanelTitle(const Panel& p) {

@@ -183,7 +183,7 @@ void Canvas::TextPx(double x_px, double y_px, const std::string& text, double si
 }
 
 void Canvas::TextPxAligned(double x_px, double y_px, const std::string& text, double size_px, double align_x,
-                           double align_y, Color color, double angle_rad, bool bold) {
+                           double align_y, Color color, double angle_rad, bool bold, double max_width_px) {
   cairo_t* cr = impl_->cr;
   cairo_save(cr);
   cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
@@ -191,6 +191,10 @@ void Canvas::TextPxAligned(double x_px, double y_px, const std::string& text, do
   cairo_set_font_size(cr, size_px);
   cairo_text_extents_t e;
   cairo_text_extents(cr, text.c_str(), &e);
+  if (max_width_px > 0.0 && e.x_advance > max_width_px) {
+    cairo_set_font_size(cr, size_px * max_width_px / e.x_advance);
+    cairo_text_extents(cr, text.c_str(), &e);
+  }
   cairo_translate(cr, x_px, y_px);
   cairo_rotate(cr, -angle_rad);  // device y points down: counter-clockwise on the page
   impl_->SetColor(color);

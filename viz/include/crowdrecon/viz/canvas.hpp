@@ -56,8 +56,10 @@ class Canvas {
   // align_x 0 = left edge at x_px, 0.5 = centred, 1 = right edge; align_y
   // 0 = top at y_px, 0.5 = centred, 1 = bottom. Turned counter-clockwise by
   // angle_rad about the anchor (pi/2: reads bottom to top, for y-axis labels).
+  // max_width_px > 0: the font shrinks so that the text fits that width.
   void TextPxAligned(double x_px, double y_px, const std::string& text, double size_px, double align_x,
-                     double align_y, Color color = Color::Black(), double angle_rad = 0.0, bool bold = false);
+                     double align_y, Color color = Color::Black(), double angle_rad = 0.0, bool bold = false,
+                     double max_width_px = 0.0);
   // A scale bar of `length_m` at the lower-left corner.
   void ScaleBar(double length_m);
 
