@@ -265,8 +265,13 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
             if (!hits.empty()) { free = false; break; }
           }
         }
-      // Across a periodic seam, compare with the nearest images too.
-      if (free && (def.periodic.x || def.periodic.y))
+      // Across a periodic seam, compare with the nearest images too (only a
+      // person within reach of a seam can meet someone's image).
+      const double seam_reach = 2.0 * max_bound * scale;
+      const bool near_seam =
+          (def.periodic.x && std::min(at.x - def.periodic.min_m.x, def.periodic.max_m.x - at.x) < seam_reach) ||
+          (def.periodic.y && std::min(at.y - def.periodic.min_m.y, def.periodic.max_m.y - at.y) < seam_reach);
+      if (free && near_seam)
         for (std::size_t j = 0; j < i && free; ++j) {
           const Vec2 d = periodic_image(position[j] - at);
           if (Length(d) > 2.0 * max_bound * scale || Length(position[j] - at - d) < 1e-9) continue;
