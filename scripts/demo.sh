@@ -4,7 +4,7 @@
 set -euo pipefail
 exe=${1:?usage: demo.sh CROWDRECON OUTDIR}
 out=${2:?usage: demo.sh CROWDRECON OUTDIR}
-mkdir -p "$out/venues" "$out/bodies" "$out/hallway"
+mkdir -p "$out/venues" "$out/bodies" "$out/hallway" "$out/phase"
 
 echo "== Madrid Arena venues"
 for venue in venues/madrid-arena/*.json; do
@@ -29,4 +29,12 @@ echo "== Rendering the hallway run (every other frame, as PNG and as a real-time
 "$exe" render "$out/hallway/run.sqlite" -o "$out/hallway/frames" --frames every:2 \
   --video "$out/hallway/hallway.mp4" --width 1600 | tee -a "$out/hallway/summary.txt"
 
-echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy)"
+echo "== Analysis of the hallway run (regime, flows, lanes, loads against 400 N)"
+"$exe" analyze "$out/hallway/run.sqlite" --json "$out/hallway/analysis.json" | tee "$out/hallway/analysis.txt"
+
+echo "== Phase diagrams of the shipped Madrid Arena sweeps (venues/madrid-arena/sweeps/results/)"
+for sweep in hallway-bodies hallway-gamma hallway-lambda; do
+  "$exe" phase "venues/madrid-arena/sweeps/results/$sweep" -o "$out/phase/$sweep" | tail -n 1
+done
+
+echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), phase/"
