@@ -74,16 +74,6 @@ Checkpoint ReadCheckpoint(const std::filesystem::path& file, std::uint64_t finge
   return c;
 }
 
-std::string Duration(double s) {
-  char buffer[32];
-  if (!std::isfinite(s)) return "?";
-  const long total = std::lround(s);
-  if (total >= 3600) std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, (total / 60) % 60);
-  else if (total >= 60) std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
-  else std::snprintf(buffer, sizeof buffer, "%lds", total);
-  return buffer;
-}
-
 }  // namespace
 
 std::filesystem::path CheckpointPath(const std::filesystem::path& run_file) {
@@ -183,7 +173,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
         const double rtf = wall > 0 ? (sim.time_s() - start_sim) / wall : 0.0;
         const double left = rtf > 0 ? (scenario.run.duration_s - sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
         std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", sim.time_s(),
-                     scenario.run.duration_s, rtf, Duration(left).c_str());
+                     scenario.run.duration_s, rtf, FormatDuration(left).c_str());
         std::fflush(stderr);
       }
       if (stop && last_frame < total_frames) {

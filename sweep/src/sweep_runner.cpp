@@ -136,16 +136,6 @@ struct StopRunsOnError {
   }
 };
 
-std::string Duration(double s) {
-  char buffer[32];
-  if (!std::isfinite(s)) return "?";
-  const long total = std::lround(s);
-  if (total >= 3600) std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, (total / 60) % 60);
-  else if (total >= 60) std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
-  else std::snprintf(buffer, sizeof buffer, "%lds", total);
-  return buffer;
-}
-
 void RemoveRunFiles(const fs::path& file) {
   std::error_code ec;
   for (const char* suffix : {"", "-journal", "-wal", "-shm", ".checkpoint", ".checkpoint.tmp", ".failed-state",
@@ -275,7 +265,7 @@ class ProgressLine {
     const double rate = elapsed_s > 0 ? static_cast<double>(done_now) / elapsed_s : 0.0;
     const double left = rate > 0 ? static_cast<double>(total - done) / rate : std::numeric_limits<double>::infinity();
     std::fprintf(stderr, "\r  sweep: %zu / %zu runs (%zu failed), %zu running, %s elapsed, %s left      ", done, total,
-                 failed, running, Duration(elapsed_s).c_str(), done == total ? "0s" : Duration(left).c_str());
+                 failed, running, FormatDuration(elapsed_s).c_str(), done == total ? "0s" : FormatDuration(left).c_str());
     std::fflush(stderr);
     shown_ = true;
   }
@@ -297,7 +287,7 @@ std::string SweepSummary::BriefReport() const {
   r += "runs: " + std::to_string(total) + " in all; " + std::to_string(already_done) + " done before, " +
        std::to_string(completed) + " now (" + std::to_string(failed) + " failed), " + std::to_string(remaining) +
        " left\n";
-  r += "wall time: " + Duration(wall_s) + ", " + std::to_string(jobs) + " run(s) at a time" +
+  r += "wall time: " + FormatDuration(wall_s) + ", " + std::to_string(jobs) + " run(s) at a time" +
        (ranks > 1 ? " on each of " + std::to_string(ranks) + " MPI ranks" : std::string()) + "\n";
   if (ranks > 1 && runs_per_rank.size() == static_cast<std::size_t>(ranks)) {
     r += "runs per rank:";

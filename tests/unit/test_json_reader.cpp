@@ -1,3 +1,5 @@
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "test_util.hpp"
@@ -48,3 +50,12 @@ TEST(JsonReader, MissingFileIsAnError) {
 
 }  // namespace
 }  // namespace crowdrecon
+
+TEST(Format, NumbersAndDurations) {
+  EXPECT_EQ(crowdrecon::FormatNumber(0.05), "0.05");
+  EXPECT_EQ(crowdrecon::FormatNumber(1e5), "100000");
+  EXPECT_EQ(crowdrecon::FormatDuration(42.4), "42s");
+  EXPECT_EQ(crowdrecon::FormatDuration(187.0), "3m07s");
+  EXPECT_EQ(crowdrecon::FormatDuration(3900.0), "1h05m");
+  EXPECT_EQ(crowdrecon::FormatDuration(std::numeric_limits<double>::infinity()), "?");
+}

@@ -24,4 +24,8 @@ class GeometryError : public InputError {
 // Formats a double compactly for messages ("0.05", "1e+05").
 std::string FormatNumber(double value);
 
+// Formats a duration in seconds for progress lines: "42s", "3m07s", "1h05m";
+// "?" if not finite.
+std::string FormatDuration(double seconds);
+
 }  // namespace crowdrecon
