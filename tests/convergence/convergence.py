@@ -12,7 +12,7 @@ people, the frames after a transient and the seeds. The change against base
 must be below the tolerance (5 %), and the seed-to-seed spread (standard error
 of the mean over seeds) is reported so that the comparison can be judged.
 
-usage: convergence.py CROWDRECON OUTDIR [--seeds N] [--duration S] [--transient S] [--tolerance F]
+usage: convergence.py CROWDRECON OUTDIR [--seeds N] [--duration S] [--transient S] [--tolerance F] [--reuse]
 Exit status 1 if a change exceeds the tolerance. Prints 'N passed, N failed'.
 """
 import argparse
@@ -84,6 +84,8 @@ def main():
     p.add_argument("--density", type=float, default=5.0)
     p.add_argument("--counter-flow", type=float, default=0.3)
     p.add_argument("--configs", default="base,half_dt,vertices36")
+    p.add_argument("--reuse", action="store_true",
+                   help="measure run files already in OUTDIR (complete runs of the same scenario) instead of running them again")
     args = p.parse_args()
     os.makedirs(args.outdir, exist_ok=True)
     default_safety = 0.04  # engine::ModelParameters::time_step_safety
@@ -100,9 +102,16 @@ def main():
         def one(seed):
             sc = os.path.join(args.outdir, f"{name}-{seed}.json")
             run = os.path.join(args.outdir, f"{name}-{seed}.sqlite")
+            text = json.dumps(scenario(seed, args.duration, cfg["body"], args.density, args.counter_flow,
+                                       cfg.get("safety")), indent=1)
+            if args.reuse and os.path.exists(run) and os.path.exists(sc) and open(sc).read() == text:
+                con = sqlite3.connect(run)
+                status = con.execute("SELECT value FROM run WHERE key = 'status'").fetchone()
+                con.close()
+                if status and status[0] == "complete":
+                    return measure(run, args.transient)
             with open(sc, "w") as f:
-                json.dump(scenario(seed, args.duration, cfg["body"], args.density, args.counter_flow, cfg.get("safety")),
-                          f, indent=1)
+                f.write(text)
             subprocess.run([args.exe, "simulate", sc, "-o", run, "-q", "--threads", str(args.threads)], check=True,
                            stdout=subprocess.DEVNULL)
             return measure(run, args.transient)
