@@ -93,6 +93,7 @@ def main():
         "base": dict(body="thorax-18.json"),
         "half_dt": dict(body="thorax-18.json", safety=default_safety / 2),
         "vertices36": dict(body="thorax-36.json"),
+        "vertices72": dict(body="thorax-72.json"),
     }
     results = {}
     wanted = args.configs.split(",")
@@ -127,7 +128,7 @@ def main():
               f"{', '.join(f'{v:.3f}' for v in speeds)} m/s; {', '.join(f'{v:.1f}' for v in forces)} N")
     passed = failed = 0
     base_s, base_f = results["base"][0][0], results["base"][1][0]
-    for name in [n for n in ("half_dt", "vertices36") if n in results]:
+    for name in [n for n in ("half_dt", "vertices36", "vertices72") if n in results]:
         ds = (results[name][0][0] - base_s) / base_s
         df = (results[name][1][0] - base_f) / base_f
         ok = abs(ds) < args.tolerance and abs(df) < args.tolerance
