@@ -163,12 +163,7 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     if (shape.vertices.empty() || shape.vertices.size() >= 32768 || !(shape.radius_m > 0))
       throw InputError("shape " + std::to_string(s) + ": needs 1..32767 vertices and a radius > 0");
     shape.core_radius_m = 0.0;
-    shape.box_min_m = shape.box_max_m = shape.vertices.front();
-    for (const Vec2& v : shape.vertices) {
-      shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
-      shape.box_min_m = {std::min(shape.box_min_m.x, v.x), std::min(shape.box_min_m.y, v.y)};
-      shape.box_max_m = {std::max(shape.box_max_m.x, v.x), std::max(shape.box_max_m.y, v.y)};
-    }
+    for (const Vec2& v : shape.vertices) shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
   }
   const std::size_t n = def_.people.size();
   if (n >= (std::size_t{1} << 31)) throw InputError("too many people");

@@ -18,10 +18,9 @@ namespace crowdrecon::engine {
 struct BodyShape {
   std::vector<Vec2> vertices;
   double radius_m = 0.05;  // sphero-radius
-  // Largest distance of a vertex from the centroid (m), and the core's
-  // bounding box in the body frame; filled by the engine.
+  // Largest distance of a vertex from the centroid (m); filled by the
+  // engine. (The narrow phase keeps its own geometry: narrow_phase.hpp.)
   double core_radius_m = 0.0;
-  Vec2 box_min_m, box_max_m;
 };
 
 // A wall: an open or closed polyline swept by a disk of radius radius_m, of
