@@ -107,8 +107,12 @@ Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) { return ClosestOnCore(p, 
 // Contacts of the vertices of `from` against the core of `to`; `flip` makes
 // normals point from B to A when `from` is B. Works in `to`'s unscaled frame
 // (its geometry's own units).
-void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, std::uint32_t tag,
-                     std::vector<ContactPoint>& out) {
+// Returns the least clearance (d - reach, metres) over the vertices that did
+// not touch, +infinity if there were none; see CollideShapes. `memory` (or
+// null): per vertex of `from`, skip it while moved < memory[i], and record
+// the bound for the vertices measured apart.
+double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, std::uint32_t tag,
+                       std::vector<ContactPoint>& out, double moved, double* memory) {
   const ShapeGeometry& f = *from.geometry;
   const ShapeGeometry& g = *to.geometry;
   const double reach = f.radius_m * from.scale + g.radius_m * to.scale;  // metres
@@ -125,10 +129,25 @@ void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, 
   const bool use_grid = !g.cell_start.empty() && reach_g <= g.grid_reach_m;
   const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
   const std::uint32_t n = f.count();
+  double clearance = std::numeric_limits<double>::infinity();  // g's units
+  // Vertex i measured apart by `gap` (g's units): the pair's least, and the
+  // vertex's own threshold.
+  const auto apart = [&](std::uint32_t i, double gap) {
+    clearance = std::min(clearance, gap);
+    if (memory) memory[i] = moved + gap * unit - kClearanceSlack_m;
+  };
   for (std::uint32_t i = 0; i < n; ++i) {
+    if (memory && moved < memory[i]) {  // still apart since it was measured
+      clearance = std::min(clearance, (memory[i] - moved) / unit);
+      continue;
+    }
     const Vec2 v = f.vertices[i];
     const Vec2 p{c * v.x - s * v.y + o.x, s * v.x + c * v.y + o.y};
-    if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) continue;
+    if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) {
+      // Outside the box grown by the reach: d(p, core) - reach >= how far outside.
+      apart(i, std::max(std::max(lo.x - p.x, p.x - hi.x), std::max(lo.y - p.y, p.y - hi.y)));
+      continue;
+    }
     Closest cl;
     if (use_grid) {
       const double fx = (p.x - g.grid_origin.x) * inverse_cell, fy = (p.y - g.grid_origin.y) * inverse_cell;
@@ -136,22 +155,33 @@ void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, 
       const std::uint32_t cy = fy <= 0.0 ? 0 : std::min(g.grid_ny - 1, static_cast<std::uint32_t>(fy));
       const std::uint32_t cell = cy * g.grid_nx + cx;
       const std::uint32_t first = g.cell_start[cell], last = g.cell_start[cell + 1];
-      if (first == last) continue;  // farther than the reach from the core
+      if (first == last) {  // farther than the reach from the core
+        apart(i, g.cell_clearance[cell] - reach_g);
+        continue;
+      }
       cl = ClosestOnCore(p, g, &g.cell_edges[first], last - first);
     } else {
       cl = ClosestOnCore(p, g);
     }
-    if (cl.distance >= reach_g) continue;
+    if (cl.distance >= reach_g) {
+      apart(i, cl.distance - reach_g);
+      continue;
+    }
     Vec2 normal;
     if (cl.distance > 0.0) {
       normal = (p - cl.point) / cl.distance;
     } else if (cl.distance < 0.0) {
       normal = (cl.point - p) / -cl.distance;  // p crossed into the core: push it back out
     } else {
+      clearance = 0.0;
       continue;  // exactly on the core boundary: no direction (measure zero)
     }
     ContactPoint cp;
     cp.overlap_m = reach - cl.distance * unit;
+    if (!(cp.overlap_m > 0.0)) {  // d < reach in g's units, but not once scaled (round-off)
+      apart(i, 0.0);
+      continue;
+    }
     const Vec2 local = cl.point * unit + normal * (g.radius_m * unit - cp.overlap_m / 2.0);  // metres, to's frame
     cp.point = to.position + Vec2{to.cos_angle * local.x - to.sin_angle * local.y,
                                   to.sin_angle * local.x + to.cos_angle * local.y};
@@ -161,12 +191,13 @@ void VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, 
     cp.feature = tag | i;
     out.push_back(cp);
   }
+  return clearance * unit;  // (an infinity stays one)
 }
 
 // True when the bounding boxes of A and B, each grown by half the reach, do
 // not overlap (separating axis theorem; four axes in 2D). Then no point of A's
 // core comes within the reach of B's core.
-bool BoxesApart(const PlacedShape& a, const PlacedShape& b, double reach) {
+double BoxesGap(const PlacedShape& a, const PlacedShape& b, double reach) {
   const ShapeGeometry& ga = *a.geometry;
   const ShapeGeometry& gb = *b.geometry;
   const double grow = reach / 2.0;
@@ -180,11 +211,11 @@ bool BoxesApart(const PlacedShape& a, const PlacedShape& b, double reach) {
   const Vec2 t = cb - ca;
   const double uu = std::abs(Dot(ua, ub)), uv = std::abs(Dot(ua, vb));
   const double vu = std::abs(Dot(va, ub)), vv = std::abs(Dot(va, vb));
-  if (std::abs(Dot(t, ua)) > ha.x + hb.x * uu + hb.y * uv) return true;
-  if (std::abs(Dot(t, va)) > ha.y + hb.x * vu + hb.y * vv) return true;
-  if (std::abs(Dot(t, ub)) > hb.x + ha.x * uu + ha.y * vu) return true;
-  if (std::abs(Dot(t, vb)) > hb.y + ha.x * uv + ha.y * vv) return true;
-  return false;
+  const double gap_ua = std::abs(Dot(t, ua)) - (ha.x + hb.x * uu + hb.y * uv);
+  const double gap_va = std::abs(Dot(t, va)) - (ha.y + hb.x * vu + hb.y * vv);
+  const double gap_ub = std::abs(Dot(t, ub)) - (hb.x + ha.x * uu + ha.y * vu);
+  const double gap_vb = std::abs(Dot(t, vb)) - (hb.y + ha.x * uv + ha.y * vv);
+  return std::max(std::max(gap_ua, gap_va), std::max(gap_ub, gap_vb));
 }
 
 }  // namespace
@@ -192,6 +223,7 @@ bool BoxesApart(const PlacedShape& a, const PlacedShape& b, double reach) {
 void ShapeGeometry::BuildEdgeGrid(double reach_m) {
   cell_start.clear();
   cell_edges.clear();
+  cell_clearance.clear();
   grid_nx = grid_ny = 0;
   grid_reach_m = 0.0;
   if (edges.size() < 6 || !(reach_m > 0.0) || edges.size() > 65535) return;
@@ -205,6 +237,7 @@ void ShapeGeometry::BuildEdgeGrid(double reach_m) {
   const double slack = 1e-9 * (1.0 + core_radius_m + reach_m);  // round-off of the distances below
   std::vector<double> distance(edges.size());
   cell_start.assign(std::size_t{nx} * ny + 1, 0);
+  cell_clearance.assign(std::size_t{nx} * ny, 0.0);
   for (std::uint32_t cy = 0; cy < ny; ++cy)
     for (std::uint32_t cx = 0; cx < nx; ++cx) {
       const Vec2 centre = lo + Vec2{(cx + 0.5) * cell, (cy + 0.5) * cell};
@@ -222,6 +255,7 @@ void ShapeGeometry::BuildEdgeGrid(double reach_m) {
       // in the core, which the engine reports as an error).
       if (!inside && least - half_diagonal > reach_m + slack) {
         cell_start[index + 1] = static_cast<std::uint32_t>(cell_edges.size());
+        cell_clearance[index] = least - half_diagonal - slack;  // any point p of the cell: d(p) >= this
         continue;
       }
       // Any point p of the cell: its closest edge e* has |p e*| <= |p e_least|
@@ -237,18 +271,30 @@ void ShapeGeometry::BuildEdgeGrid(double reach_m) {
   grid_reach_m = reach_m;
 }
 
-void CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out) {
+double CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out,
+                     const VertexClearances* memory) {
   const ShapeGeometry& ga = *a.geometry;
   const ShapeGeometry& gb = *b.geometry;
   const double reach = ga.radius_m * a.scale + gb.radius_m * b.scale;
   const double bound = ga.core_radius_m * a.scale + gb.core_radius_m * b.scale + reach;
-  if (LengthSquared(a.position - b.position) >= bound * bound) return;
-  if (BoxesApart(a, b, reach)) return;
+  const double d2 = LengthSquared(a.position - b.position);
+  // Bounding circles apart: every core point lies within its circle.
+  if (d2 >= bound * bound) return std::sqrt(d2) - bound;
+  // Grown boxes apart along an axis: the gap of their projections bounds the
+  // distance of the cores less the reach (each box is grown by half of it).
+  const double boxes = BoxesGap(a, b, reach);
+  if (boxes > 0.0) return boxes;
   // With a disk on either side, the disk's vertex alone gives the exact overlap.
   const bool a_side = ga.count() == 1 || gb.count() != 1;
   const bool b_side = ga.count() != 1;
-  if (a_side) VerticesAgainst(a, b, false, 0u, out);
-  if (b_side) VerticesAgainst(b, a, true, kVertexOfB, out);
+  const std::size_t before = out.size();
+  double clearance = std::numeric_limits<double>::infinity();
+  const double moved = memory ? memory->moved : 0.0;
+  if (a_side) clearance = std::min(clearance, VerticesAgainst(a, b, false, 0u, out, moved, memory ? memory->a : nullptr));
+  if (b_side)
+    clearance = std::min(clearance, VerticesAgainst(b, a, true, kVertexOfB, out, moved, memory ? memory->b : nullptr));
+  if (out.size() != before) return 0.0;
+  return std::max(0.0, clearance);
 }
 
 }  // namespace crowdrecon::engine

@@ -97,6 +97,26 @@ struct Simulation::Internals {
   std::vector<Vec2> position_at_build;
   bool pairs_valid = false;
 
+  // Pair clearances (temporal coherence, exact). travel_m[i] only grows: it
+  // adds, at every force evaluation, a bound on how far any core point of
+  // body i moved since the last one (|translation| + arm * |rotation|, the
+  // arm being the farthest core vertex from the centre). A pair found apart
+  // by the narrow phase with clearance c (CollideShapes) cannot touch before
+  // its two bodies' travels have grown by c together, so it is skipped while
+  // travel_m[a] + travel_m[b] < pair_clear_m[k] (walls do not move). The
+  // skipped pairs are exactly pairs without contacts: results are unchanged,
+  // bit for bit. Reset (to -infinity) whenever the lists are rebuilt.
+  std::vector<double> travel_m;
+  std::vector<Vec2> travel_position;
+  std::vector<double> travel_angle;
+  std::vector<double> rotation_arm_m;
+  std::vector<double> pair_clear_m, wall_pair_clear_m;
+  // The same per vertex of the two bodies of a pair (VertexClearances):
+  // pair k's vertices start at pair_vertex_start[k] in pair_vertex_clear_m,
+  // A's then B's; likewise for (person, wall) pairs.
+  std::vector<std::size_t> pair_vertex_start, wall_pair_vertex_start;
+  std::vector<double> pair_vertex_clear_m, wall_pair_vertex_clear_m;
+
   // Contact-law constants.
   double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
   double wall_restitution_factor = 0.0;  // same for walls
@@ -276,6 +296,17 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   }
   in_->cos_angle.assign(n, 1.0);
   in_->sin_angle.assign(n, 0.0);
+  in_->travel_m.assign(n, 0.0);
+  in_->travel_position = bodies_.position_m;
+  in_->travel_angle = bodies_.angle_rad;
+  in_->rotation_arm_m.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t shape = bodies_.shape[i];
+    // The core the narrow phase places (the family's outline at this scale),
+    // rounded up so that round-off never makes the bound too small.
+    in_->rotation_arm_m[i] =
+        in_->family_geometry[in_->shape_family[shape]].core_radius_m * in_->shape_scale[shape] * (1.0 + 1e-12);
+  }
 
   // Walls crossing a periodic boundary are extended beyond it, so that a body
   // straddling the seam meets a straight wall and never a wall's end cap.
@@ -391,6 +422,8 @@ void Simulation::UpdatePairs() {
   in.position_at_build = bodies_.position_m;
   in.pairs.clear();
   in.wall_pairs.clear();
+  in.pair_clear_m.clear();
+  in.wall_pair_clear_m.clear();
 
   std::vector<std::uint32_t> active;
   double bound_max = 0.0;
@@ -482,6 +515,23 @@ void Simulation::UpdatePairs() {
     }
   }
   std::sort(in.pairs.begin(), in.pairs.end());
+  constexpr double kNever = -std::numeric_limits<double>::infinity();
+  in.pair_clear_m.assign(in.pairs.size(), kNever);
+  in.wall_pair_clear_m.assign(in.wall_pairs.size(), kNever);
+  const auto vertices_of = [&](std::uint32_t i) {
+    return std::size_t{in.family_geometry[in.shape_family[bodies_.shape[i]]].count()};
+  };
+  in.pair_vertex_start.resize(in.pairs.size() + 1);
+  in.pair_vertex_start[0] = 0;
+  for (std::size_t k = 0; k < in.pairs.size(); ++k)
+    in.pair_vertex_start[k + 1] = in.pair_vertex_start[k] + vertices_of(in.pairs[k].first) + vertices_of(in.pairs[k].second);
+  in.pair_vertex_clear_m.assign(in.pair_vertex_start.back(), kNever);
+  in.wall_pair_vertex_start.resize(in.wall_pairs.size() + 1);
+  in.wall_pair_vertex_start[0] = 0;
+  for (std::size_t k = 0; k < in.wall_pairs.size(); ++k)
+    in.wall_pair_vertex_start[k + 1] = in.wall_pair_vertex_start[k] + vertices_of(in.wall_pairs[k].first) +
+                                       in.wall_geometry[in.wall_pairs[k].second].count();
+  in.wall_pair_vertex_clear_m.assign(in.wall_pair_vertex_start.back(), kNever);
 }
 
 void Simulation::RebuildNeighbourList() {
@@ -503,6 +553,14 @@ void Simulation::PlaceShapes() {
     const std::size_t i = static_cast<std::size_t>(ii);
     // One call for both (glibc's sincos computes exactly what sin and cos do).
     ::sincos(bodies_.angle_rad[i], &in.sin_angle[i], &in.cos_angle[i]);
+    // Travel since the last evaluation: a core point at distance r <= arm
+    // from the centre moves by at most |translation| + r |rotation|.
+    const Vec2 x = bodies_.position_m[i];
+    const double angle = bodies_.angle_rad[i];
+    in.travel_m[i] += Length(Separation(x, in.travel_position[i])) +
+                      in.rotation_arm_m[i] * std::abs(angle - in.travel_angle[i]);
+    in.travel_position[i] = x;
+    in.travel_angle[i] = angle;
   }
 }
 
@@ -566,8 +624,14 @@ struct ContactLaw {
     // onset (new contact) and until the end (separating contact) are estimated
     // from delta and v_n, and the dashpot impulse of the half kick is cut to it.
     const bool is_new = previous_spring_found == false;
-    c.trailing_fraction = (is_new && vn < 0.0) ? std::min(1.0, 2.0 * c.overlap_m / (-vn * dt)) : 1.0;
-    c.leading_fraction = vn > 0.0 ? std::min(1.0, 2.0 * c.overlap_m / (vn * dt)) : 1.0;
+    if (is_new) {
+      c.trailing_fraction = vn < 0.0 ? std::min(2.0, 2.0 * c.overlap_m / (-vn * dt)) : 1.0;
+    } else {
+      // The last leading kick already covered the time it expected the contact to last beyond its half step.
+      c.trailing_fraction = previous->leading_fraction > 1.0 ? 2.0 - previous->leading_fraction : 1.0;
+    }
+    const double until_end = vn > 0.0 ? 2.0 * c.overlap_m / (vn * dt) : 2.0;
+    c.leading_fraction = until_end < 2.0 ? until_end : 1.0;
   }
 };
 
@@ -671,13 +735,20 @@ void Simulation::Collide() {
         const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
         for (std::size_t k = chunk * kChunk; k < end; ++k) {
           const auto [a, b] = in.pairs[k];
+          const double moved = in.travel_m[a] + in.travel_m[b];
+          if (moved < in.pair_clear_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
           const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
           points.clear();
-          CollideShapes(pa, pb, points);
-          if (points.empty()) continue;
+          double* vertex_clear = in.pair_vertex_clear_m.data() + in.pair_vertex_start[k];
+          const VertexClearances memory{moved, vertex_clear, vertex_clear + pa.geometry->count()};
+          const double clearance = CollideShapes(pa, pb, points, &memory);
+          if (points.empty()) {
+            in.pair_clear_m[k] = moved + clearance - kClearanceSlack_m;
+            continue;
+          }
           const double m_ab = effective_mass(a, b);
           const std::uint64_t key = (std::uint64_t{a} << 32) | b;
           const auto [sum, k_eff] = OverlapShares(points);
@@ -700,6 +771,8 @@ void Simulation::Collide() {
         const std::size_t end = std::min(in.wall_pairs.size(), (wchunk + 1) * kChunk);
         for (std::size_t k = wchunk * kChunk; k < end; ++k) {
           const auto [a, w] = in.wall_pairs[k];
+          const double moved = in.travel_m[a];
+          if (moved < in.wall_pair_clear_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const PlacedShape pa = placed(a, xa);
@@ -707,8 +780,13 @@ void Simulation::Collide() {
           pw.geometry = &in.wall_geometry[w];
           pw.position = in.wall_origin[w];
           points.clear();
-          CollideShapes(pa, pw, points);
-          if (points.empty()) continue;
+          double* vertex_clear = in.wall_pair_vertex_clear_m.data() + in.wall_pair_vertex_start[k];
+          const VertexClearances memory{moved, vertex_clear, vertex_clear + pa.geometry->count()};
+          const double clearance = CollideShapes(pa, pw, points, &memory);
+          if (points.empty()) {
+            in.wall_pair_clear_m[k] = moved + clearance - kClearanceSlack_m;
+            continue;
+          }
           const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
           const auto [sum, k_eff] = OverlapShares(points);
           for (const ContactPoint& p : points) {

@@ -322,23 +322,29 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     engine::Simulation& sim = *relaxing;
     const bool last = stage == stages;
     const double goal = last ? tolerance : std::max(tolerance, 0.02 * scale);
-    const int budget = last ? 20000 : 3000;
+    // Budgets in simulated time, so that the placement does not depend on
+    // the step the engine chooses: quench every 5 ms, judge progress every
+    // 0.25 s, at most 5 s for the full size (0.8 s for a growing stage).
+    const double h = sim.time_step_s();
+    const int quench_steps = std::max(1, static_cast<int>(std::lround(0.005 / h)));
+    const int window_quenches = std::max(1, static_cast<int>(std::lround(0.25 / (quench_steps * h))));
+    const int budget_quenches = static_cast<int>(std::lround((last ? 5.0 : 0.8) / (quench_steps * h)));
     int steps = 0;
     residual = MaxOverlap(sim);
     // Quenched relaxation; give up early once the largest overlap stops
-    // falling (a jammed packing), judged over windows of 1000 steps.
+    // falling (a jammed packing), judged over the windows.
     double window_start = residual;
-    while (residual > goal && steps < budget) {
+    for (int quench = 1; residual > goal && quench <= budget_quenches; ++quench) {
       try {
-        for (int k = 0; k < 20; ++k) sim.Step();
+        for (int k = 0; k < quench_steps; ++k) sim.Step();
       } catch (const engine::SimulationError& e) {
         throw InputError(scenario.file.string() + ": /population: placement failed while relaxing (the density may be too high): " +
                          e.what());
       }
-      steps += 20;
+      steps += quench_steps;
       sim.Quench();
       residual = MaxOverlap(sim);
-      if (steps % 1000 == 0) {
+      if (quench % window_quenches == 0) {
         if (residual > 0.95 * window_start) break;
         window_start = residual;
       }

@@ -68,8 +68,8 @@ TEST(EnginePhysics, HeadOnCollisionsHaveTheConfiguredRestitution) {
   for (const BodyShape& shape : {DiskShape(0.2), ThoraxLikeShape()})
     for (double eps : {0.1, 0.3, 0.5}) {
       const std::string what = std::to_string(shape.vertices.size()) + " vertices, eps " + std::to_string(eps);
-      EXPECT_LT(WorstRestitutionError(shape, eps, Integrator::kVelocityVerlet, default_safety / 2), 0.02) << what;
-      EXPECT_LT(WorstRestitutionError(shape, eps, Integrator::kVelocityVerlet, default_safety), 0.03) << what;
+      EXPECT_LT(WorstRestitutionError(shape, eps, Integrator::kVelocityVerlet, default_safety), 0.02) << what;
+      EXPECT_LT(WorstRestitutionError(shape, eps, Integrator::kVelocityVerlet, default_safety / 2), 0.005) << what;
       EXPECT_LT(WorstRestitutionError(shape, eps, Integrator::kGear5, default_safety), 0.02) << what << " gear5";
     }
 }

@@ -1,6 +1,8 @@
 // Narrow phase (engine/narrow_phase.hpp): the candidate-edge grid and shape
 // families are exact shortcuts of the plain vertex-to-edge search.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -123,6 +125,126 @@ TEST(NarrowPhase, DisksAndWallsAgainstClosedForms) {
     EXPECT_NEAR(c.normal.y, 1.0, 1e-15);
     EXPECT_NEAR(c.point.y, -0.005, 1e-15);
   }
+}
+
+// The vertices of `from` in world coordinates.
+std::vector<Vec2> WorldVertices(const PlacedShape& p) {
+  std::vector<Vec2> out;
+  for (const Vec2& v : p.geometry->vertices) {
+    const Vec2 s = v * p.scale;
+    out.push_back(p.position + Vec2{p.cos_angle * s.x - p.sin_angle * s.y, p.sin_angle * s.x + p.cos_angle * s.y});
+  }
+  return out;
+}
+
+// Distance from a point to a polyline or polygon (unsigned), by brute force.
+double DistanceTo(Vec2 q, const std::vector<Vec2>& core, bool closed) {
+  if (core.size() == 1) return Length(q - core[0]);
+  double best = 1e300;
+  const std::size_t edges = closed ? core.size() : core.size() - 1;
+  for (std::size_t k = 0; k < edges; ++k) {
+    const Vec2 a = core[k], b = core[(k + 1) % core.size()];
+    const double t = std::clamp(Dot(q - a, b - a) / LengthSquared(b - a), 0.0, 1.0);
+    best = std::min(best, Length(q - (a + (b - a) * t)));
+  }
+  return best;
+}
+
+TEST(NarrowPhase, ClearanceIsALowerBoundOnTheGapAndUseful) {
+  // For pairs without contacts, the clearance is at most the exact gap
+  // min over vertices of d(vertex, other core) - (r_A + r_B), and for most
+  // pairs a good part of it (else skipping would gain nothing).
+  ShapeGeometry body = ShapeGeometry::Make(ArmsOutline(), true, 0.05);
+  body.BuildEdgeGrid(0.1);
+  const ShapeGeometry disk = ShapeGeometry::Make({{0.0, 0.0}}, true, 0.1);
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::size_t apart = 0, tight = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const bool with_disk = trial % 4 == 3;
+    const PlacedShape a = Place(body, {0.0, 0.0}, 3.2 * u(rng));
+    const PlacedShape b = Place(with_disk ? disk : body, Vec2{0.6 * u(rng), 0.7 * u(rng)}, 3.2 * u(rng));
+    std::vector<ContactPoint> out;
+    const double clearance = CollideShapes(a, b, out);
+    if (!out.empty()) {
+      EXPECT_EQ(clearance, 0.0);
+      continue;
+    }
+    const std::vector<Vec2> wa = WorldVertices(a), wb = WorldVertices(b);
+    const double reach = a.geometry->radius_m + b.geometry->radius_m;
+    double gap = 1e300;
+    if (!with_disk)
+      for (const Vec2& v : wa) gap = std::min(gap, DistanceTo(v, wb, true) - reach);
+    for (const Vec2& v : wb) gap = std::min(gap, DistanceTo(v, wa, true) - reach);
+    ASSERT_GE(clearance, 0.0) << "trial " << trial;
+    ASSERT_LE(clearance, gap + 1e-12) << "trial " << trial;
+    ++apart;
+    tight += clearance > 0.3 * gap ? 1 : 0;
+  }
+  EXPECT_GT(apart, 5000u);
+  EXPECT_GT(tight, apart * 7 / 10) << tight << " of " << apart;
+}
+
+TEST(NarrowPhase, RememberedClearancesGiveExactlyTheSameContacts) {
+  // Two bodies wander into and out of contact in small random steps; a caller
+  // keeps the pair's and the vertices' clearances between calls, bounding
+  // each body's motion by |translation| + arm |rotation| as the engine does.
+  // Every call must give the contacts of a call without memory, bit for bit,
+  // while most pairs and vertices are skipped.
+  ShapeGeometry body = ShapeGeometry::Make(ArmsOutline(), true, 0.05);
+  body.BuildEdgeGrid(0.1);
+  const double arm = body.core_radius_m * (1.0 + 1e-12);
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::size_t calls = 0, skipped = 0, touching = 0;
+  for (int walk = 0; walk < 40; ++walk) {
+    Vec2 xa{0.0, 0.0}, xb{0.45 + 0.1 * u(rng), 0.2 * u(rng)};
+    double ta = 3.2 * u(rng), tb = 3.2 * u(rng);
+    Vec2 va{0.4 * u(rng), 0.2 * u(rng)}, vb{-0.4 * std::abs(u(rng)), 0.2 * u(rng)};
+    double wa = 2.0 * u(rng), wb = 2.0 * u(rng);
+    double travel_a = 0.0, travel_b = 0.0, pair_clear = -1e300;
+    std::vector<double> memory(2 * body.count(), -std::numeric_limits<double>::infinity());
+    for (int step = 0; step < 1500; ++step) {
+      // Random accelerations; steps of ~0.3 mm and ~0.5 mrad, like the engine's.
+      const double h = 3e-4;
+      va += Vec2{u(rng), u(rng)} * 0.05;
+      vb += Vec2{u(rng), u(rng)} * 0.05;
+      wa += 0.2 * u(rng);
+      wb += 0.2 * u(rng);
+      xa += va * h;
+      xb += vb * h;
+      ta += wa * h;
+      tb += wb * h;
+      travel_a += Length(va * h) + arm * std::abs(wa * h);
+      travel_b += Length(vb * h) + arm * std::abs(wb * h);
+      const PlacedShape a = Place(body, xa, ta), b = Place(body, xb, tb);
+      std::vector<ContactPoint> expected, got;
+      CollideShapes(a, b, expected);
+      ++calls;
+      const double moved = travel_a + travel_b;
+      if (moved < pair_clear) {
+        ++skipped;
+        ASSERT_TRUE(expected.empty()) << "walk " << walk << " step " << step;
+        continue;
+      }
+      const VertexClearances remembered{moved, memory.data(), memory.data() + body.count()};
+      const double clearance = CollideShapes(a, b, got, &remembered);
+      if (got.empty()) pair_clear = moved + clearance - kClearanceSlack_m;
+      ASSERT_EQ(expected.size(), got.size()) << "walk " << walk << " step " << step;
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(expected[k].feature, got[k].feature);
+        EXPECT_EQ(expected[k].overlap_m, got[k].overlap_m);
+        EXPECT_EQ(expected[k].point.x, got[k].point.x);
+        EXPECT_EQ(expected[k].point.y, got[k].point.y);
+        EXPECT_EQ(expected[k].normal.x, got[k].normal.x);
+        EXPECT_EQ(expected[k].normal.y, got[k].normal.y);
+      }
+      touching += got.empty() ? 0 : 1;
+    }
+  }
+  // The walks spend time both touching and apart, and the memory is used.
+  EXPECT_GT(touching, calls / 10) << touching << " of " << calls;
+  EXPECT_GT(skipped, calls / 10) << skipped << " of " << calls;
 }
 
 }  // namespace

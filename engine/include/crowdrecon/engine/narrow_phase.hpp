@@ -69,6 +69,9 @@ struct ShapeGeometry {
   std::uint32_t grid_nx = 0, grid_ny = 0;
   std::vector<std::uint32_t> cell_start;  // grid_nx * grid_ny + 1
   std::vector<std::uint16_t> cell_edges;
+  // Per cell without candidates: a lower bound on the distance from any point
+  // of the cell to the core (> grid_reach_m); 0 for cells with candidates.
+  std::vector<double> cell_clearance;
 
   // Builds the geometry of a core given in its own frame (a body: centroid at
   // the origin). Vertex counts must be 1..32767.
@@ -104,8 +107,39 @@ struct ContactPoint {
 
 inline constexpr std::uint32_t kVertexOfB = 1u << 15;
 
+// Taken off every clearance that is kept for later (metres): far more than
+// the round-off of the distances and travels it is compared with (bodies
+// ~1e2 m from the origin), far less than the motion of a body in one step.
+inline constexpr double kClearanceSlack_m = 1e-9;
+
+// A pair's memory of its vertices' clearances between calls (temporal
+// coherence). `moved` bounds how far, together, the vertices of A and the
+// core of B (and the reverse) can have moved since a reference that only the
+// caller knows and that never goes back; a[i] (b[i]) holds for vertex i of A
+// (of B) the value of `moved` below which it cannot touch: it is skipped while
+// moved < a[i], and measured and updated otherwise. Start with -infinity.
+struct VertexClearances {
+  double moved = 0.0;
+  double* a = nullptr;  // A's vertex count entries
+  double* b = nullptr;  // B's vertex count entries
+};
+
 // Appends the contacts between A and B to `out` (nothing if they do not touch),
 // vertices of A first, each side in vertex order.
-void CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out);
+//
+// Returns the pair's clearance: 0 when it appended contacts; otherwise a lower
+// bound c >= 0 (metres) on the distance that separates every counted vertex
+// from the reach of the other core, min over vertices of d(vertex, other core)
+// - (r_A + r_B). The distance from a point to a set changes by no more than
+// the point and the set move, so no contact can appear before the vertices of
+// A and the core of B (and the reverse) have moved, together, by c: a caller
+// that bounds the motion of every core point since this call may skip the pair
+// until that bound reaches c (Simulation's pair clearances). Every bound comes
+// from a cull already taken: the bounding circles, the separating axis of the
+// grown boxes, per vertex its grown box or its grid cell or its distance.
+// With `memory`, vertices still apart since their last measurement are
+// skipped (they cannot touch); the result is the same, contacts and order.
+double CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out,
+                     const VertexClearances* memory = nullptr);
 
 }  // namespace crowdrecon::engine

@@ -77,11 +77,11 @@ struct ModelParameters {
   double time_step_s = 0.0;
   // Fraction of the integrator's stability limit used when the engine chooses
   // the step: h = safety * 2 / omega_max for velocity Verlet. Chosen for
-  // accuracy, not speed: at 0.04 the restitution of head-on collisions is
-  // within 3% of epsilon for epsilon in [0.1, 0.5] whatever the phase of the
-  // collision within a step, and within 2% at half that step
+  // accuracy, not speed: at 0.08 the restitution of head-on collisions is
+  // within 2% of epsilon for epsilon in [0.1, 0.5] whatever the phase of the
+  // collision within a step, and within 0.5% at half that step
   // (tests/unit/test_engine_physics.cpp; docs/model.md).
-  double time_step_safety = 0.04;
+  double time_step_safety = 0.08;
 
   // Returns false and fills *error with "name: value, expected ..." if a value
   // is out of its physical range.
