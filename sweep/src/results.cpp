@@ -201,6 +201,13 @@ ResultsStore::ResultsStore(const fs::path& dir, const SweepSpec& spec, const std
                          " changed since it was started); use a new output folder (-o), or delete " +
                          dir.string() + " to start over");
     };
+    // Runs of another build may differ (the engine may have changed): a sweep
+    // is finished by the crowdrecon that started it.
+    if (stored["crowdrecon_version"] != values.at("crowdrecon_version"))
+      throw InputError(file.string() + " holds runs made by crowdrecon " + stored["crowdrecon_version"] +
+                       "; this is crowdrecon " + values.at("crowdrecon_version") +
+                       ", whose results may differ and are not mixed with them; use a new output folder (-o), or "
+                       "delete " + dir.string() + " to start over");
     differs("sweep", "the sweep file");
     differs("scenario", "the scenario " + spec.scenario_file.string());
     differs("analysis_options", "the analysis options");

@@ -56,6 +56,14 @@ if [[ $mode == local ]]; then
   fi
   grep -q "holds the results of a different sweep (the sweep file changed" "$out/other.txt" ||
     { echo "FAIL: unclear message"; cat "$out/other.txt"; exit 1; }
+  # A sweep started by another build is not continued (its runs may differ).
+  cp -r "$out/resume" "$out/other-build"
+  sqlite3 "$out/other-build/results.sqlite" "UPDATE sweep SET value = 'v0.0-other' WHERE key = 'crowdrecon_version'"
+  if "$exe" sweep "$sweep" -o "$out/other-build" -q >"$out/other-build.txt" 2>&1; then
+    echo "FAIL: a sweep of another build was continued"; exit 1
+  fi
+  grep -q "holds runs made by crowdrecon v0.0-other; this is crowdrecon .*not mixed" "$out/other-build.txt" ||
+    { echo "FAIL: unclear message"; cat "$out/other-build.txt"; exit 1; }
   echo "sweeps, local: OK"
 elif [[ $mode == mpi ]]; then
   command -v mpirun >/dev/null || { echo "mpirun not found: skipped"; exit 77; }
