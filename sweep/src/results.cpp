@@ -11,9 +11,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/scenario/sqlite.hpp"
 
-#ifndef CROWDRECON_GIT_VERSION
-#define CROWDRECON_GIT_VERSION "unknown"
-#endif
+#include "crowdrecon/sweep/version.hpp"  // generated at build time: CROWDRECON_GIT_VERSION
 
 namespace crowdrecon::sweep {
 

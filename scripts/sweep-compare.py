@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""Paired differences of a metric between two variants of sweeps.
+
+Compares, run by run, the rows of sweep results (results.sqlite written by
+`crowdrecon sweep`) that share a seed and the values of the diagram axes:
+variant B minus variant A, averaged over the selected points, with the
+standard error over the paired differences. Used for the readings in
+venues/madrid-arena/sweeps/results/README.md.
+
+usage: sweep-compare.py A_DIR:VARIANT B_DIR:VARIANT [--metric M]
+                        [--min-y Y] [--max-y Y] [--min-x X] [--max-x X]
+
+A_DIR and B_DIR may be the same folder (two variants of one sweep) or two
+sweeps over grids that share points (a coarse grid inside a fine one); only
+points present in both are compared. Exit status 1 if none are.
+"""
+import argparse
+import math
+import sqlite3
+import sys
+
+
+def load(spec, metric):
+    folder, variant = spec.rsplit(":", 1)
+    con = sqlite3.connect(f"{folder}/results.sqlite")
+    meta = dict(con.execute("SELECT key, value FROM sweep"))
+    x, y = meta["diagram_x"], meta["diagram_y"]
+    rows = con.execute(
+        f'SELECT "{x}", "{y}", seed, "{metric}" FROM runs WHERE variant = ? AND status = \'complete\'', (variant,))
+    out = {}
+    for vx, vy, seed, value in rows:
+        if value is not None:
+            out[(round(float(vx), 9), round(float(vy), 9), int(seed))] = float(value)
+    if not out:
+        sys.exit(f"sweep-compare: no complete runs of variant '{variant}' with {metric} in {folder}")
+    return out
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("a")
+    p.add_argument("b")
+    p.add_argument("--metric", default="mean_speed_m_per_s")
+    p.add_argument("--min-x", type=float, default=-math.inf)
+    p.add_argument("--max-x", type=float, default=math.inf)
+    p.add_argument("--min-y", type=float, default=-math.inf)
+    p.add_argument("--max-y", type=float, default=math.inf)
+    args = p.parse_args()
+    a, b = load(args.a, args.metric), load(args.b, args.metric)
+    keys = sorted(k for k in a if k in b and args.min_x <= k[0] <= args.max_x and args.min_y <= k[1] <= args.max_y)
+    if not keys:
+        sys.exit("sweep-compare: no common (point, seed) in the selection")
+    d = [b[k] - a[k] for k in keys]
+    mean = sum(d) / len(d)
+    sem = math.sqrt(sum((v - mean) ** 2 for v in d) / (len(d) - 1) / len(d)) if len(d) > 1 else float("nan")
+    points = len({(k[0], k[1]) for k in keys})
+    print(f"{args.metric}: {args.b} - {args.a} = {mean:+.4f} +- {sem:.4f} "
+          f"(paired by seed over {len(d)} runs at {points} points; A mean {sum(a[k] for k in keys) / len(keys):.4f})")
+
+
+if __name__ == "__main__":
+    main()
