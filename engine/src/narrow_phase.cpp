@@ -173,7 +173,7 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     } else if (cl.distance < 0.0) {
       normal = (cl.point - p) / -cl.distance;  // p crossed into the core: push it back out
     } else {
-      clearance = 0.0;
+      apart(i, 0.0);
       continue;  // exactly on the core boundary: no direction (measure zero)
     }
     ContactPoint cp;

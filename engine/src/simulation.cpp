@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <type_traits>
 #include <unordered_map>
@@ -29,6 +30,38 @@ constexpr std::size_t kChunk = 64;
 constexpr std::int64_t kParallelBodies = 512;
 
 using Clock = std::chrono::steady_clock;
+
+// The clearances of one pair list (person pairs, or person-wall pairs): per
+// pair, the travel sum below which it is still apart, and per vertex of its
+// two shapes the same (VertexClearances), pair k's vertices at
+// vertex_start[k], the first shape's then the second's. See Internals.
+struct PairClearances {
+  std::vector<double> pair_m;
+  std::vector<std::size_t> vertex_start;
+  std::vector<double> vertex_m;
+
+  // For a new list: nothing known. `vertices(k)` = the vertex count of both shapes of pair k.
+  template <typename VertexCount>
+  void Reset(std::size_t pairs, VertexCount vertices) {
+    constexpr double kNever = -std::numeric_limits<double>::infinity();
+    pair_m.assign(pairs, kNever);
+    vertex_start.resize(pairs + 1);
+    vertex_start[0] = 0;
+    for (std::size_t k = 0; k < pairs; ++k) vertex_start[k + 1] = vertex_start[k] + vertices(k);
+    vertex_m.assign(vertex_start.back(), kNever);
+  }
+
+  // Narrow phase of pair k, whose shapes' core points have moved `moved`
+  // together (travel sum): appends its contacts to `points` unless it is
+  // known to be still apart, and remembers what it finds.
+  void Collide(std::size_t k, double moved, const PlacedShape& a, const PlacedShape& b,
+               std::vector<ContactPoint>& points) {
+    double* vertex_clear = vertex_m.data() + vertex_start[k];
+    const VertexClearances memory{moved, vertex_clear, vertex_clear + a.geometry->count()};
+    const double clearance = CollideShapes(a, b, points, &memory);
+    if (points.empty()) pair_m[k] = moved + clearance - kClearanceSlack_m;
+  }
+};
 
 class ScopedTimer {
  public:
@@ -103,19 +136,15 @@ struct Simulation::Internals {
   // arm being the farthest core vertex from the centre). A pair found apart
   // by the narrow phase with clearance c (CollideShapes) cannot touch before
   // its two bodies' travels have grown by c together, so it is skipped while
-  // travel_m[a] + travel_m[b] < pair_clear_m[k] (walls do not move). The
+  // travel_m[a] + travel_m[b] < pair_clear.pair_m[k] (walls do not move). The
   // skipped pairs are exactly pairs without contacts: results are unchanged,
   // bit for bit. Reset (to -infinity) whenever the lists are rebuilt.
   std::vector<double> travel_m;
   std::vector<Vec2> travel_position;
   std::vector<double> travel_angle;
   std::vector<double> rotation_arm_m;
-  std::vector<double> pair_clear_m, wall_pair_clear_m;
-  // The same per vertex of the two bodies of a pair (VertexClearances):
-  // pair k's vertices start at pair_vertex_start[k] in pair_vertex_clear_m,
-  // A's then B's; likewise for (person, wall) pairs.
-  std::vector<std::size_t> pair_vertex_start, wall_pair_vertex_start;
-  std::vector<double> pair_vertex_clear_m, wall_pair_vertex_clear_m;
+  // The same per vertex of the two shapes of a pair, inside touching pairs.
+  PairClearances pair_clear, wall_pair_clear;
 
   // Contact-law constants.
   double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
@@ -422,8 +451,6 @@ void Simulation::UpdatePairs() {
   in.position_at_build = bodies_.position_m;
   in.pairs.clear();
   in.wall_pairs.clear();
-  in.pair_clear_m.clear();
-  in.wall_pair_clear_m.clear();
 
   std::vector<std::uint32_t> active;
   double bound_max = 0.0;
@@ -515,23 +542,14 @@ void Simulation::UpdatePairs() {
     }
   }
   std::sort(in.pairs.begin(), in.pairs.end());
-  constexpr double kNever = -std::numeric_limits<double>::infinity();
-  in.pair_clear_m.assign(in.pairs.size(), kNever);
-  in.wall_pair_clear_m.assign(in.wall_pairs.size(), kNever);
   const auto vertices_of = [&](std::uint32_t i) {
     return std::size_t{in.family_geometry[in.shape_family[bodies_.shape[i]]].count()};
   };
-  in.pair_vertex_start.resize(in.pairs.size() + 1);
-  in.pair_vertex_start[0] = 0;
-  for (std::size_t k = 0; k < in.pairs.size(); ++k)
-    in.pair_vertex_start[k + 1] = in.pair_vertex_start[k] + vertices_of(in.pairs[k].first) + vertices_of(in.pairs[k].second);
-  in.pair_vertex_clear_m.assign(in.pair_vertex_start.back(), kNever);
-  in.wall_pair_vertex_start.resize(in.wall_pairs.size() + 1);
-  in.wall_pair_vertex_start[0] = 0;
-  for (std::size_t k = 0; k < in.wall_pairs.size(); ++k)
-    in.wall_pair_vertex_start[k + 1] = in.wall_pair_vertex_start[k] + vertices_of(in.wall_pairs[k].first) +
-                                       in.wall_geometry[in.wall_pairs[k].second].count();
-  in.wall_pair_vertex_clear_m.assign(in.wall_pair_vertex_start.back(), kNever);
+  in.pair_clear.Reset(in.pairs.size(),
+                      [&](std::size_t k) { return vertices_of(in.pairs[k].first) + vertices_of(in.pairs[k].second); });
+  in.wall_pair_clear.Reset(in.wall_pairs.size(), [&](std::size_t k) {
+    return vertices_of(in.wall_pairs[k].first) + in.wall_geometry[in.wall_pairs[k].second].count();
+  });
 }
 
 void Simulation::RebuildNeighbourList() {
@@ -592,7 +610,6 @@ struct ContactLaw {
   void Apply(Contact& c, Vec2 relative_velocity, double effective_mass, const Contact* previous,
              double weight, double k_eff) const {
     const double previous_spring = previous ? previous->tangential_spring_m : 0.0;
-    const bool previous_spring_found = previous != nullptr;
     const Vec2 t = Perp(c.normal);
     const double vn = Dot(relative_velocity, c.normal);  // > 0: separating
     const double vt = Dot(relative_velocity, t);
@@ -619,12 +636,12 @@ struct ContactLaw {
     c.viscous_tangential_n = -effective_mass * gamma_t * vt;
     c.tangential_force_n = -kt * spring + c.viscous_tangential_n;  // eqs. (9) + (12)
     // Onset and end within a step. The dashpots jump at delta = 0 (eqs. 11-12),
-    // so a kick that applies them for a whole half step when the contact began
-    // or ends inside it biases the restitution by O(gamma h). The time since
-    // onset (new contact) and until the end (separating contact) are estimated
-    // from delta and v_n, and the dashpot impulse of the half kick is cut to it.
-    const bool is_new = previous_spring_found == false;
-    if (is_new) {
+    // so kicks that apply them for whole half steps bias the restitution by
+    // O(gamma h). The time since onset (new contact, up to a whole step ago)
+    // and until the end (separating contact, if before the next evaluation)
+    // are estimated from delta and v_n, and the dashpot impulse of the
+    // adjacent half kick is scaled to it, by up to two (docs/model.md).
+    if (previous == nullptr) {
       c.trailing_fraction = vn < 0.0 ? std::min(2.0, 2.0 * c.overlap_m / (-vn * dt)) : 1.0;
     } else {
       // The last leading kick already covered the time it expected the contact to last beyond its half step.
@@ -736,19 +753,14 @@ void Simulation::Collide() {
         for (std::size_t k = chunk * kChunk; k < end; ++k) {
           const auto [a, b] = in.pairs[k];
           const double moved = in.travel_m[a] + in.travel_m[b];
-          if (moved < in.pair_clear_m[k]) continue;  // still apart (see Internals)
+          if (moved < in.pair_clear.pair_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
           const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
           points.clear();
-          double* vertex_clear = in.pair_vertex_clear_m.data() + in.pair_vertex_start[k];
-          const VertexClearances memory{moved, vertex_clear, vertex_clear + pa.geometry->count()};
-          const double clearance = CollideShapes(pa, pb, points, &memory);
-          if (points.empty()) {
-            in.pair_clear_m[k] = moved + clearance - kClearanceSlack_m;
-            continue;
-          }
+          in.pair_clear.Collide(k, moved, pa, pb, points);
+          if (points.empty()) continue;
           const double m_ab = effective_mass(a, b);
           const std::uint64_t key = (std::uint64_t{a} << 32) | b;
           const auto [sum, k_eff] = OverlapShares(points);
@@ -772,7 +784,7 @@ void Simulation::Collide() {
         for (std::size_t k = wchunk * kChunk; k < end; ++k) {
           const auto [a, w] = in.wall_pairs[k];
           const double moved = in.travel_m[a];
-          if (moved < in.wall_pair_clear_m[k]) continue;  // still apart (see Internals)
+          if (moved < in.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const PlacedShape pa = placed(a, xa);
@@ -780,13 +792,8 @@ void Simulation::Collide() {
           pw.geometry = &in.wall_geometry[w];
           pw.position = in.wall_origin[w];
           points.clear();
-          double* vertex_clear = in.wall_pair_vertex_clear_m.data() + in.wall_pair_vertex_start[k];
-          const VertexClearances memory{moved, vertex_clear, vertex_clear + pa.geometry->count()};
-          const double clearance = CollideShapes(pa, pw, points, &memory);
-          if (points.empty()) {
-            in.wall_pair_clear_m[k] = moved + clearance - kClearanceSlack_m;
-            continue;
-          }
+          in.wall_pair_clear.Collide(k, moved, pa, pw, points);
+          if (points.empty()) continue;
           const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
           const auto [sum, k_eff] = OverlapShares(points);
           for (const ContactPoint& p : points) {

@@ -29,6 +29,18 @@ PlacedShape Place(const ShapeGeometry& g, Vec2 at, double angle, double scale = 
   return p;
 }
 
+// Two contact lists of the same length are equal bit for bit.
+void ExpectSameContacts(const std::vector<ContactPoint>& expected, const std::vector<ContactPoint>& got) {
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    EXPECT_EQ(expected[k].feature, got[k].feature);
+    EXPECT_EQ(expected[k].overlap_m, got[k].overlap_m);
+    EXPECT_EQ(expected[k].point.x, got[k].point.x);
+    EXPECT_EQ(expected[k].point.y, got[k].point.y);
+    EXPECT_EQ(expected[k].normal.x, got[k].normal.x);
+    EXPECT_EQ(expected[k].normal.y, got[k].normal.y);
+  }
+}
+
 TEST(NarrowPhase, EdgeGridGivesExactlyTheFullSearch) {
   const ShapeGeometry plain = ShapeGeometry::Make(ArmsOutline(), true, 0.05);
   ShapeGeometry gridded = plain;
@@ -44,15 +56,7 @@ TEST(NarrowPhase, EdgeGridGivesExactlyTheFullSearch) {
     CollideShapes(Place(plain, {0, 0}, ta), Place(plain, at, tb), expected);
     CollideShapes(Place(gridded, {0, 0}, ta), Place(gridded, at, tb), got);
     ASSERT_EQ(expected.size(), got.size()) << "trial " << trial;
-    for (std::size_t k = 0; k < got.size(); ++k) {
-      // Bit for bit: the same edges with the same arithmetic.
-      EXPECT_EQ(expected[k].feature, got[k].feature);
-      EXPECT_EQ(expected[k].overlap_m, got[k].overlap_m);
-      EXPECT_EQ(expected[k].point.x, got[k].point.x);
-      EXPECT_EQ(expected[k].point.y, got[k].point.y);
-      EXPECT_EQ(expected[k].normal.x, got[k].normal.x);
-      EXPECT_EQ(expected[k].normal.y, got[k].normal.y);
-    }
+    ExpectSameContacts(expected, got);  // the same edges with the same arithmetic
     touching += got.empty() ? 0 : 1;
     points += got.size();
   }
@@ -231,14 +235,7 @@ TEST(NarrowPhase, RememberedClearancesGiveExactlyTheSameContacts) {
       const double clearance = CollideShapes(a, b, got, &remembered);
       if (got.empty()) pair_clear = moved + clearance - kClearanceSlack_m;
       ASSERT_EQ(expected.size(), got.size()) << "walk " << walk << " step " << step;
-      for (std::size_t k = 0; k < got.size(); ++k) {
-        EXPECT_EQ(expected[k].feature, got[k].feature);
-        EXPECT_EQ(expected[k].overlap_m, got[k].overlap_m);
-        EXPECT_EQ(expected[k].point.x, got[k].point.x);
-        EXPECT_EQ(expected[k].point.y, got[k].point.y);
-        EXPECT_EQ(expected[k].normal.x, got[k].normal.x);
-        EXPECT_EQ(expected[k].normal.y, got[k].normal.y);
-      }
+      ExpectSameContacts(expected, got);
       touching += got.empty() ? 0 : 1;
     }
   }
