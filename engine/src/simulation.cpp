@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/fast_math.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 
 #ifdef _OPENMP
@@ -569,8 +570,7 @@ void Simulation::PlaceShapes() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
-    // One call for both (glibc's sincos computes exactly what sin and cos do).
-    ::sincos(bodies_.angle_rad[i], &in.sin_angle[i], &in.cos_angle[i]);
+    SinCos(bodies_.angle_rad[i], in.sin_angle[i], in.cos_angle[i]);  // common/fast_math.hpp
     // Travel since the last evaluation: a core point at distance r <= arm
     // from the centre moves by at most |translation| + r |rotation|.
     const Vec2 x = bodies_.position_m[i];
@@ -905,10 +905,16 @@ void Simulation::Drive() {
   ScopedTimer timer(profile_.drive_s);
   const Internals& in = *in_;
   const ModelParameters& mp = def_.parameters;
-  const double tau = mp.relaxation_time_s;
+  // Loop invariants, so that the loop below divides only where it must.
+  const double inverse_tau = 1.0 / mp.relaxation_time_s;
+  const double back_factor = mp.back_force_gamma * inverse_tau;                                      // eq. (15): Gamma / tau
+  const double torsion_factor = mp.torsion_stiffness_lambda * inverse_tau * inverse_tau;             // eq. (16): lambda / tau^2
+  const double rotation_damping = 1.0 / mp.rotation_relaxation_time_s;                               // eq. (17)
+  const bool face_velocity = mp.facing_target == FacingTarget::kVelocity;
   const double slope_force_per_kg =
       def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
                                 : 0.0;
+  const Vec2 slope_force_dir = def_.slope.downhill * slope_force_per_kg;
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
   for (std::int64_t ii = 0; ii < n; ++ii) {
@@ -920,26 +926,26 @@ void Simulation::Drive() {
       const double v0 = bodies_.desired_speed_m_per_s[i];
       const Vec2 v = bodies_.velocity_m_per_s[i];
       const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i]);
-      force += (e * v0 - v) * (m / tau);  // eq. (3)
+      force += (e * v0 - v) * (m * inverse_tau);  // eq. (3)
       // Back force, eq. (15): only when pushed backwards (Theta(x) = 1 for x > 0
       // only, ERRATA 9), along e plus e x k, which points to the person's right.
-      if (-Dot(e, v) > 0.0) force += (e + Vec2{e.y, -e.x}) * (mp.back_force_gamma * m * v0 / tau);
+      if (-Dot(e, v) > 0.0) force += (e + Vec2{e.y, -e.x}) * (back_factor * m * v0);
       // Motive torque, eq. (16) with the restoring sign (ERRATA 4) and the angle
       // difference wrapped to (-pi, pi].
       const double speed = Length(v);
       Vec2 facing = e;
-      if (mp.facing_target == FacingTarget::kVelocity) facing = speed > 0.0 ? v / speed : Vec2{};
+      if (face_velocity) facing = speed > 0.0 ? v / speed : Vec2{};
       if (facing.x != 0.0 || facing.y != 0.0) {
         // theta_D - theta wrapped to (-pi, pi], as the angle from the body's
         // orientation (cos, sin from PlaceShapes) to the facing direction.
         const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
-        const double angle_to_target = std::atan2(Cross(orientation, facing), Dot(orientation, facing));
+        const double angle_to_target = Atan2(Cross(orientation, facing), Dot(orientation, facing));
         const double gain = v0 > 0.0 ? 1.0 - std::exp(-speed / v0) : 1.0;
-        torque += mp.torsion_stiffness_lambda * inertia / (tau * tau) * gain * angle_to_target;
+        torque += torsion_factor * inertia * gain * angle_to_target;
       }
       // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
-      torque -= inertia / mp.rotation_relaxation_time_s * bodies_.angular_velocity_rad_per_s[i];
-      force += def_.slope.downhill * (m * slope_force_per_kg);
+      torque -= inertia * rotation_damping * bodies_.angular_velocity_rad_per_s[i];
+      force += slope_force_dir * m;
     }
     bodies_.force_n[i] = force;
     bodies_.torque_n_m[i] = torque;

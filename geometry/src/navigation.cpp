@@ -292,8 +292,7 @@ bool Bilinear(Vec2 p, Vec2 origin, double h, std::size_t nx, std::size_t ny, Val
 
 }  // namespace
 
-Vec2 NavigationField::Direction(Vec2 p) const {
-  if (constant_) return constant_direction_;
+Vec2 NavigationField::FieldDirection(Vec2 p) const {
   Vec2 sum;
   auto valid = [&](std::size_t k) { return std::isfinite(distance_m_[k]); };
   if (!Bilinear(p, origin_m_, spacing_m_, nx_, ny_, valid, [&](std::size_t k, double w) { sum += w * direction_[k]; })) {

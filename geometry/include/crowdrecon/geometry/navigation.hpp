@@ -50,7 +50,8 @@ class NavigationField {
 
   // Desired direction at p: a unit vector, or (0, 0) where the target cannot be
   // reached (a disconnected part of the venue) or p is far outside the area.
-  Vec2 Direction(Vec2 p) const;
+  // (Inline for the constant field: the engine asks once per person and step.)
+  Vec2 Direction(Vec2 p) const { return constant_ ? constant_direction_ : FieldDirection(p); }
   // Geodesic distance to the exit at p (m), bilinearly interpolated;
   // +infinity where unreachable. For a constant field: 0.
   double Distance(Vec2 p) const;
@@ -67,6 +68,8 @@ class NavigationField {
   const std::vector<Vec2>& direction() const { return direction_; }
 
  private:
+  Vec2 FieldDirection(Vec2 p) const;
+
   bool constant_ = true;
   Vec2 constant_direction_;
   Vec2 origin_m_;
