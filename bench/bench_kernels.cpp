@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <map>
@@ -27,6 +28,7 @@
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/geometry/body.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
 
 namespace crowdrecon::bench {
 
@@ -246,6 +248,35 @@ void Step(benchmark::State& state, const std::string& world, int threads) {
   state.counters["dt_s"] = sim.time_step_s();
 }
 
+// Writing one frame of the run file (trajectories, states and every contact,
+// one SQLite transaction), as `crowdrecon simulate` does 10 times a simulated
+// second; the frames go to a temporary file, one per benchmark.
+void FrameWrite(benchmark::State& state, const std::string& world) {
+  engine::Simulation sim = MakeSimulation(world, 1);
+  sim.LoadState(WarmState(world));
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("crowdrecon-bench-frames-" + world + ".sqlite");
+  scenario::RunHeader header;
+  header.scenario_json = "{}";
+  header.walkable_wkt = CachedWorld(world).walkable_wkt;
+  header.time_step_s = sim.time_step_s();
+  std::int64_t frame = 0;
+  {
+    scenario::RunFileWriter writer = scenario::RunFileWriter::Create(file, header, sim);
+    scenario::FrameSnapshot snapshot;
+    snapshot.Take(0, sim, {}, true);
+    for (auto _ : state) {
+      snapshot.frame = frame++;
+      writer.WriteFrame(snapshot);
+    }
+  }
+  std::error_code ec;
+  std::filesystem::remove(file, ec);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(sim.bodies().size()));
+  state.counters["people"] = static_cast<double>(sim.bodies().size());
+  state.counters["contacts"] = static_cast<double>(sim.contacts().size());
+}
+
 void RegisterAll() {
   const Vec2 along_x{1.0, 0.0}, along_y{0.0, 1.0};
   const Vec2 diagonal{std::sqrt(0.5), std::sqrt(0.5)};
@@ -275,6 +306,10 @@ void RegisterAll() {
                                    [w, threads](benchmark::State& s) { NeighbourRebuild(s, w, threads); })
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
+  for (const std::string& w : worlds)
+    benchmark::RegisterBenchmark(("FrameWrite/" + w).c_str(), [w](benchmark::State& s) { FrameWrite(s, w); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   for (const std::string& w : worlds)
     for (int threads : {1, 2})
       benchmark::RegisterBenchmark(("Step/" + w + "/threads:" + std::to_string(threads)).c_str(),

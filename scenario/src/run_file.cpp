@@ -1,8 +1,14 @@
 #include "crowdrecon/scenario/run_file.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <exception>
 #include <limits>
+#include <mutex>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -45,6 +51,11 @@ std::vector<Vec2> PointsFromJson(const std::string& text, const std::string& fil
   }
   return points;
 }
+
+// The writer's connection is used by one thread at a time (the caller, or
+// FrameWriterThread's thread between handoffs under its mutex), so SQLite
+// need not lock it around every call (a tenth of the time of writing frames).
+constexpr int kWriterMutexMode = SQLITE_OPEN_NOMUTEX;
 
 constexpr const char* kSchema = R"SQL(
 CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL,
@@ -90,7 +101,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
   std::filesystem::remove(file, ec);
   for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
   RunFileWriter w;
-  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
   Database& db = *w.impl_->db;
   db.Exec("PRAGMA synchronous=NORMAL");
   db.Exec("BEGIN");
@@ -152,7 +163,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
 RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int64_t last_frame) {
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": run file to resume does not exist");
   RunFileWriter w;
-  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE);
+  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | kWriterMutexMode);
   Database& db = *w.impl_->db;
   db.Exec("PRAGMA synchronous=NORMAL");
   db.Exec("BEGIN");
@@ -176,52 +187,94 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   return w;
 }
 
+void FrameSnapshot::Take(std::int64_t frame_index, const engine::Simulation& sim, const std::vector<Event>& frame_events,
+                         bool contacts_too) {
+  const engine::BodyState& b = sim.bodies();
+  frame = frame_index;
+  time_s = sim.time_s();
+  person.clear();
+  position_m.clear();
+  velocity_m_per_s.clear();
+  angle_rad.clear();
+  angular_velocity_rad_per_s.clear();
+  state.clear();
+  load_n.clear();
+  // Per-person load: the sum of the magnitudes of the contact forces on the
+  // person (the quantity compared with the 400 N threshold).
+  std::vector<double>& load = load_n;
+  load.assign(b.size(), 0.0);
+  for (const engine::Contact& c : sim.contacts()) {
+    const double f = Length(c.Force());
+    load[c.a] += f;
+    if (!c.wall) load[c.b] += f;
+  }
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.state[i] == engine::PersonState::kRemoved) continue;
+    person.push_back(static_cast<std::uint32_t>(i));
+    position_m.push_back(b.position_m[i]);
+    velocity_m_per_s.push_back(b.velocity_m_per_s[i]);
+    angle_rad.push_back(b.angle_rad[i]);
+    angular_velocity_rad_per_s.push_back(b.angular_velocity_rad_per_s[i]);
+    state.push_back(b.state[i]);
+    load[kept++] = load[i];  // kept <= i: compacts in place
+  }
+  load.resize(kept);
+  with_contacts = contacts_too;
+  if (with_contacts) {
+    contacts.assign(sim.contacts().begin(), sim.contacts().end());
+  } else {
+    contacts.clear();
+  }
+  events = frame_events;
+}
+
 void RunFileWriter::WriteFrame(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
                                bool with_contacts) {
+  FrameSnapshot snapshot;
+  snapshot.Take(frame, sim, events, with_contacts);
+  WriteFrame(snapshot);
+}
+
+void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
   Database& db = *impl_->db;
-  const engine::BodyState& b = sim.bodies();
+  const std::int64_t frame = f.frame;
   db.Exec("BEGIN");
   {
-    // Per-person load: the sum of the magnitudes of the contact forces on the
-    // person (the quantity compared with the 400 N threshold).
-    std::vector<double> load(b.size(), 0.0);
-    for (const engine::Contact& c : sim.contacts()) {
-      const double f = Length(c.Force());
-      load[c.a] += f;
-      if (!c.wall) load[c.b] += f;
-    }
-    Statement traj(db, "INSERT INTO trajectory_data VALUES(?, ?, ?, ?, ?, ?)");
-    Statement state(db, "INSERT INTO person_state VALUES(?, ?, ?, ?, ?, ?, ?, ?)");
-    for (std::size_t i = 0; i < b.size(); ++i) {
-      if (b.state[i] == engine::PersonState::kRemoved) continue;
-      const Vec2 x = b.position_m[i];
-      const double angle = b.angle_rad[i];
-      traj.Bind(1, frame).Bind(2, static_cast<std::int64_t>(i + 1)).Bind(3, x.x).Bind(4, x.y)
-          .Bind(5, std::cos(angle)).Bind(6, std::sin(angle)).Run();
-      state.Bind(1, frame).Bind(2, static_cast<std::int64_t>(i + 1))
-          .Bind(3, b.velocity_m_per_s[i].x).Bind(4, b.velocity_m_per_s[i].y)
-          .Bind(5, angle).Bind(6, b.angular_velocity_rad_per_s[i])
-          .Bind(7, static_cast<std::int64_t>(b.state[i])).Bind(8, load[i]).Run();
+    sqlite::BatchInsert traj(db, "trajectory_data", 6);
+    sqlite::BatchInsert state(db, "person_state", 8);
+    for (std::size_t k = 0; k < f.person.size(); ++k) {
+      const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
+      const Vec2 x = f.position_m[k];
+      const double angle = f.angle_rad[k];
+      traj.Add(frame).Add(id).Add(x.x).Add(x.y).Add(std::cos(angle)).Add(std::sin(angle));
+      state.Add(frame).Add(id)
+          .Add(f.velocity_m_per_s[k].x).Add(f.velocity_m_per_s[k].y)
+          .Add(angle).Add(f.angular_velocity_rad_per_s[k])
+          .Add(static_cast<std::int64_t>(f.state[k])).Add(f.load_n[k]);
       impl_->xmin = std::min(impl_->xmin, x.x);
       impl_->xmax = std::max(impl_->xmax, x.x);
       impl_->ymin = std::min(impl_->ymin, x.y);
       impl_->ymax = std::max(impl_->ymax, x.y);
     }
-    if (with_contacts) {
-      Statement contact(db, "INSERT INTO contact VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-      for (const engine::Contact& c : sim.contacts())
-        contact.Bind(1, frame).Bind(2, static_cast<std::int64_t>(c.a + 1))
-            .Bind(3, static_cast<std::int64_t>(c.wall ? c.b : c.b + 1))
-            .Bind(4, static_cast<std::int64_t>(c.wall))
-            .Bind(5, c.point_m.x).Bind(6, c.point_m.y).Bind(7, c.normal.x).Bind(8, c.normal.y)
-            .Bind(9, c.overlap_m).Bind(10, c.normal_force_n).Bind(11, c.tangential_force_n).Run();
+    traj.Finish();
+    state.Finish();
+    if (f.with_contacts) {
+      sqlite::BatchInsert contact(db, "contact", 11);
+      for (const engine::Contact& c : f.contacts)
+        contact.Add(frame).Add(static_cast<std::int64_t>(c.a + 1))
+            .Add(static_cast<std::int64_t>(c.wall ? c.b : c.b + 1))
+            .Add(static_cast<std::int64_t>(c.wall))
+            .Add(c.point_m.x).Add(c.point_m.y).Add(c.normal.x).Add(c.normal.y)
+            .Add(c.overlap_m).Add(c.normal_force_n).Add(c.tangential_force_n);
+      contact.Finish();
     }
     Statement ft(db, "INSERT INTO frame_time VALUES(?, ?)");
-    ft.Bind(1, frame).Bind(2, sim.time_s()).Run();
+    ft.Bind(1, frame).Bind(2, f.time_s).Run();
     Statement fd(db, "INSERT INTO frame_data VALUES(?, ?)");
     fd.Bind(1, frame).Bind(2, impl_->geometry_hash).Run();
     Statement ev(db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
-    for (const Event& e : events)
+    for (const Event& e : f.events)
       ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
           .Bind(4, e.person >= 0 ? e.person + 1 : std::int64_t{0})
           .Bind(5, e.other >= 0 ? e.other + 1 : std::int64_t{0}).Bind(6, e.detail).Run();
@@ -234,6 +287,106 @@ void RunFileWriter::WriteFrame(std::int64_t frame, const engine::Simulation& sim
     }
   }
   db.Exec("COMMIT");
+}
+
+// ---------------------------------------------------------------------------
+
+struct FrameWriterThread::Impl {
+  RunFileWriter& writer;
+  bool background;
+  std::size_t capacity;
+  FrameSnapshot direct;  // the frame being written when not on a thread
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<std::unique_ptr<FrameSnapshot>> queued;  // oldest first
+  std::vector<std::unique_ptr<FrameSnapshot>> spare;  // written, storage kept for reuse
+  bool busy = false;                                  // the thread is writing one
+  bool stopping = false;
+  std::exception_ptr error;
+  std::thread thread;
+
+  Impl(RunFileWriter& w, bool on_thread, std::size_t queue)
+      : writer(w), background(on_thread), capacity(std::max<std::size_t>(1, queue)) {}
+
+  void Loop() {
+    std::unique_lock<std::mutex> lock(mutex);
+    for (;;) {
+      changed.wait(lock, [&] { return stopping || !queued.empty(); });
+      if (queued.empty()) return;  // stopping, nothing left
+      std::unique_ptr<FrameSnapshot> frame = std::move(queued.front());
+      queued.pop_front();
+      busy = true;
+      lock.unlock();
+      std::exception_ptr failure;
+      if (!error) {  // after a failure, later frames are dropped (the run is stopping)
+        try {
+          writer.WriteFrame(*frame);
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      }
+      lock.lock();
+      busy = false;
+      if (failure && !error) error = failure;
+      spare.push_back(std::move(frame));
+      changed.notify_all();
+    }
+  }
+
+  void RethrowLocked(std::unique_lock<std::mutex>& lock) {
+    if (!error) return;
+    std::exception_ptr e = error;
+    lock.unlock();
+    std::rethrow_exception(e);
+  }
+};
+
+FrameWriterThread::FrameWriterThread(RunFileWriter& writer, bool background, std::size_t queue)
+    : impl_(std::make_unique<Impl>(writer, background, queue)) {
+  if (impl_->background) impl_->thread = std::thread([this] { impl_->Loop(); });
+}
+
+FrameWriterThread::~FrameWriterThread() {
+  if (!impl_->background) return;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->changed.notify_all();
+  impl_->thread.join();
+}
+
+void FrameWriterThread::Write(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
+                              bool with_contacts) {
+  if (!impl_->background) {
+    impl_->direct.Take(frame, sim, events, with_contacts);
+    impl_->writer.WriteFrame(impl_->direct);
+    return;
+  }
+  std::unique_ptr<FrameSnapshot> snapshot;
+  {
+    std::unique_lock<std::mutex> lock(impl_->mutex);
+    impl_->changed.wait(lock, [&] { return impl_->error || impl_->queued.size() < impl_->capacity; });
+    impl_->RethrowLocked(lock);
+    if (!impl_->spare.empty()) {
+      snapshot = std::move(impl_->spare.back());
+      impl_->spare.pop_back();
+    }
+  }
+  if (!snapshot) snapshot = std::make_unique<FrameSnapshot>();
+  snapshot->Take(frame, sim, events, with_contacts);  // outside the lock: the thread may be writing
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->queued.push_back(std::move(snapshot));
+  }
+  impl_->changed.notify_all();
+}
+
+void FrameWriterThread::Flush() {
+  if (!impl_->background) return;
+  std::unique_lock<std::mutex> lock(impl_->mutex);
+  impl_->changed.wait(lock, [&] { return impl_->error || (impl_->queued.empty() && !impl_->busy); });
+  impl_->RethrowLocked(lock);
 }
 
 void RunFileWriter::WriteEvent(std::int64_t frame, const Event& e) {

@@ -1,5 +1,6 @@
 #include "crowdrecon/scenario/runner.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
@@ -150,9 +152,19 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const double start_sim = sim.time_s();
   auto last_print = start;
 
+  // Frames are written by a thread of their own while the next ones are
+  // simulated, if the engine leaves a core free (see FrameWriterThread);
+  // everything that must follow the frames in the file (a checkpoint naming
+  // the last frame, an event, the status) waits for them with Flush.
+  const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
+  FrameWriterThread frames(writer, core_free);
   const auto write_frame = [&](std::int64_t frame) {
-    writer.WriteFrame(frame, sim, {}, scenario.run.write_contacts);
+    frames.Write(frame, sim, {}, scenario.run.write_contacts);
     last_frame = frame;
+  };
+  const auto checkpoint_now = [&](const std::filesystem::path& file) {
+    frames.Flush();
+    WriteCheckpoint(file, fingerprint, last_frame, sim);
   };
   if (last_frame < 0) write_frame(0);
 
@@ -163,7 +175,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
         sim.Step();
       }
       write_frame(last_frame + 1);
-      if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) WriteCheckpoint(checkpoint, fingerprint, last_frame, sim);
+      if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) checkpoint_now(checkpoint);
       const bool stop = g_stop_requested.load() || (options.stop_flag && options.stop_flag->load()) ||
                         (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);
       const auto now = Clock::now();
@@ -177,7 +189,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
         std::fflush(stderr);
       }
       if (stop && last_frame < total_frames) {
-        WriteCheckpoint(checkpoint, fingerprint, last_frame, sim);
+        checkpoint_now(checkpoint);
         status = "interrupted";
         break;
       }
@@ -185,7 +197,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   } catch (const engine::SimulationError& e) {
     // Save the state in which the run failed, next to the run file, and say so.
     const std::filesystem::path failed = options.output.string() + ".failed-state";
-    WriteCheckpoint(failed, fingerprint, last_frame, sim);
+    checkpoint_now(failed);
     Event event;
     event.time_s = sim.time_s();
     event.kind = "numerical_failure";
@@ -199,6 +211,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
                      "; frames up to " + std::to_string(last_frame) + " are in the run file and the state is saved in " +
                      failed.string());
   }
+  frames.Flush();
   if (options.show_progress) std::fprintf(stderr, "\n");
   writer.SetStatus(status);
   if (status == "complete") {

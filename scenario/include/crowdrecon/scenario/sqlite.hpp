@@ -7,7 +7,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "crowdrecon/common/error.hpp"
 
@@ -104,6 +107,77 @@ class Statement {
   [[noreturn]] void Fail() const { throw InputError(db_.file() + ": SQLite error: " + sqlite3_errmsg(db_.get())); }
   const Database& db_;
   sqlite3_stmt* stmt_ = nullptr;
+};
+
+// Inserts rows of numbers into one table, many rows per INSERT statement
+// ("INSERT INTO t VALUES (?, ...), (?, ...), ..."): per row, SQLite then
+// skips a statement's start, its cursors' opening and closing, and its reset,
+// which cost more than the row itself (a 10,000-person frame: about half the
+// time of single-row inserts). Add a row's values in column order; Finish
+// inserts the rows still held (call it before committing).
+class BatchInsert {
+ public:
+  static constexpr std::size_t kRowsPerStatement = 64;
+
+  BatchInsert(const Database& db, std::string table, int columns)
+      : db_(db), table_(std::move(table)), columns_(static_cast<std::size_t>(columns)) {
+    values_.reserve(kRowsPerStatement * columns_);
+  }
+  BatchInsert& Add(std::int64_t v) { return Push({true, v, 0.0}); }
+  BatchInsert& Add(double v) { return Push({false, 0, v}); }
+  void Finish() {
+    if (!values_.empty()) Insert();
+  }
+
+ private:
+  struct Value {
+    bool integer;
+    std::int64_t i;
+    double d;
+  };
+  BatchInsert& Push(Value v) {
+    values_.push_back(v);
+    if (values_.size() == kRowsPerStatement * columns_) Insert();
+    return *this;
+  }
+  std::string Sql(std::size_t rows) const {
+    std::string row = "(";
+    for (std::size_t c = 0; c < columns_; ++c) row += c == 0 ? "?" : ", ?";
+    row += ")";
+    std::string sql = "INSERT INTO " + table_ + " VALUES ";
+    for (std::size_t r = 0; r < rows; ++r) sql += (r == 0 ? "" : ", ") + row;
+    return sql;
+  }
+  void Insert() {
+    if (values_.size() % columns_ != 0)
+      throw InputError(db_.file() + ": internal error: incomplete row for table " + table_);
+    const std::size_t rows = values_.size() / columns_;
+    std::unique_ptr<Statement> partial;
+    Statement* statement = nullptr;
+    if (rows == kRowsPerStatement) {
+      if (!full_) full_ = std::make_unique<Statement>(db_, Sql(rows));
+      statement = full_.get();
+    } else {
+      partial = std::make_unique<Statement>(db_, Sql(rows));
+      statement = partial.get();
+    }
+    for (std::size_t k = 0; k < values_.size(); ++k) {
+      const int index = static_cast<int>(k) + 1;
+      if (values_[k].integer) {
+        statement->Bind(index, values_[k].i);
+      } else {
+        statement->Bind(index, values_[k].d);
+      }
+    }
+    statement->Run();
+    values_.clear();
+  }
+
+  const Database& db_;
+  std::string table_;
+  std::size_t columns_;
+  std::vector<Value> values_;
+  std::unique_ptr<Statement> full_;
 };
 
 }  // namespace crowdrecon::sqlite
