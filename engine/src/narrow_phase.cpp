@@ -136,9 +136,13 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     clearance = std::min(clearance, gap);
     if (memory) memory[i] = moved + gap * unit - kClearanceSlack_m;
   };
+  // Least threshold of the vertices skipped below: their clearance, min over
+  // i of (memory[i] - moved) / unit, is (least - moved) / unit (monotone in
+  // memory[i], so exactly the same value), one division instead of one each.
+  double least_skipped = std::numeric_limits<double>::infinity();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (memory && moved < memory[i]) {  // still apart since it was measured
-      clearance = std::min(clearance, (memory[i] - moved) / unit);
+      least_skipped = std::min(least_skipped, memory[i]);
       continue;
     }
     const Vec2 v = f.vertices[i];
@@ -191,6 +195,8 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     cp.feature = tag | i;
     out.push_back(cp);
   }
+  if (least_skipped < std::numeric_limits<double>::infinity())
+    clearance = std::min(clearance, (least_skipped - moved) / unit);
   return clearance * unit;  // (an infinity stays one)
 }
 
