@@ -23,7 +23,9 @@
 // expects ids), i.e. engine index + 1; contact.a/b use the same ids.
 //
 // Each frame is one transaction: a run killed at any moment leaves a valid
-// file holding every frame committed so far.
+// file holding every frame committed so far (in write-ahead-log mode while
+// written: a killed run's RUN.sqlite-wal holds the last frames, and readers
+// fold it in; docs/scenarios.md).
 #pragma once
 
 #include <cstdint>

@@ -114,7 +114,8 @@ class Statement {
 // skips a statement's start, its cursors' opening and closing, and its reset,
 // which cost more than the row itself (a 10,000-person frame: about half the
 // time of single-row inserts). Add a row's values in column order; Finish
-// inserts the rows still held (call it before committing).
+// inserts the rows still held (call it before committing). Keep the object
+// for the next batch: its statements (one per number of rows) stay prepared.
 class BatchInsert {
  public:
   static constexpr std::size_t kRowsPerStatement = 64;
@@ -128,6 +129,8 @@ class BatchInsert {
   void Finish() {
     if (!values_.empty()) Insert();
   }
+  // Drops rows added but not inserted (after a failure).
+  void Discard() { values_.clear(); }
 
  private:
   struct Value {
@@ -152,15 +155,9 @@ class BatchInsert {
     if (values_.size() % columns_ != 0)
       throw InputError(db_.file() + ": internal error: incomplete row for table " + table_);
     const std::size_t rows = values_.size() / columns_;
-    std::unique_ptr<Statement> partial;
-    Statement* statement = nullptr;
-    if (rows == kRowsPerStatement) {
-      if (!full_) full_ = std::make_unique<Statement>(db_, Sql(rows));
-      statement = full_.get();
-    } else {
-      partial = std::make_unique<Statement>(db_, Sql(rows));
-      statement = partial.get();
-    }
+    std::unique_ptr<Statement>& prepared = statements_[rows - 1];
+    if (!prepared) prepared = std::make_unique<Statement>(db_, Sql(rows));
+    Statement* statement = prepared.get();
     for (std::size_t k = 0; k < values_.size(); ++k) {
       const int index = static_cast<int>(k) + 1;
       if (values_[k].integer) {
@@ -177,7 +174,7 @@ class BatchInsert {
   std::string table_;
   std::size_t columns_;
   std::vector<Value> values_;
-  std::unique_ptr<Statement> full_;
+  std::unique_ptr<Statement> statements_[kRowsPerStatement];  // [rows - 1]
 };
 
 }  // namespace crowdrecon::sqlite
