@@ -193,6 +193,7 @@ void NarrowPhase(benchmark::State& state, const NarrowPhaseCase& c) {
 
 constexpr double kWarmUpSeconds = 0.25;  // simulated
 constexpr std::int64_t kWindowSteps = 100;
+constexpr double kDevelopedSeconds = 5.0;  // simulated; see RegisterAll
 
 engine::Simulation MakeSimulation(const std::string& world, int threads) {
   engine::WorldDef def = CachedWorld(world).world;
@@ -202,14 +203,14 @@ engine::Simulation MakeSimulation(const std::string& world, int threads) {
 
 // The state after the warm-up, once per world (results do not depend on the
 // thread count, so it serves every thread count).
-const std::string& WarmState(const std::string& world) {
-  static std::map<std::string, std::string> cache;
-  auto it = cache.find(world);
+const std::string& WarmState(const std::string& world, double warm_up_s = kWarmUpSeconds) {
+  static std::map<std::pair<std::string, double>, std::string> cache;
+  auto it = cache.find({world, warm_up_s});
   if (it == cache.end()) {
     engine::Simulation sim =
         MakeSimulation(world, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-    while (sim.time_s() < kWarmUpSeconds) sim.Step();
-    it = cache.emplace(world, sim.SaveState()).first;
+    while (sim.time_s() < warm_up_s) sim.Step();
+    it = cache.emplace(std::pair{world, warm_up_s}, sim.SaveState()).first;
   }
   return it->second;
 }
@@ -224,8 +225,8 @@ void NeighbourRebuild(benchmark::State& state, const std::string& world, int thr
   state.counters["pairs"] = static_cast<double>(sim.neighbour_pair_count());
 }
 
-void Step(benchmark::State& state, const std::string& world, int threads) {
-  const std::string& warm = WarmState(world);
+void Step(benchmark::State& state, const std::string& world, int threads, double warm_up_s = kWarmUpSeconds) {
+  const std::string& warm = WarmState(world, warm_up_s);
   engine::Simulation sim = MakeSimulation(world, threads);
   sim.LoadState(warm);
   const auto people = static_cast<std::int64_t>(sim.bodies().size());
@@ -246,6 +247,7 @@ void Step(benchmark::State& state, const std::string& world, int threads) {
   state.counters["people"] = static_cast<double>(people);
   state.counters["contacts"] = contacts / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["dt_s"] = sim.time_step_s();
+  state.counters["warm_up_s"] = warm_up_s;
 }
 
 // Writing one frame of the run file (trajectories, states and every contact,
@@ -314,6 +316,15 @@ void RegisterAll() {
     for (int threads : {1, 2})
       benchmark::RegisterBenchmark(("Step/" + w + "/threads:" + std::to_string(threads)).c_str(),
                                    [w, threads](benchmark::State& s) { Step(s, w, threads); })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  // A developed crowd: after kDevelopedSeconds of walking, contacts have built
+  // up (box-10000: from 1,400 after the placement to about 12,000), and a
+  // step costs about twice as much as just after the placement.
+  for (const std::string& w : {std::string("box-2000"), std::string("box-10000")})
+    for (int threads : {1, 2})
+      benchmark::RegisterBenchmark(("Step/" + w + "/developed/threads:" + std::to_string(threads)).c_str(),
+                                   [w, threads](benchmark::State& s) { Step(s, w, threads, kDevelopedSeconds); })
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
 }

@@ -914,7 +914,7 @@ void Simulation::Drive() {
   const double slope_force_per_kg =
       def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
                                 : 0.0;
-  const Vec2 slope_force_dir = def_.slope.downhill * slope_force_per_kg;
+  const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
   // In blocks of bodies, in three passes: the motive torque's angle (eq. 16)
   // is a long chain of dependent operations (a division, a polynomial), so
@@ -974,7 +974,7 @@ void Simulation::Drive() {
         if (turning[k]) torque += torsion_factor * inertia * gain[k] * angle[k];
         // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
         torque -= inertia * rotation_damping * bodies_.angular_velocity_rad_per_s[i];
-        force += slope_force_dir * m;
+        force += slope_acceleration * m;
       }
       bodies_.force_n[i] = force;
       bodies_.torque_n_m[i] = torque;

@@ -1,6 +1,6 @@
-// The run file's frame writing on a thread of its own (FrameWriterThread):
-// the same file as writing each frame in turn, and a failure of the writing
-// thread reaches the caller.
+// The run file's frame writing: on a thread of its own (FrameWriterThread)
+// the same file as writing each frame in turn, a failure of the writing
+// thread reaches the caller; the write-ahead log while the run is written.
 #include <gtest/gtest.h>
 
 #include <sqlite3.h>
@@ -105,6 +105,40 @@ TEST(FrameWriterThread, AFailureOfTheWritingThreadReachesTheCaller) {
   }
   EXPECT_NE(message.find("gas-fail.sqlite"), std::string::npos) << message;
   EXPECT_NE(message.find("person_state"), std::string::npos) << message;
+}
+
+// While a run is written its file is in write-ahead-log mode: committed frames
+// are readable by another (read-only) connection at once; closing the writer
+// leaves one plain file in rollback-journal mode, without -wal or -shm.
+TEST(RunFileWriter, FramesAreReadableWhileWrittenAndTheFileIsPlainWhenClosed) {
+  engine::Simulation sim(engine::testing::RandomGas(4, 0.5, 5, true));
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "gas-wal.sqlite";
+  const auto query = [&](const char* sql) {
+    sqlite3* db = nullptr;
+    EXPECT_EQ(sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    sqlite3_stmt* stmt = nullptr;
+    EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &stmt, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    std::string value;
+    if (sqlite3_step(stmt) == SQLITE_ROW) value = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0));
+    sqlite3_finalize(stmt);
+    sqlite3_close(db);
+    return value;
+  };
+  {
+    RunFileWriter writer = RunFileWriter::Create(file, Header(sim), sim);
+    for (int k = 0; k <= 3; ++k) {
+      if (k > 0) sim.AdvanceTo(k / 10.0);
+      writer.WriteFrame(k, sim, {}, true);
+    }
+    EXPECT_EQ(query("PRAGMA journal_mode"), "wal");
+    EXPECT_EQ(query("SELECT COUNT(*) FROM frame_time"), "4");
+    EXPECT_TRUE(std::filesystem::exists(file.string() + "-wal"));
+    writer.SetStatus("complete");
+  }
+  EXPECT_EQ(query("PRAGMA journal_mode"), "delete");
+  EXPECT_EQ(query("SELECT COUNT(*) FROM trajectory_data"), std::to_string(4 * 16));
+  EXPECT_FALSE(std::filesystem::exists(file.string() + "-wal"));
+  EXPECT_FALSE(std::filesystem::exists(file.string() + "-shm"));
 }
 
 }  // namespace
