@@ -319,8 +319,8 @@ void RegisterAll() {
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   // A developed crowd: after kDevelopedSeconds of walking, contacts have built
-  // up (box-10000: from 1,400 after the placement to about 12,000), and a
-  // step costs about twice as much as just after the placement.
+  // up (box-10000: from 1,400 after the placement to about 11,700), and a
+  // step costs two to three times as much as just after the placement.
   for (const std::string& w : {std::string("box-2000"), std::string("box-10000")})
     for (int threads : {1, 2})
       benchmark::RegisterBenchmark(("Step/" + w + "/developed/threads:" + std::to_string(threads)).c_str(),

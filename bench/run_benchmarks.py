@@ -23,6 +23,7 @@ Examples:
   python3 bench/run_benchmarks.py --scenarios hallway-400 --threads 1 --repeat 1 --duration 0.5 \\
       --exe build/ha/cli/crowdrecon --label smoke
   python3 bench/run_benchmarks.py --kernels --label before
+  python3 bench/run_benchmarks.py --scenarios box-10000 --steady-from 4 --duration 2 --label "developed crowd"
 """
 
 import argparse
@@ -137,6 +138,28 @@ def run_once(exe, scenario, threads, workdir):
     return result
 
 
+def steady_difference(first, whole):
+    """The part of run `whole` after run `first` (the same scenario and seed,
+    shorter): results are deterministic, so the first part is identical work
+    in both, and differences of the times measure the rest alone."""
+    out = {"people": whole["people"], "time_step_s": whole["time_step_s"], "threads": whole["threads"],
+           "status": whole.get("status"), "max_rss_kib": whole.get("max_rss_kib"),
+           "cpu_percent": whole.get("cpu_percent"), "stages_percent": whole.get("stages_percent", {}),
+           "first": first, "whole": whole}
+    for key in ("simulated_s", "loop_wall_s", "engine_s", "steps", "frames", "pair_rebuilds"):
+        a, b = first.get(key), whole.get(key)
+        out[key] = (b - a) if a is not None and b is not None else None
+    agent_steps = out["people"] * out["steps"]
+    out["agent_steps"] = agent_steps
+    for key, seconds in (("engine", out["engine_s"]), ("loop", out["loop_wall_s"])):
+        out[f"agent_steps_per_s_{key}"] = agent_steps / seconds if seconds and seconds > 0 else None
+    # Start-up and world building are not part of the difference.
+    out["process_wall_s"] = out["agent_steps_per_s_process"] = None
+    out["real_time_factor"] = out["simulated_s"] / out["loop_wall_s"] if out["loop_wall_s"] and out["loop_wall_s"] > 0 else None
+    out["setup_s"] = None
+    return out
+
+
 def summarise_runs(runs):
     keys = ["agent_steps_per_s_engine", "agent_steps_per_s_loop", "agent_steps_per_s_process", "real_time_factor",
             "engine_s", "loop_wall_s", "process_wall_s", "setup_s", "max_rss_kib", "cpu_percent"]
@@ -163,11 +186,22 @@ def whole_runs(args):
     results = []
     with tempfile.TemporaryDirectory(prefix="crowdrecon-bench-", dir=args.tmpdir) as work:
         for name, path in scenarios:
-            scenario = scenario_copy(path, args.duration, work) if args.duration is not None else path
+            if args.steady_from is not None:
+                # Two copies: up to --steady-from, and --duration beyond it.
+                folders = [pathlib.Path(work) / "first", pathlib.Path(work) / "whole"]
+                for folder in folders:
+                    folder.mkdir(exist_ok=True)
+                first = scenario_copy(path, args.steady_from, folders[0])
+                scenario = scenario_copy(path, args.steady_from + args.duration, folders[1])
+            else:
+                scenario = scenario_copy(path, args.duration, work) if args.duration is not None else path
             for t in threads:
                 runs = []
                 for rep in range(args.repeat):
-                    r = run_once(exe, scenario, t, work)
+                    if args.steady_from is not None:
+                        r = steady_difference(run_once(exe, first, t, work), run_once(exe, scenario, t, work))
+                    else:
+                        r = run_once(exe, scenario, t, work)
                     runs.append(r)
                     print(f"  {name:>12} threads {t} run {rep + 1}/{args.repeat}: {r['people']} people, "
                           f"{r['steps']} steps, engine {bc.si(r['agent_steps_per_s_engine'])} agent-steps/s, "
@@ -194,7 +228,12 @@ def whole_runs(args):
              "*loop* = the run loop's wall time (steps + writing every frame with contacts); *process* = "
              "the whole `crowdrecon simulate` process (start-up, world building, run loop); real-time factor = "
              "simulated / loop seconds; peak RSS from `/usr/bin/time -v`"]
-    if args.duration is not None:
+    if args.steady_from is not None:
+        notes.append(f"- steady state: every figure is the difference between a run of {args.steady_from + args.duration} s "
+                     f"and one of {args.steady_from} s (same scenario and seed: the first {args.steady_from} s are the "
+                     f"same work in both), i.e. the {args.duration} s after {args.steady_from} s of walking, when "
+                     "contacts have built up; stages % and peak RSS are those of the longer run")
+    elif args.duration is not None:
         notes.append(f"- run.duration_s overridden to {args.duration} s")
     return results, table, notes, started, load_before, load_after
 
@@ -253,6 +292,9 @@ def main():
     p.add_argument("--threads", default="1,2", help="comma-separated thread counts (default: %(default)s)")
     p.add_argument("--repeat", type=int, default=3, help="repetitions; medians are reported (default: %(default)s)")
     p.add_argument("--duration", type=float, help="override run.duration_s (simulated seconds) of every scenario")
+    p.add_argument("--steady-from", type=float, metavar="S",
+                   help="measure a developed crowd: the --duration seconds (default 2) after S seconds of walking, "
+                        "as the difference of runs of S + duration and S seconds")
     p.add_argument("--label", default="", help='what the measurement is, e.g. "before narrow-phase optimisation"; '
                    "a later run with the same label replaces its section of bench/RESULTS.md")
     p.add_argument("--exe", default="build/release/cli/crowdrecon", help="crowdrecon program (default: %(default)s)")
@@ -269,6 +311,11 @@ def main():
         bc.fail("--repeat must be at least 1")
     if args.duration is not None and args.duration <= 0:
         bc.fail("--duration must be positive")
+    if args.steady_from is not None:
+        if args.steady_from <= 0:
+            bc.fail("--steady-from must be positive")
+        if args.duration is None:
+            args.duration = 2.0
     if not shutil.which("git"):
         print("warning: git not found; the commit will be 'unknown'", file=sys.stderr)
 
