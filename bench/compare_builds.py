@@ -16,7 +16,7 @@ drift). Raw results to bench/results/DATE-compare[-LABEL].json; a section in
 bench/RESULTS.md unless --no-results-md.
 
 Example:
-  python3 bench/compare_builds.py --build before=/work/old/build/release/cli/crowdrecon \\
+  python3 bench/compare_builds.py --build before=/tmp/old/build/cli/crowdrecon \\
       --build after=build/release/cli/crowdrecon --scenarios box-10000,box-2000 --repeat 8 --label "fast math"
 """
 
