@@ -1,6 +1,7 @@
 #include "crowdrecon/engine/narrow_phase.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -140,17 +141,14 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
   // i of (memory[i] - moved) / unit, is (least - moved) / unit (monotone in
   // memory[i], so exactly the same value), one division instead of one each.
   double least_skipped = std::numeric_limits<double>::infinity();
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (memory && moved < memory[i]) {  // still apart since it was measured
-      least_skipped = std::min(least_skipped, memory[i]);
-      continue;
-    }
+  // Measures vertex i: appends its contact, or records it apart.
+  const auto measure = [&](std::uint32_t i) {
     const Vec2 v = f.vertices[i];
     const Vec2 p{c * v.x - s * v.y + o.x, s * v.x + c * v.y + o.y};
     if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) {
       // Outside the box grown by the reach: d(p, core) - reach >= how far outside.
       apart(i, std::max(std::max(lo.x - p.x, p.x - hi.x), std::max(lo.y - p.y, p.y - hi.y)));
-      continue;
+      return;
     }
     Closest cl;
     if (use_grid) {
@@ -161,7 +159,7 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
       const std::uint32_t first = g.cell_start[cell], last = g.cell_start[cell + 1];
       if (first == last) {  // farther than the reach from the core
         apart(i, g.cell_clearance[cell] - reach_g);
-        continue;
+        return;
       }
       cl = ClosestOnCore(p, g, &g.cell_edges[first], last - first);
     } else {
@@ -169,7 +167,7 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     }
     if (cl.distance >= reach_g) {
       apart(i, cl.distance - reach_g);
-      continue;
+      return;
     }
     Vec2 normal;
     if (cl.distance > 0.0) {
@@ -178,13 +176,13 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
       normal = (cl.point - p) / -cl.distance;  // p crossed into the core: push it back out
     } else {
       apart(i, 0.0);
-      continue;  // exactly on the core boundary: no direction (measure zero)
+      return;  // exactly on the core boundary: no direction (measure zero)
     }
     ContactPoint cp;
     cp.overlap_m = reach - cl.distance * unit;
     if (!(cp.overlap_m > 0.0)) {  // d < reach in g's units, but not once scaled (round-off)
       apart(i, 0.0);
-      continue;
+      return;
     }
     const Vec2 local = cl.point * unit + normal * (g.radius_m * unit - cp.overlap_m / 2.0);  // metres, to's frame
     cp.point = to.position + Vec2{to.cos_angle * local.x - to.sin_angle * local.y,
@@ -194,6 +192,25 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     cp.normal = flip ? -world_normal : world_normal;
     cp.feature = tag | i;
     out.push_back(cp);
+  };
+  // In blocks of 64 vertices: first, in a short loop of their own, which
+  // vertices are still apart since they were last measured (and the least of
+  // their thresholds), then the others are measured, in vertex order.
+  for (std::uint32_t base = 0; base < n; base += 64) {
+    const std::uint32_t count = std::min<std::uint32_t>(64, n - base);
+    std::uint64_t todo = count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
+    if (memory) {
+      todo = 0;
+      double least = least_skipped;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const double threshold = memory[base + k];
+        const bool skip = moved < threshold;
+        least = std::min(least, skip ? threshold : std::numeric_limits<double>::infinity());
+        todo |= std::uint64_t{!skip} << k;
+      }
+      least_skipped = least;
+    }
+    for (; todo != 0; todo &= todo - 1) measure(base + static_cast<std::uint32_t>(std::countr_zero(todo)));
   }
   if (least_skipped < std::numeric_limits<double>::infinity())
     clearance = std::min(clearance, (least_skipped - moved) / unit);
