@@ -56,7 +56,11 @@ struct PairClearances {
   // together (travel sum): appends its contacts to `points` unless it is
   // known to be still apart, and remembers what it finds.
   void Collide(std::size_t k, double moved, const PlacedShape& a, const PlacedShape& b,
-               std::vector<ContactPoint>& points) {
+               std::vector<ContactPoint>& points, bool remember) {
+    if (!remember) {
+      CollideShapes(a, b, points);
+      return;
+    }
     double* vertex_clear = vertex_m.data() + vertex_start[k];
     const VertexClearances memory{moved, vertex_clear, vertex_clear + a.geometry->count()};
     const double clearance = CollideShapes(a, b, points, &memory);
@@ -146,6 +150,7 @@ struct Simulation::Internals {
   std::vector<double> rotation_arm_m;
   // The same per vertex of the two shapes of a pair, inside touching pairs.
   PairClearances pair_clear, wall_pair_clear;
+  bool pair_memory = true;  // SetPairMemory
 
   // Contact-law constants.
   double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
@@ -560,6 +565,11 @@ void Simulation::RebuildNeighbourList() {
 
 std::size_t Simulation::neighbour_pair_count() const { return in_->pairs.size(); }
 
+void Simulation::SetPairMemory(bool enabled) {
+  if (enabled && !in_->pair_memory) in_->pairs_valid = false;  // what was remembered is stale: start afresh
+  in_->pair_memory = enabled;
+}
+
 // ---------------------------------------------------------------------------
 // Stage 2: shapes to world frame
 
@@ -753,13 +763,13 @@ void Simulation::Collide() {
         for (std::size_t k = chunk * kChunk; k < end; ++k) {
           const auto [a, b] = in.pairs[k];
           const double moved = in.travel_m[a] + in.travel_m[b];
-          if (moved < in.pair_clear.pair_m[k]) continue;  // still apart (see Internals)
+          if (in.pair_memory && moved < in.pair_clear.pair_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
           const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
           points.clear();
-          in.pair_clear.Collide(k, moved, pa, pb, points);
+          in.pair_clear.Collide(k, moved, pa, pb, points, in.pair_memory);
           if (points.empty()) continue;
           const double m_ab = effective_mass(a, b);
           const std::uint64_t key = (std::uint64_t{a} << 32) | b;
@@ -784,7 +794,7 @@ void Simulation::Collide() {
         for (std::size_t k = wchunk * kChunk; k < end; ++k) {
           const auto [a, w] = in.wall_pairs[k];
           const double moved = in.travel_m[a];
-          if (moved < in.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
+          if (in.pair_memory && moved < in.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
           if (bodies_.state[a] == PersonState::kRemoved) continue;
           const Vec2 xa = bodies_.position_m[a];
           const PlacedShape pa = placed(a, xa);
@@ -792,7 +802,7 @@ void Simulation::Collide() {
           pw.geometry = &in.wall_geometry[w];
           pw.position = in.wall_origin[w];
           points.clear();
-          in.wall_pair_clear.Collide(k, moved, pa, pw, points);
+          in.wall_pair_clear.Collide(k, moved, pa, pw, points, in.pair_memory);
           if (points.empty()) continue;
           const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
           const auto [sum, k_eff] = OverlapShares(points);

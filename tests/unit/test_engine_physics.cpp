@@ -297,6 +297,55 @@ TEST(EnginePhysics, ResultsDoNotDependOnTheThreadCount) {
   }
 }
 
+TEST(EnginePhysics, RememberingWhatIsStillApartChangesNothing) {
+  // The narrow phase skips pairs and vertices that cannot touch yet (pair
+  // and vertex clearances against a bound on how far bodies moved): the
+  // results must be those of measuring every listed pair at every step, bit
+  // for bit, for person pairs (periodic crowd) and person-wall pairs (a
+  // crowd pushed against walls), with contacts made and broken.
+  for (bool periodic : {true, false}) {
+    WorldDef def = RandomGas(8, 0.45, 33, periodic);
+    def.parameters.ground_reaction = true;
+    if (!periodic) {
+      def.walls.push_back({{{-0.3, -0.3}, {3.9, -0.3}, {3.9, 3.9}, {-0.3, 3.9}, {-0.3, -0.3}}, false, 0.1});
+      def.walls.push_back({{{1.0, 1.8}, {2.6, 1.9}}, false, 0.1});
+      std::erase_if(def.people, [](const PersonDef& p) { return std::abs(p.position_m.y - 1.85) < 0.4; });
+    }
+    Simulation remembering(def), measuring(def);
+    measuring.SetPairMemory(false);
+    std::size_t touching_steps = 0, changes = 0, previous = 0, wall_contacts = 0;
+    while (remembering.time_s() < 0.3) {
+      remembering.Step();
+      measuring.Step();
+      const auto& a = remembering.contacts();
+      const auto& b = measuring.contacts();
+      ASSERT_EQ(a.size(), b.size()) << "periodic " << periodic << " t " << remembering.time_s();
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        ASSERT_EQ(a[k].a, b[k].a);
+        ASSERT_EQ(a[k].b, b[k].b);
+        ASSERT_EQ(a[k].feature, b[k].feature);
+        ASSERT_EQ(a[k].normal_force_n, b[k].normal_force_n);
+        ASSERT_EQ(a[k].tangential_force_n, b[k].tangential_force_n);
+        wall_contacts += a[k].wall ? 1 : 0;
+      }
+      touching_steps += a.empty() ? 0 : 1;
+      changes += a.size() != previous ? 1 : 0;
+      previous = a.size();
+    }
+    const auto& x = remembering.bodies();
+    const auto& y = measuring.bodies();
+    EXPECT_EQ(std::memcmp(x.position_m.data(), y.position_m.data(), x.size() * sizeof(Vec2)), 0);
+    EXPECT_EQ(std::memcmp(x.angle_rad.data(), y.angle_rad.data(), x.size() * sizeof(double)), 0);
+    EXPECT_EQ(std::memcmp(x.velocity_m_per_s.data(), y.velocity_m_per_s.data(), x.size() * sizeof(Vec2)), 0);
+    // The scene does what it is for: contacts all along, made and broken.
+    EXPECT_GT(touching_steps, remembering.step_count() * 9 / 10);
+    EXPECT_GT(changes, 50u);
+    if (!periodic) {
+      EXPECT_GT(wall_contacts, 100u);
+    }
+  }
+}
+
 TEST(EnginePhysics, RestoredCheckpointContinuesBitForBit) {
   for (Integrator integrator : {Integrator::kVelocityVerlet, Integrator::kGear5}) {
     WorldDef def = RandomGas(6, 0.42, 9, true);

@@ -144,6 +144,10 @@ class Simulation {
   // Results do not depend on when it is rebuilt. For benchmarks and tests.
   void RebuildNeighbourList();
   std::size_t neighbour_pair_count() const;  // person-person pairs in the list
+  // With false, the narrow phase forgets what it knows of pairs and vertices
+  // still apart (temporal coherence) and measures every pair of the list at
+  // every evaluation. The results are the same, bit for bit; for tests.
+  void SetPairMemory(bool enabled);
 
   // Diagnostics for tests and reports.
   Vec2 LinearMomentum() const;
