@@ -8,7 +8,10 @@
 // stages, each followed by a passive relaxation (no ground reaction forces,
 // velocities quenched) until the largest overlap is below the tolerance. A
 // density that cannot be relaxed below the tolerance is refused with the
-// residual overlap stated. Everything is deterministic given the seed.
+// residual overlap stated. People are then numbered along a Hilbert curve
+// through their places (neighbours in the crowd get close numbers, so their
+// data lie close in the engine's arrays), each with its own body shape at the
+// same index. Everything is deterministic given the seed.
 #pragma once
 
 #include <functional>
