@@ -748,8 +748,85 @@ void Simulation::Collide() {
     return bodies_.mass_kg[a] * bodies_.mass_kg[b] / (bodies_.mass_kg[a] + bodies_.mass_kg[b]);  // eq. (14)
   };
 
+  // One chunk of pairs: its contacts appended to `out`, in pair order.
+  const auto collide_chunk = [&](std::size_t chunk, std::vector<Contact>& out, std::vector<ContactPoint>& points) {
+    PreviousContacts previous(in.previous_contacts);
+    if (chunk < person_chunks) {
+      const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
+      for (std::size_t k = chunk * kChunk; k < end; ++k) {
+        const auto [a, b] = in.pairs[k];
+        const double moved = in.travel_m[a] + in.travel_m[b];
+        if (in.pair_memory && moved < in.pair_clear.pair_m[k]) continue;  // still apart (see Internals)
+        if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
+        const Vec2 xa = bodies_.position_m[a];
+        const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
+        const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
+        points.clear();
+        in.pair_clear.Collide(k, moved, pa, pb, points, in.pair_memory);
+        if (points.empty()) continue;
+        const double m_ab = effective_mass(a, b);
+        const std::uint64_t key = (std::uint64_t{a} << 32) | b;
+        const auto [sum, k_eff] = OverlapShares(points);
+        for (const ContactPoint& p : points) {
+          Contact c;
+          c.a = a;
+          c.b = b;
+          c.feature = p.feature;
+          c.point_m = p.point;
+          c.normal = p.normal;
+          c.overlap_m = p.overlap_m;
+          const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
+          const Contact* prev = previous.Find(key, p.feature);
+          law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
+          out.push_back(c);
+        }
+      }
+    } else {
+      const std::size_t wchunk = chunk - person_chunks;
+      const std::size_t end = std::min(in.wall_pairs.size(), (wchunk + 1) * kChunk);
+      for (std::size_t k = wchunk * kChunk; k < end; ++k) {
+        const auto [a, w] = in.wall_pairs[k];
+        const double moved = in.travel_m[a];
+        if (in.pair_memory && moved < in.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
+        if (bodies_.state[a] == PersonState::kRemoved) continue;
+        const Vec2 xa = bodies_.position_m[a];
+        const PlacedShape pa = placed(a, xa);
+        PlacedShape pw;
+        pw.geometry = &in.wall_geometry[w];
+        pw.position = in.wall_origin[w];
+        points.clear();
+        in.wall_pair_clear.Collide(k, moved, pa, pw, points, in.pair_memory);
+        if (points.empty()) continue;
+        const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
+        const auto [sum, k_eff] = OverlapShares(points);
+        for (const ContactPoint& p : points) {
+          Contact c;
+          c.a = a;
+          c.b = w;
+          c.wall = true;
+          c.feature = p.feature;
+          c.point_m = p.point;
+          c.normal = p.normal;
+          c.overlap_m = p.overlap_m;
+          const Vec2 rel = velocity_at(a, p.point - xa);
+          const Contact* prev = previous.Find(key, p.feature);
+          wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
+          out.push_back(c);
+        }
+      }
+    }
+  };
+
   const std::int64_t total = static_cast<std::int64_t>(chunks);
-#pragma omp parallel num_threads(def_.threads) if (total >= 4)
+  if (def_.threads == 1 || total < 4) {
+    // On one thread the chunks come in order: straight into the contact list,
+    // which is then what the concatenation below would have made.
+    contacts_.clear();
+    std::vector<ContactPoint> points;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) collide_chunk(chunk, contacts_, points);
+    return;
+  }
+#pragma omp parallel num_threads(def_.threads)
   {
     std::vector<ContactPoint> points;
 #pragma omp for schedule(dynamic, 1)
@@ -757,71 +834,7 @@ void Simulation::Collide() {
       const std::size_t chunk = static_cast<std::size_t>(ck);
       std::vector<Contact>& out = in.chunk_contacts[chunk];
       out.clear();
-      PreviousContacts previous(in.previous_contacts);
-      if (chunk < person_chunks) {
-        const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
-        for (std::size_t k = chunk * kChunk; k < end; ++k) {
-          const auto [a, b] = in.pairs[k];
-          const double moved = in.travel_m[a] + in.travel_m[b];
-          if (in.pair_memory && moved < in.pair_clear.pair_m[k]) continue;  // still apart (see Internals)
-          if (bodies_.state[a] == PersonState::kRemoved || bodies_.state[b] == PersonState::kRemoved) continue;
-          const Vec2 xa = bodies_.position_m[a];
-          const Vec2 xb_image = xa - Separation(xa, bodies_.position_m[b]);
-          const PlacedShape pa = placed(a, xa), pb = placed(b, xb_image);
-          points.clear();
-          in.pair_clear.Collide(k, moved, pa, pb, points, in.pair_memory);
-          if (points.empty()) continue;
-          const double m_ab = effective_mass(a, b);
-          const std::uint64_t key = (std::uint64_t{a} << 32) | b;
-          const auto [sum, k_eff] = OverlapShares(points);
-          for (const ContactPoint& p : points) {
-            Contact c;
-            c.a = a;
-            c.b = b;
-            c.feature = p.feature;
-            c.point_m = p.point;
-            c.normal = p.normal;
-            c.overlap_m = p.overlap_m;
-            const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
-            const Contact* prev = previous.Find(key, p.feature);
-            law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
-            out.push_back(c);
-          }
-        }
-      } else {
-        const std::size_t wchunk = chunk - person_chunks;
-        const std::size_t end = std::min(in.wall_pairs.size(), (wchunk + 1) * kChunk);
-        for (std::size_t k = wchunk * kChunk; k < end; ++k) {
-          const auto [a, w] = in.wall_pairs[k];
-          const double moved = in.travel_m[a];
-          if (in.pair_memory && moved < in.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
-          if (bodies_.state[a] == PersonState::kRemoved) continue;
-          const Vec2 xa = bodies_.position_m[a];
-          const PlacedShape pa = placed(a, xa);
-          PlacedShape pw;
-          pw.geometry = &in.wall_geometry[w];
-          pw.position = in.wall_origin[w];
-          points.clear();
-          in.wall_pair_clear.Collide(k, moved, pa, pw, points, in.pair_memory);
-          if (points.empty()) continue;
-          const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
-          const auto [sum, k_eff] = OverlapShares(points);
-          for (const ContactPoint& p : points) {
-            Contact c;
-            c.a = a;
-            c.b = w;
-            c.wall = true;
-            c.feature = p.feature;
-            c.point_m = p.point;
-            c.normal = p.normal;
-            c.overlap_m = p.overlap_m;
-            const Vec2 rel = velocity_at(a, p.point - xa);
-            const Contact* prev = previous.Find(key, p.feature);
-            wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
-            out.push_back(c);
-          }
-        }
-      }
+      collide_chunk(chunk, out, points);
     }
   }
   // Concatenate the chunks in order (each copied by whichever thread).
