@@ -23,6 +23,37 @@ def fail(message):
     sys.exit(1)
 
 
+def parse_builds(specs):
+    """The --build NAME=EXE options of the before/after scripts: [(name, path)],
+    paths made absolute from the repository root; at least two."""
+    builds = []
+    for spec in specs:
+        name, sep, exe = spec.partition("=")
+        if not sep or not name or not exe:
+            fail(f"--build {spec}: expected NAME=EXE")
+        path = pathlib.Path(exe)
+        path = path if path.is_absolute() else ROOT / path
+        if not path.exists():
+            fail(f"--build {spec}: {path} not found")
+        builds.append((name, path))
+    if len(builds) < 2:
+        fail("give at least two --build NAME=EXE")
+    return builds
+
+
+def save_comparison(kind, what, args, started, load_before, load_after, notes, table, data):
+    """Writes a before/after script's raw results (JSON, with the load
+    averages) and, unless --no-results-md, its section of RESULTS.md titled
+    `what` (e.g. "interleaved builds")."""
+    data = dict(data, load_before=load_before, load_after=load_after)
+    json_path = write_json(default_json_path(kind, started, args.label), data)
+    print(f"raw results: {json_path}", file=sys.stderr)
+    if not args.no_results_md:
+        body = header_lines(command_line(), started, load_before, load_after, notes) + "\n\n" + table + "\n"
+        title = f"{started.strftime('%Y-%m-%d %H:%M UTC')} · {what}" + (f" · {args.label}" if args.label else "")
+        print(f"updated {update_results(kind, args.label, title, body, started)}", file=sys.stderr)
+
+
 def machine():
     """CPU model, logical cores (and how many this process may use), memory, kernel."""
     model = "unknown CPU"

@@ -65,18 +65,7 @@ def main():
     p.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = p.parse_args()
 
-    builds = []
-    for spec in args.build:
-        name, sep, exe = spec.partition("=")
-        if not sep or not name or not exe:
-            bc.fail(f"--build {spec}: expected NAME=EXE")
-        path = pathlib.Path(exe)
-        path = path if path.is_absolute() else bc.ROOT / path
-        if not path.exists():
-            bc.fail(f"--build {spec}: {path} not found")
-        builds.append((name, path))
-    if len(builds) < 2:
-        bc.fail("give at least two --build NAME=EXE")
+    builds = bc.parse_builds(args.build)
     if args.repeat < 1:
         bc.fail("--repeat must be at least 1")
 
@@ -118,16 +107,8 @@ def main():
     notes = [f"- builds: " + ", ".join(f"{name} = `{exe}`" for name, exe in builds),
              f"- {args.repeat} repetitions, each running every build once in turn; filter `{args.filter}`, "
              f"min time {args.min_time} s"]
-    stamp = started
-    json_path = bc.write_json(bc.default_json_path("kernels-compare", stamp, args.label),
-                              {"builds": [[n, str(e)] for n, e in builds], "filter": args.filter, "runs": runs,
-                               "load_before": load_before, "load_after": load_after})
-    print(f"raw results: {json_path}", file=sys.stderr)
-    if not args.no_results_md:
-        body = bc.header_lines(bc.command_line(), started, load_before, load_after, notes) + "\n\n" + table + "\n"
-        title = f"{started.strftime('%Y-%m-%d %H:%M UTC')} · interleaved kernel builds" + (f" · {args.label}" if args.label else "")
-        print(f"updated {bc.update_results('kernels-compare', args.label, title, body, stamp)}", file=sys.stderr)
-
+    bc.save_comparison("kernels-compare", "interleaved kernel builds", args, started, load_before, load_after, notes,
+                       table, {"builds": [[n, str(e)] for n, e in builds], "filter": args.filter, "runs": runs})
 
 if __name__ == "__main__":
     main()

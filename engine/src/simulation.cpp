@@ -662,6 +662,20 @@ struct ContactLaw {
   }
 };
 
+// The contact of persons (or person and wall) a, b at a narrow-phase point,
+// before the contact law fills its forces.
+Contact ContactAt(const ContactPoint& p, std::uint32_t a, std::uint32_t b, bool wall) {
+  Contact c;
+  c.a = a;
+  c.b = b;
+  c.wall = wall;
+  c.feature = p.feature;
+  c.point_m = p.point;
+  c.normal = p.normal;
+  c.overlap_m = p.overlap_m;
+  return c;
+}
+
 // Sum of the overlaps of a pair's points and their overlap-weighted count
 // k_eff = (sum delta)^2 / sum delta^2 (see ContactLaw::Apply).
 std::pair<double, double> OverlapShares(const std::vector<ContactPoint>& points) {
@@ -768,13 +782,7 @@ void Simulation::Collide() {
         const std::uint64_t key = (std::uint64_t{a} << 32) | b;
         const auto [sum, k_eff] = OverlapShares(points);
         for (const ContactPoint& p : points) {
-          Contact c;
-          c.a = a;
-          c.b = b;
-          c.feature = p.feature;
-          c.point_m = p.point;
-          c.normal = p.normal;
-          c.overlap_m = p.overlap_m;
+          Contact c = ContactAt(p, a, b, false);
           const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
           const Contact* prev = previous.Find(key, p.feature);
           law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
@@ -800,14 +808,7 @@ void Simulation::Collide() {
         const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
         const auto [sum, k_eff] = OverlapShares(points);
         for (const ContactPoint& p : points) {
-          Contact c;
-          c.a = a;
-          c.b = w;
-          c.wall = true;
-          c.feature = p.feature;
-          c.point_m = p.point;
-          c.normal = p.normal;
-          c.overlap_m = p.overlap_m;
+          Contact c = ContactAt(p, a, w, true);
           const Vec2 rel = velocity_at(a, p.point - xa);
           const Contact* prev = previous.Find(key, p.feature);
           wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
