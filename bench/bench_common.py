@@ -23,11 +23,23 @@ def fail(message):
     sys.exit(1)
 
 
-def parse_builds(specs):
-    """The --build NAME=EXE options of the before/after scripts: [(name, path)],
-    paths made absolute from the repository root; at least two."""
+def add_comparison_arguments(parser, program):
+    """The options every before/after script takes: --build (of `program`),
+    --repeat, --label, --no-results-md."""
+    parser.add_argument("--build", action="append", required=True, metavar="NAME=EXE",
+                        help=f"a {program} to run (give two or more; the first is the reference)")
+    parser.add_argument("--repeat", type=int, default=5, help="repetitions (default: %(default)s)")
+    parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
+    parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
+
+
+def parse_builds(args):
+    """The builds of add_comparison_arguments' options: [(name, path)], paths
+    made absolute from the repository root; at least two, and --repeat >= 1."""
+    if args.repeat < 1:
+        fail("--repeat must be at least 1")
     builds = []
-    for spec in specs:
+    for spec in args.build:
         name, sep, exe = spec.partition("=")
         if not sep or not name or not exe:
             fail(f"--build {spec}: expected NAME=EXE")

@@ -32,19 +32,13 @@ import run_benchmarks as rb  # noqa: E402
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--build", action="append", required=True, metavar="NAME=EXE",
-                   help="a build to run (give two or more; the first is the reference)")
+    bc.add_comparison_arguments(p, "crowdrecon")
     p.add_argument("--scenarios", default="box-10000,box-2000", help="comma-separated (default: %(default)s)")
     p.add_argument("--threads", default="1,2", help="comma-separated thread counts (default: %(default)s)")
-    p.add_argument("--repeat", type=int, default=5, help="repetitions (default: %(default)s)")
     p.add_argument("--duration", type=float, default=1.0, help="simulated seconds per run (default: %(default)s)")
-    p.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
-    p.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = p.parse_args()
 
-    builds = bc.parse_builds(args.build)
-    if args.repeat < 1:
-        bc.fail("--repeat must be at least 1")
+    builds = bc.parse_builds(args)
     scenarios = [(n, rb.scenario_path(n)) for n in args.scenarios.split(",") if n]
     threads = [int(t) for t in args.threads.split(",") if t]
 

@@ -56,18 +56,12 @@ def run_kernels(exe, pattern, min_time):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--build", action="append", required=True, metavar="NAME=EXE",
-                   help="a crowdrecon_bench_kernels to run (give two or more; the first is the reference)")
+    bc.add_comparison_arguments(p, "crowdrecon_bench_kernels")
     p.add_argument("--filter", required=True, help="Google Benchmark filter (regular expression)")
-    p.add_argument("--repeat", type=int, default=5, help="repetitions (default: %(default)s)")
     p.add_argument("--min-time", type=float, default=1.0, help="--benchmark_min_time, seconds (default: %(default)s)")
-    p.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
-    p.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = p.parse_args()
 
-    builds = bc.parse_builds(args.build)
-    if args.repeat < 1:
-        bc.fail("--repeat must be at least 1")
+    builds = bc.parse_builds(args)
 
     started = bc.now()
     load_before = bc.warn_if_busy()

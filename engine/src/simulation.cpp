@@ -738,7 +738,6 @@ void Simulation::Collide() {
   const std::size_t person_chunks = (in.pairs.size() + kChunk - 1) / kChunk;
   const std::size_t wall_chunks = (in.wall_pairs.size() + kChunk - 1) / kChunk;
   const std::size_t chunks = person_chunks + wall_chunks;
-  in.chunk_contacts.resize(chunks);
 
   const auto placed = [&](std::uint32_t i, Vec2 position) {
     PlacedShape p;
@@ -827,6 +826,7 @@ void Simulation::Collide() {
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) collide_chunk(chunk, contacts_, points);
     return;
   }
+  in.chunk_contacts.resize(chunks);  // one buffer per chunk, concatenated below
 #pragma omp parallel num_threads(def_.threads)
   {
     std::vector<ContactPoint> points;

@@ -92,13 +92,12 @@ std::uint64_t HilbertIndex(std::uint32_t x, std::uint32_t y) {
 // box [lo, hi] (ties by the original order).
 std::vector<std::size_t> SpatialOrder(const std::vector<Vec2>& position, Vec2 lo, Vec2 hi) {
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, 1e-9});
+  const auto cell = [&](double u) {
+    return static_cast<std::uint32_t>(std::clamp(u / extent * 65536.0, 0.0, 65535.0));
+  };
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(position.size());
-  for (std::size_t i = 0; i < position.size(); ++i) {
-    const auto cell = [&](double u) {
-      return static_cast<std::uint32_t>(std::clamp(u / extent * 65536.0, 0.0, 65535.0));
-    };
+  for (std::size_t i = 0; i < position.size(); ++i)
     keyed[i] = {HilbertIndex(cell(position[i].x - lo.x), cell(position[i].y - lo.y)), i};
-  }
   std::sort(keyed.begin(), keyed.end());
   std::vector<std::size_t> order(position.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = keyed[i].second;
