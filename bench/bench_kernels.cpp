@@ -232,6 +232,7 @@ void Step(benchmark::State& state, const std::string& world, int threads, double
   const auto people = static_cast<std::int64_t>(sim.bodies().size());
   std::int64_t in_window = 0;
   double contacts = 0.0;
+  const engine::Profile before = sim.profile();
   for (auto _ : state) {
     if (in_window == kWindowSteps) {
       state.PauseTiming();
@@ -248,6 +249,16 @@ void Step(benchmark::State& state, const std::string& world, int threads, double
   state.counters["contacts"] = contacts / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["dt_s"] = sim.time_step_s();
   state.counters["warm_up_s"] = warm_up_s;
+  // Where the time goes: milliseconds per step in each stage (Profile).
+  const engine::Profile& after = sim.profile();
+  const double per_step_ms = 1e3 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["pairs_ms"] = (after.update_pairs_s - before.update_pairs_s) * per_step_ms;
+  state.counters["place_ms"] = (after.place_shapes_s - before.place_shapes_s) * per_step_ms;
+  state.counters["collide_ms"] = (after.collide_s - before.collide_s) * per_step_ms;
+  state.counters["gather_ms"] = (after.gather_s - before.gather_s) * per_step_ms;
+  state.counters["drive_ms"] = (after.drive_s - before.drive_s) * per_step_ms;
+  state.counters["integrate_ms"] = (after.integrate_s - before.integrate_s) * per_step_ms;
+  state.counters["check_ms"] = (after.check_s - before.check_s) * per_step_ms;
 }
 
 // Writing one frame of the run file (trajectories, states and every contact,

@@ -1,6 +1,7 @@
 #include "crowdrecon/engine/simulation.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -42,14 +43,19 @@ struct PairClearances {
   std::vector<double> vertex_m;
 
   // For a new list: nothing known. `vertices(k)` = the vertex count of both shapes of pair k.
+  // The vertex entries (several megabytes for 10,000 people) are filled by
+  // `threads` threads.
   template <typename VertexCount>
-  void Reset(std::size_t pairs, VertexCount vertices) {
+  void Reset(std::size_t pairs, VertexCount vertices, int threads) {
     constexpr double kNever = -std::numeric_limits<double>::infinity();
     pair_m.assign(pairs, kNever);
     vertex_start.resize(pairs + 1);
     vertex_start[0] = 0;
     for (std::size_t k = 0; k < pairs; ++k) vertex_start[k + 1] = vertex_start[k] + vertices(k);
-    vertex_m.assign(vertex_start.back(), kNever);
+    vertex_m.resize(vertex_start.back());
+    const std::int64_t count = static_cast<std::int64_t>(vertex_m.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (count >= 65536)
+    for (std::int64_t v = 0; v < count; ++v) vertex_m[static_cast<std::size_t>(v)] = kNever;
   }
 
   // Narrow phase of pair k, whose shapes' core points have moved `moved`
@@ -161,8 +167,21 @@ struct Simulation::Internals {
   std::vector<std::array<double, 4>> gear_theta;
   bool gear_initialised = false;
 
-  std::vector<std::vector<Contact>> chunk_contacts;
-  std::vector<std::size_t> chunk_offset;  // start of each chunk in contacts_
+  // Parallel Collide: each thread's contacts, in the order of the chunks it
+  // took (buffers apart in memory), where each chunk's contacts lie in them,
+  // and where each chunk's contacts start in the contact list.
+  struct alignas(64) ThreadContacts {
+    std::vector<Contact> items;
+    std::size_t next = 0, end = 0;  // the thread's run of chunks still to take
+  };
+  struct ChunkSpan {
+    std::uint32_t thread = 0;
+    std::size_t begin = 0, end = 0;
+  };
+  std::vector<ThreadContacts> thread_contacts;
+  std::vector<ChunkSpan> chunk_span;
+  std::vector<std::size_t> chunk_offset;
+  bool overlap_beyond = false;  // set by Collide, see Check
   // Contacts of each body (indices into contacts_, in contact order): CSR.
   std::vector<std::uint32_t> body_contact_start, body_contact_items, body_contact_fill;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
@@ -507,55 +526,76 @@ void Simulation::UpdatePairs() {
     std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
     for (std::size_t k = 0; k < active.size(); ++k) cell_items[fill[body_cell[k]]++] = active[k];
   }
-  std::vector<std::uint32_t> candidates;
-  std::vector<std::size_t> neighbour_cells;
-  for (std::size_t k = 0; k < active.size(); ++k) {
-    const std::uint32_t i = active[k];
-    const Vec2 pi = bodies_.position_m[i];
-    const std::int64_t cx = static_cast<std::int64_t>(body_cell[k] % static_cast<std::size_t>(ncx));
-    const std::int64_t cy = static_cast<std::int64_t>(body_cell[k] / static_cast<std::size_t>(ncx));
-    neighbour_cells.clear();
-    for (std::int64_t dy = -1; dy <= 1; ++dy)
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        std::int64_t x = cx + dx, y = cy + dy;
-        if (box.x) x = (x + ncx) % ncx;
-        if (box.y) y = (y + ncy) % ncy;
-        if (x < 0 || x >= ncx || y < 0 || y >= ncy) continue;
-        neighbour_cells.push_back(static_cast<std::size_t>(y * ncx + x));
-      }
-    std::sort(neighbour_cells.begin(), neighbour_cells.end());
-    neighbour_cells.erase(std::unique(neighbour_cells.begin(), neighbour_cells.end()), neighbour_cells.end());
-    candidates.clear();
-    for (std::size_t c : neighbour_cells)
-      for (std::uint32_t s = cell_start[c]; s < cell_start[c + 1]; ++s) {
-        const std::uint32_t j = cell_items[s];
-        if (j <= i) continue;
-        const double range = in.bound_m[i] + in.bound_m[j] + in.skin_m;
-        if (LengthSquared(Separation(pi, bodies_.position_m[j])) < range * range) candidates.push_back(j);
-      }
-    std::sort(candidates.begin(), candidates.end());
-    for (std::uint32_t j : candidates) in.pairs.emplace_back(i, j);
-    for (std::uint32_t w = 0; w < def_.walls.size(); ++w) {
-      const Wall& wall = def_.walls[w];
-      const double range = in.bound_m[i] + wall.radius_m + in.skin_m;
-      if (Length(pi - in.wall_origin[w]) > in.wall_geometry[w].core_radius_m + range) continue;
-      const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
-      for (std::size_t seg = 0; seg < segments; ++seg)
-        if (DistanceToSegment(pi, wall.points[seg], wall.points[(seg + 1) % wall.points.size()]) < range) {
-          in.wall_pairs.emplace_back(i, w);
-          break;
+  // The pairs of each person with the later people of its own and the eight
+  // neighbouring cells, and with the walls. People are taken in index order
+  // and each one's partners in increasing order, so the lists come out sorted;
+  // with many people, in as many contiguous parts as there are threads, each
+  // into a list of its own, joined in order: the same lists either way.
+  const std::size_t parts =
+      static_cast<std::int64_t>(active.size()) >= kParallelBodies ? static_cast<std::size_t>(def_.threads) : 1;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> part_pairs(parts), part_wall_pairs(parts);
+  const std::int64_t part_count = static_cast<std::int64_t>(parts);
+#pragma omp parallel for schedule(static, 1) num_threads(def_.threads) if (part_count > 1)
+  for (std::int64_t part = 0; part < part_count; ++part) {
+    const std::size_t q = static_cast<std::size_t>(part);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs = part_pairs[q];
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>& wall_pairs = part_wall_pairs[q];
+    std::vector<std::uint32_t> candidates;
+    std::vector<std::size_t> neighbour_cells;
+    for (std::size_t k = active.size() * q / parts; k < active.size() * (q + 1) / parts; ++k) {
+      const std::uint32_t i = active[k];
+      const Vec2 pi = bodies_.position_m[i];
+      const std::int64_t cx = static_cast<std::int64_t>(body_cell[k] % static_cast<std::size_t>(ncx));
+      const std::int64_t cy = static_cast<std::int64_t>(body_cell[k] / static_cast<std::size_t>(ncx));
+      neighbour_cells.clear();
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dx = -1; dx <= 1; ++dx) {
+          std::int64_t x = cx + dx, y = cy + dy;
+          if (box.x) x = (x + ncx) % ncx;
+          if (box.y) y = (y + ncy) % ncy;
+          if (x < 0 || x >= ncx || y < 0 || y >= ncy) continue;
+          neighbour_cells.push_back(static_cast<std::size_t>(y * ncx + x));
         }
+      std::sort(neighbour_cells.begin(), neighbour_cells.end());
+      neighbour_cells.erase(std::unique(neighbour_cells.begin(), neighbour_cells.end()), neighbour_cells.end());
+      candidates.clear();
+      for (std::size_t c : neighbour_cells)
+        for (std::uint32_t s = cell_start[c]; s < cell_start[c + 1]; ++s) {
+          const std::uint32_t j = cell_items[s];
+          if (j <= i) continue;
+          const double range = in.bound_m[i] + in.bound_m[j] + in.skin_m;
+          if (LengthSquared(Separation(pi, bodies_.position_m[j])) < range * range) candidates.push_back(j);
+        }
+      std::sort(candidates.begin(), candidates.end());
+      for (std::uint32_t j : candidates) pairs.emplace_back(i, j);
+      for (std::uint32_t w = 0; w < def_.walls.size(); ++w) {
+        const Wall& wall = def_.walls[w];
+        const double range = in.bound_m[i] + wall.radius_m + in.skin_m;
+        if (Length(pi - in.wall_origin[w]) > in.wall_geometry[w].core_radius_m + range) continue;
+        const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
+        for (std::size_t seg = 0; seg < segments; ++seg)
+          if (DistanceToSegment(pi, wall.points[seg], wall.points[(seg + 1) % wall.points.size()]) < range) {
+            wall_pairs.emplace_back(i, w);
+            break;
+          }
+      }
     }
   }
-  std::sort(in.pairs.begin(), in.pairs.end());
+  for (std::size_t q = 0; q < parts; ++q) {
+    in.pairs.insert(in.pairs.end(), part_pairs[q].begin(), part_pairs[q].end());
+    in.wall_pairs.insert(in.wall_pairs.end(), part_wall_pairs[q].begin(), part_wall_pairs[q].end());
+  }
+  assert(std::is_sorted(in.pairs.begin(), in.pairs.end()));
   const auto vertices_of = [&](std::uint32_t i) {
     return std::size_t{in.family_geometry[in.shape_family[bodies_.shape[i]]].count()};
   };
-  in.pair_clear.Reset(in.pairs.size(),
-                      [&](std::size_t k) { return vertices_of(in.pairs[k].first) + vertices_of(in.pairs[k].second); });
-  in.wall_pair_clear.Reset(in.wall_pairs.size(), [&](std::size_t k) {
-    return vertices_of(in.wall_pairs[k].first) + in.wall_geometry[in.wall_pairs[k].second].count();
-  });
+  in.pair_clear.Reset(
+      in.pairs.size(), [&](std::size_t k) { return vertices_of(in.pairs[k].first) + vertices_of(in.pairs[k].second); },
+      def_.threads);
+  in.wall_pair_clear.Reset(
+      in.wall_pairs.size(),
+      [&](std::size_t k) { return vertices_of(in.wall_pairs[k].first) + in.wall_geometry[in.wall_pairs[k].second].count(); },
+      def_.threads);
 }
 
 void Simulation::RebuildNeighbourList() {
@@ -617,21 +657,31 @@ struct ContactLaw {
   // counts points weighted by overlap, so that a point that starts touching
   // joins the sum continuously. `weight` = delta_i / sum delta; for a single
   // point weight = k_eff = 1 and this is eq. (19) as written (docs/model.md).
+  //
+  // The pair's damping rates (before the sharing by `weight`) are the same for
+  // all its points: PairRates, once per pair.
+  struct Rates {
+    double normal = 0.0, tangential = 0.0;
+  };
+  Rates PairRates(double effective_mass, double k_eff) const {
+    Rates r;
+    r.normal = damping_factor * std::sqrt(k_eff * kn / effective_mass);  // eq. (19) inverted
+    switch (tangential_mode) {
+      case TangentialDamping::kFromRestitution: r.tangential = damping_factor * std::sqrt(k_eff * kt / effective_mass); break;
+      case TangentialDamping::kEqualToNormal: r.tangential = r.normal; break;
+      case TangentialDamping::kFixed: r.tangential = tangential_rate; break;
+    }
+    return r;
+  }
+
   void Apply(Contact& c, Vec2 relative_velocity, double effective_mass, const Contact* previous,
-             double weight, double k_eff) const {
+             double weight, Rates rates) const {
     const double previous_spring = previous ? previous->tangential_spring_m : 0.0;
     const Vec2 t = Perp(c.normal);
     const double vn = Dot(relative_velocity, c.normal);  // > 0: separating
     const double vt = Dot(relative_velocity, t);
-    const double gamma_n = damping_factor * std::sqrt(k_eff * kn / effective_mass) * weight;  // eq. (19) inverted
-    double gamma_t = 0.0;
-    switch (tangential_mode) {
-      case TangentialDamping::kFromRestitution:
-        gamma_t = damping_factor * std::sqrt(k_eff * kt / effective_mass) * weight;
-        break;
-      case TangentialDamping::kEqualToNormal: gamma_t = gamma_n; break;
-      case TangentialDamping::kFixed: gamma_t = tangential_rate * weight; break;
-    }
+    const double gamma_n = rates.normal * weight;
+    const double gamma_t = rates.tangential * weight;
     const double elastic_n = kn * c.overlap_m;                      // eq. (8)
     double fn = elastic_n - effective_mass * gamma_n * vn;           // + eq. (11)
     if (!tensile && fn < 0.0) fn = 0.0;
@@ -761,9 +811,18 @@ void Simulation::Collide() {
     return bodies_.mass_kg[a] * bodies_.mass_kg[b] / (bodies_.mass_kg[a] + bodies_.mass_kg[b]);  // eq. (14)
   };
 
-  // One chunk of pairs: its contacts appended to `out`, in pair order.
+  // A contact whose overlap exceeds the sum of the two sphero-radii means that
+  // the cores interpenetrate: Check() reports it (and looks for it only then).
+  const auto beyond = [](const std::vector<ContactPoint>& points, double radii) {
+    bool found = false;
+    for (const ContactPoint& p : points) found = found || !(p.overlap_m <= radii);
+    return found;
+  };
+  // One chunk of pairs: its contacts appended to `out`, in pair order. Returns
+  // true if one of them overlaps beyond the sum of the radii (see `beyond`).
   const auto collide_chunk = [&](std::size_t chunk, std::vector<Contact>& out, std::vector<ContactPoint>& points) {
     PreviousContacts previous(in.previous_contacts);
+    bool overlap_beyond = false;
     if (chunk < person_chunks) {
       const std::size_t end = std::min(in.pairs.size(), (chunk + 1) * kChunk);
       for (std::size_t k = chunk * kChunk; k < end; ++k) {
@@ -780,13 +839,14 @@ void Simulation::Collide() {
         const double m_ab = effective_mass(a, b);
         const std::uint64_t key = (std::uint64_t{a} << 32) | b;
         const auto [sum, k_eff] = OverlapShares(points);
+        const ContactLaw::Rates rates = law.PairRates(m_ab, k_eff);
         for (const ContactPoint& p : points) {
-          Contact c = ContactAt(p, a, b, false);
+          Contact& c = out.emplace_back(ContactAt(p, a, b, false));
           const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
           const Contact* prev = previous.Find(key, p.feature);
-          law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, k_eff);
-          out.push_back(c);
+          law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, rates);
         }
+        overlap_beyond = overlap_beyond || beyond(points, pa.scale + pb.scale);  // (family radius 1)
       }
     } else {
       const std::size_t wchunk = chunk - person_chunks;
@@ -806,15 +866,17 @@ void Simulation::Collide() {
         if (points.empty()) continue;
         const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
         const auto [sum, k_eff] = OverlapShares(points);
+        const ContactLaw::Rates rates = wall_law.PairRates(bodies_.mass_kg[a], k_eff);
         for (const ContactPoint& p : points) {
-          Contact c = ContactAt(p, a, w, true);
+          Contact& c = out.emplace_back(ContactAt(p, a, w, true));
           const Vec2 rel = velocity_at(a, p.point - xa);
           const Contact* prev = previous.Find(key, p.feature);
-          wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, k_eff);
-          out.push_back(c);
+          wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, rates);
         }
+        overlap_beyond = overlap_beyond || beyond(points, pa.scale + pw.geometry->radius_m);
       }
     }
+    return overlap_beyond;
   };
 
   const std::int64_t total = static_cast<std::int64_t>(chunks);
@@ -823,29 +885,64 @@ void Simulation::Collide() {
     // which is then what the concatenation below would have made.
     contacts_.clear();
     std::vector<ContactPoint> points;
-    for (std::size_t chunk = 0; chunk < chunks; ++chunk) collide_chunk(chunk, contacts_, points);
+    bool overlap_beyond = false;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
+      overlap_beyond = collide_chunk(chunk, contacts_, points) || overlap_beyond;
+    in.overlap_beyond = overlap_beyond;
     return;
   }
-  in.chunk_contacts.resize(chunks);  // one buffer per chunk, concatenated below
-#pragma omp parallel num_threads(def_.threads)
+  // Each thread owns a contiguous run of chunks (thread 0 the first, and so
+  // on) and takes them one at a time from its front; a thread done with its
+  // own run takes what is left of the others' (their costs vary). Pairs are
+  // sorted by their first person and people are numbered along the crowd, so
+  // a thread works mostly on the people whose motion it integrates and whose
+  // forces it sums (the stages split by body): less data crosses between
+  // cores than when chunks are dealt in turn. Each thread appends its chunks'
+  // contacts to a buffer of its own (apart in memory: no cache line is written
+  // by two threads) and notes where each chunk's lie; the chunks are then
+  // copied into the contact list in chunk order: the same list whatever the
+  // thread count, and whichever thread took which chunk.
+  const std::size_t team = static_cast<std::size_t>(def_.threads);
+  in.thread_contacts.resize(team);
+  for (std::size_t t = 0; t < team; ++t) {
+    in.thread_contacts[t].next = chunks * t / team;
+    in.thread_contacts[t].end = chunks * (t + 1) / team;
+  }
+  in.chunk_span.resize(chunks);
+  bool overlap_beyond = false;
+#pragma omp parallel num_threads(def_.threads) reduction(|| : overlap_beyond)
   {
+    std::uint32_t thread = 0;
+#ifdef _OPENMP
+    thread = static_cast<std::uint32_t>(omp_get_thread_num());
+#endif
     std::vector<ContactPoint> points;
-#pragma omp for schedule(dynamic, 1)
-    for (std::int64_t ck = 0; ck < total; ++ck) {
-      const std::size_t chunk = static_cast<std::size_t>(ck);
-      std::vector<Contact>& out = in.chunk_contacts[chunk];
-      out.clear();
-      collide_chunk(chunk, out, points);
+    std::vector<Contact>& out = in.thread_contacts[thread].items;
+    out.clear();
+    for (std::size_t turn = 0; turn < team; ++turn) {  // its own run first, then the others'
+      Internals::ThreadContacts& owner = in.thread_contacts[(thread + turn) % team];
+      for (;;) {
+        std::size_t chunk;
+#pragma omp atomic capture
+        chunk = owner.next++;
+        if (chunk >= owner.end) break;
+        const std::size_t begin = out.size();
+        overlap_beyond = collide_chunk(chunk, out, points) || overlap_beyond;
+        in.chunk_span[chunk] = {thread, begin, out.size()};
+      }
     }
   }
-  // Concatenate the chunks in order (each copied by whichever thread).
+  in.overlap_beyond = overlap_beyond;
   in.chunk_offset.assign(chunks + 1, 0);
-  for (std::size_t k = 0; k < chunks; ++k) in.chunk_offset[k + 1] = in.chunk_offset[k] + in.chunk_contacts[k].size();
+  for (std::size_t k = 0; k < chunks; ++k)
+    in.chunk_offset[k + 1] = in.chunk_offset[k] + (in.chunk_span[k].end - in.chunk_span[k].begin);
   contacts_.resize(in.chunk_offset[chunks]);
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (total >= 64)
   for (std::int64_t ck = 0; ck < total; ++ck) {
-    const std::size_t k = static_cast<std::size_t>(ck);
-    std::copy(in.chunk_contacts[k].begin(), in.chunk_contacts[k].end(), contacts_.begin() + static_cast<std::ptrdiff_t>(in.chunk_offset[k]));
+    const Internals::ChunkSpan& span = in.chunk_span[static_cast<std::size_t>(ck)];
+    const auto from = in.thread_contacts[span.thread].items.begin();
+    std::copy(from + static_cast<std::ptrdiff_t>(span.begin), from + static_cast<std::ptrdiff_t>(span.end),
+              contacts_.begin() + static_cast<std::ptrdiff_t>(in.chunk_offset[static_cast<std::size_t>(ck)]));
   }
 }
 
@@ -864,22 +961,49 @@ void Simulation::Gather() {
   // body's sums run in a fixed order whichever thread computes them (ERRATA
   // 11: each contact acts on both bodies, equal and opposite, each with its
   // own branch vector).
+  // With many contacts, in as many contiguous parts of the contact list as
+  // there are threads: each part counts its contacts per body, the counts
+  // give each part's place within each body's run (the earlier parts first),
+  // and each part files its contacts there. The same index either way.
   std::vector<std::uint32_t>& start = in.body_contact_start;
   std::vector<std::uint32_t>& items = in.body_contact_items;
-  start.assign(n + 1, 0);
-  for (const Contact& c : contacts_) {
-    ++start[c.a + 1];
-    if (!c.wall) ++start[c.b + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
-  items.resize(start[n]);
-  {
-    std::vector<std::uint32_t>& fill = in.body_contact_fill;
-    fill.assign(start.begin(), start.end() - 1);
-    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+  const std::size_t m = contacts_.size();
+  const std::size_t parts =
+      def_.threads > 1 && static_cast<std::int64_t>(m) >= kParallelBodies ? static_cast<std::size_t>(def_.threads) : 1;
+  std::vector<std::uint32_t>& fill = in.body_contact_fill;  // parts x n: counts, then where each part files
+  fill.resize(parts * n);
+  const std::int64_t part_count = static_cast<std::int64_t>(parts);
+#pragma omp parallel for schedule(static, 1) num_threads(def_.threads) if (part_count > 1)
+  for (std::int64_t part = 0; part < part_count; ++part) {
+    const std::size_t q = static_cast<std::size_t>(part);
+    std::uint32_t* count = fill.data() + q * n;
+    std::fill(count, count + n, 0u);
+    for (std::size_t k = m * q / parts; k < m * (q + 1) / parts; ++k) {
       const Contact& c = contacts_[k];
-      items[fill[c.a]++] = static_cast<std::uint32_t>(k);
-      if (!c.wall) items[fill[c.b]++] = static_cast<std::uint32_t>(k);
+      ++count[c.a];
+      if (!c.wall) ++count[c.b];
+    }
+  }
+  start.resize(n + 1);
+  std::uint32_t running = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    start[i] = running;
+    for (std::size_t q = 0; q < parts; ++q) {
+      const std::uint32_t c = fill[q * n + i];
+      fill[q * n + i] = running;
+      running += c;
+    }
+  }
+  start[n] = running;
+  items.resize(running);
+#pragma omp parallel for schedule(static, 1) num_threads(def_.threads) if (part_count > 1)
+  for (std::int64_t part = 0; part < part_count; ++part) {
+    const std::size_t q = static_cast<std::size_t>(part);
+    std::uint32_t* place = fill.data() + q * n;
+    for (std::size_t k = m * q / parts; k < m * (q + 1) / parts; ++k) {
+      const Contact& c = contacts_[k];
+      items[place[c.a]++] = static_cast<std::uint32_t>(k);
+      if (!c.wall) items[place[c.b]++] = static_cast<std::uint32_t>(k);
     }
   }
   const std::int64_t count = static_cast<std::int64_t>(n);
@@ -1133,25 +1257,17 @@ void Simulation::GearCorrect() {
 
 void Simulation::Check() {
   ScopedTimer timer(profile_.check_s);
-  // Find the first bad body and contact in parallel; report them as the serial scan would.
+  // Look for a bad body in parallel (Collide already looked at the contacts);
+  // if there is one, report the first as the serial scan below would.
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
-  const std::int64_t m = static_cast<std::int64_t>(contacts_.size());
-  std::int64_t first_body = n, first_contact = m;
-#pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies) reduction(min : first_body)
+  bool bad_body = false;
+#pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies) reduction(|| : bad_body)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
     const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
-    if (!std::isfinite(x.x + x.y + v.x + v.y + bodies_.angle_rad[i] + bodies_.angular_velocity_rad_per_s[i]))
-      first_body = std::min(first_body, ii);
+    bad_body = !std::isfinite(x.x + x.y + v.x + v.y + bodies_.angle_rad[i] + bodies_.angular_velocity_rad_per_s[i]) || bad_body;
   }
-#pragma omp parallel for schedule(static) num_threads(def_.threads) if (m >= kParallelBodies) reduction(min : first_contact)
-  for (std::int64_t k = 0; k < m; ++k) {
-    const Contact& c = contacts_[static_cast<std::size_t>(k)];
-    const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
-    const double rb = c.wall ? def_.walls[c.b].radius_m : def_.shapes[bodies_.shape[c.b]].radius_m;
-    if (!(c.overlap_m <= ra + rb)) first_contact = std::min(first_contact, k);
-  }
-  if (first_body == n && first_contact == m) return;
+  if (!bad_body && !in_->overlap_beyond) return;
   for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
     const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(v.x) || !std::isfinite(v.y) ||

@@ -297,6 +297,46 @@ TEST(EnginePhysics, ResultsDoNotDependOnTheThreadCount) {
   }
 }
 
+TEST(EnginePhysics, ResultsOfALargeCrowdDoNotDependOnTheThreadCount) {
+  // Enough people and contacts (>= 512 each) for every stage to split its
+  // work between threads: the neighbour list built in parts, the contacts
+  // filed per body in parts, the per-body stages. Positions and the whole
+  // contact list must be the same, bit for bit, on 1, 2 and 3 threads.
+  WorldDef def = RandomGas(26, 0.38, 7, true);
+  def.parameters.ground_reaction = true;
+  std::vector<Vec2> reference;
+  std::vector<Contact> reference_contacts;
+  std::vector<Vec2> reference_forces;
+  for (int threads : {1, 2, 3}) {
+    def.threads = threads;
+    Simulation sim(def);
+    sim.AdvanceTo(0.05);
+    sim.RebuildNeighbourList();  // at least one rebuild with every thread count
+    sim.AdvanceTo(0.1);
+    const auto& x = sim.bodies().position_m;
+    const auto& contacts = sim.contacts();
+    if (reference.empty()) {
+      ASSERT_GE(x.size(), 512u);
+      ASSERT_GE(contacts.size(), 512u) << "too few contacts to split the filing between threads";
+      reference = x;
+      reference_contacts = contacts;
+      reference_forces = sim.bodies().contact_force_n;
+      continue;
+    }
+    ASSERT_EQ(std::memcmp(reference.data(), x.data(), x.size() * sizeof(Vec2)), 0) << threads;
+    ASSERT_EQ(contacts.size(), reference_contacts.size()) << threads;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const Contact& c = contacts[k];
+      const Contact& r = reference_contacts[k];
+      ASSERT_TRUE(c.a == r.a && c.b == r.b && c.wall == r.wall && c.feature == r.feature) << threads << " " << k;
+      ASSERT_EQ(std::memcmp(&c.normal_force_n, &r.normal_force_n, sizeof(double)), 0) << threads << " " << k;
+      ASSERT_EQ(std::memcmp(&c.tangential_force_n, &r.tangential_force_n, sizeof(double)), 0) << threads << " " << k;
+    }
+    const auto& f = sim.bodies().contact_force_n;  // gathered from the contacts filed per body
+    ASSERT_EQ(std::memcmp(reference_forces.data(), f.data(), f.size() * sizeof(Vec2)), 0) << threads;
+  }
+}
+
 TEST(EnginePhysics, RememberingWhatIsStillApartChangesNothing) {
   // The narrow phase skips pairs and vertices that cannot touch yet (pair
   // and vertex clearances against a bound on how far bodies moved): the

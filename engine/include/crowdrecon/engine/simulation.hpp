@@ -8,7 +8,8 @@
 //   4. gather         contact forces and torques onto bodies in a fixed order (eq. 18)
 //   5. drive          self-driven force (3), back force (15), torques (16-17), slope
 //   6. integrate      velocity Verlet or Gear 5th-order predictor-corrector
-//   7. check          non-finite state or overlap beyond the sum of radii -> SimulationError
+//   7. check          non-finite state, or an overlap beyond the sum of radii (which
+//                     collide flags as it computes the contacts) -> SimulationError
 //
 // Forces read only the current state and every sum runs in a fixed order, so
 // results are identical whatever the number of threads.
