@@ -968,8 +968,9 @@ void Simulation::Gather() {
   std::vector<std::uint32_t>& start = in.body_contact_start;
   std::vector<std::uint32_t>& items = in.body_contact_items;
   const std::size_t m = contacts_.size();
-  const std::size_t parts =
-      def_.threads > 1 && static_cast<std::int64_t>(m) >= kParallelBodies ? static_cast<std::size_t>(def_.threads) : 1;
+  const bool split = def_.threads > 1 && static_cast<std::int64_t>(n) >= kParallelBodies &&
+                     static_cast<std::int64_t>(m) >= kParallelBodies;  // as the per-body sums below
+  const std::size_t parts = split ? static_cast<std::size_t>(def_.threads) : 1;
   std::vector<std::uint32_t>& fill = in.body_contact_fill;  // parts x n: counts, then where each part files
   fill.resize(parts * n);
   const std::int64_t part_count = static_cast<std::int64_t>(parts);
