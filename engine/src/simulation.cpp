@@ -33,6 +33,14 @@ constexpr std::int64_t kParallelBodies = 512;
 
 using Clock = std::chrono::steady_clock;
 
+// Part q of `parts` contiguous, nearly equal parts of [0, count): the work a
+// stage splits between threads in a fixed way (the results then do not
+// depend on which thread takes which part).
+struct Part {
+  std::size_t begin, end;
+};
+Part PartOf(std::size_t count, std::size_t q, std::size_t parts) { return {count * q / parts, count * (q + 1) / parts}; }
+
 // The clearances of one pair list (person pairs, or person-wall pairs): per
 // pair, the travel sum below which it is still apart, and per vertex of its
 // two shapes the same (VertexClearances), pair k's vertices at
@@ -542,7 +550,8 @@ void Simulation::UpdatePairs() {
     std::vector<std::pair<std::uint32_t, std::uint32_t>>& wall_pairs = part_wall_pairs[q];
     std::vector<std::uint32_t> candidates;
     std::vector<std::size_t> neighbour_cells;
-    for (std::size_t k = active.size() * q / parts; k < active.size() * (q + 1) / parts; ++k) {
+    const Part people = PartOf(active.size(), q, parts);
+    for (std::size_t k = people.begin; k < people.end; ++k) {
       const std::uint32_t i = active[k];
       const Vec2 pi = bodies_.position_m[i];
       const std::int64_t cx = static_cast<std::int64_t>(body_cell[k] % static_cast<std::size_t>(ncx));
@@ -811,15 +820,27 @@ void Simulation::Collide() {
     return bodies_.mass_kg[a] * bodies_.mass_kg[b] / (bodies_.mass_kg[a] + bodies_.mass_kg[b]);  // eq. (14)
   };
 
-  // A contact whose overlap exceeds the sum of the two sphero-radii means that
-  // the cores interpenetrate: Check() reports it (and looks for it only then).
-  const auto beyond = [](const std::vector<ContactPoint>& points, double radii) {
-    bool found = false;
-    for (const ContactPoint& p : points) found = found || !(p.overlap_m <= radii);
-    return found;
+  // The contacts of one pair (persons a and b, or person a and wall b) at its
+  // narrow-phase points, with the forces of `pair_law`; `relative_velocity(x)`
+  // is a's velocity less b's at the point x. Returns true if a point overlaps
+  // beyond `radii`, the sum of the two sphero-radii: the cores interpenetrate,
+  // which Check() reports (and looks for only then).
+  const auto add_contacts = [](const std::vector<ContactPoint>& points, std::uint32_t a, std::uint32_t b, bool wall,
+                               const ContactLaw& pair_law, double mass, double radii, PreviousContacts& previous,
+                               std::vector<Contact>& out, const auto& relative_velocity) {
+    const std::uint64_t key = (wall ? kWallBit : 0) | (std::uint64_t{a} << 32) | b;
+    const auto [sum, k_eff] = OverlapShares(points);
+    const ContactLaw::Rates rates = pair_law.PairRates(mass, k_eff);
+    bool beyond = false;
+    for (const ContactPoint& p : points) {
+      Contact& c = out.emplace_back(ContactAt(p, a, b, wall));
+      pair_law.Apply(c, relative_velocity(p.point), mass, previous.Find(key, p.feature), p.overlap_m / sum, rates);
+      beyond = beyond || !(p.overlap_m <= radii);
+    }
+    return beyond;
   };
   // One chunk of pairs: its contacts appended to `out`, in pair order. Returns
-  // true if one of them overlaps beyond the sum of the radii (see `beyond`).
+  // true if one of them overlaps beyond the sum of the radii (see add_contacts).
   const auto collide_chunk = [&](std::size_t chunk, std::vector<Contact>& out, std::vector<ContactPoint>& points) {
     PreviousContacts previous(in.previous_contacts);
     bool overlap_beyond = false;
@@ -836,17 +857,10 @@ void Simulation::Collide() {
         points.clear();
         in.pair_clear.Collide(k, moved, pa, pb, points, in.pair_memory);
         if (points.empty()) continue;
-        const double m_ab = effective_mass(a, b);
-        const std::uint64_t key = (std::uint64_t{a} << 32) | b;
-        const auto [sum, k_eff] = OverlapShares(points);
-        const ContactLaw::Rates rates = law.PairRates(m_ab, k_eff);
-        for (const ContactPoint& p : points) {
-          Contact& c = out.emplace_back(ContactAt(p, a, b, false));
-          const Vec2 rel = velocity_at(a, p.point - xa) - velocity_at(b, p.point - xb_image);
-          const Contact* prev = previous.Find(key, p.feature);
-          law.Apply(c, rel, m_ab, prev, p.overlap_m / sum, rates);
-        }
-        overlap_beyond = overlap_beyond || beyond(points, pa.scale + pb.scale);  // (family radius 1)
+        const auto relative_velocity = [&](Vec2 x) { return velocity_at(a, x - xa) - velocity_at(b, x - xb_image); };
+        overlap_beyond = add_contacts(points, a, b, false, law, effective_mass(a, b), pa.scale + pb.scale,  // (family radius 1)
+                                      previous, out, relative_velocity) ||
+                         overlap_beyond;
       }
     } else {
       const std::size_t wchunk = chunk - person_chunks;
@@ -864,16 +878,10 @@ void Simulation::Collide() {
         points.clear();
         in.wall_pair_clear.Collide(k, moved, pa, pw, points, in.pair_memory);
         if (points.empty()) continue;
-        const std::uint64_t key = kWallBit | (std::uint64_t{a} << 32) | w;
-        const auto [sum, k_eff] = OverlapShares(points);
-        const ContactLaw::Rates rates = wall_law.PairRates(bodies_.mass_kg[a], k_eff);
-        for (const ContactPoint& p : points) {
-          Contact& c = out.emplace_back(ContactAt(p, a, w, true));
-          const Vec2 rel = velocity_at(a, p.point - xa);
-          const Contact* prev = previous.Find(key, p.feature);
-          wall_law.Apply(c, rel, bodies_.mass_kg[a], prev, p.overlap_m / sum, rates);
-        }
-        overlap_beyond = overlap_beyond || beyond(points, pa.scale + pw.geometry->radius_m);
+        const auto relative_velocity = [&](Vec2 x) { return velocity_at(a, x - xa); };
+        overlap_beyond = add_contacts(points, a, w, true, wall_law, bodies_.mass_kg[a], pa.scale + pw.geometry->radius_m,
+                                      previous, out, relative_velocity) ||
+                         overlap_beyond;
       }
     }
     return overlap_beyond;
@@ -905,8 +913,9 @@ void Simulation::Collide() {
   const std::size_t team = static_cast<std::size_t>(def_.threads);
   in.thread_contacts.resize(team);
   for (std::size_t t = 0; t < team; ++t) {
-    in.thread_contacts[t].next = chunks * t / team;
-    in.thread_contacts[t].end = chunks * (t + 1) / team;
+    const Part run = PartOf(chunks, t, team);
+    in.thread_contacts[t].next = run.begin;
+    in.thread_contacts[t].end = run.end;
   }
   in.chunk_span.resize(chunks);
   bool overlap_beyond = false;
@@ -979,7 +988,8 @@ void Simulation::Gather() {
     const std::size_t q = static_cast<std::size_t>(part);
     std::uint32_t* count = fill.data() + q * n;
     std::fill(count, count + n, 0u);
-    for (std::size_t k = m * q / parts; k < m * (q + 1) / parts; ++k) {
+    const Part listed = PartOf(m, q, parts);
+    for (std::size_t k = listed.begin; k < listed.end; ++k) {
       const Contact& c = contacts_[k];
       ++count[c.a];
       if (!c.wall) ++count[c.b];
@@ -1001,7 +1011,8 @@ void Simulation::Gather() {
   for (std::int64_t part = 0; part < part_count; ++part) {
     const std::size_t q = static_cast<std::size_t>(part);
     std::uint32_t* place = fill.data() + q * n;
-    for (std::size_t k = m * q / parts; k < m * (q + 1) / parts; ++k) {
+    const Part listed = PartOf(m, q, parts);
+    for (std::size_t k = listed.begin; k < listed.end; ++k) {
       const Contact& c = contacts_[k];
       items[place[c.a]++] = static_cast<std::uint32_t>(k);
       if (!c.wall) items[place[c.b]++] = static_cast<std::uint32_t>(k);
