@@ -13,10 +13,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -27,6 +29,7 @@
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/engine/world_file.hpp"
 #include "crowdrecon/geometry/body.hpp"
 #include "crowdrecon/scenario/run_file.hpp"
 
@@ -340,11 +343,41 @@ void RegisterAll() {
           ->UseRealTime();
 }
 
+// Writes the worlds of the Step benchmarks, and their states after the
+// warm-up, as DIR/<name>.world and DIR/<name>.state, for bench_device on
+// machines that cannot build worlds from scenarios (a GPU machine).
+void DumpWorlds(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const auto dump = [&](const std::string& world, const std::string& name, double warm_up_s) {
+    engine::SaveWorldFile(CachedWorld(world).world, dir / (name + ".world"));
+    const std::string& state = WarmState(world, warm_up_s);
+    const std::filesystem::path file = dir / (name + ".state");
+    std::ofstream out(file, std::ios::binary);
+    out.write(state.data(), static_cast<std::streamsize>(state.size()));
+    if (!out) throw std::runtime_error(file.string() + ": cannot write");
+    std::printf("wrote %s and %s\n", (dir / (name + ".world")).c_str(), file.c_str());
+  };
+  dump("hallway-400", "hallway-400", kWarmUpSeconds);
+  dump("box-2000", "box-2000-developed", kDevelopedSeconds);
+  dump("box-10000", "box-10000-developed", kDevelopedSeconds);
+}
+
 }  // namespace
 
 }  // namespace crowdrecon::bench
 
 int main(int argc, char** argv) {
+  // --dump_worlds=DIR: write the worlds and states (see DumpWorlds), run nothing.
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind("--dump_worlds=", 0) == 0) {
+      try {
+        crowdrecon::bench::DumpWorlds(std::string(argv[i]).substr(14));
+        return 0;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "crowdrecon_bench_kernels: %s\n", e.what());
+        return 1;
+      }
+    }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   try {

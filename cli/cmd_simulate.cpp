@@ -1,4 +1,4 @@
-// crowdrecon simulate SCENARIO -o RUN.sqlite [--threads N] [--resume]
+// crowdrecon simulate SCENARIO -o RUN.sqlite [--threads N] [--device cpu|cuda] [--resume]
 #include <unistd.h>
 
 #include <cstdio>
@@ -18,6 +18,7 @@ struct SimulateArgs {
   std::string scenario;
   std::string output;
   int threads = 0;
+  std::string device = "cpu";
   bool resume = false;
   bool quiet = false;
   double stop_after_s = -1.0;
@@ -28,13 +29,16 @@ int RunSimulate(const SimulateArgs& args) {
   scenario::RunOptions options;
   options.output = args.output;
   options.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (!engine::FromString(args.device, &options.device))
+    throw InputError("--device: \"" + args.device + "\", expected \"cpu\" or \"cuda\"");
   options.resume = args.resume;
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.stop_after_s = args.stop_after_s;
   scenario::InstallInterruptHandlers();
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
   std::printf("scenario: %s\n", sc.name.c_str());
-  std::printf("people: %zu, time step %.6g s, %d thread(s)\n", s.people, s.time_step_s, options.threads);
+  std::printf("people: %zu, time step %.6g s, %d thread(s)%s\n", s.people, s.time_step_s, options.threads,
+              options.device == engine::ComputeDevice::kCuda ? ", person-pair forces on CUDA" : "");
   std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());
@@ -64,6 +68,9 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Run file to write (.sqlite)")->required();
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(CLI::Range(0, 1024));
+  cmd->add_option("--device", args->device,
+                  "Where person-pair forces are computed: cpu (default) or cuda (a build with CUDA and a GPU); "
+                  "results do not depend on it");
   cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption");

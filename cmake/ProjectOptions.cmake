@@ -3,13 +3,17 @@
 # optional sanitizers.
 add_library(crowdrecon_options INTERFACE)
 target_compile_options(crowdrecon_options INTERFACE
+  $<$<COMPILE_LANGUAGE:CXX>:
   -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
   -Wnon-virtual-dtor -Woverloaded-virtual -Wdouble-promotion
   # GCC 12 at -O3 reports false positives inside libstdc++ for these two
   # (GCC bugs 105329 and 105562 family); they are not errors in our code.
   -Wno-restrict -Wno-null-dereference
   -Werror
-  -ffp-contract=off)
+  -ffp-contract=off>
+  # CUDA sources (the optional force computation on a GPU): no contraction
+  # on the device nor in their host code, as above; warnings as errors.
+  $<$<COMPILE_LANGUAGE:CUDA>:--fmad=false -Xcompiler=-ffp-contract=off --expt-relaxed-constexpr>)
 if(CROWDRECON_SANITIZE)
   target_compile_options(crowdrecon_options INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/world.hpp"
 
 namespace crowdrecon::engine {
 
@@ -37,6 +38,14 @@ const char* ToString(Integrator t) { return t == Integrator::kVelocityVerlet ? "
 bool FromString(const std::string& s, Integrator* t) {
   if (s == "velocity_verlet") *t = Integrator::kVelocityVerlet;
   else if (s == "gear5") *t = Integrator::kGear5;
+  else return false;
+  return true;
+}
+
+const char* ToString(ComputeDevice d) { return d == ComputeDevice::kCpu ? "cpu" : "cuda"; }
+bool FromString(const std::string& s, ComputeDevice* d) {
+  if (s == "cpu") *d = ComputeDevice::kCpu;
+  else if (s == "cuda") *d = ComputeDevice::kCuda;
   else return false;
   return true;
 }

@@ -12,6 +12,8 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fast_math.hpp"
+#include "contact_law.hpp"
+#include "cuda_collide.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 
 #ifdef _OPENMP
@@ -21,6 +23,9 @@
 namespace crowdrecon::engine {
 
 namespace {
+
+using detail::ContactHistory;
+using detail::ContactLaw;
 
 constexpr double kPi = std::numbers::pi;
 constexpr std::uint64_t kWallBit = std::uint64_t{1} << 63;
@@ -190,6 +195,12 @@ struct Simulation::Internals {
   std::vector<ChunkSpan> chunk_span;
   std::vector<std::size_t> chunk_offset;
   bool overlap_beyond = false;  // set by Collide, see Check
+  // The CUDA force computation of person pairs (WorldDef::device), and
+  // whether it holds the previous evaluation's contacts (then they are not
+  // sent again); a new list of pairs is sent when pair_generation changes.
+  std::unique_ptr<cuda::Collider> cuda;
+  bool cuda_has_history = false;
+  std::uint64_t pair_generation = 0;
   // Contacts of each body (indices into contacts_, in contact order): CSR.
   std::vector<std::uint32_t> body_contact_start, body_contact_items, body_contact_fill;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
@@ -234,6 +245,8 @@ TimeStepEstimate EstimateTimeStep(const WorldDef& def) {
                                                  : def.parameters.time_step_safety * e.stability_limit_s;
   return e;
 }
+
+bool CudaAvailable(std::string* why) { return cuda::Available(why); }
 
 Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
   std::string error;
@@ -416,6 +429,9 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
                      " rad/s); use a smaller step or 0 for automatic");
   dt_s_ = dt_estimate_.chosen_s;
 
+  if (def_.device == ComputeDevice::kCuda)
+    in_->cuda = std::make_unique<cuda::Collider>(in_->family_geometry, in_->shape_family, in_->shape_scale,
+                                                 def_.periodic);
   ComputeForces();  // forces at t = 0 (no spring increment: contacts start unloaded)
   in_->previous_contacts = contacts_;
 }
@@ -480,6 +496,7 @@ void Simulation::UpdatePairs() {
     if (!rebuild) return;
   }
   ++profile_.pair_rebuilds;
+  ++in.pair_generation;
   in.pairs_valid = true;
   in.position_at_build = bodies_.position_m;
   in.pairs.clear();
@@ -646,81 +663,6 @@ void Simulation::PlaceShapes() {
 
 namespace {
 
-struct ContactLaw {
-  double kn, kt, mu, dt;
-  double damping_factor;  // 2L/sqrt(pi^2+L^2): gamma = factor * sqrt(k / m_ij)
-  TangentialDamping tangential_mode;
-  double tangential_rate;
-  bool tensile;
-  bool advance_springs;
-
-  // Fills the forces of contact c given the relative velocity at the contact
-  // point and the previous tangential displacement.
-  //
-  //
-  // Restitution per pair. A pair touching at several points (a flat face) acts
-  // as one spring of stiffness k_eff kn along the normal, and the pair's
-  // restitution should be epsilon whatever the number of points. The pair
-  // damping rate follows from eq. (19) with k_eff kn, and is shared among the
-  // points in proportion to their overlaps. k_eff = (sum delta)^2 / sum delta^2
-  // counts points weighted by overlap, so that a point that starts touching
-  // joins the sum continuously. `weight` = delta_i / sum delta; for a single
-  // point weight = k_eff = 1 and this is eq. (19) as written (docs/model.md).
-  //
-  // The pair's damping rates (before the sharing by `weight`) are the same for
-  // all its points: PairRates, once per pair.
-  struct Rates {
-    double normal = 0.0, tangential = 0.0;
-  };
-  Rates PairRates(double effective_mass, double k_eff) const {
-    Rates r;
-    r.normal = damping_factor * std::sqrt(k_eff * kn / effective_mass);  // eq. (19) inverted
-    switch (tangential_mode) {
-      case TangentialDamping::kFromRestitution: r.tangential = damping_factor * std::sqrt(k_eff * kt / effective_mass); break;
-      case TangentialDamping::kEqualToNormal: r.tangential = r.normal; break;
-      case TangentialDamping::kFixed: r.tangential = tangential_rate; break;
-    }
-    return r;
-  }
-
-  void Apply(Contact& c, Vec2 relative_velocity, double effective_mass, const Contact* previous,
-             double weight, Rates rates) const {
-    const double previous_spring = previous ? previous->tangential_spring_m : 0.0;
-    const Vec2 t = Perp(c.normal);
-    const double vn = Dot(relative_velocity, c.normal);  // > 0: separating
-    const double vt = Dot(relative_velocity, t);
-    const double gamma_n = rates.normal * weight;
-    const double gamma_t = rates.tangential * weight;
-    const double elastic_n = kn * c.overlap_m;                      // eq. (8)
-    double fn = elastic_n - effective_mass * gamma_n * vn;           // + eq. (11)
-    if (!tensile && fn < 0.0) fn = 0.0;
-    // Tangential elastic displacement (eq. 9), accumulated while the contact
-    // persists and capped by Coulomb's condition on the elastic parts (eq. 10).
-    double spring = previous_spring + (advance_springs ? vt * dt : 0.0);
-    const double cap = mu * elastic_n;
-    if (kt * std::abs(spring) > cap) spring = std::copysign(cap / kt, spring);
-    c.tangential_spring_m = spring;
-    c.normal_force_n = fn;
-    c.viscous_normal_n = fn - elastic_n;
-    c.viscous_tangential_n = -effective_mass * gamma_t * vt;
-    c.tangential_force_n = -kt * spring + c.viscous_tangential_n;  // eqs. (9) + (12)
-    // Onset and end within a step. The dashpots jump at delta = 0 (eqs. 11-12),
-    // so kicks that apply them for whole half steps bias the restitution by
-    // O(gamma h). The time since onset (new contact, up to a whole step ago)
-    // and until the end (separating contact, if before the next evaluation)
-    // are estimated from delta and v_n, and the dashpot impulse of the
-    // adjacent half kick is scaled to it, by up to two (docs/model.md).
-    if (previous == nullptr) {
-      c.trailing_fraction = vn < 0.0 ? std::min(2.0, 2.0 * c.overlap_m / (-vn * dt)) : 1.0;
-    } else {
-      // The last leading kick already covered the time it expected the contact to last beyond its half step.
-      c.trailing_fraction = previous->leading_fraction > 1.0 ? 2.0 - previous->leading_fraction : 1.0;
-    }
-    const double until_end = vn > 0.0 ? 2.0 * c.overlap_m / (vn * dt) : 2.0;
-    c.leading_fraction = until_end < 2.0 ? until_end : 1.0;
-  }
-};
-
 // The contact of persons (or person and wall) a, b at a narrow-phase point,
 // before the contact law fills its forces.
 Contact ContactAt(const ContactPoint& p, std::uint32_t a, std::uint32_t b, bool wall) {
@@ -834,7 +776,10 @@ void Simulation::Collide() {
     bool beyond = false;
     for (const ContactPoint& p : points) {
       Contact& c = out.emplace_back(ContactAt(p, a, b, wall));
-      pair_law.Apply(c, relative_velocity(p.point), mass, previous.Find(key, p.feature), p.overlap_m / sum, rates);
+      const Contact* before = previous.Find(key, p.feature);
+      const ContactHistory history =
+          before ? ContactHistory{true, before->tangential_spring_m, before->leading_fraction} : ContactHistory{};
+      pair_law.Apply(c, relative_velocity(p.point), mass, history, p.overlap_m / sum, rates);
       beyond = beyond || !(p.overlap_m <= radii);
     }
     return beyond;
@@ -887,6 +832,34 @@ void Simulation::Collide() {
     return overlap_beyond;
   };
 
+  if (in.cuda) {
+    // Person pairs on the device, in list order; then the wall pairs here, as
+    // below (they follow the person pairs in the contact list).
+    cuda::CollideInput input;
+    input.n = bodies_.size();
+    input.position_m = bodies_.position_m.data();
+    input.cos_angle = in.cos_angle.data();
+    input.sin_angle = in.sin_angle.data();
+    input.velocity_m_per_s = bodies_.velocity_m_per_s.data();
+    input.angular_velocity_rad_per_s = bodies_.angular_velocity_rad_per_s.data();
+    input.state = bodies_.state.data();
+    input.mass_kg = bodies_.mass_kg.data();
+    input.shape = bodies_.shape.data();
+    input.pairs = in.pairs.data();
+    input.pair_count = in.pairs.size();
+    input.pair_generation = in.pair_generation;
+    input.previous = &in.previous_contacts;
+    input.previous_is_last_output = in.cuda_has_history;
+    input.law = law;
+    contacts_.clear();
+    bool overlap_beyond = in.cuda->Collide(input, contacts_);
+    in.cuda_has_history = true;
+    std::vector<ContactPoint> points;
+    for (std::size_t chunk = person_chunks; chunk < chunks; ++chunk)
+      overlap_beyond = collide_chunk(chunk, contacts_, points) || overlap_beyond;
+    in.overlap_beyond = overlap_beyond;
+    return;
+  }
   const std::int64_t total = static_cast<std::int64_t>(chunks);
   if (def_.threads == 1 || total < 4) {
     // On one thread the chunks come in order: straight into the contact list,
@@ -1483,6 +1456,7 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
+  in_->cuda_has_history = false;  // the device's last contacts are not these
   PlaceShapes();  // orientations of the restored angles (Drive reads them)
 }
 

@@ -111,6 +111,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     built.world.parameters.time_step_s = frame_dt / steps;
   }
   const auto steps_per_frame = static_cast<std::int64_t>(std::llround(frame_dt / built.world.parameters.time_step_s));
+  built.world.device = options.device;
   engine::Simulation sim(built.world);
 
   RunHeader header;

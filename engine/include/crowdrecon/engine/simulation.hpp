@@ -22,33 +22,10 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/engine/contact.hpp"
 #include "crowdrecon/engine/world.hpp"
 
 namespace crowdrecon::engine {
-
-// A contact between person `a` and person `b`, or between person `a` and wall
-// segment `b` when `wall` is true. Forces are those acting on `a`; `b` feels
-// the opposite. Every contact of the step is kept (force network, injury risk).
-struct Contact {
-  std::uint32_t a = 0;
-  std::uint32_t b = 0;
-  bool wall = false;
-  std::uint32_t feature = 0;      // owning vertex within (a, b), see narrow_phase.hpp
-  Vec2 point_m;                   // application point (in a's periodic image)
-  Vec2 normal;                    // unit, from b to a
-  double overlap_m = 0.0;         // delta_n
-  double normal_force_n = 0.0;    // along `normal` (elastic + viscous, eqs. 8, 11)
-  double tangential_force_n = 0.0;  // along Perp(normal) (eqs. 9, 12)
-  double tangential_spring_m = 0.0;  // delta_t, elastic tangential displacement (eqs. 9-10)
-  // The viscous parts of the two forces above (eqs. 11, 12), and the fractions
-  // of the half steps before and after this evaluation during which the
-  // contact existed (see "contact onset and end within a step" in docs/model.md).
-  double viscous_normal_n = 0.0;
-  double viscous_tangential_n = 0.0;
-  double trailing_fraction = 1.0;
-  double leading_fraction = 1.0;
-  Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
-};
 
 // Hot state, one entry per person (structure of arrays).
 struct BodyState {
@@ -185,6 +162,10 @@ class Simulation {
   std::uint64_t step_count_ = 0;
   bool advance_springs_ = false;
 };
+
+// True when this build has the CUDA force computation (ComputeDevice::kCuda)
+// and a CUDA device is present; otherwise false with the reason in *why.
+bool CudaAvailable(std::string* why = nullptr);
 
 // Time-step estimate for a world (used by the constructor; exposed for tests).
 TimeStepEstimate EstimateTimeStep(const WorldDef& def);

@@ -64,6 +64,16 @@ struct FloorSlope {
   double gradient = 0.0;  // rise over run (e.g. 0.30 m / 12 m = 0.025)
 };
 
+// Where the narrow phase and contact law of person pairs run. The results
+// are the same, bit for bit (engine/src/cuda_collide.hpp); kCuda needs a build
+// with CUDA and a device, and is refused with a clear message otherwise.
+enum class ComputeDevice : std::uint8_t {
+  kCpu = 0,
+  kCuda = 1,
+};
+const char* ToString(ComputeDevice d);
+bool FromString(const std::string& s, ComputeDevice* d);
+
 struct WorldDef {
   ModelParameters parameters;
   std::vector<BodyShape> shapes;
@@ -73,6 +83,7 @@ struct WorldDef {
   PeriodicBox periodic;
   FloorSlope slope;
   int threads = 1;  // worker threads for the force computation (results do not depend on it)
+  ComputeDevice device = ComputeDevice::kCpu;  // nor on this
 };
 
 }  // namespace crowdrecon::engine

@@ -19,6 +19,9 @@ namespace crowdrecon::scenario {
 struct RunOptions {
   std::filesystem::path output;  // RUN.sqlite
   int threads = 1;
+  // Where the force computation of person pairs runs (engine::WorldDef::device);
+  // results are the same on either.
+  engine::ComputeDevice device = engine::ComputeDevice::kCpu;
   bool resume = false;           // continue from output + ".checkpoint"
   bool show_progress = false;    // a progress line on stderr
   // Stop (as if interrupted) once the simulated time reaches this; < 0 never.

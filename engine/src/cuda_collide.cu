@@ -1,0 +1,570 @@
+// The force computation of person pairs on a CUDA device: see cuda_collide.hpp
+// for what it computes and why its results are the processor's, bit for bit.
+//
+// One thread per pair of the neighbour list, in two passes over the list:
+// CountContacts runs the narrow phase and counts each pair's contact points;
+// an exclusive prefix sum of the counts gives each pair's place in the
+// contact list; WriteContacts runs the narrow phase again, writes the points
+// there, and applies the contact law to them (the pair's overlap shares, its
+// damping rates, each point's tangential spring from the previous
+// evaluation's contact of the same pair and vertex, found by binary search).
+// Running the narrow phase twice costs less than keeping a slot for every
+// vertex of every pair between the passes.
+#include "cuda_collide.hpp"
+
+#include <cuda_runtime.h>
+
+#include <cub/device/device_scan.cuh>
+#include <limits>
+#include <stdexcept>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::engine::cuda {
+
+namespace {
+
+void Check(cudaError_t status, const char* what) {
+  if (status != cudaSuccess)
+    throw std::runtime_error(std::string("CUDA force computation: ") + what + ": " + cudaGetErrorString(status));
+}
+
+constexpr std::uint64_t kWallBit = std::uint64_t{1} << 63;
+
+// A device buffer that grows (never shrinks) to what is asked of it.
+template <typename T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  ~DeviceBuffer() {
+    if (data_) cudaFree(data_);
+  }
+  void Reserve(std::size_t count) {
+    if (count <= capacity_) return;
+    if (data_) Check(cudaFree(data_), "cudaFree");
+    data_ = nullptr;
+    const std::size_t grown = std::max(count, capacity_ + capacity_ / 2);
+    Check(cudaMalloc(&data_, grown * sizeof(T)), "cudaMalloc");
+    capacity_ = grown;
+  }
+  void Upload(const T* host, std::size_t count, cudaStream_t stream) {
+    Reserve(count);
+    size_ = count;
+    if (count > 0) Check(cudaMemcpyAsync(data_, host, count * sizeof(T), cudaMemcpyHostToDevice, stream), "upload");
+  }
+  T* data() { return data_; }
+  const T* data() const { return data_; }
+  std::size_t size() const { return size_; }
+  void set_size(std::size_t count) {
+    Reserve(count);
+    size_ = count;
+  }
+  void swap(DeviceBuffer& other) noexcept {
+    std::swap(data_, other.data_);
+    std::swap(size_, other.size_);
+    std::swap(capacity_, other.capacity_);
+  }
+
+ private:
+  T* data_ = nullptr;
+  std::size_t size_ = 0, capacity_ = 0;
+};
+
+// ShapeGeometry (narrow_phase.hpp) on the device: the same arrays, as
+// pointers into one pool per kind.
+struct DeviceGeometry {
+  const Vec2* vertices = nullptr;
+  const CoreEdge* edges = nullptr;
+  const std::uint8_t* reflex = nullptr;
+  std::uint32_t count = 0, edge_count = 0;
+  bool closed = true;
+  double radius_m = 0.0, core_radius_m = 0.0;
+  Vec2 box_min, box_max;
+  bool grid = false;
+  double grid_reach_m = 0.0;
+  Vec2 grid_origin;
+  double grid_cell_m = 0.0;
+  std::uint32_t grid_nx = 0, grid_ny = 0;
+  const std::uint32_t* cell_start = nullptr;
+  const std::uint16_t* cell_edges = nullptr;
+};
+
+struct Placed {
+  const DeviceGeometry* geometry;
+  Vec2 position;
+  double cos_angle, sin_angle, scale;
+};
+
+struct Box {
+  bool x = false, y = false;
+  double lx = 0.0, ly = 0.0;
+};
+
+struct Bodies {
+  const Vec2* position;
+  const double* cos_angle;
+  const double* sin_angle;
+  const Vec2* velocity;
+  const double* angular_velocity;
+  const PersonState* state;
+  const double* mass;
+  const std::uint32_t* shape;
+  const std::uint32_t* shape_family;
+  const double* shape_scale;
+  const DeviceGeometry* families;
+};
+
+// The previous evaluation's contacts, sorted by (pair key, feature).
+struct History {
+  const Contact* contacts;
+  std::size_t count;
+};
+
+// The same operations, in the same order, as the processor's (vec2.hpp and
+// the std:: functions of narrow_phase.cpp).
+__device__ inline double LengthDevice(Vec2 a) { return sqrt(a.x * a.x + a.y * a.y); }
+__device__ inline double MaxDevice(double a, double b) { return a < b ? b : a; }  // std::max
+
+struct Closest {
+  Vec2 point;
+  double distance;
+};
+
+// ClosestOnCore of narrow_phase.cpp.
+__device__ Closest ClosestOnCore(Vec2 p, const DeviceGeometry& g, const std::uint16_t* edge_index, std::uint32_t m) {
+  Closest best;
+  if (g.edge_count == 0) {
+    best.point = g.vertices[0];
+    best.distance = LengthDevice(p - g.vertices[0]);
+    return best;
+  }
+  double best_d2 = std::numeric_limits<double>::infinity();
+  std::uint32_t best_edge = 0;
+  double best_t = 0.0;
+  best.point = Vec2{};
+  for (std::uint32_t k = 0; k < m; ++k) {
+    const std::uint32_t j = edge_index ? edge_index[k] : k;
+    const CoreEdge e = g.edges[j];
+    double t = Dot(p - e.start, e.direction) * e.inverse_length2;
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    const Vec2 q = e.start + e.direction * t;
+    const double d2 = LengthSquared(p - q);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best.point = q;
+      best_edge = j;
+      best_t = t;
+    }
+  }
+  best.distance = sqrt(best_d2);
+  if (g.closed) {
+    bool inside;
+    if (best_t > 0.0 && best_t < 1.0) {
+      const CoreEdge e = g.edges[best_edge];
+      inside = Cross(e.direction, p - e.start) > 0.0;
+    } else {
+      const std::uint32_t n = g.count;
+      const std::uint32_t k = best_t <= 0.0 ? best_edge : (best_edge + 1 == n ? 0 : best_edge + 1);
+      inside = g.reflex[k] != 0;
+    }
+    if (inside) best.distance = -best.distance;
+  }
+  return best;
+}
+
+// BoxesGap of narrow_phase.cpp.
+__device__ double BoxesGap(const Placed& a, const Placed& b, double reach) {
+  const DeviceGeometry& ga = *a.geometry;
+  const DeviceGeometry& gb = *b.geometry;
+  const double grow = reach / 2.0;
+  const Vec2 ha = (ga.box_max - ga.box_min) * (a.scale / 2.0) + Vec2{grow, grow};
+  const Vec2 hb = (gb.box_max - gb.box_min) * (b.scale / 2.0) + Vec2{grow, grow};
+  const Vec2 ma = (ga.box_max + ga.box_min) * (a.scale / 2.0), mb = (gb.box_max + gb.box_min) * (b.scale / 2.0);
+  const Vec2 ua{a.cos_angle, a.sin_angle}, va{-a.sin_angle, a.cos_angle};
+  const Vec2 ub{b.cos_angle, b.sin_angle}, vb{-b.sin_angle, b.cos_angle};
+  const Vec2 ca = a.position + ua * ma.x + va * ma.y;
+  const Vec2 cb = b.position + ub * mb.x + vb * mb.y;
+  const Vec2 t = cb - ca;
+  const double uu = fabs(Dot(ua, ub)), uv = fabs(Dot(ua, vb));
+  const double vu = fabs(Dot(va, ub)), vv = fabs(Dot(va, vb));
+  const double gap_ua = fabs(Dot(t, ua)) - (ha.x + hb.x * uu + hb.y * uv);
+  const double gap_va = fabs(Dot(t, va)) - (ha.y + hb.x * vu + hb.y * vv);
+  const double gap_ub = fabs(Dot(t, ub)) - (hb.x + ha.x * uu + ha.y * vu);
+  const double gap_vb = fabs(Dot(t, vb)) - (hb.y + ha.x * uv + ha.y * vv);
+  return MaxDevice(MaxDevice(gap_ua, gap_va), MaxDevice(gap_ub, gap_vb));
+}
+
+// VerticesAgainst of narrow_phase.cpp, every vertex measured (no memory):
+// calls sink(point, normal, overlap, feature) for each contact, in vertex order.
+template <typename Sink>
+__device__ void VerticesAgainst(const Placed& from, const Placed& to, bool flip, std::uint32_t tag, Sink& sink) {
+  const DeviceGeometry& f = *from.geometry;
+  const DeviceGeometry& g = *to.geometry;
+  const double reach = f.radius_m * from.scale + g.radius_m * to.scale;
+  const double unit = to.scale;
+  const double reach_g = reach / unit;
+  const double ratio = from.scale / unit;
+  const double c = (from.cos_angle * to.cos_angle + from.sin_angle * to.sin_angle) * ratio;
+  const double s = (from.sin_angle * to.cos_angle - from.cos_angle * to.sin_angle) * ratio;
+  const Vec2 d = from.position - to.position;
+  const Vec2 o = Vec2{to.cos_angle * d.x + to.sin_angle * d.y, -to.sin_angle * d.x + to.cos_angle * d.y} / unit;
+  const Vec2 lo = g.box_min - Vec2{reach_g, reach_g}, hi = g.box_max + Vec2{reach_g, reach_g};
+  const bool use_grid = g.grid && reach_g <= g.grid_reach_m;
+  const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
+  for (std::uint32_t i = 0; i < f.count; ++i) {
+    const Vec2 v = f.vertices[i];
+    const Vec2 p{c * v.x - s * v.y + o.x, s * v.x + c * v.y + o.y};
+    if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) continue;
+    Closest cl;
+    if (use_grid) {
+      const double fx = (p.x - g.grid_origin.x) * inverse_cell, fy = (p.y - g.grid_origin.y) * inverse_cell;
+      const std::uint32_t cx = fx <= 0.0 ? 0 : min(g.grid_nx - 1, static_cast<std::uint32_t>(fx));
+      const std::uint32_t cy = fy <= 0.0 ? 0 : min(g.grid_ny - 1, static_cast<std::uint32_t>(fy));
+      const std::uint32_t cell = cy * g.grid_nx + cx;
+      const std::uint32_t first = g.cell_start[cell], last = g.cell_start[cell + 1];
+      if (first == last) continue;
+      cl = ClosestOnCore(p, g, g.cell_edges + first, last - first);
+    } else {
+      cl = ClosestOnCore(p, g, nullptr, g.edge_count);
+    }
+    if (cl.distance >= reach_g) continue;
+    Vec2 normal;
+    if (cl.distance > 0.0) {
+      normal = (p - cl.point) / cl.distance;
+    } else if (cl.distance < 0.0) {
+      normal = (cl.point - p) / -cl.distance;
+    } else {
+      continue;
+    }
+    const double overlap = reach - cl.distance * unit;
+    if (!(overlap > 0.0)) continue;
+    const Vec2 local = cl.point * unit + normal * (g.radius_m * unit - overlap / 2.0);
+    const Vec2 point = to.position + Vec2{to.cos_angle * local.x - to.sin_angle * local.y,
+                                          to.sin_angle * local.x + to.cos_angle * local.y};
+    const Vec2 world_normal{to.cos_angle * normal.x - to.sin_angle * normal.y,
+                            to.sin_angle * normal.x + to.cos_angle * normal.y};
+    sink(point, flip ? -world_normal : world_normal, overlap, tag | i);
+  }
+}
+
+// CollideShapes of narrow_phase.cpp (contacts only).
+template <typename Sink>
+__device__ void CollideShapes(const Placed& a, const Placed& b, Sink& sink) {
+  const DeviceGeometry& ga = *a.geometry;
+  const DeviceGeometry& gb = *b.geometry;
+  const double reach = ga.radius_m * a.scale + gb.radius_m * b.scale;
+  const double bound = ga.core_radius_m * a.scale + gb.core_radius_m * b.scale + reach;
+  const double d2 = LengthSquared(a.position - b.position);
+  if (d2 >= bound * bound) return;
+  if (BoxesGap(a, b, reach) > 0.0) return;
+  const bool a_side = ga.count == 1 || gb.count != 1;
+  const bool b_side = ga.count != 1;
+  if (a_side) VerticesAgainst(a, b, false, 0u, sink);
+  if (b_side) VerticesAgainst(b, a, true, kVertexOfB, sink);
+}
+
+// Simulation::Separation.
+__device__ Vec2 Separation(Vec2 a, Vec2 b, const Box& box) {
+  Vec2 d = a - b;
+  if (box.x && fabs(d.x) > box.lx / 2.0) d.x -= box.lx * nearbyint(d.x / box.lx);
+  if (box.y && fabs(d.y) > box.ly / 2.0) d.y -= box.ly * nearbyint(d.y / box.ly);
+  return d;
+}
+
+__device__ Placed PlaceBody(const Bodies& bodies, std::uint32_t i, Vec2 position) {
+  const std::uint32_t shape = bodies.shape[i];
+  return Placed{bodies.families + bodies.shape_family[shape], position, bodies.cos_angle[i], bodies.sin_angle[i],
+                bodies.shape_scale[shape]};
+}
+
+// The pair's two placed shapes (b in a's periodic image), or false if one
+// of the two has left.
+__device__ bool PlacePair(const Bodies& bodies, const Box& box, std::uint32_t a, std::uint32_t b, Placed& pa,
+                          Placed& pb) {
+  if (bodies.state[a] == PersonState::kRemoved || bodies.state[b] == PersonState::kRemoved) return false;
+  const Vec2 xa = bodies.position[a];
+  const Vec2 xb_image = xa - Separation(xa, bodies.position[b], box);
+  pa = PlaceBody(bodies, a, xa);
+  pb = PlaceBody(bodies, b, xb_image);
+  return true;
+}
+
+__global__ void CountContacts(Bodies bodies, Box box, const std::pair<std::uint32_t, std::uint32_t>* pairs,
+                              std::size_t pair_count, std::uint32_t* counts) {
+  const std::size_t k = blockIdx.x * static_cast<std::size_t>(blockDim.x) + threadIdx.x;
+  if (k > pair_count) return;
+  std::uint32_t count = 0;
+  Placed pa, pb;
+  if (k < pair_count && PlacePair(bodies, box, pairs[k].first, pairs[k].second, pa, pb)) {
+    auto sink = [&](Vec2, Vec2, double, std::uint32_t) { ++count; };
+    CollideShapes(pa, pb, sink);
+  }
+  counts[k] = count;  // counts[pair_count] = 0: the prefix sum's last entry is the total
+}
+
+// The previous contact with this key and feature, as ContactHistory.
+__device__ detail::ContactHistory FindHistory(const History& history, std::uint64_t key, std::uint32_t feature) {
+  std::size_t lo = 0, hi = history.count;
+  while (lo < hi) {  // first contact not before (key, feature)
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const Contact& c = history.contacts[mid];
+    const std::uint64_t ck = (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
+    if (ck < key || (ck == key && c.feature < feature))
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  detail::ContactHistory h;
+  if (lo < history.count) {
+    const Contact& c = history.contacts[lo];
+    const std::uint64_t ck = (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
+    if (ck == key && c.feature == feature) {
+      h.exists = true;
+      h.tangential_spring_m = c.tangential_spring_m;
+      h.leading_fraction = c.leading_fraction;
+    }
+  }
+  return h;
+}
+
+__global__ void WriteContacts(Bodies bodies, Box box, const std::pair<std::uint32_t, std::uint32_t>* pairs,
+                              std::size_t pair_count, const std::uint32_t* offsets, detail::ContactLaw law,
+                              History history, Contact* out, int* overlap_beyond) {
+  const std::size_t k = blockIdx.x * static_cast<std::size_t>(blockDim.x) + threadIdx.x;
+  if (k >= pair_count) return;
+  const std::uint32_t first = offsets[k], last = offsets[k + 1];
+  if (first == last) return;
+  const std::uint32_t a = pairs[k].first, b = pairs[k].second;
+  Placed pa, pb;
+  PlacePair(bodies, box, a, b, pa, pb);
+  std::uint32_t next = first;
+  auto sink = [&](Vec2 point, Vec2 normal, double overlap, std::uint32_t feature) {
+    Contact& c = out[next++];
+    c.a = a;
+    c.b = b;
+    c.wall = false;
+    c.feature = feature;
+    c.point_m = point;
+    c.normal = normal;
+    c.overlap_m = overlap;
+  };
+  CollideShapes(pa, pb, sink);
+  // The contact law (Simulation::Collide's add_contacts): overlap shares,
+  // damping rates once per pair, then each point.
+  double sum = 0.0, sum2 = 0.0;
+  for (std::uint32_t q = first; q < last; ++q) {
+    sum += out[q].overlap_m;
+    sum2 += out[q].overlap_m * out[q].overlap_m;
+  }
+  const double k_eff = sum * sum / sum2;
+  const bool fa = bodies.state[a] != PersonState::kWalking, fb = bodies.state[b] != PersonState::kWalking;
+  const double ma = bodies.mass[a], mb = bodies.mass[b];
+  const double mass = fa && fb ? 0.5 * (ma + mb) : (fa ? mb : (fb ? ma : ma * mb / (ma + mb)));  // eq. (14)
+  const detail::ContactLaw::Rates rates = law.PairRates(mass, k_eff);
+  const double radii = pa.scale + pb.scale;  // (family radius 1)
+  const std::uint64_t key = (std::uint64_t{a} << 32) | b;
+  bool beyond = false;
+  for (std::uint32_t q = first; q < last; ++q) {
+    Contact& c = out[q];
+    const Vec2 va = fa ? Vec2{} : bodies.velocity[a] + Perp(c.point_m - pa.position) * bodies.angular_velocity[a];
+    const Vec2 vb = fb ? Vec2{} : bodies.velocity[b] + Perp(c.point_m - pb.position) * bodies.angular_velocity[b];
+    law.Apply(c, va - vb, mass, FindHistory(history, key, c.feature), c.overlap_m / sum, rates);
+    beyond = beyond || !(c.overlap_m <= radii);
+  }
+  if (beyond) atomicOr(overlap_beyond, 1);
+}
+
+}  // namespace
+
+bool Available(std::string* why) {
+  int devices = 0;
+  const cudaError_t status = cudaGetDeviceCount(&devices);
+  if (status != cudaSuccess || devices == 0) {
+    if (why)
+      *why = status != cudaSuccess ? std::string("no CUDA device: ") + cudaGetErrorString(status)
+                                   : std::string("no CUDA device");
+    return false;
+  }
+  return true;
+}
+
+struct Collider::Impl {
+  cudaStream_t stream = nullptr;
+  cudaEvent_t events[4] = {};
+  Box box;
+  // Geometry pools and the families that point into them.
+  DeviceBuffer<Vec2> vertices;
+  DeviceBuffer<CoreEdge> edges;
+  DeviceBuffer<std::uint8_t> reflex;
+  DeviceBuffer<std::uint32_t> cell_start;
+  DeviceBuffer<std::uint16_t> cell_edges;
+  DeviceBuffer<DeviceGeometry> families;
+  DeviceBuffer<std::uint32_t> shape_family;
+  DeviceBuffer<double> shape_scale;
+  // Bodies.
+  DeviceBuffer<Vec2> position, velocity;
+  DeviceBuffer<double> cos_angle, sin_angle, angular_velocity, mass;
+  DeviceBuffer<PersonState> state;
+  DeviceBuffer<std::uint32_t> shape;
+  // Pairs, counts and offsets, scan workspace.
+  DeviceBuffer<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  std::uint64_t pair_generation = 0;
+  bool pairs_loaded = false;
+  DeviceBuffer<std::uint32_t> counts, offsets;
+  DeviceBuffer<unsigned char> scan_workspace;
+  // This evaluation's contacts and the previous one's.
+  DeviceBuffer<Contact> contacts, previous;
+  bool have_output = false;
+  DeviceBuffer<int> flag;
+  Timing timing;
+};
+
+Collider::Collider(const std::vector<ShapeGeometry>& families, const std::vector<std::uint32_t>& shape_family,
+                   const std::vector<double>& shape_scale, const PeriodicBox& periodic)
+    : impl_(std::make_unique<Impl>()) {
+  std::string why;
+  if (!Available(&why)) throw InputError("device: \"cuda\": " + why);
+  Impl& m = *impl_;
+  Check(cudaStreamCreateWithFlags(&m.stream, cudaStreamNonBlocking), "cudaStreamCreate");
+  for (cudaEvent_t& e : m.events) Check(cudaEventCreate(&e), "cudaEventCreate");
+  m.box.x = periodic.x;
+  m.box.y = periodic.y;
+  m.box.lx = periodic.max_m.x - periodic.min_m.x;
+  m.box.ly = periodic.max_m.y - periodic.min_m.y;
+  // Pools first (their device addresses are final once uploaded), then the
+  // families that point into them.
+  std::vector<Vec2> all_vertices;
+  std::vector<CoreEdge> all_edges;
+  std::vector<std::uint8_t> all_reflex;
+  std::vector<std::uint32_t> all_cell_start;
+  std::vector<std::uint16_t> all_cell_edges;
+  struct Offsets {
+    std::size_t vertices, edges, reflex, cell_start, cell_edges;
+  };
+  std::vector<Offsets> at;
+  for (const ShapeGeometry& g : families) {
+    at.push_back({all_vertices.size(), all_edges.size(), all_reflex.size(), all_cell_start.size(), all_cell_edges.size()});
+    all_vertices.insert(all_vertices.end(), g.vertices.begin(), g.vertices.end());
+    all_edges.insert(all_edges.end(), g.edges.begin(), g.edges.end());
+    all_reflex.insert(all_reflex.end(), g.reflex.begin(), g.reflex.end());
+    all_cell_start.insert(all_cell_start.end(), g.cell_start.begin(), g.cell_start.end());
+    all_cell_edges.insert(all_cell_edges.end(), g.cell_edges.begin(), g.cell_edges.end());
+  }
+  m.vertices.Upload(all_vertices.data(), all_vertices.size(), m.stream);
+  m.edges.Upload(all_edges.data(), all_edges.size(), m.stream);
+  m.reflex.Upload(all_reflex.data(), all_reflex.size(), m.stream);
+  m.cell_start.Upload(all_cell_start.data(), all_cell_start.size(), m.stream);
+  m.cell_edges.Upload(all_cell_edges.data(), all_cell_edges.size(), m.stream);
+  std::vector<DeviceGeometry> device_families;
+  for (std::size_t k = 0; k < families.size(); ++k) {
+    const ShapeGeometry& g = families[k];
+    DeviceGeometry d;
+    d.vertices = m.vertices.data() + at[k].vertices;
+    d.edges = m.edges.data() + at[k].edges;
+    d.reflex = m.reflex.data() + at[k].reflex;
+    d.count = g.count();
+    d.edge_count = static_cast<std::uint32_t>(g.edges.size());
+    d.closed = g.closed;
+    d.radius_m = g.radius_m;
+    d.core_radius_m = g.core_radius_m;
+    d.box_min = g.box_min;
+    d.box_max = g.box_max;
+    d.grid = !g.cell_start.empty();
+    d.grid_reach_m = g.grid_reach_m;
+    d.grid_origin = g.grid_origin;
+    d.grid_cell_m = g.grid_cell_m;
+    d.grid_nx = g.grid_nx;
+    d.grid_ny = g.grid_ny;
+    d.cell_start = m.cell_start.data() + at[k].cell_start;
+    d.cell_edges = m.cell_edges.data() + at[k].cell_edges;
+    device_families.push_back(d);
+  }
+  m.families.Upload(device_families.data(), device_families.size(), m.stream);
+  m.shape_family.Upload(shape_family.data(), shape_family.size(), m.stream);
+  m.shape_scale.Upload(shape_scale.data(), shape_scale.size(), m.stream);
+  m.flag.set_size(1);
+  Check(cudaStreamSynchronize(m.stream), "geometry upload");
+}
+
+Collider::~Collider() {
+  if (!impl_) return;
+  for (cudaEvent_t e : impl_->events)
+    if (e) cudaEventDestroy(e);
+  if (impl_->stream) cudaStreamDestroy(impl_->stream);
+}
+
+Collider::Timing Collider::last_timing() const { return impl_->timing; }
+
+bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out) {
+  Impl& m = *impl_;
+  cudaStream_t stream = m.stream;
+  Check(cudaEventRecord(m.events[0], stream), "cudaEventRecord");
+  const std::size_t n = in.n;
+  m.position.Upload(in.position_m, n, stream);
+  m.cos_angle.Upload(in.cos_angle, n, stream);
+  m.sin_angle.Upload(in.sin_angle, n, stream);
+  m.velocity.Upload(in.velocity_m_per_s, n, stream);
+  m.angular_velocity.Upload(in.angular_velocity_rad_per_s, n, stream);
+  m.state.Upload(in.state, n, stream);
+  m.mass.Upload(in.mass_kg, n, stream);
+  m.shape.Upload(in.shape, n, stream);
+  if (!m.pairs_loaded || in.pair_generation != m.pair_generation) {
+    m.pairs.Upload(in.pairs, in.pair_count, stream);
+    m.pair_generation = in.pair_generation;
+    m.pairs_loaded = true;
+  }
+  // The previous contacts: the device's own last output, or the caller's.
+  if (!(in.previous_is_last_output && m.have_output)) {
+    m.contacts.Upload(in.previous->data(), in.previous->size(), stream);
+    m.have_output = true;
+  }
+  m.previous.swap(m.contacts);  // last output (or the caller's) becomes the history
+  Check(cudaMemsetAsync(m.flag.data(), 0, sizeof(int), stream), "cudaMemset");
+  Check(cudaEventRecord(m.events[1], stream), "cudaEventRecord");
+
+  const std::size_t pairs = in.pair_count;
+  Bodies bodies{m.position.data(), m.cos_angle.data(), m.sin_angle.data(),  m.velocity.data(),
+                m.angular_velocity.data(), m.state.data(), m.mass.data(), m.shape.data(),
+                m.shape_family.data(), m.shape_scale.data(), m.families.data()};
+  m.counts.set_size(pairs + 1);
+  m.offsets.set_size(pairs + 1);
+  constexpr unsigned kThreads = 128;
+  const auto blocks = static_cast<unsigned>((pairs + 1 + kThreads - 1) / kThreads);
+  CountContacts<<<blocks, kThreads, 0, stream>>>(bodies, m.box, m.pairs.data(), pairs, m.counts.data());
+  Check(cudaGetLastError(), "CountContacts");
+  std::size_t workspace = 0;
+  Check(cub::DeviceScan::ExclusiveSum(nullptr, workspace, m.counts.data(), m.offsets.data(), pairs + 1, stream),
+        "scan size");
+  m.scan_workspace.set_size(workspace);
+  Check(cub::DeviceScan::ExclusiveSum(m.scan_workspace.data(), workspace, m.counts.data(), m.offsets.data(),
+                                      pairs + 1, stream),
+        "scan");
+  std::uint32_t total = 0;
+  Check(cudaMemcpyAsync(&total, m.offsets.data() + pairs, sizeof(total), cudaMemcpyDeviceToHost, stream), "total");
+  Check(cudaStreamSynchronize(stream), "count");
+  m.contacts.set_size(total);
+  const History history{m.previous.data(), m.previous.size()};
+  if (pairs > 0)
+    WriteContacts<<<static_cast<unsigned>((pairs + kThreads - 1) / kThreads), kThreads, 0, stream>>>(
+        bodies, m.box, m.pairs.data(), pairs, m.offsets.data(), in.law, history, m.contacts.data(), m.flag.data());
+  Check(cudaGetLastError(), "WriteContacts");
+  int beyond = 0;
+  Check(cudaMemcpyAsync(&beyond, m.flag.data(), sizeof(int), cudaMemcpyDeviceToHost, stream), "flag");
+  Check(cudaEventRecord(m.events[2], stream), "cudaEventRecord");
+  const std::size_t before = out.size();
+  out.resize(before + total);
+  if (total > 0)
+    Check(cudaMemcpyAsync(out.data() + before, m.contacts.data(), total * sizeof(Contact), cudaMemcpyDeviceToHost,
+                          stream),
+          "download");
+  Check(cudaEventRecord(m.events[3], stream), "cudaEventRecord");
+  Check(cudaStreamSynchronize(stream), "download");
+  float ms[3] = {};
+  for (int k = 0; k < 3; ++k) Check(cudaEventElapsedTime(&ms[k], m.events[k], m.events[k + 1]), "timing");
+  m.timing = {ms[0], ms[1], ms[2]};
+  return beyond != 0;
+}
+
+}  // namespace crowdrecon::engine::cuda
