@@ -15,6 +15,7 @@
 #include "contact_law.hpp"
 #include "cuda_collide.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
+#include "binary_io.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -1328,76 +1329,21 @@ namespace {
 
 constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
 
-class StateWriter {
+// The checkpoint's writer and reader (binary_io.hpp, shared with world files).
+class StateWriter : public detail::BinaryWriter {
  public:
-  template <typename T>
-  void Put(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    out_.append(reinterpret_cast<const char*>(&value), sizeof(T));
-  }
-  template <typename T>
-  void PutVector(const std::vector<T>& values) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    Put(static_cast<std::uint64_t>(values.size()));
-    if (!values.empty()) out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-  }
-  std::string Finish() {
-    // FNV-1a checksum of everything written.
-    std::uint64_t h = 1469598103934665603ull;
-    for (unsigned char c : out_) h = (h ^ c) * 1099511628211ull;
-    Put(h);
-    return std::move(out_);
-  }
-
- private:
-  std::string out_;
+  StateWriter() : BinaryWriter(kStateMagic) {}
 };
 
-class StateReader {
+class StateReader : public detail::BinaryReader {
  public:
-  explicit StateReader(const std::string& data) : data_(data) {
-    if (data.size() < sizeof(kStateMagic) + 8 || std::memcmp(data.data(), kStateMagic, sizeof(kStateMagic)) != 0)
-      throw InputError("checkpoint: not a crowdrecon engine state (bad magic)");
-    std::uint64_t h = 1469598103934665603ull;
-    for (std::size_t i = 0; i < data.size() - 8; ++i)
-      h = (h ^ static_cast<unsigned char>(data[i])) * 1099511628211ull;
-    std::uint64_t stored;
-    std::memcpy(&stored, data.data() + data.size() - 8, 8);
-    if (h != stored) throw InputError("checkpoint: checksum mismatch (the file is damaged or truncated)");
-    pos_ = sizeof(kStateMagic);
-    end_ = data.size() - 8;
-  }
-  template <typename T>
-  T Get() {
-    static_assert(std::is_trivially_copyable_v<T>);
-    if (pos_ + sizeof(T) > end_) throw InputError("checkpoint: truncated state");
-    T value;
-    std::memcpy(&value, data_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  template <typename T>
-  void GetVector(std::vector<T>& values, std::size_t expected_size = SIZE_MAX) {
-    const auto n = Get<std::uint64_t>();
-    if (expected_size != SIZE_MAX && n != expected_size)
-      throw InputError("checkpoint: holds " + std::to_string(n) + " entries where this run has " +
-                       std::to_string(expected_size) + " (different scenario?)");
-    if (pos_ + n * sizeof(T) > end_) throw InputError("checkpoint: truncated state");
-    values.resize(n);
-    if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));
-    pos_ += n * sizeof(T);
-  }
-
- private:
-  const std::string& data_;
-  std::size_t pos_ = 0, end_ = 0;
+  explicit StateReader(const std::string& data) : BinaryReader(data, kStateMagic, "checkpoint", "state") {}
 };
 
 }  // namespace
 
 std::string Simulation::SaveState() const {
   StateWriter w;
-  for (char c : kStateMagic) w.Put(c);
   w.Put(static_cast<std::uint64_t>(bodies_.size()));
   w.Put(step_count_);
   w.Put(time_s_);

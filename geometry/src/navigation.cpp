@@ -1,5 +1,6 @@
 // Navigation fields: geodesic distance to an exit by fast marching, and the
-// desired direction -grad T.
+// desired direction -grad T. (Evaluating a field is in navigation_field.cpp,
+// which the engine links without the rest of this module.)
 #include "crowdrecon/geometry/navigation.hpp"
 
 #include <algorithm>
@@ -112,13 +113,6 @@ bool SegmentsMeet(Vec2 p, Vec2 q, Vec2 a, Vec2 b) {
 }
 
 }  // namespace
-
-NavigationField NavigationField::Constant(Vec2 direction) {
-  NavigationField f;
-  f.constant_ = true;
-  f.constant_direction_ = Length(direction) > 0.0 ? Normalized(direction) : Vec2{};
-  return f;
-}
 
 NavigationField NavigationField::ForTarget(const Venue& venue, std::string_view target_id,
                                            const NavigationOptions& options) {
@@ -257,70 +251,6 @@ NavigationField NavigationField::ToExit(const Venue& venue, std::string_view exi
       if (Length(g) > 0.0) f.direction_[k] = Normalized(g);
     }
   return f;
-}
-
-// ---------------------------------------------------------------------------
-// Sampling
-// ---------------------------------------------------------------------------
-
-namespace {
-
-// Bilinear weights of the four nodes around p; nodes for which `valid` is
-// false are left out and the others renormalised. Returns false if no node
-// of the cell is valid.
-template <typename Valid, typename Accumulate>
-bool Bilinear(Vec2 p, Vec2 origin, double h, std::size_t nx, std::size_t ny, Valid valid, Accumulate accumulate) {
-  const double fx = (p.x - origin.x) / h, fy = (p.y - origin.y) / h;
-  if (!(fx >= 0.0 && fy >= 0.0 && fx <= static_cast<double>(nx - 1) && fy <= static_cast<double>(ny - 1))) return false;
-  const auto i = std::min(static_cast<std::size_t>(fx), nx - 2);
-  const auto j = std::min(static_cast<std::size_t>(fy), ny - 2);
-  const double u = fx - static_cast<double>(i), v = fy - static_cast<double>(j);
-  const std::size_t k[4] = {j * nx + i, j * nx + i + 1, (j + 1) * nx + i, (j + 1) * nx + i + 1};
-  const double w[4] = {(1 - u) * (1 - v), u * (1 - v), (1 - u) * v, u * v};
-  double total = 0.0;
-  for (int c = 0; c < 4; ++c)
-    if (valid(k[c])) total += w[c];
-  if (total <= 0.0) {
-    // Every node of the cell is outside (a point right at a wall with its
-    // cell's nodes beyond it): fall back to the nearest valid node around.
-    return false;
-  }
-  for (int c = 0; c < 4; ++c)
-    if (valid(k[c])) accumulate(k[c], w[c] / total);
-  return true;
-}
-
-}  // namespace
-
-Vec2 NavigationField::FieldDirection(Vec2 p) const {
-  Vec2 sum;
-  auto valid = [&](std::size_t k) { return std::isfinite(distance_m_[k]); };
-  if (!Bilinear(p, origin_m_, spacing_m_, nx_, ny_, valid, [&](std::size_t k, double w) { sum += w * direction_[k]; })) {
-    // Nearest reachable node within two cells.
-    double best = 2.5 * spacing_m_;
-    const double fx = (p.x - origin_m_.x) / spacing_m_, fy = (p.y - origin_m_.y) / spacing_m_;
-    for (int dj = -2; dj <= 3; ++dj)
-      for (int di = -2; di <= 3; ++di) {
-        const double ci = std::floor(fx) + di, cj = std::floor(fy) + dj;
-        if (ci < 0 || cj < 0 || ci >= static_cast<double>(nx_) || cj >= static_cast<double>(ny_)) continue;
-        const std::size_t k = static_cast<std::size_t>(cj) * nx_ + static_cast<std::size_t>(ci);
-        const double d = Length(p - (origin_m_ + spacing_m_ * Vec2{ci, cj}));
-        if (valid(k) && d < best) {
-          best = d;
-          sum = direction_[k];
-        }
-      }
-  }
-  return Length(sum) > 1e-12 ? Normalized(sum) : Vec2{};
-}
-
-double NavigationField::Distance(Vec2 p) const {
-  if (constant_) return 0.0;
-  double sum = 0.0;
-  auto valid = [&](std::size_t k) { return std::isfinite(distance_m_[k]); };
-  if (!Bilinear(p, origin_m_, spacing_m_, nx_, ny_, valid, [&](std::size_t k, double w) { sum += w * distance_m_[k]; }))
-    return kUnreachable;
-  return sum;
 }
 
 }  // namespace crowdrecon::geometry

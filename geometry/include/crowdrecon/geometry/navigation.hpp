@@ -12,7 +12,9 @@
 // For a fixed-direction target (periodic corridors) the field is constant.
 //
 // The grid is exposed as plain arrays so that the engine can sample it without
-// this module.
+// this module: evaluating a field (navigation_field.cpp, the library
+// crowdrecon_navigation_field) needs neither a venue nor CGAL, and FromGrid
+// rebuilds a field from its arrays (engine world files).
 #pragma once
 
 #include <cstddef>
@@ -42,11 +44,26 @@ class NavigationField {
                                 const NavigationOptions& options = {});
   // Constant field.
   static NavigationField Constant(Vec2 direction);
+  // Constant field whose direction is kept exactly as given, not normalised
+  // again: normalising a unit vector can move it by a rounding error, and a
+  // field read back from a world file must be the same bit for bit.
+  // `unit_direction` must be a unit vector (to rounding) or (0, 0); throws
+  // InputError otherwise.
+  static NavigationField ConstantExact(Vec2 unit_direction);
+  // A grid field from its arrays (see the accessors below): node (i, j) at
+  // origin + (i, j) * spacing, index j * nx + i. Throws InputError unless
+  // spacing > 0, nx and ny >= 2 (a cell to interpolate in), both arrays hold
+  // nx * ny entries, distances are +infinity (unreachable) or finite and
+  // >= 0, and directions are finite.
+  static NavigationField FromGrid(Vec2 origin_m, double spacing_m, std::size_t nx, std::size_t ny,
+                                  std::vector<double> distance_m, std::vector<Vec2> direction);
   // The field of a target (see Venue::FindTarget): ToExit or Constant.
   static NavigationField ForTarget(const Venue& venue, std::string_view target_id,
                                    const NavigationOptions& options = {});
 
   bool is_constant() const { return constant_; }
+  // The direction of a constant field ((0, 0) for a grid field).
+  Vec2 constant_direction() const { return constant_direction_; }
 
   // Desired direction at p: a unit vector, or (0, 0) where the target cannot be
   // reached (a disconnected part of the venue) or p is far outside the area.
