@@ -7,7 +7,8 @@
 //   crowdrecon_bench_device --worlds=DIR [--threads=1,2,16] [Google Benchmark flags]
 //
 // For every DIR/<name>.world with its DIR/<name>.state: Step/<name>/cpu/threads:N
-// for each N, and Step/<name>/cuda/threads:N where CUDA is available. The
+// for each N, and Step/<name>/cuda/threads:N where CUDA is available; and the
+// same as Run/...: one simulated second from the state, timed whole. The
 // steps are those of bench_kernels' Step benchmarks (the state is restored
 // every 100 steps, timer paused), so the figures compare. Items per second
 // are agent-steps per second. Before timing, the CUDA run is compared with
@@ -115,6 +116,32 @@ void Step(benchmark::State& state, const SavedWorld& w, int threads, engine::Com
   state.counters["drive_ms"] = (after.drive_s - before.drive_s) * per_step_ms;
   state.counters["integrate_ms"] = (after.integrate_s - before.integrate_s) * per_step_ms;
   state.counters["check_ms"] = (after.check_s - before.check_s) * per_step_ms;
+  if (device == engine::ComputeDevice::kCuda) {
+    state.counters["device_copy_ms"] = (after.device_copy_s - before.device_copy_s) * per_step_ms;
+    state.counters["device_kernels_ms"] = (after.device_kernels_s - before.device_kernels_s) * per_step_ms;
+  }
+}
+
+// A whole second of simulated time from the saved state, neighbour-list
+// rebuilds and all (one iteration per repetition): agent-steps per second and
+// the real-time factor of the engine alone (no run file is written).
+void Run(benchmark::State& state, const SavedWorld& w, int threads, engine::ComputeDevice device) {
+  constexpr double kSeconds = 1.0;
+  std::int64_t agent_steps = 0;
+  double simulated = 0.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    engine::Simulation sim = Make(w, threads, device);
+    const double start = sim.time_s();
+    const std::uint64_t steps = sim.step_count();
+    state.ResumeTiming();
+    sim.AdvanceTo(start + kSeconds);
+    agent_steps += static_cast<std::int64_t>((sim.step_count() - steps) * sim.bodies().size());
+    simulated += sim.time_s() - start;
+  }
+  state.SetItemsProcessed(agent_steps);
+  state.counters["simulated_s"] = simulated;
+  state.counters["real_time_factor"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
 }
 
 std::vector<int> ParseThreads(const std::string& list) {
@@ -171,12 +198,18 @@ int main(int argc, char** argv) {
     for (const auto& w : worlds)
       for (engine::ComputeDevice device : {engine::ComputeDevice::kCpu, engine::ComputeDevice::kCuda}) {
         if (device == engine::ComputeDevice::kCuda && !cuda) continue;
-        for (int t : threads)
-          benchmark::RegisterBenchmark(
-              ("Step/" + w.name + "/" + engine::ToString(device) + "/threads:" + std::to_string(t)).c_str(),
-              [&w, t, device](benchmark::State& s) { bench::Step(s, w, t, device); })
+        for (int t : threads) {
+          const std::string suffix = w.name + "/" + engine::ToString(device) + "/threads:" + std::to_string(t);
+          benchmark::RegisterBenchmark(("Step/" + suffix).c_str(),
+                                       [&w, t, device](benchmark::State& s) { bench::Step(s, w, t, device); })
               ->Unit(benchmark::kMillisecond)
               ->UseRealTime();
+          benchmark::RegisterBenchmark(("Run/" + suffix).c_str(),
+                                       [&w, t, device](benchmark::State& s) { bench::Run(s, w, t, device); })
+              ->Unit(benchmark::kMillisecond)
+              ->UseRealTime()
+              ->Iterations(1);
+        }
       }
     benchmark::RunSpecifiedBenchmarks();
   } catch (const std::exception& e) {

@@ -114,13 +114,15 @@ def parse_time_v(text):
     return out
 
 
-def run_once(exe, scenario, threads, workdir):
+def run_once(exe, scenario, threads, workdir, device="cpu"):
     run_file = pathlib.Path(workdir) / "run.sqlite"
     time_file = pathlib.Path(workdir) / "time.txt"
     for stale in (run_file, pathlib.Path(str(run_file) + ".checkpoint")):
         stale.unlink(missing_ok=True)
     cmd = [TIME, "-v", "-o", str(time_file), str(exe), "simulate", str(scenario), "-o", str(run_file),
            "--threads", str(threads), "-q"]
+    if device != "cpu":
+        cmd += ["--device", device]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=bc.ROOT)
     if proc.returncode != 0:
         bc.fail(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stdout}{proc.stderr}")
@@ -199,9 +201,10 @@ def whole_runs(args):
                 runs = []
                 for rep in range(args.repeat):
                     if args.steady_from is not None:
-                        r = steady_difference(run_once(exe, first, t, work), run_once(exe, scenario, t, work))
+                        r = steady_difference(run_once(exe, first, t, work, args.device),
+                                              run_once(exe, scenario, t, work, args.device))
                     else:
-                        r = run_once(exe, scenario, t, work)
+                        r = run_once(exe, scenario, t, work, args.device)
                     runs.append(r)
                     print(f"  {name:>12} threads {t} run {rep + 1}/{args.repeat}: {r['people']} people, "
                           f"{r['steps']} steps, engine {bc.si(r['agent_steps_per_s_engine'])} agent-steps/s, "
@@ -290,6 +293,8 @@ def main():
     p.add_argument("--scenarios", default=",".join(DEFAULT_SCENARIOS),
                    help="comma-separated names under bench/scenarios/ or scenario files (default: %(default)s)")
     p.add_argument("--threads", default="1,2", help="comma-separated thread counts (default: %(default)s)")
+    p.add_argument("--device", default="cpu", choices=["cpu", "cuda"],
+                   help="where person-pair forces are computed (simulate --device; default: %(default)s)")
     p.add_argument("--repeat", type=int, default=3, help="repetitions; medians are reported (default: %(default)s)")
     p.add_argument("--duration", type=float, help="override run.duration_s (simulated seconds) of every scenario")
     p.add_argument("--steady-from", type=float, metavar="S",

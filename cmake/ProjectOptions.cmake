@@ -15,8 +15,10 @@ target_compile_options(crowdrecon_options INTERFACE
   # on the device nor in their host code, as above; warnings as errors.
   $<$<COMPILE_LANGUAGE:CUDA>:--fmad=false -Xcompiler=-ffp-contract=off --expt-relaxed-constexpr>)
 if(CROWDRECON_SANITIZE)
+  # (C++ sources only: nvcc takes no such flags; the CUDA file's host code,
+  # a few copies and launches, goes unsanitised.)
   target_compile_options(crowdrecon_options INTERFACE
-    -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+    $<$<COMPILE_LANGUAGE:CXX>:-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined>)
   target_link_options(crowdrecon_options INTERFACE -fsanitize=address,undefined)
 endif()
 

@@ -76,8 +76,8 @@ class Collider {
 
   // Appends the person pairs' contacts to `out`, in list order, with their
   // forces. Returns true if one overlaps beyond the sum of the sphero-radii
-  // (see Simulation::Check). Throws SimulationError-free std::runtime_error
-  // on a device failure (message from the CUDA runtime).
+  // (see Simulation::Check). Throws std::runtime_error, with the CUDA
+  // runtime's message, if the device fails.
   bool Collide(const CollideInput& input, std::vector<Contact>& out);
 
   // Milliseconds of the last call spent in kernels, and copying to and from

@@ -855,6 +855,9 @@ void Simulation::Collide() {
     contacts_.clear();
     bool overlap_beyond = in.cuda->Collide(input, contacts_);
     in.cuda_has_history = true;
+    const cuda::Collider::Timing timing = in.cuda->last_timing();
+    profile_.device_copy_s += (timing.upload_ms + timing.download_ms) * 1e-3;
+    profile_.device_kernels_s += timing.kernels_ms * 1e-3;
     std::vector<ContactPoint> points;
     for (std::size_t chunk = person_chunks; chunk < chunks; ++chunk)
       overlap_beyond = collide_chunk(chunk, contacts_, points) || overlap_beyond;

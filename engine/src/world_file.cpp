@@ -290,6 +290,7 @@ std::string SaveWorld(const WorldDef& def) {
   PeriodicFields(w, def.periodic);
   SlopeFields(w, def.slope);
   w.Field(def.threads);
+  w.Enum(def.device, ComputeDevice::kCuda, "device");
   return w.Finish();
 }
 
@@ -309,6 +310,7 @@ WorldDef LoadWorld(const std::string& data, const std::string& origin) {
   PeriodicFields(r, def.periodic);
   SlopeFields(r, def.slope);
   r.Field(def.threads);
+  r.Enum(def.device, ComputeDevice::kCuda, "device");
   // The checksum matched, so extra bytes were written on purpose by another
   // writer: refuse rather than ignore what we do not understand.
   if (r.remaining() != 0)

@@ -173,6 +173,10 @@ TEST(WorldFile, RoundTripGivesTheSameBytes) {
   EXPECT_TRUE(SameBits(loaded.periodic.max_m, def.periodic.max_m));
   EXPECT_TRUE(SameBits(loaded.slope.downhill, def.slope.downhill));
   EXPECT_EQ(loaded.threads, 2);
+  EXPECT_EQ(loaded.device, ComputeDevice::kCpu);
+  WorldDef on_cuda = def;
+  on_cuda.device = ComputeDevice::kCuda;
+  EXPECT_EQ(LoadWorld(SaveWorld(on_cuda), "memory").device, ComputeDevice::kCuda);
 
   // An empty world too.
   EXPECT_EQ(SaveWorld(LoadWorld(SaveWorld(WorldDef{}), "memory")), SaveWorld(WorldDef{}));
