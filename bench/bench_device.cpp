@@ -28,12 +28,12 @@
 
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
+#include "step_benchmark.hpp"
 
 namespace crowdrecon::bench {
 
 namespace {
 
-constexpr std::int64_t kWindowSteps = 100;
 constexpr int kCheckSteps = 200;
 
 std::string ReadFile(const std::filesystem::path& path) {
@@ -87,39 +87,7 @@ void CheckSameResults(const SavedWorld& w) {
 
 void Step(benchmark::State& state, const SavedWorld& w, int threads, engine::ComputeDevice device) {
   engine::Simulation sim = Make(w, threads, device);
-  const auto people = static_cast<std::int64_t>(sim.bodies().size());
-  std::int64_t in_window = 0;
-  double contacts = 0.0;
-  const engine::Profile before = sim.profile();
-  for (auto _ : state) {
-    if (in_window == kWindowSteps) {
-      state.PauseTiming();
-      sim.LoadState(w.state);
-      state.ResumeTiming();
-      in_window = 0;
-    }
-    sim.Step();
-    ++in_window;
-    contacts += static_cast<double>(sim.contacts().size());
-  }
-  state.SetItemsProcessed(state.iterations() * people);
-  const double steps = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
-  state.counters["people"] = static_cast<double>(people);
-  state.counters["contacts"] = contacts / steps;
-  state.counters["dt_s"] = sim.time_step_s();
-  const engine::Profile& after = sim.profile();
-  const double per_step_ms = 1e3 / steps;
-  state.counters["pairs_ms"] = (after.update_pairs_s - before.update_pairs_s) * per_step_ms;
-  state.counters["place_ms"] = (after.place_shapes_s - before.place_shapes_s) * per_step_ms;
-  state.counters["collide_ms"] = (after.collide_s - before.collide_s) * per_step_ms;
-  state.counters["gather_ms"] = (after.gather_s - before.gather_s) * per_step_ms;
-  state.counters["drive_ms"] = (after.drive_s - before.drive_s) * per_step_ms;
-  state.counters["integrate_ms"] = (after.integrate_s - before.integrate_s) * per_step_ms;
-  state.counters["check_ms"] = (after.check_s - before.check_s) * per_step_ms;
-  if (device == engine::ComputeDevice::kCuda) {
-    state.counters["device_copy_ms"] = (after.device_copy_s - before.device_copy_s) * per_step_ms;
-    state.counters["device_kernels_ms"] = (after.device_kernels_s - before.device_kernels_s) * per_step_ms;
-  }
+  TimeSteps(state, sim, w.state);
 }
 
 // A whole second of simulated time from the saved state, neighbour-list

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "bench_worlds.hpp"
+#include "step_benchmark.hpp"
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "crowdrecon/engine/simulation.hpp"
@@ -195,7 +196,6 @@ void NarrowPhase(benchmark::State& state, const NarrowPhaseCase& c) {
 // list, once per window: a run at 1 m/s rebuilds about as often.)
 
 constexpr double kWarmUpSeconds = 0.25;  // simulated
-constexpr std::int64_t kWindowSteps = 100;
 constexpr double kDevelopedSeconds = 5.0;  // simulated; see RegisterAll
 
 engine::Simulation MakeSimulation(const std::string& world, int threads) {
@@ -232,36 +232,8 @@ void Step(benchmark::State& state, const std::string& world, int threads, double
   const std::string& warm = WarmState(world, warm_up_s);
   engine::Simulation sim = MakeSimulation(world, threads);
   sim.LoadState(warm);
-  const auto people = static_cast<std::int64_t>(sim.bodies().size());
-  std::int64_t in_window = 0;
-  double contacts = 0.0;
-  const engine::Profile before = sim.profile();
-  for (auto _ : state) {
-    if (in_window == kWindowSteps) {
-      state.PauseTiming();
-      sim.LoadState(warm);
-      state.ResumeTiming();
-      in_window = 0;
-    }
-    sim.Step();
-    ++in_window;
-    contacts += static_cast<double>(sim.contacts().size());
-  }
-  state.SetItemsProcessed(state.iterations() * people);
-  state.counters["people"] = static_cast<double>(people);
-  state.counters["contacts"] = contacts / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
-  state.counters["dt_s"] = sim.time_step_s();
+  TimeSteps(state, sim, warm);
   state.counters["warm_up_s"] = warm_up_s;
-  // Where the time goes: milliseconds per step in each stage (Profile).
-  const engine::Profile& after = sim.profile();
-  const double per_step_ms = 1e3 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
-  state.counters["pairs_ms"] = (after.update_pairs_s - before.update_pairs_s) * per_step_ms;
-  state.counters["place_ms"] = (after.place_shapes_s - before.place_shapes_s) * per_step_ms;
-  state.counters["collide_ms"] = (after.collide_s - before.collide_s) * per_step_ms;
-  state.counters["gather_ms"] = (after.gather_s - before.gather_s) * per_step_ms;
-  state.counters["drive_ms"] = (after.drive_s - before.drive_s) * per_step_ms;
-  state.counters["integrate_ms"] = (after.integrate_s - before.integrate_s) * per_step_ms;
-  state.counters["check_ms"] = (after.check_s - before.check_s) * per_step_ms;
 }
 
 // Writing one frame of the run file (trajectories, states and every contact,

@@ -12,12 +12,7 @@
 
 #include "crowdrecon/engine/contact.hpp"
 #include "crowdrecon/engine/parameters.hpp"
-
-#if defined(__CUDACC__)
-#define CROWDRECON_HOST_DEVICE __host__ __device__
-#else
-#define CROWDRECON_HOST_DEVICE
-#endif
+#include "host_device.hpp"
 
 namespace crowdrecon::engine::detail {
 

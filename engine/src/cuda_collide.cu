@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "crowdrecon/common/error.hpp"
+#include "narrow_phase_core.hpp"
 
 namespace crowdrecon::engine::cuda {
 
@@ -136,7 +137,9 @@ struct DeviceGeometry {
   const Vec2* vertices = nullptr;
   const CoreEdge* edges = nullptr;
   const std::uint8_t* reflex = nullptr;
-  std::uint32_t count = 0, edge_count = 0;
+  std::uint32_t vertex_total = 0, edge_total = 0;
+  __host__ __device__ std::uint32_t count() const { return vertex_total; }
+  __host__ __device__ std::uint32_t edge_count() const { return edge_total; }
   bool closed = true;
   double radius_m = 0.0, core_radius_m = 0.0;
   Vec2 box_min, box_max;
@@ -180,79 +183,9 @@ struct History {
   std::size_t count;
 };
 
-// The same operations, in the same order, as the processor's (vec2.hpp and
-// the std:: functions of narrow_phase.cpp).
-__device__ inline double LengthDevice(Vec2 a) { return sqrt(a.x * a.x + a.y * a.y); }
-__device__ inline double MaxDevice(double a, double b) { return a < b ? b : a; }  // std::max
-
-struct Closest {
-  Vec2 point;
-  double distance;
-};
-
-// ClosestOnCore of narrow_phase.cpp.
-__device__ Closest ClosestOnCore(Vec2 p, const DeviceGeometry& g, const std::uint16_t* edge_index, std::uint32_t m) {
-  Closest best;
-  if (g.edge_count == 0) {
-    best.point = g.vertices[0];
-    best.distance = LengthDevice(p - g.vertices[0]);
-    return best;
-  }
-  double best_d2 = std::numeric_limits<double>::infinity();
-  std::uint32_t best_edge = 0;
-  double best_t = 0.0;
-  best.point = Vec2{};
-  for (std::uint32_t k = 0; k < m; ++k) {
-    const std::uint32_t j = edge_index ? edge_index[k] : k;
-    const CoreEdge e = g.edges[j];
-    double t = Dot(p - e.start, e.direction) * e.inverse_length2;
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    const Vec2 q = e.start + e.direction * t;
-    const double d2 = LengthSquared(p - q);
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best.point = q;
-      best_edge = j;
-      best_t = t;
-    }
-  }
-  best.distance = sqrt(best_d2);
-  if (g.closed) {
-    bool inside;
-    if (best_t > 0.0 && best_t < 1.0) {
-      const CoreEdge e = g.edges[best_edge];
-      inside = Cross(e.direction, p - e.start) > 0.0;
-    } else {
-      const std::uint32_t n = g.count;
-      const std::uint32_t k = best_t <= 0.0 ? best_edge : (best_edge + 1 == n ? 0 : best_edge + 1);
-      inside = g.reflex[k] != 0;
-    }
-    if (inside) best.distance = -best.distance;
-  }
-  return best;
-}
-
-// BoxesGap of narrow_phase.cpp.
-__device__ double BoxesGap(const Placed& a, const Placed& b, double reach) {
-  const DeviceGeometry& ga = *a.geometry;
-  const DeviceGeometry& gb = *b.geometry;
-  const double grow = reach / 2.0;
-  const Vec2 ha = (ga.box_max - ga.box_min) * (a.scale / 2.0) + Vec2{grow, grow};
-  const Vec2 hb = (gb.box_max - gb.box_min) * (b.scale / 2.0) + Vec2{grow, grow};
-  const Vec2 ma = (ga.box_max + ga.box_min) * (a.scale / 2.0), mb = (gb.box_max + gb.box_min) * (b.scale / 2.0);
-  const Vec2 ua{a.cos_angle, a.sin_angle}, va{-a.sin_angle, a.cos_angle};
-  const Vec2 ub{b.cos_angle, b.sin_angle}, vb{-b.sin_angle, b.cos_angle};
-  const Vec2 ca = a.position + ua * ma.x + va * ma.y;
-  const Vec2 cb = b.position + ub * mb.x + vb * mb.y;
-  const Vec2 t = cb - ca;
-  const double uu = fabs(Dot(ua, ub)), uv = fabs(Dot(ua, vb));
-  const double vu = fabs(Dot(va, ub)), vv = fabs(Dot(va, vb));
-  const double gap_ua = fabs(Dot(t, ua)) - (ha.x + hb.x * uu + hb.y * uv);
-  const double gap_va = fabs(Dot(t, va)) - (ha.y + hb.x * vu + hb.y * vv);
-  const double gap_ub = fabs(Dot(t, ub)) - (hb.x + ha.x * uu + ha.y * vu);
-  const double gap_vb = fabs(Dot(t, vb)) - (hb.y + ha.x * uv + ha.y * vv);
-  return MaxDevice(MaxDevice(gap_ua, gap_va), MaxDevice(gap_ub, gap_vb));
-}
+using detail::BoxesGap;
+using detail::Closest;
+using detail::ClosestOnCore;
 
 // VerticesAgainst of narrow_phase.cpp, every vertex measured (no memory):
 // calls sink(point, normal, overlap, feature) for each contact, in vertex order.
@@ -271,7 +204,7 @@ __device__ void VerticesAgainst(const Placed& from, const Placed& to, bool flip,
   const Vec2 lo = g.box_min - Vec2{reach_g, reach_g}, hi = g.box_max + Vec2{reach_g, reach_g};
   const bool use_grid = g.grid && reach_g <= g.grid_reach_m;
   const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
-  for (std::uint32_t i = 0; i < f.count; ++i) {
+  for (std::uint32_t i = 0; i < f.count(); ++i) {
     const Vec2 v = f.vertices[i];
     const Vec2 p{c * v.x - s * v.y + o.x, s * v.x + c * v.y + o.y};
     if (p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y) continue;
@@ -285,7 +218,7 @@ __device__ void VerticesAgainst(const Placed& from, const Placed& to, bool flip,
       if (first == last) continue;
       cl = ClosestOnCore(p, g, g.cell_edges + first, last - first);
     } else {
-      cl = ClosestOnCore(p, g, nullptr, g.edge_count);
+      cl = ClosestOnCore(p, g, nullptr, g.edge_count());
     }
     if (cl.distance >= reach_g) continue;
     Vec2 normal;
@@ -317,8 +250,8 @@ __device__ void CollideShapes(const Placed& a, const Placed& b, Sink& sink) {
   const double d2 = LengthSquared(a.position - b.position);
   if (d2 >= bound * bound) return;
   if (BoxesGap(a, b, reach) > 0.0) return;
-  const bool a_side = ga.count == 1 || gb.count != 1;
-  const bool b_side = ga.count != 1;
+  const bool a_side = ga.count() == 1 || gb.count() != 1;
+  const bool b_side = ga.count() != 1;
   if (a_side) VerticesAgainst(a, b, false, 0u, sink);
   if (b_side) VerticesAgainst(b, a, true, kVertexOfB, sink);
 }
@@ -524,8 +457,8 @@ Collider::Collider(const std::vector<ShapeGeometry>& families, const std::vector
     d.vertices = m.vertices.data() + at[k].vertices;
     d.edges = m.edges.data() + at[k].edges;
     d.reflex = m.reflex.data() + at[k].reflex;
-    d.count = g.count();
-    d.edge_count = static_cast<std::uint32_t>(g.edges.size());
+    d.vertex_total = g.count();
+    d.edge_total = g.edge_count();
     d.closed = g.closed;
     d.radius_m = g.radius_m;
     d.core_radius_m = g.core_radius_m;

@@ -1,5 +1,7 @@
 #include "crowdrecon/engine/narrow_phase.hpp"
 
+#include "narrow_phase_core.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -53,55 +55,9 @@ ShapeGeometry ShapeGeometry::FromWorld(const std::vector<Vec2>& points, bool clo
 
 namespace {
 
-// Closest point of the core of `g` (in g's frame) to p, with the signed
-// distance: negative when p lies inside a polygon.
-struct Closest {
-  Vec2 point;
-  double distance = std::numeric_limits<double>::infinity();
-};
-
-// Searches the edges edge_index[0..m) (all edges when edge_index is null).
-Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g, const std::uint16_t* edge_index, std::size_t m) {
-  Closest best;
-  if (g.edges.empty()) {
-    best.point = g.vertices[0];
-    best.distance = Length(p - g.vertices[0]);
-    return best;
-  }
-  double best_d2 = std::numeric_limits<double>::infinity();
-  std::size_t best_edge = 0;
-  double best_t = 0.0;
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::size_t j = edge_index ? edge_index[k] : k;
-    const CoreEdge& e = g.edges[j];
-    double t = Dot(p - e.start, e.direction) * e.inverse_length2;
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    const Vec2 q = e.start + e.direction * t;
-    const double d2 = LengthSquared(p - q);
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best.point = q;
-      best_edge = j;
-      best_t = t;
-    }
-  }
-  best.distance = std::sqrt(best_d2);
-  if (g.closed) {
-    // Inside test from the closest feature: across an edge interior by the
-    // side of its line; at a vertex, p is inside exactly when the vertex is reflex.
-    bool inside;
-    if (best_t > 0.0 && best_t < 1.0) {
-      const CoreEdge& e = g.edges[best_edge];
-      inside = Cross(e.direction, p - e.start) > 0.0;  // left of a counter-clockwise edge
-    } else {
-      const std::size_t n = g.vertices.size();
-      const std::size_t k = best_t <= 0.0 ? best_edge : (best_edge + 1 == n ? 0 : best_edge + 1);
-      inside = g.reflex[k] != 0;
-    }
-    if (inside) best.distance = -best.distance;
-  }
-  return best;
-}
+using detail::BoxesGap;
+using detail::Closest;
+using detail::ClosestOnCore;
 
 Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) { return ClosestOnCore(p, g, nullptr, g.edges.size()); }
 
@@ -217,29 +173,6 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
   return clearance * unit;  // (an infinity stays one)
 }
 
-// True when the bounding boxes of A and B, each grown by half the reach, do
-// not overlap (separating axis theorem; four axes in 2D). Then no point of A's
-// core comes within the reach of B's core.
-double BoxesGap(const PlacedShape& a, const PlacedShape& b, double reach) {
-  const ShapeGeometry& ga = *a.geometry;
-  const ShapeGeometry& gb = *b.geometry;
-  const double grow = reach / 2.0;
-  const Vec2 ha = (ga.box_max - ga.box_min) * (a.scale / 2.0) + Vec2{grow, grow};
-  const Vec2 hb = (gb.box_max - gb.box_min) * (b.scale / 2.0) + Vec2{grow, grow};
-  const Vec2 ma = (ga.box_max + ga.box_min) * (a.scale / 2.0), mb = (gb.box_max + gb.box_min) * (b.scale / 2.0);
-  const Vec2 ua{a.cos_angle, a.sin_angle}, va{-a.sin_angle, a.cos_angle};
-  const Vec2 ub{b.cos_angle, b.sin_angle}, vb{-b.sin_angle, b.cos_angle};
-  const Vec2 ca = a.position + ua * ma.x + va * ma.y;
-  const Vec2 cb = b.position + ub * mb.x + vb * mb.y;
-  const Vec2 t = cb - ca;
-  const double uu = std::abs(Dot(ua, ub)), uv = std::abs(Dot(ua, vb));
-  const double vu = std::abs(Dot(va, ub)), vv = std::abs(Dot(va, vb));
-  const double gap_ua = std::abs(Dot(t, ua)) - (ha.x + hb.x * uu + hb.y * uv);
-  const double gap_va = std::abs(Dot(t, va)) - (ha.y + hb.x * vu + hb.y * vv);
-  const double gap_ub = std::abs(Dot(t, ub)) - (hb.x + ha.x * uu + ha.y * vu);
-  const double gap_vb = std::abs(Dot(t, vb)) - (hb.y + ha.x * uv + ha.y * vv);
-  return std::max(std::max(gap_ua, gap_va), std::max(gap_ub, gap_vb));
-}
 
 }  // namespace
 

@@ -84,6 +84,7 @@ struct ShapeGeometry {
   // (shapes with fewer than 6 edges get none: the full search is as cheap).
   void BuildEdgeGrid(double reach_m);
   std::uint32_t count() const { return static_cast<std::uint32_t>(vertices.size()); }
+  std::uint32_t edge_count() const { return static_cast<std::uint32_t>(edges.size()); }
 };
 
 // A shape placed in the world: its geometry, uniformly scaled by `scale`
