@@ -14,6 +14,7 @@
 
 #include <cuda_runtime.h>
 
+#include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 #include <cstring>
 #include <limits>
@@ -367,6 +368,44 @@ __global__ void WriteContacts(Bodies bodies, Box box, const std::pair<std::uint3
   if (beyond) atomicOr(overlap_beyond, 1);
 }
 
+// Two entries per contact k, (a, k) and (b, k): sorted stably by body, they
+// list each body's contacts in contact order.
+__global__ void ListBodyContacts(const Contact* contacts, std::uint32_t count, std::uint32_t* bodies,
+                                 std::uint32_t* indices) {
+  const std::uint32_t k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= count) return;
+  bodies[2 * k] = contacts[k].a;
+  indices[2 * k] = k;
+  bodies[2 * k + 1] = contacts[k].b;
+  indices[2 * k + 1] = k;
+}
+
+// Body i's sums over its contacts, in contact order (Simulation::Gather).
+__global__ void SumPerBody(const Contact* contacts, const std::uint32_t* bodies, const std::uint32_t* indices,
+                           std::uint32_t entries, const Vec2* position, Box box, std::uint32_t n,
+                           detail::BodySums* sums) {
+  const std::uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  std::uint32_t lo = 0, hi = entries;
+  while (lo < hi) {  // first entry of body i or after
+    const std::uint32_t mid = lo + (hi - lo) / 2;
+    if (bodies[mid] < i)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  detail::BodySums s;
+  for (std::uint32_t e = lo; e < entries && bodies[e] == i; ++e) {
+    const Contact& c = contacts[indices[e]];
+    const Vec2 xa = position[c.a];
+    if (c.a == i)
+      detail::AddContact(s, c, true, xa);
+    else
+      detail::AddContact(s, c, false, xa - Separation(xa, position[c.b], box));
+  }
+  sums[i] = s;
+}
+
 }  // namespace
 
 bool Available(std::string* why) {
@@ -411,6 +450,11 @@ struct Collider::Impl {
   DeviceBuffer<Contact> contacts, previous;
   bool have_output = false;
   DeviceBuffer<int> flag;
+  // Each body's contacts (stable sort by body) and its sums.
+  DeviceBuffer<std::uint32_t> entry_body, entry_index, sorted_body, sorted_index;
+  DeviceBuffer<unsigned char> sort_workspace;
+  DeviceBuffer<detail::BodySums> sums;
+  PinnedBuffer sums_stage;
   Timing timing;
 };
 
@@ -490,7 +534,7 @@ Collider::~Collider() {
 
 Collider::Timing Collider::last_timing() const { return impl_->timing; }
 
-bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out) {
+bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out, std::vector<detail::BodySums>& body_sums) {
   Impl& m = *impl_;
   cudaStream_t stream = m.stream;
   Check(cudaEventRecord(m.events[0], stream), "cudaEventRecord");
@@ -549,6 +593,36 @@ bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out) {
     WriteContacts<<<static_cast<unsigned>((pairs + kThreads - 1) / kThreads), kThreads, 0, stream>>>(
         bodies, m.box, m.pairs.data(), pairs, m.offsets.data(), in.law, history, m.contacts.data(), m.flag.data());
   Check(cudaGetLastError(), "WriteContacts");
+  // Each body's sums: its contacts listed in contact order by a stable radix
+  // sort on the body (over the bits that body numbers use), then summed.
+  const std::size_t entries = 2 * std::size_t{total};
+  m.entry_body.set_size(entries);
+  m.entry_index.set_size(entries);
+  m.sorted_body.set_size(entries);
+  m.sorted_index.set_size(entries);
+  m.sums.set_size(n);
+  if (total > 0) {
+    ListBodyContacts<<<static_cast<unsigned>((total + kThreads - 1) / kThreads), kThreads, 0, stream>>>(
+        m.contacts.data(), total, m.entry_body.data(), m.entry_index.data());
+    Check(cudaGetLastError(), "ListBodyContacts");
+    int bits = 1;
+    while (bits < 32 && (std::size_t{1} << bits) < n) ++bits;
+    std::size_t sort_bytes = 0;
+    Check(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, m.entry_body.data(), m.sorted_body.data(),
+                                          m.entry_index.data(), m.sorted_index.data(), entries, 0, bits, stream),
+          "sort size");
+    m.sort_workspace.set_size(sort_bytes);
+    Check(cub::DeviceRadixSort::SortPairs(m.sort_workspace.data(), sort_bytes, m.entry_body.data(),
+                                          m.sorted_body.data(), m.entry_index.data(), m.sorted_index.data(), entries,
+                                          0, bits, stream),
+          "sort");
+  }
+  if (n > 0) {
+    SumPerBody<<<static_cast<unsigned>((n + kThreads - 1) / kThreads), kThreads, 0, stream>>>(
+        m.contacts.data(), m.sorted_body.data(), m.sorted_index.data(), static_cast<std::uint32_t>(entries), position,
+        m.box, static_cast<std::uint32_t>(n), m.sums.data());
+    Check(cudaGetLastError(), "SumPerBody");
+  }
   int beyond = 0;
   Check(cudaMemcpyAsync(&beyond, m.flag.data(), sizeof(int), cudaMemcpyDeviceToHost, stream), "flag");
   Check(cudaEventRecord(m.events[2], stream), "cudaEventRecord");
@@ -557,11 +631,17 @@ bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out) {
   if (total > 0)
     Check(cudaMemcpyAsync(staged, m.contacts.data(), total * sizeof(Contact), cudaMemcpyDeviceToHost, stream),
           "download");
+  unsigned char* staged_sums = m.sums_stage.Reserve(n * sizeof(detail::BodySums));
+  if (n > 0)
+    Check(cudaMemcpyAsync(staged_sums, m.sums.data(), n * sizeof(detail::BodySums), cudaMemcpyDeviceToHost, stream),
+          "download");
   Check(cudaEventRecord(m.events[3], stream), "cudaEventRecord");
   Check(cudaStreamSynchronize(stream), "download");
   // (Copied in one pass: resizing first would also write every record once.)
   const Contact* first = reinterpret_cast<const Contact*>(staged);
   out.insert(out.end(), first, first + total);
+  const detail::BodySums* first_sums = reinterpret_cast<const detail::BodySums*>(staged_sums);
+  body_sums.assign(first_sums, first_sums + n);
   float ms[3] = {};
   for (int k = 0; k < 3; ++k) Check(cudaEventElapsedTime(&ms[k], m.events[k], m.events[k + 1]), "timing");
   m.timing = {ms[0], ms[1], ms[2]};

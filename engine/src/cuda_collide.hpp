@@ -16,7 +16,9 @@
 // vertices and pairs still apart only skips work whose result is "no
 // contact", so the contacts are the same. Each pair's contacts are written at
 // the pair's place in the list (a count, a prefix sum, then the write), in the
-// processor's order: pairs in list order, A's vertices then B's.
+// processor's order: pairs in list order, A's vertices then B's. Each body's
+// contacts are then listed in that order (a stable sort by body) and summed
+// on the device, so that only the sums and the contacts come back.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "contact_law.hpp"
+#include "gather_core.hpp"
 #include "crowdrecon/engine/contact.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "crowdrecon/engine/world.hpp"
@@ -75,10 +78,12 @@ class Collider {
   Collider& operator=(const Collider&) = delete;
 
   // Appends the person pairs' contacts to `out`, in list order, with their
-  // forces. Returns true if one overlaps beyond the sum of the sphero-radii
-  // (see Simulation::Check). Throws std::runtime_error, with the CUDA
-  // runtime's message, if the device fails.
-  bool Collide(const CollideInput& input, std::vector<Contact>& out);
+  // forces, and sets body_sums[i] to the sums of the forces and torques of
+  // body i's contacts among them, added in list order (gather_core.hpp), as
+  // Simulation::Gather would. Returns true if a contact overlaps beyond the
+  // sum of the sphero-radii (see Simulation::Check). Throws
+  // std::runtime_error, with the CUDA runtime's message, if the device fails.
+  bool Collide(const CollideInput& input, std::vector<Contact>& out, std::vector<detail::BodySums>& body_sums);
 
   // Milliseconds of the last call spent in kernels, and copying to and from
   // the device (for the benchmarks).

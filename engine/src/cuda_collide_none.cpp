@@ -25,7 +25,7 @@ Collider::Collider(const std::vector<ShapeGeometry>&, const std::vector<std::uin
 }
 Collider::~Collider() = default;
 
-bool Collider::Collide(const CollideInput&, std::vector<Contact>&) { return false; }
+bool Collider::Collide(const CollideInput&, std::vector<Contact>&, std::vector<detail::BodySums>&) { return false; }
 
 Collider::Timing Collider::last_timing() const { return {}; }
 

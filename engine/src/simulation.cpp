@@ -13,6 +13,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fast_math.hpp"
 #include "contact_law.hpp"
+#include "gather_core.hpp"
 #include "cuda_collide.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "binary_io.hpp"
@@ -199,8 +200,12 @@ struct Simulation::Internals {
   // The CUDA force computation of person pairs (WorldDef::device), and
   // whether it holds the previous evaluation's contacts (then they are not
   // sent again); a new list of pairs is sent when pair_generation changes.
+  // It also sums, per body, the forces and torques of the contacts it makes
+  // (the first device_contacts of the contact list), as Gather would.
   std::unique_ptr<cuda::Collider> cuda;
   bool cuda_has_history = false;
+  std::size_t device_contacts = 0;
+  std::vector<detail::BodySums> device_sums;
   std::uint64_t pair_generation = 0;
   // Contacts of each body (indices into contacts_, in contact order): CSR.
   std::vector<std::uint32_t> body_contact_start, body_contact_items, body_contact_fill;
@@ -853,7 +858,8 @@ void Simulation::Collide() {
     input.previous_is_last_output = in.cuda_has_history;
     input.law = law;
     contacts_.clear();
-    bool overlap_beyond = in.cuda->Collide(input, contacts_);
+    bool overlap_beyond = in.cuda->Collide(input, contacts_, in.device_sums);
+    in.device_contacts = contacts_.size();
     in.cuda_has_history = true;
     const cuda::Collider::Timing timing = in.cuda->last_timing();
     profile_.device_copy_s += (timing.upload_ms + timing.download_ms) * 1e-3;
@@ -944,16 +950,18 @@ void Simulation::Gather() {
   in.leading_force.resize(n);
   in.leading_torque.resize(n);
   // Each body's contacts in contact order (counting sort), so that every
-  // body's sums run in a fixed order whichever thread computes them (ERRATA
-  // 11: each contact acts on both bodies, equal and opposite, each with its
-  // own branch vector).
+  // body's sums run in a fixed order whichever thread computes them.
   // With many contacts, in as many contiguous parts of the contact list as
   // there are threads: each part counts its contacts per body, the counts
   // give each part's place within each body's run (the earlier parts first),
   // and each part files its contacts there. The same index either way.
+  // With the CUDA force computation the device has summed the person pairs'
+  // contacts (the list's first in.device_contacts) per body, in the same
+  // order; the sums here go on from there with the wall contacts after them.
   std::vector<std::uint32_t>& start = in.body_contact_start;
   std::vector<std::uint32_t>& items = in.body_contact_items;
-  const std::size_t m = contacts_.size();
+  const std::size_t first = in.cuda ? in.device_contacts : 0;
+  const std::size_t m = contacts_.size() - first;
   const bool split = def_.threads > 1 && static_cast<std::int64_t>(n) >= kParallelBodies &&
                      static_cast<std::int64_t>(m) >= kParallelBodies;  // as the per-body sums below
   const std::size_t parts = split ? static_cast<std::size_t>(def_.threads) : 1;
@@ -966,7 +974,7 @@ void Simulation::Gather() {
     std::uint32_t* count = fill.data() + q * n;
     std::fill(count, count + n, 0u);
     const Part listed = PartOf(m, q, parts);
-    for (std::size_t k = listed.begin; k < listed.end; ++k) {
+    for (std::size_t k = first + listed.begin; k < first + listed.end; ++k) {
       const Contact& c = contacts_[k];
       ++count[c.a];
       if (!c.wall) ++count[c.b];
@@ -989,7 +997,7 @@ void Simulation::Gather() {
     const std::size_t q = static_cast<std::size_t>(part);
     std::uint32_t* place = fill.data() + q * n;
     const Part listed = PartOf(m, q, parts);
-    for (std::size_t k = listed.begin; k < listed.end; ++k) {
+    for (std::size_t k = first + listed.begin; k < first + listed.end; ++k) {
       const Contact& c = contacts_[k];
       items[place[c.a]++] = static_cast<std::uint32_t>(k);
       if (!c.wall) items[place[c.b]++] = static_cast<std::uint32_t>(k);
@@ -999,39 +1007,21 @@ void Simulation::Gather() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
   for (std::int64_t ii = 0; ii < count; ++ii) {
     const std::uint32_t i = static_cast<std::uint32_t>(ii);
-    Vec2 force, trailing_force, leading_force;
-    double torque = 0.0, trailing_torque = 0.0, leading_torque = 0.0;
+    detail::BodySums sums = in.cuda ? in.device_sums[i] : detail::BodySums{};
     for (std::uint32_t s = start[i]; s < start[i + 1]; ++s) {
       const Contact& c = contacts_[items[s]];
-      const Vec2 f = c.Force();
-      const Vec2 viscous = c.normal * c.viscous_normal_n + Perp(c.normal) * c.viscous_tangential_n;
-      const Vec2 trailing = viscous * (c.trailing_fraction - 1.0);
-      const Vec2 leading = viscous * (c.leading_fraction - 1.0);
       const Vec2 xa = bodies_.position_m[c.a];
-      if (c.a == i) {
-        const Vec2 arm = c.point_m - xa;
-        force += f;
-        torque += Cross(arm, f);
-        trailing_force += trailing;
-        trailing_torque += Cross(arm, trailing);
-        leading_force += leading;
-        leading_torque += Cross(arm, leading);
-      } else {
-        const Vec2 arm = c.point_m - (xa - Separation(xa, bodies_.position_m[c.b]));
-        force -= f;
-        torque -= Cross(arm, f);
-        trailing_force -= trailing;
-        trailing_torque -= Cross(arm, trailing);
-        leading_force -= leading;
-        leading_torque -= Cross(arm, leading);
-      }
+      if (c.a == i)
+        detail::AddContact(sums, c, true, xa);
+      else
+        detail::AddContact(sums, c, false, xa - Separation(xa, bodies_.position_m[c.b]));
     }
-    bodies_.contact_force_n[i] = force;
-    bodies_.contact_torque_n_m[i] = torque;
-    in.trailing_force[i] = trailing_force;
-    in.trailing_torque[i] = trailing_torque;
-    in.leading_force[i] = leading_force;
-    in.leading_torque[i] = leading_torque;
+    bodies_.contact_force_n[i] = sums.force;
+    bodies_.contact_torque_n_m[i] = sums.torque;
+    in.trailing_force[i] = sums.trailing_force;
+    in.trailing_torque[i] = sums.trailing_torque;
+    in.leading_force[i] = sums.leading_force;
+    in.leading_torque[i] = sums.leading_torque;
   }
 }
 
