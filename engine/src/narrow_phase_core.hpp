@@ -26,7 +26,7 @@ struct Closest {
 // Searches the edges edge_index[0..m) (all edges when edge_index is null).
 // `Geometry`: ShapeGeometry, or the device's copy of it (cuda_collide.cu).
 template <typename Geometry>
-CROWDRECON_HOST_DEVICE Closest ClosestOnCore(Vec2 p, const Geometry& g, const std::uint16_t* edge_index,
+CROWDRECON_HOST_DEVICE CROWDRECON_INLINE Closest ClosestOnCore(Vec2 p, const Geometry& g, const std::uint16_t* edge_index,
                                              std::size_t m) {
   Closest best;
   if (g.edge_count() == 0) {
@@ -75,7 +75,7 @@ CROWDRECON_HOST_DEVICE Closest ClosestOnCore(Vec2 p, const Geometry& g, const st
 // core comes within the reach of B's core.
 // `Placed`: PlacedShape, or the device's (cuda_collide.cu).
 template <typename Placed>
-CROWDRECON_HOST_DEVICE double BoxesGap(const Placed& a, const Placed& b, double reach) {
+CROWDRECON_HOST_DEVICE CROWDRECON_INLINE double BoxesGap(const Placed& a, const Placed& b, double reach) {
   const auto& ga = *a.geometry;
   const auto& gb = *b.geometry;
   const double grow = reach / 2.0;

@@ -1003,11 +1003,12 @@ void Simulation::Gather() {
       if (!c.wall) items[place[c.b]++] = static_cast<std::uint32_t>(k);
     }
   }
+  const detail::BodySums* device_sums = in.cuda ? in.device_sums.data() : nullptr;
   const std::int64_t count = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
   for (std::int64_t ii = 0; ii < count; ++ii) {
     const std::uint32_t i = static_cast<std::uint32_t>(ii);
-    detail::BodySums sums = in.cuda ? in.device_sums[i] : detail::BodySums{};
+    detail::BodySums sums = device_sums ? device_sums[i] : detail::BodySums{};
     for (std::uint32_t s = start[i]; s < start[i + 1]; ++s) {
       const Contact& c = contacts_[items[s]];
       const Vec2 xa = bodies_.position_m[c.a];
