@@ -4,12 +4,15 @@
 // it where the build has a CUDA compiler (CROWDRECON_CUDA), and
 // cuda_collide_none.cpp elsewhere, where creating one reports that the build
 // has no CUDA. A Simulation built with ComputeDevice::kCuda hands the narrow
-// phase and the contact law of its person pairs to it (walls stay on the
-// processor) and keeps every other stage.
+// phase and the contact law of its person pairs, and the per-body sums of
+// their forces, to it (walls stay on the processor) and keeps every other
+// stage.
 //
-// Same results, bit for bit. The device code repeats the processor's
-// expressions in the same order (the narrow phase of narrow_phase.cpp, the
-// contact law of contact_law.hpp, shared as source), is compiled without
+// Same results, bit for bit. The device code runs the processor's
+// expressions in the same order (the contact law, the closest-point search,
+// the box test and the per-body sums are shared as source: contact_law.hpp,
+// narrow_phase_core.hpp, gather_core.hpp; the rest of the narrow phase
+// repeats narrow_phase.cpp), is compiled without
 // contraction of a*b+c (--fmad=false, as -ffp-contract=off on the processor),
 // and IEEE double division and square root are correctly rounded on both. It
 // measures every vertex of every pair of the list: the processor's memory of
