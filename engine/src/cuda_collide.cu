@@ -16,6 +16,7 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -456,6 +457,9 @@ struct Collider::Impl {
   DeviceBuffer<detail::BodySums> sums;
   PinnedBuffer sums_stage;
   Timing timing;
+  // Fault injection for tests (CROWDRECON_CUDA_FAIL_AFTER, cuda_collide.hpp).
+  long fail_after = -1;
+  long calls = 0;
 };
 
 Collider::Collider(const std::vector<ShapeGeometry>& families, const std::vector<std::uint32_t>& shape_family,
@@ -464,6 +468,7 @@ Collider::Collider(const std::vector<ShapeGeometry>& families, const std::vector
   std::string why;
   if (!Available(&why)) throw InputError("device: \"cuda\": " + why);
   Impl& m = *impl_;
+  if (const char* fail = std::getenv("CROWDRECON_CUDA_FAIL_AFTER")) m.fail_after = std::atol(fail);
   Check(cudaStreamCreateWithFlags(&m.stream, cudaStreamNonBlocking), "cudaStreamCreate");
   for (cudaEvent_t& e : m.events) Check(cudaEventCreate(&e), "cudaEventCreate");
   m.box.x = periodic.x;
@@ -536,6 +541,8 @@ Collider::Timing Collider::last_timing() const { return impl_->timing; }
 
 bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out, std::vector<detail::BodySums>& body_sums) {
   Impl& m = *impl_;
+  if (m.fail_after >= 0 && m.calls++ >= m.fail_after)
+    throw std::runtime_error("CUDA force computation: failure injected by CROWDRECON_CUDA_FAIL_AFTER");
   cudaStream_t stream = m.stream;
   Check(cudaEventRecord(m.events[0], stream), "cudaEventRecord");
   const std::size_t n = in.n;

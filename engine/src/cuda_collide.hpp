@@ -85,7 +85,10 @@ class Collider {
   // body i's contacts among them, added in list order (gather_core.hpp), as
   // Simulation::Gather would. Returns true if a contact overlaps beyond the
   // sum of the sphero-radii (see Simulation::Check). Throws
-  // std::runtime_error, with the CUDA runtime's message, if the device fails.
+  // std::runtime_error, with the CUDA runtime's message, if the device fails
+  // (Simulation then goes on with the processor). For tests of that, the
+  // environment variable CROWDRECON_CUDA_FAIL_AFTER=N makes every call after
+  // the first N fail so.
   bool Collide(const CollideInput& input, std::vector<Contact>& out, std::vector<detail::BodySums>& body_sums);
 
   // Milliseconds of the last call spent in kernels, and copying to and from

@@ -858,17 +858,35 @@ void Simulation::Collide() {
     input.previous_is_last_output = in.cuda_has_history;
     input.law = law;
     contacts_.clear();
-    bool overlap_beyond = in.cuda->Collide(input, contacts_, in.device_sums);
-    in.device_contacts = contacts_.size();
-    in.cuda_has_history = true;
-    const cuda::Collider::Timing timing = in.cuda->last_timing();
-    profile_.device_copy_s += (timing.upload_ms + timing.download_ms) * 1e-3;
-    profile_.device_kernels_s += timing.kernels_ms * 1e-3;
-    std::vector<ContactPoint> points;
-    for (std::size_t chunk = person_chunks; chunk < chunks; ++chunk)
-      overlap_beyond = collide_chunk(chunk, contacts_, points) || overlap_beyond;
-    in.overlap_beyond = overlap_beyond;
-    return;
+    bool overlap_beyond = false;
+    bool computed = false;
+    try {
+      overlap_beyond = in.cuda->Collide(input, contacts_, in.device_sums);
+      computed = true;
+    } catch (const std::runtime_error& e) {
+      // The device failed (a lost GPU, a driver error). The processor gives
+      // the same results, so the run goes on there, from this evaluation on;
+      // the reason is kept for the caller to report (device_fallback()).
+      // The processor's pair clearances were never set while the device
+      // computed (all "unknown"), so it simply measures every pair at first.
+      device_fallback_ = std::string(e.what()) + " (at t = " + FormatNumber(time_s_) +
+                         " s; the processor took over, with the same results)";
+      in.cuda.reset();
+      in.device_sums.clear();
+      contacts_.clear();
+    }
+    if (computed) {
+      in.device_contacts = contacts_.size();
+      in.cuda_has_history = true;
+      const cuda::Collider::Timing timing = in.cuda->last_timing();
+      profile_.device_copy_s += (timing.upload_ms + timing.download_ms) * 1e-3;
+      profile_.device_kernels_s += timing.kernels_ms * 1e-3;
+      std::vector<ContactPoint> points;
+      for (std::size_t chunk = person_chunks; chunk < chunks; ++chunk)
+        overlap_beyond = collide_chunk(chunk, contacts_, points) || overlap_beyond;
+      in.overlap_beyond = overlap_beyond;
+      return;
+    }
   }
   const std::int64_t total = static_cast<std::int64_t>(chunks);
   if (def_.threads == 1 || total < 4) {

@@ -170,12 +170,25 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   if (last_frame < 0) write_frame(0);
 
   std::string status = "complete";
+  bool device_fallback_reported = false;
   try {
     while (last_frame < total_frames) {
       for (std::int64_t k = 0; k < steps_per_frame; ++k) {
         sim.Step();
       }
       write_frame(last_frame + 1);
+      if (!device_fallback_reported && !sim.device_fallback().empty()) {
+        // The GPU failed and the processor took over (same results): say so,
+        // on the terminal and in the run file, once.
+        device_fallback_reported = true;
+        frames.Flush();
+        Event event;
+        event.time_s = sim.time_s();
+        event.kind = "device_fallback";
+        event.detail = sim.device_fallback();
+        writer.WriteEvent(last_frame, event);
+        std::fprintf(stderr, "%scrowdrecon: note: %s\n", options.show_progress ? "\n" : "", sim.device_fallback().c_str());
+      }
       if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) checkpoint_now(checkpoint);
       const bool stop = g_stop_requested.load() || (options.stop_flag && options.stop_flag->load()) ||
                         (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);

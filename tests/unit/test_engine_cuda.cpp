@@ -4,6 +4,7 @@
 // device (skipped elsewhere, with the reason).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -124,6 +125,33 @@ TEST(EngineCuda, SameResultsAsTheProcessorWithWalls) {
     if (::testing::Test::HasFatalFailure()) return;
   }
   EXPECT_TRUE(walls_touched);
+}
+
+TEST(EngineCuda, AFailedDeviceHandsOverToTheProcessorWithTheSameResults) {
+  std::string why;
+  if (!CudaOrSkip(&why)) GTEST_SKIP() << why;
+  // A device failure mid-run (injected after 60 evaluations): the run goes
+  // on with the processor, says why, and its results are those of a run on
+  // the processor throughout.
+  WorldDef def = RandomGas(16, 0.38, 3, true);
+  def.parameters.ground_reaction = true;
+  WorldDef gpu_def = def;
+  gpu_def.device = ComputeDevice::kCuda;
+  setenv("CROWDRECON_CUDA_FAIL_AFTER", "60", 1);
+  Simulation gpu(gpu_def);
+  unsetenv("CROWDRECON_CUDA_FAIL_AFTER");
+  Simulation cpu(def);
+  for (int step = 1; step <= 200; ++step) {
+    cpu.Step();
+    gpu.Step();
+    if (step == 40) {
+      EXPECT_TRUE(gpu.device_fallback().empty());
+    }
+  }
+  EXPECT_NE(gpu.device_fallback().find("injected"), std::string::npos) << gpu.device_fallback();
+  EXPECT_NE(gpu.device_fallback().find("processor took over"), std::string::npos) << gpu.device_fallback();
+  EXPECT_TRUE(cpu.device_fallback().empty());
+  ExpectSameRun(cpu, gpu, "after the hand-over");
 }
 
 }  // namespace

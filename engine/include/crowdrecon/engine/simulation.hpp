@@ -103,6 +103,10 @@ class Simulation {
   // Contacts of the last force evaluation, in a fixed order.
   const std::vector<Contact>& contacts() const { return contacts_; }
   const Profile& profile() const { return profile_; }
+  // With ComputeDevice::kCuda: empty while the device computes; once it has
+  // failed (a lost GPU, a driver error), why and when, and the processor
+  // computes from then on, with the same results.
+  const std::string& device_fallback() const { return device_fallback_; }
 
   // Sets every velocity and angular velocity to zero and forgets the
   // integrator's history (used to relax an initial placement).
@@ -166,6 +170,7 @@ class Simulation {
   double time_s_ = 0.0;
   std::uint64_t step_count_ = 0;
   bool advance_springs_ = false;
+  std::string device_fallback_;
 };
 
 // True when this build has the CUDA force computation (ComputeDevice::kCuda)
