@@ -38,7 +38,9 @@ int RunSimulate(const SimulateArgs& args) {
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
   std::printf("scenario: %s\n", sc.name.c_str());
   std::printf("people: %zu, time step %.6g s, %d thread(s)%s\n", s.people, s.time_step_s, options.threads,
-              options.device == engine::ComputeDevice::kCuda ? ", person-pair forces on CUDA" : "");
+              options.device != engine::ComputeDevice::kCuda ? ""
+              : s.device_fallback.empty()                      ? ", person-pair forces on CUDA"
+                                                               : ", person-pair forces on CUDA until it failed (see the note)");
   std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());

@@ -10,13 +10,13 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include "binary_io.hpp"
+#include "contact_law.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fast_math.hpp"
-#include "contact_law.hpp"
-#include "gather_core.hpp"
-#include "cuda_collide.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
-#include "binary_io.hpp"
+#include "cuda_collide.hpp"
+#include "gather_core.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>

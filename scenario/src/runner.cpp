@@ -238,6 +238,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   summary.real_time_factor = summary.wall_s > 0 ? (sim.time_s() - start_sim) / summary.wall_s : 0.0;
   summary.frames = last_frame + 1;
   summary.profile = sim.profile();
+  summary.device_fallback = sim.device_fallback();
   return summary;
 }
 

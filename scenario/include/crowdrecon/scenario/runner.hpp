@@ -43,6 +43,7 @@ struct RunSummary {
   std::int64_t frames = 0;      // frames in the run file
   double real_time_factor = 0.0;  // simulated / wall seconds (this invocation)
   engine::Profile profile;         // time per engine stage (this invocation)
+  std::string device_fallback;     // why and when the GPU failed, if it did (engine::Simulation)
 };
 
 // Path of the checkpoint that belongs to a run file.
