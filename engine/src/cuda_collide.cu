@@ -22,6 +22,7 @@
 #include <stdexcept>
 
 #include "crowdrecon/common/error.hpp"
+#include "minimum_image.hpp"
 #include "narrow_phase_core.hpp"
 
 namespace crowdrecon::engine::cuda {
@@ -32,8 +33,6 @@ void Check(cudaError_t status, const char* what) {
   if (status != cudaSuccess)
     throw std::runtime_error(std::string("CUDA force computation: ") + what + ": " + cudaGetErrorString(status));
 }
-
-constexpr std::uint64_t kWallBit = std::uint64_t{1} << 63;
 
 // A device buffer that grows (never shrinks) to what is asked of it.
 template <typename T>
@@ -261,8 +260,8 @@ __device__ void CollideShapes(const Placed& a, const Placed& b, Sink& sink) {
 // Simulation::Separation.
 __device__ Vec2 Separation(Vec2 a, Vec2 b, const Box& box) {
   Vec2 d = a - b;
-  if (box.x && fabs(d.x) > box.lx / 2.0) d.x -= box.lx * nearbyint(d.x / box.lx);
-  if (box.y && fabs(d.y) > box.ly / 2.0) d.y -= box.ly * nearbyint(d.y / box.ly);
+  if (box.x) d.x = detail::MinimumImage(d.x, box.lx);
+  if (box.y) d.y = detail::MinimumImage(d.y, box.ly);
   return d;
 }
 
@@ -303,7 +302,7 @@ __device__ detail::ContactHistory FindHistory(const History& history, std::uint6
   while (lo < hi) {  // first contact not before (key, feature)
     const std::size_t mid = lo + (hi - lo) / 2;
     const Contact& c = history.contacts[mid];
-    const std::uint64_t ck = (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
+    const std::uint64_t ck = PairKey(c);
     if (ck < key || (ck == key && c.feature < feature))
       lo = mid + 1;
     else
@@ -312,8 +311,7 @@ __device__ detail::ContactHistory FindHistory(const History& history, std::uint6
   detail::ContactHistory h;
   if (lo < history.count) {
     const Contact& c = history.contacts[lo];
-    const std::uint64_t ck = (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
-    if (ck == key && c.feature == feature) {
+    if (PairKey(c) == key && c.feature == feature) {
       h.exists = true;
       h.tangential_spring_m = c.tangential_spring_m;
       h.leading_fraction = c.leading_fraction;
@@ -357,7 +355,7 @@ __global__ void WriteContacts(Bodies bodies, Box box, const std::pair<std::uint3
   const double mass = fa && fb ? 0.5 * (ma + mb) : (fa ? mb : (fb ? ma : ma * mb / (ma + mb)));  // eq. (14)
   const detail::ContactLaw::Rates rates = law.PairRates(mass, k_eff);
   const double radii = pa.scale + pb.scale;  // (family radius 1)
-  const std::uint64_t key = (std::uint64_t{a} << 32) | b;
+  const std::uint64_t key = PairKey(false, a, b);
   bool beyond = false;
   for (std::uint32_t q = first; q < last; ++q) {
     Contact& c = out[q];
@@ -443,13 +441,11 @@ struct Collider::Impl {
   std::size_t constant_bodies = 0;  // how many bodies' masses and shapes were sent
   // Pairs, counts and offsets, scan workspace.
   DeviceBuffer<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  std::uint64_t pair_generation = 0;
-  bool pairs_loaded = false;
+  std::uint64_t pair_generation = ~std::uint64_t{0};  // of the list on the device (none yet)
   DeviceBuffer<std::uint32_t> counts, offsets;
   DeviceBuffer<unsigned char> scan_workspace;
   // This evaluation's contacts and the previous one's.
   DeviceBuffer<Contact> contacts, previous;
-  bool have_output = false;
   DeviceBuffer<int> flag;
   // Each body's contacts (stable sort by body) and its sums.
   DeviceBuffer<std::uint32_t> entry_body, entry_index, sorted_body, sorted_index;
@@ -561,16 +557,12 @@ bool Collider::Collide(const CollideInput& in, std::vector<Contact>& out, std::v
   const double* angular_velocity = upload.Add(in.angular_velocity_rad_per_s, n);
   const PersonState* state = upload.Add(in.state, n);
   upload.Send(stream);
-  if (!m.pairs_loaded || in.pair_generation != m.pair_generation) {
+  if (in.pair_generation != m.pair_generation) {
     m.pairs.Upload(in.pairs, in.pair_count, stream);
     m.pair_generation = in.pair_generation;
-    m.pairs_loaded = true;
   }
   // The previous contacts: the device's own last output, or the caller's.
-  if (!(in.previous_is_last_output && m.have_output)) {
-    m.contacts.Upload(in.previous->data(), in.previous->size(), stream);
-    m.have_output = true;
-  }
+  if (!in.previous_is_last_output) m.contacts.Upload(in.previous->data(), in.previous->size(), stream);
   m.previous.swap(m.contacts);  // last output (or the caller's) becomes the history
   Check(cudaMemsetAsync(m.flag.data(), 0, sizeof(int), stream), "cudaMemset");
   Check(cudaEventRecord(m.events[1], stream), "cudaEventRecord");

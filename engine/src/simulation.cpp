@@ -17,6 +17,7 @@
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "cuda_collide.hpp"
 #include "gather_core.hpp"
+#include "minimum_image.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -30,7 +31,6 @@ using detail::ContactHistory;
 using detail::ContactLaw;
 
 constexpr double kPi = std::numbers::pi;
-constexpr std::uint64_t kWallBit = std::uint64_t{1} << 63;
 // Pairs per work chunk. Chunks are fixed by the pair list, not by the thread
 // count, and their outputs are concatenated in order: determinism by construction.
 constexpr std::size_t kChunk = 64;
@@ -100,10 +100,6 @@ class ScopedTimer {
   double& sink_;
   Clock::time_point start_;
 };
-
-std::uint64_t PairKey(const Contact& c) {
-  return (c.wall ? kWallBit : 0) | (std::uint64_t{c.a} << 32) | c.b;
-}
 
 // People are named by id = index + 1, as in run files.
 std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i + 1); }
@@ -199,14 +195,13 @@ struct Simulation::Internals {
   bool overlap_beyond = false;  // set by Collide, see Check
   // The CUDA force computation of person pairs (WorldDef::device), and
   // whether it holds the previous evaluation's contacts (then they are not
-  // sent again); a new list of pairs is sent when pair_generation changes.
+  // sent again); a new list of pairs is sent at each rebuild (pair_rebuilds).
   // It also sums, per body, the forces and torques of the contacts it makes
   // (the first device_contacts of the contact list), as Gather would.
   std::unique_ptr<cuda::Collider> cuda;
   bool cuda_has_history = false;
   std::size_t device_contacts = 0;
   std::vector<detail::BodySums> device_sums;
-  std::uint64_t pair_generation = 0;
   // Contacts of each body (indices into contacts_, in contact order): CSR.
   std::vector<std::uint32_t> body_contact_start, body_contact_items, body_contact_fill;
   std::vector<Contact> previous_contacts;  // sorted by (pair key, feature)
@@ -469,16 +464,8 @@ void Simulation::Wrap(Vec2& p) const {
 Vec2 Simulation::Separation(Vec2 a, Vec2 b) const {
   Vec2 d = a - b;
   const PeriodicBox& box = def_.periodic;
-  // Rounding (a library call without SSE4.1) only when the difference is
-  // longer than half a period: the same result, far fewer calls.
-  if (box.x) {
-    const double l = box.max_m.x - box.min_m.x;
-    if (std::abs(d.x) > l / 2.0) d.x -= l * std::nearbyint(d.x / l);
-  }
-  if (box.y) {
-    const double l = box.max_m.y - box.min_m.y;
-    if (std::abs(d.y) > l / 2.0) d.y -= l * std::nearbyint(d.y / l);
-  }
+  if (box.x) d.x = detail::MinimumImage(d.x, box.max_m.x - box.min_m.x);
+  if (box.y) d.y = detail::MinimumImage(d.y, box.max_m.y - box.min_m.y);
   return d;
 }
 
@@ -502,7 +489,6 @@ void Simulation::UpdatePairs() {
     if (!rebuild) return;
   }
   ++profile_.pair_rebuilds;
-  ++in.pair_generation;
   in.pairs_valid = true;
   in.position_at_build = bodies_.position_m;
   in.pairs.clear();
@@ -776,7 +762,7 @@ void Simulation::Collide() {
   const auto add_contacts = [](const std::vector<ContactPoint>& points, std::uint32_t a, std::uint32_t b, bool wall,
                                const ContactLaw& pair_law, double mass, double radii, PreviousContacts& previous,
                                std::vector<Contact>& out, const auto& relative_velocity) {
-    const std::uint64_t key = (wall ? kWallBit : 0) | (std::uint64_t{a} << 32) | b;
+    const std::uint64_t key = PairKey(wall, a, b);
     const auto [sum, k_eff] = OverlapShares(points);
     const ContactLaw::Rates rates = pair_law.PairRates(mass, k_eff);
     bool beyond = false;
@@ -853,7 +839,7 @@ void Simulation::Collide() {
     input.shape = bodies_.shape.data();
     input.pairs = in.pairs.data();
     input.pair_count = in.pairs.size();
-    input.pair_generation = in.pair_generation;
+    input.pair_generation = profile_.pair_rebuilds;
     input.previous = &in.previous_contacts;
     input.previous_is_last_output = in.cuda_has_history;
     input.law = law;

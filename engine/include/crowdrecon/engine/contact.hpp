@@ -34,4 +34,12 @@ struct Contact {
   constexpr Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
 };
 
+// The key that orders contacts by pair (the contact list is sorted by it,
+// then by feature): person pairs by (a, b), then person-wall pairs.
+inline constexpr std::uint64_t kWallPairBit = std::uint64_t{1} << 63;
+constexpr std::uint64_t PairKey(bool wall, std::uint32_t a, std::uint32_t b) {
+  return (wall ? kWallPairBit : 0) | (std::uint64_t{a} << 32) | b;
+}
+constexpr std::uint64_t PairKey(const Contact& c) { return PairKey(c.wall, c.a, c.b); }
+
 }  // namespace crowdrecon::engine
