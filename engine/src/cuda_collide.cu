@@ -194,15 +194,9 @@ template <typename Sink>
 __device__ void VerticesAgainst(const Placed& from, const Placed& to, bool flip, std::uint32_t tag, Sink& sink) {
   const DeviceGeometry& f = *from.geometry;
   const DeviceGeometry& g = *to.geometry;
-  const double reach = f.radius_m * from.scale + g.radius_m * to.scale;
-  const double unit = to.scale;
-  const double reach_g = reach / unit;
-  const double ratio = from.scale / unit;
-  const double c = (from.cos_angle * to.cos_angle + from.sin_angle * to.sin_angle) * ratio;
-  const double s = (from.sin_angle * to.cos_angle - from.cos_angle * to.sin_angle) * ratio;
-  const Vec2 d = from.position - to.position;
-  const Vec2 o = Vec2{to.cos_angle * d.x + to.sin_angle * d.y, -to.sin_angle * d.x + to.cos_angle * d.y} / unit;
-  const Vec2 lo = g.box_min - Vec2{reach_g, reach_g}, hi = g.box_max + Vec2{reach_g, reach_g};
+  const detail::VertexFrame frame = detail::FrameOf(from, to);  // g's units and frame
+  const double reach = frame.reach, unit = frame.unit, reach_g = frame.reach_g, c = frame.c, s = frame.s;
+  const Vec2 o = frame.o, lo = frame.lo, hi = frame.hi;
   const bool use_grid = g.grid && reach_g <= g.grid_reach_m;
   const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
   for (std::uint32_t i = 0; i < f.count(); ++i) {

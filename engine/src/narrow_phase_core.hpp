@@ -96,4 +96,34 @@ CROWDRECON_HOST_DEVICE CROWDRECON_INLINE double BoxesGap(const Placed& a, const 
   return std::max(std::max(gap_ua, gap_va), std::max(gap_ub, gap_vb));
 }
 
+// The frame in which the vertices of `from` are measured against the core of
+// `to` (VerticesAgainst): to's geometry's own units and frame. A vertex v of
+// from's geometry is at (c v.x - s v.y + o.x, s v.x + c v.y + o.y) there: the
+// rotation by (theta_from - theta_to) with the ratio of scales, then the
+// offset of from's origin seen in to's frame. `reach` (metres) is the sum of
+// the two sphero-radii, `reach_g` the same in to's units; [lo, hi] is to's
+// core box grown by it.
+struct VertexFrame {
+  double reach, unit, reach_g, c, s;
+  Vec2 o, lo, hi;
+};
+
+template <typename Placed>
+CROWDRECON_HOST_DEVICE CROWDRECON_INLINE VertexFrame FrameOf(const Placed& from, const Placed& to) {
+  const auto& f = *from.geometry;
+  const auto& g = *to.geometry;
+  VertexFrame fr;
+  fr.reach = f.radius_m * from.scale + g.radius_m * to.scale;  // metres
+  fr.unit = to.scale;                                            // metres per unit of g
+  fr.reach_g = fr.reach / fr.unit;
+  const double ratio = from.scale / fr.unit;
+  fr.c = (from.cos_angle * to.cos_angle + from.sin_angle * to.sin_angle) * ratio;
+  fr.s = (from.sin_angle * to.cos_angle - from.cos_angle * to.sin_angle) * ratio;
+  const Vec2 d = from.position - to.position;
+  fr.o = Vec2{to.cos_angle * d.x + to.sin_angle * d.y, -to.sin_angle * d.x + to.cos_angle * d.y} / fr.unit;
+  fr.lo = g.box_min - Vec2{fr.reach_g, fr.reach_g};
+  fr.hi = g.box_max + Vec2{fr.reach_g, fr.reach_g};
+  return fr;
+}
+
 }  // namespace crowdrecon::engine::detail
