@@ -24,27 +24,25 @@ struct BodySums {
 // body b, whose centre in the contact's frame (a's periodic image) is
 // `centre` (ERRATA 11: each contact acts on both bodies, equal and opposite,
 // each with its own branch vector).
+//
+// A contact that lasted the whole step both sides of this evaluation (both
+// fractions 1, nearly every contact) has no corrections: its terms would be
+// zeros (+0 or -0), which leave any sum as it is (a sum that starts at +0
+// never becomes -0 in round-to-nearest), so they are not added at all.
 CROWDRECON_HOST_DEVICE inline void AddContact(BodySums& s, const Contact& c, bool on_a, Vec2 centre) {
   const Vec2 f = c.Force();
+  const Vec2 arm = c.point_m - centre;
+  const double sign = on_a ? 1.0 : -1.0;
+  s.force += f * sign;
+  s.torque += Cross(arm, f) * sign;
+  if (c.trailing_fraction == 1.0 && c.leading_fraction == 1.0) return;
   const Vec2 viscous = c.normal * c.viscous_normal_n + Perp(c.normal) * c.viscous_tangential_n;
   const Vec2 trailing = viscous * (c.trailing_fraction - 1.0);
   const Vec2 leading = viscous * (c.leading_fraction - 1.0);
-  const Vec2 arm = c.point_m - centre;
-  if (on_a) {
-    s.force += f;
-    s.torque += Cross(arm, f);
-    s.trailing_force += trailing;
-    s.trailing_torque += Cross(arm, trailing);
-    s.leading_force += leading;
-    s.leading_torque += Cross(arm, leading);
-  } else {
-    s.force -= f;
-    s.torque -= Cross(arm, f);
-    s.trailing_force -= trailing;
-    s.trailing_torque -= Cross(arm, trailing);
-    s.leading_force -= leading;
-    s.leading_torque -= Cross(arm, leading);
-  }
+  s.trailing_force += trailing * sign;
+  s.trailing_torque += Cross(arm, trailing) * sign;
+  s.leading_force += leading * sign;
+  s.leading_torque += Cross(arm, leading) * sign;
 }
 
 }  // namespace crowdrecon::engine::detail
