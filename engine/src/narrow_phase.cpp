@@ -67,10 +67,9 @@ Closest ClosestOnCore(Vec2 p, const ShapeGeometry& g) { return ClosestOnCore(p, 
 // Returns the least clearance (d - reach, metres) over the vertices that did
 // not touch, +infinity if there were none; see CollideShapes. `memory` (or
 // null): per vertex of `from`, skip it while moved < memory[i], and record
-// the bound for the vertices measured apart; `summary` (or null, and only
-// with memory): from's side of the pair's VertexSummary.
+// the bound for the vertices measured apart.
 double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip, std::uint32_t tag,
-                       std::vector<ContactPoint>& out, double moved, double* memory, VertexSummary* summary) {
+                       std::vector<ContactPoint>& out, double moved, double* memory) {
   const ShapeGeometry& f = *from.geometry;
   const ShapeGeometry& g = *to.geometry;
   const detail::VertexFrame frame = detail::FrameOf(from, to);  // g's units and frame
@@ -80,23 +79,11 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
   const double inverse_cell = use_grid ? 1.0 / g.grid_cell_m : 0.0;
   const std::uint32_t n = f.count();
   double clearance = std::numeric_limits<double>::infinity();  // g's units
-  // With a summary (n <= 64), kept up to date here: the vertices within
-  // reach (hot), and the least threshold of the others (cold).
-  const bool summarised = summary && n <= 64;
-  std::uint64_t hot = 0;
-  double cold = std::numeric_limits<double>::infinity();
   // Vertex i measured apart by `gap` (g's units): the pair's least, and the
-  // vertex's own threshold; ahead, it is cold now.
+  // vertex's own threshold.
   const auto apart = [&](std::uint32_t i, double gap) {
     clearance = std::min(clearance, gap);
-    if (memory) {
-      const double threshold = moved + gap * unit - kClearanceSlack_m;
-      memory[i] = threshold;
-      if (summarised && moved < threshold) {
-        hot &= ~(std::uint64_t{1} << i);
-        cold = std::min(cold, threshold);
-      }
-    }
+    if (memory) memory[i] = moved + gap * unit - kClearanceSlack_m;
   };
   // Least threshold of the vertices skipped below: their clearance, min over
   // i of (memory[i] - moved) / unit, is (least - moved) / unit (monotone in
@@ -157,37 +144,22 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
   // In blocks of 64 vertices: first, in a short loop of their own, which
   // vertices are still apart since they were last measured (and the least of
   // their thresholds), then the others are measured, in vertex order.
-  if (summarised && moved < summary->cold) {
-    // Only the hot vertices can touch (their thresholds are behind: they
-    // were at the last call, and `moved` never goes back); the others are
-    // skipped unread, the least of their thresholds being `cold`.
-    hot = summary->hot;
-    cold = least_skipped = summary->cold;
-    for (std::uint64_t todo = hot; todo != 0; todo &= todo - 1)
-      measure(static_cast<std::uint32_t>(std::countr_zero(todo)));
-  } else {
-    for (std::uint32_t base = 0; base < n; base += 64) {
-      const std::uint32_t count = std::min<std::uint32_t>(64, n - base);
-      std::uint64_t todo = count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
-      if (memory) {
-        todo = 0;
-        double least = least_skipped;
-        for (std::uint32_t k = 0; k < count; ++k) {
-          const double threshold = memory[base + k];
-          const bool skip = moved < threshold;
-          least = std::min(least, skip ? threshold : std::numeric_limits<double>::infinity());
-          todo |= std::uint64_t{!skip} << k;
-        }
-        least_skipped = least;
+  for (std::uint32_t base = 0; base < n; base += 64) {
+    const std::uint32_t count = std::min<std::uint32_t>(64, n - base);
+    std::uint64_t todo = count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
+    if (memory) {
+      todo = 0;
+      double least = least_skipped;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        const double threshold = memory[base + k];
+        const bool skip = moved < threshold;
+        least = std::min(least, skip ? threshold : std::numeric_limits<double>::infinity());
+        todo |= std::uint64_t{!skip} << k;
       }
-      if (summarised) {  // (a single block: base 0)
-        hot = todo;
-        cold = least_skipped;
-      }
-      for (; todo != 0; todo &= todo - 1) measure(base + static_cast<std::uint32_t>(std::countr_zero(todo)));
+      least_skipped = least;
     }
+    for (; todo != 0; todo &= todo - 1) measure(base + static_cast<std::uint32_t>(std::countr_zero(todo)));
   }
-  if (summarised) *summary = {hot, cold};
   if (least_skipped < std::numeric_limits<double>::infinity())
     clearance = std::min(clearance, (least_skipped - moved) / unit);
   return clearance * unit;  // (an infinity stays one)
@@ -266,12 +238,9 @@ double CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<Con
   const std::size_t before = out.size();
   double clearance = std::numeric_limits<double>::infinity();
   const double moved = memory ? memory->moved : 0.0;
-  VertexSummary* summary = memory ? memory->summary : nullptr;
-  if (a_side)
-    clearance = std::min(clearance, VerticesAgainst(a, b, false, 0u, out, moved, memory ? memory->a : nullptr, summary));
+  if (a_side) clearance = std::min(clearance, VerticesAgainst(a, b, false, 0u, out, moved, memory ? memory->a : nullptr));
   if (b_side)
-    clearance = std::min(clearance, VerticesAgainst(b, a, true, kVertexOfB, out, moved, memory ? memory->b : nullptr,
-                                                    summary ? summary + 1 : nullptr));
+    clearance = std::min(clearance, VerticesAgainst(b, a, true, kVertexOfB, out, moved, memory ? memory->b : nullptr));
   if (out.size() != before) return 0.0;
   return std::max(0.0, clearance);
 }

@@ -56,7 +56,6 @@ struct PairClearances {
   std::vector<double> pair_m;
   std::vector<std::size_t> vertex_start;
   std::vector<double> vertex_m;
-  std::vector<VertexSummary> summary;  // two per pair: its first shape's vertices', its second's
 
   // For a new list: nothing known. `vertices(k)` = the vertex count of both shapes of pair k.
   // The vertex entries (several megabytes for 10,000 people) are filled by
@@ -69,7 +68,6 @@ struct PairClearances {
     vertex_start[0] = 0;
     for (std::size_t k = 0; k < pairs; ++k) vertex_start[k + 1] = vertex_start[k] + vertices(k);
     vertex_m.resize(vertex_start.back());
-    summary.assign(2 * pairs, VertexSummary{});
     const std::int64_t count = static_cast<std::int64_t>(vertex_m.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (count >= 65536)
     for (std::int64_t v = 0; v < count; ++v) vertex_m[static_cast<std::size_t>(v)] = kNever;
@@ -85,7 +83,7 @@ struct PairClearances {
       return;
     }
     double* vertex_clear = vertex_m.data() + vertex_start[k];
-    const VertexClearances memory{moved, vertex_clear, vertex_clear + a.geometry->count(), &summary[2 * k]};
+    const VertexClearances memory{moved, vertex_clear, vertex_clear + a.geometry->count()};
     const double clearance = CollideShapes(a, b, points, &memory);
     if (points.empty()) pair_m[k] = moved + clearance - kClearanceSlack_m;
   }

@@ -32,7 +32,6 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 #include "crowdrecon/common/vec2.hpp"
@@ -120,24 +119,10 @@ inline constexpr double kClearanceSlack_m = 1e-9;
 // caller knows and that never goes back; a[i] (b[i]) holds for vertex i of A
 // (of B) the value of `moved` below which it cannot touch: it is skipped while
 // moved < a[i], and measured and updated otherwise. Start with -infinity.
-//
-// Optionally, per side, a summary of those entries that spares reading them
-// all at every call (shapes of up to 64 vertices; larger ones always read
-// them): `hot`, the vertices within reach after the last call (bit i: vertex
-// i, a[i] <= moved then), and `cold`, the least entry of the others. While
-// moved < cold, only the hot vertices can touch: they are measured, the
-// others skipped unread. Start with hot 0, cold -infinity; a summary needs
-// the entries a and b.
-struct VertexSummary {
-  std::uint64_t hot = 0;
-  double cold = -std::numeric_limits<double>::infinity();
-};
-
 struct VertexClearances {
   double moved = 0.0;
   double* a = nullptr;  // A's vertex count entries
   double* b = nullptr;  // B's vertex count entries
-  VertexSummary* summary = nullptr;  // null, or two: A's vertices', B's
 };
 
 // Appends the contacts between A and B to `out` (nothing if they do not touch),
@@ -154,8 +139,7 @@ struct VertexClearances {
 // from a cull already taken: the bounding circles, the separating axis of the
 // grown boxes, per vertex its grown box or its grid cell or its distance.
 // With `memory`, vertices still apart since their last measurement are
-// skipped (they cannot touch); the result is the same, contacts, order and
-// clearance, with or without summaries.
+// skipped (they cannot touch); the result is the same, contacts and order.
 double CollideShapes(const PlacedShape& a, const PlacedShape& b, std::vector<ContactPoint>& out,
                      const VertexClearances* memory = nullptr);
 
