@@ -10,7 +10,7 @@
 // steps after a load measure every pair afresh), then --steps steps (100)
 // inside MeasuredSteps(), the function to give callgrind:
 //
-//   valgrind --tool=callgrind --toggle-collect='MeasuredSteps*'
+//   valgrind --tool=callgrind --toggle-collect='*MeasuredSteps*'
 //       build/release/bench/crowdrecon_step_world W.world W.state --steps=10
 //   (one command)
 //

@@ -657,16 +657,10 @@ namespace {
 
 // The contact of persons (or person and wall) a, b at a narrow-phase point,
 // before the contact law fills its forces.
+// Every member is given (no zero-filling of the record first): the contact
+// law then sets the forces.
 Contact ContactAt(const ContactPoint& p, std::uint32_t a, std::uint32_t b, bool wall) {
-  Contact c;
-  c.a = a;
-  c.b = b;
-  c.wall = wall;
-  c.feature = p.feature;
-  c.point_m = p.point;
-  c.normal = p.normal;
-  c.overlap_m = p.overlap_m;
-  return c;
+  return Contact{a, b, wall, p.feature, p.point, p.normal, p.overlap_m, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0};
 }
 
 // Sum of the overlaps of a pair's points and their overlap-weighted count
