@@ -1,7 +1,8 @@
-// DXF floor plans via dxflib. Curves are flattened into segments, pieces whose
-// endpoints meet are chained into rings, and the nesting of the rings decides
-// what is walkable (even depth) and what is an obstacle (odd depth), which is
-// how a plan drawn as "outline plus pillars" reads.
+// DXF floor plans via dxflib. Curves are flattened into segments, block
+// inserts are expanded (nested, scaled, rotated, mirrored, in arrays), pieces
+// whose endpoints meet are chained into rings, and the nesting of the rings
+// decides what is walkable (even depth) and what is an obstacle (odd depth),
+// which is how a plan drawn as "outline plus pillars" reads.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -24,6 +25,42 @@ namespace {
 struct Piece {
   std::vector<Vec2> points;  // in file units
   bool closed = false;
+  std::string layer;        // the entity's layer ("0" inside a block: the INSERT's)
+  std::string unsupported;  // an entity that cannot be read ("SPLINE"): an error if it is wanted
+};
+
+// An INSERT: block `name` placed at `at`, scaled, rotated (degrees,
+// counter-clockwise) and repeated in `columns` x `rows` (MINSERT spacing,
+// along the rotated axes).
+struct Insert {
+  std::string name, layer;
+  Vec2 at;
+  double scale_x = 1.0, scale_y = 1.0, angle_deg = 0.0;
+  int columns = 1, rows = 1;
+  double column_spacing = 0.0, row_spacing = 0.0;
+};
+
+// A block definition: its base point and what it draws, inserts included.
+struct Block {
+  Vec2 base;
+  std::vector<Piece> pieces;
+  std::vector<Insert> inserts;
+};
+
+// x' = m[0] x + m[1] y + m[4], y' = m[2] x + m[3] y + m[5].
+struct Affine {
+  double m[6] = {1.0, 0.0, 0.0, 1.0, 0.0, 0.0};
+  Vec2 operator()(Vec2 p) const { return {m[0] * p.x + m[1] * p.y + m[4], m[2] * p.x + m[3] * p.y + m[5]}; }
+  Affine Then(const Affine& outer) const {  // outer after this
+    Affine r;
+    r.m[0] = outer.m[0] * m[0] + outer.m[1] * m[2];
+    r.m[1] = outer.m[0] * m[1] + outer.m[1] * m[3];
+    r.m[2] = outer.m[2] * m[0] + outer.m[3] * m[2];
+    r.m[3] = outer.m[2] * m[1] + outer.m[3] * m[3];
+    r.m[4] = outer.m[0] * m[4] + outer.m[1] * m[5] + outer.m[4];
+    r.m[5] = outer.m[2] * m[4] + outer.m[3] * m[5] + outer.m[5];
+    return r;
+  }
 };
 
 // Number of segments for an arc of radius r and sweep |angle| so that the
@@ -77,36 +114,84 @@ class Collector : public DL_CreationAdapter {
   void setVariableInt(const std::string& key, int value, int /*code*/) override {
     if (key == "$INSUNITS") insunits_ = value;
   }
-  void addBlock(const DL_BlockData&) override {
+  // Block definitions are kept, and drawn where an INSERT places them
+  // (Collect); what lies in a block is drawn only through its inserts.
+  void addBlock(const DL_BlockData& d) override {
     FinishPolyline();
-    in_block_ = true;  // block definitions are templates, not drawn geometry
+    block_ = &blocks_[d.name];
+    *block_ = Block{};
+    block_->base = {d.bpx, d.bpy};
   }
-  void endBlock() override { in_block_ = false; }
+  void endBlock() override {
+    FinishPolyline();
+    block_ = nullptr;
+  }
+  void addInsert(const DL_InsertData& d) override {
+    FinishPolyline();
+    Insert insert;
+    insert.name = d.name;
+    insert.layer = getAttributes().getLayer();
+    insert.at = {d.ipx, d.ipy};
+    insert.scale_x = d.sx;
+    insert.scale_y = d.sy;
+    insert.angle_deg = d.angle;
+    insert.columns = std::max(1, d.cols);
+    insert.rows = std::max(1, d.rows);
+    insert.column_spacing = d.colSp;
+    insert.row_spacing = d.rowSp;
+    (block_ ? block_->inserts : inserts_).push_back(std::move(insert));
+  }
 
   void addLine(const DL_LineData& d) override {
     FinishPolyline();
-    if (!Wanted()) return;
-    pieces_.push_back({{{d.x1, d.y1}, {d.x2, d.y2}}, false});
+    Add({{d.x1, d.y1}, {d.x2, d.y2}}, false);
   }
   void addArc(const DL_ArcData& d) override {
     FinishPolyline();
-    if (!Wanted() || d.radius <= 0.0) return;
+    if (d.radius <= 0.0) return;
     double sweep_deg = std::fmod(d.angle2 - d.angle1, 360.0);
     if (sweep_deg <= 0.0) sweep_deg += 360.0;  // DXF arcs run counter-clockwise
-    pieces_.push_back({ArcPoints({d.cx, d.cy}, d.radius, Radians(d.angle1), Radians(sweep_deg), Tolerance(), true),
-                       false});
+    Add(ArcPoints({d.cx, d.cy}, d.radius, Radians(d.angle1), Radians(sweep_deg), Tolerance(), true), false);
   }
   void addCircle(const DL_CircleData& d) override {
     FinishPolyline();
-    if (!Wanted() || d.radius <= 0.0) return;
+    if (d.radius <= 0.0) return;
     std::vector<Vec2> ring = ArcPoints({d.cx, d.cy}, d.radius, 0.0, 2.0 * std::numbers::pi, Tolerance(), false);
     // A circle needs at least a few vertices to be a ring of the right area.
     if (ring.size() < 8) ring = ArcPoints({d.cx, d.cy}, d.radius, 0.0, 2.0 * std::numbers::pi, 0.0, false);
-    pieces_.push_back({ring, true});
+    Add(std::move(ring), true);
+  }
+  // An ellipse or elliptic arc: centre, major axis (end point relative to the
+  // centre), ratio of the axes, and the range of the parameter (radians).
+  void addEllipse(const DL_EllipseData& d) override {
+    FinishPolyline();
+    const Vec2 centre{d.cx, d.cy}, major{d.mx, d.my};
+    const Vec2 minor = Perp(major) * d.ratio;
+    const double radius = Length(major);
+    if (radius <= 0.0 || d.ratio <= 0.0) return;
+    double sweep = std::fmod(d.angle2 - d.angle1, 2.0 * std::numbers::pi);
+    if (sweep <= 1e-12) sweep += 2.0 * std::numbers::pi;
+    const bool closed = std::abs(sweep - 2.0 * std::numbers::pi) < 1e-9;
+    // Segments as for a circle of the major radius (the chord deviation of
+    // an ellipse is at most that of its major circle for the same parameter step).
+    const std::size_t n = std::max<std::size_t>(ArcSegments(radius, sweep, Tolerance()), closed ? 8 : 1);
+    std::vector<Vec2> points;
+    for (std::size_t k = 0; k <= n; ++k) {
+      if (k == n && closed) break;
+      const double t = d.angle1 + sweep * static_cast<double>(k) / static_cast<double>(n);
+      points.push_back(centre + major * std::cos(t) + minor * std::sin(t));
+    }
+    Add(std::move(points), closed);
+  }
+  // Splines are not flattened here: a wanted one is an error (Collect).
+  void addSpline(const DL_SplineData&) override {
+    FinishPolyline();
+    Add({}, false, "SPLINE");
   }
   void addPolyline(const DL_PolylineData& d) override {
     FinishPolyline();
-    polyline_active_ = Wanted();
+    polyline_active_ = true;
+    polyline_layer_ = getAttributes().getLayer();
     polyline_closed_ = (d.flags & 1) != 0;
     vertices_.clear();
     bulges_.clear();
@@ -146,36 +231,96 @@ class Collector : public DL_CreationAdapter {
       }
     }
     if (!polyline_closed_) points.push_back(vertices_.back());
-    pieces_.push_back({std::move(points), polyline_closed_});
+    Piece piece{std::move(points), polyline_closed_, polyline_layer_, {}};
+    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
   }
 
-  std::vector<Piece>& pieces() { return pieces_; }
+  // The drawing's pieces on the wanted layer (all layers if none was named),
+  // with every INSERT expanded, in drawing units. Entities in a block on
+  // layer "0" take the layer of the INSERT that places them (DXF's rule).
+  std::vector<Piece> Collect(const std::string& file) {
+    std::vector<Piece> out;
+    for (const Piece& p : pieces_) Keep(p, p.layer, Affine{}, "", file, out);
+    for (const Insert& insert : inserts_) Expand(insert, Affine{}, insert.layer, 0, file, out);
+    return out;
+  }
+
   std::size_t skipped_layers() const { return skipped_; }
 
  private:
   static double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
-  bool Wanted() {
-    if (in_block_) return false;
-    if (!layer_.empty() && getAttributes().getLayer() != layer_) {
-      ++skipped_;
-      return false;
-    }
-    return true;
+  // Into the current block or the drawing, with the entity's layer.
+  void Add(std::vector<Vec2> points, bool closed, std::string unsupported = {}) {
+    Piece piece{std::move(points), closed, getAttributes().getLayer(), std::move(unsupported)};
+    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
   }
 
-  double Tolerance() const { return tolerance_m_ / Scale(); }
+  // Piece p (drawn with `layer`) placed by `to`, if on the wanted layer.
+  void Keep(const Piece& p, const std::string& layer, const Affine& to, const std::string& block,
+            const std::string& file, std::vector<Piece>& out) {
+    if (!layer_.empty() && layer != layer_) {
+      ++skipped_;
+      return;
+    }
+    if (!p.unsupported.empty())
+      throw InputError(file + ": a " + p.unsupported + " on layer \"" + layer + "\"" +
+                       (block.empty() ? "" : " (in block \"" + block + "\")") +
+                       " cannot be read; expected lines, arcs, circles, ellipses and polylines (convert the " +
+                       p.unsupported + " to a polyline, or draw it on a layer that is not imported)");
+    Piece placed{{}, p.closed, layer, {}};
+    placed.points.reserve(p.points.size());
+    for (Vec2 q : p.points) placed.points.push_back(to(q));
+    out.push_back(std::move(placed));
+  }
 
+  void Expand(const Insert& insert, const Affine& outer, const std::string& layer, int depth, const std::string& file,
+              std::vector<Piece>& out) {
+    const auto found = blocks_.find(insert.name);
+    if (found == blocks_.end())
+      throw InputError(file + ": an INSERT places block \"" + insert.name + "\", which the file does not define");
+    if (depth >= kMaxBlockDepth)
+      throw InputError(file + ": block \"" + insert.name + "\" is inserted more than " +
+                       std::to_string(kMaxBlockDepth) + " levels deep (does a block insert itself?)");
+    const Block& block = found->second;
+    const double a = Radians(insert.angle_deg), c = std::cos(a), s = std::sin(a);
+    for (int row = 0; row < insert.rows; ++row)
+      for (int column = 0; column < insert.columns; ++column) {
+        // Block point q: u = scale (q - base) + array offset; placed at `at` + R(angle) u.
+        Affine local;
+        local.m[0] = c * insert.scale_x;
+        local.m[1] = -s * insert.scale_y;
+        local.m[2] = s * insert.scale_x;
+        local.m[3] = c * insert.scale_y;
+        const Vec2 offset{column * insert.column_spacing - insert.scale_x * block.base.x,
+                          row * insert.row_spacing - insert.scale_y * block.base.y};
+        local.m[4] = insert.at.x + c * offset.x - s * offset.y;
+        local.m[5] = insert.at.y + s * offset.x + c * offset.y;
+        const Affine to = local.Then(outer);
+        for (const Piece& p : block.pieces) Keep(p, p.layer == "0" ? layer : p.layer, to, insert.name, file, out);
+        for (const Insert& inner : block.inserts)
+          Expand(inner, to, inner.layer == "0" ? layer : inner.layer, depth + 1, file, out);
+      }
+  }
+
+  // Drawing units. Curves in blocks are flattened 16 times finer, since an
+  // INSERT may scale them up.
+  double Tolerance() const { return tolerance_m_ / Scale() / (block_ ? 16.0 : 1.0); }
+
+  static constexpr int kMaxBlockDepth = 32;
   std::string layer_;
   double tolerance_m_;
   double scale_override_;
   int insunits_ = 0;
-  bool in_block_ = false;
   bool polyline_active_ = false;
   bool polyline_closed_ = false;
+  std::string polyline_layer_;
   std::vector<Vec2> vertices_;
   std::vector<double> bulges_;
   std::vector<Piece> pieces_;
+  std::vector<Insert> inserts_;
+  std::map<std::string, Block> blocks_;
+  Block* block_ = nullptr;  // the block being defined, or null
   std::size_t skipped_ = 0;
 };
 
@@ -266,7 +411,7 @@ Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options)
   collector.FinishPolyline();
   const double scale = collector.Scale();
 
-  std::vector<Piece> pieces = std::move(collector.pieces());
+  std::vector<Piece> pieces = collector.Collect(file.string());
   const double join_units = options.dxf_join_tolerance_m / scale;
   for (Piece& p : pieces) p.points = WithoutRepeats(p.points, join_units * 1e-3);
   pieces.erase(std::remove_if(pieces.begin(), pieces.end(),

@@ -211,6 +211,123 @@ TEST(VenueImport, DxfWithoutClosedRegionIsAnError) {
   EXPECT_NE(m.find("no closed region found on layer \"nothing-here\""), std::string::npos) << m;
 }
 
+// A DXF file with a BLOCKS section before the entities.
+std::string DxfFileWithBlocks(const std::string& blocks, const std::string& entities) {
+  return "0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n6\n0\nENDSEC\n0\nSECTION\n2\nBLOCKS\n" + blocks +
+         "0\nENDSEC\n0\nSECTION\n2\nENTITIES\n" + entities + "0\nENDSEC\n0\nEOF\n";
+}
+
+std::string DxfBlock(const std::string& name, Vec2 base, const std::string& entities) {
+  return "0\nBLOCK\n8\n0\n2\n" + name + "\n70\n0\n10\n" + Num(base.x) + "\n20\n" + Num(base.y) + "\n30\n0\n" +
+         entities + "0\nENDBLK\n8\n0\n";
+}
+
+struct DxfPlacement {
+  Vec2 at;
+  double scale_x = 1.0, scale_y = 1.0, angle_deg = 0.0;
+  int columns = 1, rows = 1;
+  double column_spacing = 0.0, row_spacing = 0.0;
+};
+
+std::string DxfInsert(const std::string& block, const DxfPlacement& p, const std::string& layer = "0") {
+  return "0\nINSERT\n8\n" + layer + "\n2\n" + block + "\n10\n" + Num(p.at.x) + "\n20\n" + Num(p.at.y) + "\n41\n" +
+         Num(p.scale_x) + "\n42\n" + Num(p.scale_y) + "\n50\n" + Num(p.angle_deg) + "\n70\n" +
+         std::to_string(p.columns) + "\n71\n" + std::to_string(p.rows) + "\n44\n" + Num(p.column_spacing) +
+         "\n45\n" + Num(p.row_spacing) + "\n";
+}
+
+// The obstacle whose polygon contains p (by its bounding box), or null.
+const Obstacle* ObstacleAt(const Venue& v, Vec2 p) {
+  for (const Obstacle& o : v.obstacles) {
+    Vec2 lo = o.polygon[0], hi = o.polygon[0];
+    for (Vec2 q : o.polygon) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    if (p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y) return &o;
+  }
+  return nullptr;
+}
+
+double ExtentX(const Obstacle& o) {
+  double lo = o.polygon[0].x, hi = lo;
+  for (Vec2 q : o.polygon) lo = std::min(lo, q.x), hi = std::max(hi, q.x);
+  return hi - lo;
+}
+
+TEST(VenueImport, DxfBlockInsertsAreExpanded) {
+  // A 10 m x 6 m room; pillars drawn once, in block PILLAR (a 0.4 m square
+  // around its base point (1, 1), on layer "0"), and placed by INSERTs: plain,
+  // scaled by 2 and turned 45 degrees, mirrored, as a 2 x 2 array (MINSERT),
+  // twice through a nested block PAIR, and once on another layer.
+  const std::string pillar =
+      DxfBlock("PILLAR", {1, 1}, DxfPolyline({{0.8, 0.8}, {1.2, 0.8}, {1.2, 1.2}, {0.8, 1.2}}, true));
+  const std::string pair =
+      DxfBlock("PAIR", {0, 0}, DxfInsert("PILLAR", {{0, 0}}) + DxfInsert("PILLAR", {{0.8, 0}}));
+  DxfPlacement turned{{5, 3}};
+  turned.scale_x = turned.scale_y = 2.0;
+  turned.angle_deg = 45.0;
+  DxfPlacement mirrored{{4, 1}};
+  mirrored.scale_x = -1.0;
+  DxfPlacement array{{7, 1.5}};
+  array.columns = array.rows = 2;
+  array.column_spacing = array.row_spacing = 1.0;
+  const std::string entities = DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true, "plan") +
+                               DxfInsert("PILLAR", {{2, 3}}, "plan") + DxfInsert("PILLAR", turned, "plan") +
+                               DxfInsert("PILLAR", mirrored, "plan") + DxfInsert("PILLAR", array, "plan") +
+                               DxfInsert("PAIR", {{2, 5}}, "plan") + DxfInsert("PILLAR", {{8.5, 4.5}}, "furniture");
+  const auto path = WriteText("blocks.dxf", DxfFileWithBlocks(pillar + pair, entities));
+  ImportOptions options;
+  options.dxf_layer = "plan";
+  const Venue v = ImportDxf(path, options);
+  // 1 + 1 + 1 + 4 + 2 pillars of 0.16 m2, the turned one 0.64 m2.
+  EXPECT_EQ(v.obstacles.size(), 9u);
+  EXPECT_NEAR(WalkableArea_m2(v), 60.0 - 8 * 0.16 - 0.64, 1e-9);
+  for (Vec2 centre : {Vec2{2, 3}, Vec2{4, 1}, Vec2{7, 1.5}, Vec2{8, 1.5}, Vec2{7, 2.5}, Vec2{8, 2.5}, Vec2{2, 5},
+                      Vec2{2.8, 5}}) {
+    const Obstacle* o = ObstacleAt(v, centre);
+    ASSERT_NE(o, nullptr) << centre.x << ", " << centre.y;
+    EXPECT_NEAR(ExtentX(*o), 0.4, 1e-9) << centre.x << ", " << centre.y;
+  }
+  const Obstacle* turned_pillar = ObstacleAt(v, {5, 3});
+  ASSERT_NE(turned_pillar, nullptr);
+  EXPECT_NEAR(ExtentX(*turned_pillar), 0.8 * std::sqrt(2.0), 1e-9);  // a 0.8 m square turned 45 degrees
+  EXPECT_EQ(ObstacleAt(v, {8.5, 4.5}), nullptr);                      // on layer "furniture"
+  // All layers: the furniture's pillar too.
+  EXPECT_EQ(ImportDxf(path).obstacles.size(), 10u);
+}
+
+TEST(VenueImport, DxfBlockErrorsAndEllipses) {
+  const std::string room = DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true);
+  // An INSERT of a block the file does not define.
+  std::string m = ErrorOf([&] { ImportDxf(WriteText("no-block.dxf", DxfFileWithBlocks("", room + DxfInsert("GHOST", {{1, 1}})))); });
+  EXPECT_NE(m.find("no-block.dxf: an INSERT places block \"GHOST\", which the file does not define"),
+            std::string::npos) << m;
+  // A block that inserts itself.
+  const std::string loop = DxfBlock("LOOP", {0, 0}, DxfInsert("LOOP", {{0.1, 0}}));
+  m = ErrorOf([&] { ImportDxf(WriteText("loop.dxf", DxfFileWithBlocks(loop, room + DxfInsert("LOOP", {{1, 1}})))); });
+  EXPECT_NE(m.find("loop.dxf: block \"LOOP\" is inserted more than 32 levels deep"), std::string::npos) << m;
+  // A spline on the imported layer is refused, naming it; on another layer it is left out.
+  const std::string spline = "0\nSPLINE\n8\ncurves\n70\n8\n71\n3\n72\n8\n73\n4\n40\n0\n40\n0\n40\n0\n40\n0\n40\n1\n40\n1\n40\n1\n40\n1\n"
+                             "10\n1\n20\n1\n10\n2\n20\n2\n10\n3\n20\n1\n10\n4\n20\n2\n";
+  const auto spline_path = WriteText("spline.dxf", DxfFile(DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true, "plan") + spline));
+  m = ErrorOf([&] { ImportDxf(spline_path); });
+  EXPECT_NE(m.find("spline.dxf: a SPLINE on layer \"curves\" cannot be read"), std::string::npos) << m;
+  ImportOptions options;
+  options.dxf_layer = "plan";
+  EXPECT_NEAR(WalkableArea_m2(ImportDxf(spline_path, options)), 60.0, 1e-9);
+  // A full ellipse (semi-axes 1 and 0.5, turned 30 degrees) as a pillar: its area within the flattening.
+  const double c = std::cos(std::numbers::pi / 6.0), s = std::sin(std::numbers::pi / 6.0);
+  const std::string ellipse = "0\nELLIPSE\n8\n0\n10\n5\n20\n3\n30\n0\n11\n" + Num(c) + "\n21\n" + Num(s) +
+                              "\n31\n0\n40\n0.5\n41\n0\n42\n" + Num(2.0 * std::numbers::pi) + "\n";
+  options.dxf_layer.clear();
+  options.dxf_arc_tolerance_m = 1e-4;
+  const Venue v = ImportDxf(WriteText("ellipse.dxf", DxfFile(room + ellipse)), options);
+  ASSERT_EQ(v.obstacles.size(), 1u);
+  EXPECT_NEAR(WalkableArea_m2(v), 60.0 - std::numbers::pi * 0.5, 2e-3);
+  EXPECT_NEAR(ExtentX(v.obstacles[0]), 2.0 * std::sqrt(c * c + 0.25 * s * s), 1e-3);
+}
+
 // --- raster -------------------------------------------------------------------
 
 // Draws a plan at `ppm` pixels per metre: black everywhere, a white 10 m x 4 m
