@@ -26,7 +26,7 @@ struct Piece {
   std::vector<Vec2> points;  // in file units
   bool closed = false;
   std::string layer;        // the entity's layer ("0" inside a block: the INSERT's)
-  std::string unsupported;  // an entity that cannot be read ("SPLINE"): an error if it is wanted
+  std::string unsupported;  // an entity that cannot be read, described: an error if it is wanted
 };
 
 // An INSERT: block `name` placed at `at`, scaled, rotated (degrees,
@@ -117,17 +117,17 @@ class Collector : public DL_CreationAdapter {
   // Block definitions are kept, and drawn where an INSERT places them
   // (Collect); what lies in a block is drawn only through its inserts.
   void addBlock(const DL_BlockData& d) override {
-    FinishPolyline();
+    FinishPending();
     block_ = &blocks_[d.name];
     *block_ = Block{};
     block_->base = {d.bpx, d.bpy};
   }
   void endBlock() override {
-    FinishPolyline();
+    FinishPending();
     block_ = nullptr;
   }
   void addInsert(const DL_InsertData& d) override {
-    FinishPolyline();
+    FinishPending();
     Insert insert;
     insert.name = d.name;
     insert.layer = getAttributes().getLayer();
@@ -143,18 +143,18 @@ class Collector : public DL_CreationAdapter {
   }
 
   void addLine(const DL_LineData& d) override {
-    FinishPolyline();
+    FinishPending();
     Add({{d.x1, d.y1}, {d.x2, d.y2}}, false);
   }
   void addArc(const DL_ArcData& d) override {
-    FinishPolyline();
+    FinishPending();
     if (d.radius <= 0.0) return;
     double sweep_deg = std::fmod(d.angle2 - d.angle1, 360.0);
     if (sweep_deg <= 0.0) sweep_deg += 360.0;  // DXF arcs run counter-clockwise
     Add(ArcPoints({d.cx, d.cy}, d.radius, Radians(d.angle1), Radians(sweep_deg), Tolerance(), true), false);
   }
   void addCircle(const DL_CircleData& d) override {
-    FinishPolyline();
+    FinishPending();
     if (d.radius <= 0.0) return;
     std::vector<Vec2> ring = ArcPoints({d.cx, d.cy}, d.radius, 0.0, 2.0 * std::numbers::pi, Tolerance(), false);
     // A circle needs at least a few vertices to be a ring of the right area.
@@ -164,7 +164,7 @@ class Collector : public DL_CreationAdapter {
   // An ellipse or elliptic arc: centre, major axis (end point relative to the
   // centre), ratio of the axes, and the range of the parameter (radians).
   void addEllipse(const DL_EllipseData& d) override {
-    FinishPolyline();
+    FinishPending();
     const Vec2 centre{d.cx, d.cy}, major{d.mx, d.my};
     const Vec2 minor = Perp(major) * d.ratio;
     const double radius = Length(major);
@@ -183,13 +183,94 @@ class Collector : public DL_CreationAdapter {
     }
     Add(std::move(points), closed);
   }
-  // Splines are not flattened here: a wanted one is an error (Collect).
-  void addSpline(const DL_SplineData&) override {
-    FinishPolyline();
-    Add({}, false, "SPLINE");
+  // A spline (NURBS): degree, flags (1 closed, 4 rational), then its knots
+  // and control points (with weights) as separate calls; flattened by
+  // FinishSpline. Fit points alone (no control points) are not read.
+  void addSpline(const DL_SplineData& d) override {
+    FinishPending();
+    spline_active_ = true;
+    spline_layer_ = getAttributes().getLayer();
+    spline_degree_ = d.degree;
+    spline_closed_ = (d.flags & 1) != 0;
+    knots_.clear();
+    control_.clear();
+    weights_.clear();
+  }
+  void addKnot(const DL_KnotData& d) override {
+    if (spline_active_) knots_.push_back(d.k);
+  }
+  void addControlPoint(const DL_ControlPointData& d) override {
+    if (!spline_active_) return;
+    control_.push_back({d.x, d.y});
+    weights_.push_back(d.w > 0.0 ? d.w : 1.0);  // (absent weights read as 0 or 1: no weight)
+  }
+
+  // The spline's point at parameter u in knot span s (knots_[s] <= u <
+  // knots_[s + 1]), by de Boor's algorithm on homogeneous coordinates.
+  Vec2 SplinePoint(std::size_t s, double u) const {
+    const std::size_t p = spline_degree_;
+    std::vector<Vec2> d(p + 1);
+    std::vector<double> w(p + 1);
+    for (std::size_t j = 0; j <= p; ++j) {
+      w[j] = weights_[s - p + j];
+      d[j] = control_[s - p + j] * w[j];
+    }
+    for (std::size_t r = 1; r <= p; ++r)
+      for (std::size_t j = p; j >= r; --j) {
+        const std::size_t i = s - p + j;
+        const double span = knots_[i + p + 1 - r] - knots_[i];
+        const double alpha = span > 0.0 ? (u - knots_[i]) / span : 0.0;
+        d[j] = d[j - 1] * (1.0 - alpha) + d[j] * alpha;
+        w[j] = w[j - 1] * (1.0 - alpha) + w[j] * alpha;
+      }
+    return d[p] / w[p];
+  }
+
+  // Flattens the pending spline: each knot span is split until the middle
+  // of every chord's arc lies within the tolerance of the chord.
+  void FinishSpline() {
+    if (!spline_active_) return;
+    spline_active_ = false;
+    const std::size_t p = spline_degree_, n = control_.size();
+    if (p < 1 || n < p + 1 || knots_.size() != n + p + 1 ||
+        !std::is_sorted(knots_.begin(), knots_.end())) {
+      Piece marker{{}, false, spline_layer_,
+                   "SPLINE of degree " + std::to_string(p) + " with " + std::to_string(n) + " control points and " +
+                       std::to_string(knots_.size()) + " knots (expected degree + control points + 1)"};
+      (block_ ? block_->pieces : pieces_).push_back(std::move(marker));
+      return;
+    }
+    const double tolerance = Tolerance();
+    std::vector<Vec2> points;
+    const auto refine = [&](auto&& self, std::size_t s, double u0, Vec2 a, double u1, Vec2 b, int depth) -> void {
+      const double um = 0.5 * (u0 + u1);
+      const Vec2 m = SplinePoint(s, um);
+      const Vec2 chord = b - a;
+      const double length = Length(chord);
+      const double off = length > 0.0 ? std::abs(Cross(chord, m - a)) / length : Length(m - a);
+      if (depth < 16 && (off > tolerance || depth < 2)) {
+        self(self, s, u0, a, um, m, depth + 1);
+        self(self, s, um, m, u1, b, depth + 1);
+      } else {
+        points.push_back(b);
+      }
+    };
+    for (std::size_t s = p; s < n; ++s) {
+      if (!(knots_[s + 1] > knots_[s])) continue;
+      // The end of the span is evaluated in it, as its limit.
+      const double u0 = knots_[s], u1 = knots_[s + 1];
+      const Vec2 a = SplinePoint(s, u0), b = SplinePoint(s, u1);
+      if (points.empty()) points.push_back(a);
+      refine(refine, s, u0, a, u1, b, 0);
+    }
+    if (points.size() < 2) return;
+    const bool closed = spline_closed_ || Length(points.front() - points.back()) <= tolerance * 1e-3;
+    if (closed && Length(points.front() - points.back()) <= tolerance) points.pop_back();
+    Piece piece{std::move(points), closed, spline_layer_, {}};
+    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
   }
   void addPolyline(const DL_PolylineData& d) override {
-    FinishPolyline();
+    FinishPending();
     polyline_active_ = true;
     polyline_layer_ = getAttributes().getLayer();
     polyline_closed_ = (d.flags & 1) != 0;
@@ -201,10 +282,16 @@ class Collector : public DL_CreationAdapter {
     vertices_.push_back({d.x, d.y});
     bulges_.push_back(d.bulge);
   }
-  void endSequence() override { FinishPolyline(); }
+  void endSequence() override { FinishPending(); }
 
-  // Completes a pending polyline (LWPOLYLINE has no end marker of its own).
-  void FinishPolyline() {
+  // Completes a pending polyline or spline (their vertices, control points
+  // and knots come as separate calls; LWPOLYLINE has no end marker).
+  void FinishPending() {
+    FinishSpline();
+    FinishPolylineNow();
+  }
+
+  void FinishPolylineNow() {
     if (!polyline_active_) return;
     polyline_active_ = false;
     if (vertices_.size() < 2) return;
@@ -266,8 +353,7 @@ class Collector : public DL_CreationAdapter {
     if (!p.unsupported.empty())
       throw InputError(file + ": a " + p.unsupported + " on layer \"" + layer + "\"" +
                        (block.empty() ? "" : " (in block \"" + block + "\")") +
-                       " cannot be read; expected lines, arcs, circles, ellipses and polylines (convert the " +
-                       p.unsupported + " to a polyline, or draw it on a layer that is not imported)");
+                       " cannot be read (convert it to a polyline, or leave its layer out with --layer)");
     Piece placed{{}, p.closed, layer, {}};
     placed.points.reserve(p.points.size());
     for (Vec2 q : p.points) placed.points.push_back(to(q));
@@ -312,6 +398,13 @@ class Collector : public DL_CreationAdapter {
   double tolerance_m_;
   double scale_override_;
   int insunits_ = 0;
+  bool spline_active_ = false;
+  bool spline_closed_ = false;
+  std::size_t spline_degree_ = 0;
+  std::string spline_layer_;
+  std::vector<double> knots_;
+  std::vector<Vec2> control_;
+  std::vector<double> weights_;
   bool polyline_active_ = false;
   bool polyline_closed_ = false;
   std::string polyline_layer_;
@@ -408,7 +501,7 @@ Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options)
   Collector collector(options.dxf_layer, options.dxf_arc_tolerance_m, options.scale_m_per_unit);
   DL_Dxf dxf;
   if (!dxf.in(file.string(), &collector)) throw InputError(file.string() + ": cannot read the file as DXF");
-  collector.FinishPolyline();
+  collector.FinishPending();
   const double scale = collector.Scale();
 
   std::vector<Piece> pieces = collector.Collect(file.string());

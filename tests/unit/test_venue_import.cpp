@@ -307,12 +307,16 @@ TEST(VenueImport, DxfBlockErrorsAndEllipses) {
   const std::string loop = DxfBlock("LOOP", {0, 0}, DxfInsert("LOOP", {{0.1, 0}}));
   m = ErrorOf([&] { ImportDxf(WriteText("loop.dxf", DxfFileWithBlocks(loop, room + DxfInsert("LOOP", {{1, 1}})))); });
   EXPECT_NE(m.find("loop.dxf: block \"LOOP\" is inserted more than 32 levels deep"), std::string::npos) << m;
-  // A spline on the imported layer is refused, naming it; on another layer it is left out.
-  const std::string spline = "0\nSPLINE\n8\ncurves\n70\n8\n71\n3\n72\n8\n73\n4\n40\n0\n40\n0\n40\n0\n40\n0\n40\n1\n40\n1\n40\n1\n40\n1\n"
-                             "10\n1\n20\n1\n10\n2\n20\n2\n10\n3\n20\n1\n10\n4\n20\n2\n";
-  const auto spline_path = WriteText("spline.dxf", DxfFile(DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true, "plan") + spline));
+  // A spline whose knots do not fit its control points is refused, naming it;
+  // on a layer that is not imported it is left out.
+  const std::string bad_spline = "0\nSPLINE\n8\ncurves\n70\n8\n71\n3\n72\n5\n73\n4\n40\n0\n40\n0\n40\n0\n40\n1\n40\n1\n"
+                                 "10\n1\n20\n1\n10\n2\n20\n2\n10\n3\n20\n1\n10\n4\n20\n2\n";
+  const auto spline_path =
+      WriteText("spline.dxf", DxfFile(DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true, "plan") + bad_spline));
   m = ErrorOf([&] { ImportDxf(spline_path); });
-  EXPECT_NE(m.find("spline.dxf: a SPLINE on layer \"curves\" cannot be read"), std::string::npos) << m;
+  EXPECT_NE(m.find("spline.dxf: a SPLINE of degree 3 with 4 control points and 5 knots (expected degree + control "
+                   "points + 1) on layer \"curves\" cannot be read"),
+            std::string::npos) << m;
   ImportOptions options;
   options.dxf_layer = "plan";
   EXPECT_NEAR(WalkableArea_m2(ImportDxf(spline_path, options)), 60.0, 1e-9);
@@ -326,6 +330,52 @@ TEST(VenueImport, DxfBlockErrorsAndEllipses) {
   ASSERT_EQ(v.obstacles.size(), 1u);
   EXPECT_NEAR(WalkableArea_m2(v), 60.0 - std::numbers::pi * 0.5, 2e-3);
   EXPECT_NEAR(ExtentX(v.obstacles[0]), 2.0 * std::sqrt(c * c + 0.25 * s * s), 1e-3);
+}
+
+// A SPLINE entity: degree, knots, control points and (if given) weights.
+std::string DxfSpline(int degree, const std::vector<double>& knots, const std::vector<Vec2>& control,
+                      const std::vector<double>& weights = {}, bool closed = false) {
+  std::string e = "0\nSPLINE\n8\n0\n70\n" + std::to_string(8 + (closed ? 1 : 0) + (weights.empty() ? 0 : 4)) +
+                  "\n71\n" + std::to_string(degree) + "\n72\n" + std::to_string(knots.size()) + "\n73\n" +
+                  std::to_string(control.size()) + "\n74\n0\n";
+  for (double k : knots) e += "40\n" + Num(k) + "\n";
+  for (std::size_t i = 0; i < control.size(); ++i) {
+    e += "10\n" + Num(control[i].x) + "\n20\n" + Num(control[i].y) + "\n30\n0\n";
+    if (!weights.empty()) e += "41\n" + Num(weights[i]) + "\n";
+  }
+  return e;
+}
+
+TEST(VenueImport, DxfSplinesAreFlattened) {
+  const std::string room = DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true);
+  ImportOptions options;
+  options.dxf_arc_tolerance_m = 1e-5;
+  // A cubic Bezier (one clamped span) closed by a line: the region between
+  // them, by Green's theorem over the Bernstein form, is the pillar's area.
+  const std::vector<Vec2> c{{2, 2}, {2, 3.5}, {5, 3.5}, {5, 2}};
+  const auto bezier = [&](double t) {
+    const double s = 1.0 - t;
+    return c[0] * (s * s * s) + c[1] * (3 * s * s * t) + c[2] * (3 * s * t * t) + c[3] * (t * t * t);
+  };
+  double area = 0.0;
+  const int steps = 200000;
+  for (int k = 0; k < steps; ++k) area += Cross(bezier(double(k) / steps), bezier(double(k + 1) / steps)) / 2.0;
+  area += Cross(c[3], c[0]) / 2.0;  // the closing line
+  const Venue v = ImportDxf(
+      WriteText("bezier.dxf", DxfFile(room + DxfSpline(3, {0, 0, 0, 0, 1, 1, 1, 1}, c) + DxfLine({5, 2}, {2, 2}))),
+      options);
+  ASSERT_EQ(v.obstacles.size(), 1u);
+  EXPECT_NEAR(60.0 - WalkableArea_m2(v), std::abs(area), 1e-4);
+  // A circle of radius 1 around (7, 3) as a rational quadratic NURBS (nine
+  // control points on a square, weights 1 and 1/sqrt(2)): area pi within the flattening.
+  const double h = std::sqrt(0.5);
+  const std::vector<Vec2> square{{8, 3}, {8, 4}, {7, 4}, {6, 4}, {6, 3}, {6, 2}, {7, 2}, {8, 2}, {8, 3}};
+  const std::string circle =
+      DxfSpline(2, {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1}, square, {1, h, 1, h, 1, h, 1, h, 1}, true);
+  const Venue round = ImportDxf(WriteText("nurbs-circle.dxf", DxfFile(room + circle)), options);
+  ASSERT_EQ(round.obstacles.size(), 1u);
+  EXPECT_NEAR(60.0 - WalkableArea_m2(round), std::numbers::pi, 1e-3);
+  EXPECT_NEAR(ExtentX(round.obstacles[0]), 2.0, 1e-6);
 }
 
 // --- raster -------------------------------------------------------------------
