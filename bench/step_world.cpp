@@ -26,6 +26,7 @@
 #include <sstream>
 #include <string>
 
+#include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
 
@@ -101,13 +102,9 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     MeasuredSteps(simulation, steps);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    // FNV-1a over the bytes of the positions: equal lines, equal work.
-    std::uint64_t hash = 1469598103934665603ull;
-    for (const auto& p : simulation.bodies().position_m) {
-      unsigned char bytes[sizeof p];
-      std::memcpy(bytes, &p, sizeof p);
-      for (unsigned char b : bytes) hash = (hash ^ b) * 1099511628211ull;
-    }
+    // A checksum of the positions' bytes: equal lines, equal work.
+    const auto& positions = simulation.bodies().position_m;
+    const std::uint64_t hash = crowdrecon::Fnv1a(positions.data(), positions.size() * sizeof(positions[0]));
     std::printf("%.4f ms/step  %d steps  %zu contacts  positions %016llx\n", steps > 0 ? ms / steps : 0.0, steps,
                 simulation.contacts().size(), static_cast<unsigned long long>(hash));
   } catch (const std::exception& e) {

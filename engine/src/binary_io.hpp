@@ -14,15 +14,9 @@
 #include <vector>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/fnv.hpp"
 
 namespace crowdrecon::engine::detail {
-
-// FNV-1a, 64 bits: enough to catch a damaged or cut file, which is all it is for.
-inline std::uint64_t Fnv1a(const char* data, std::size_t size) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ static_cast<unsigned char>(data[i])) * 1099511628211ull;
-  return h;
-}
 
 class BinaryWriter {
  public:

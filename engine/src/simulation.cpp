@@ -657,10 +657,11 @@ namespace {
 
 // The contact of persons (or person and wall) a, b at a narrow-phase point,
 // before the contact law fills its forces.
-// Every member is given (no zero-filling of the record first): the contact
-// law then sets the forces.
+// Made member by member in one initialiser (not zero-filled first and then
+// assigned); the others keep their defaults until the contact law sets them.
 Contact ContactAt(const ContactPoint& p, std::uint32_t a, std::uint32_t b, bool wall) {
-  return Contact{a, b, wall, p.feature, p.point, p.normal, p.overlap_m, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0};
+  return Contact{.a = a, .b = b, .wall = wall, .feature = p.feature, .point_m = p.point, .normal = p.normal,
+                 .overlap_m = p.overlap_m};
 }
 
 // Sum of the overlaps of a pair's points and their overlap-weighted count

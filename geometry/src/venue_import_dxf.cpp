@@ -237,7 +237,7 @@ class Collector : public DL_CreationAdapter {
       Piece marker{{}, false, spline_layer_,
                    "SPLINE of degree " + std::to_string(p) + " with " + std::to_string(n) + " control points and " +
                        std::to_string(knots_.size()) + " knots (expected degree + control points + 1)"};
-      (block_ ? block_->pieces : pieces_).push_back(std::move(marker));
+      Current().push_back(std::move(marker));
       return;
     }
     const double tolerance = Tolerance();
@@ -267,7 +267,7 @@ class Collector : public DL_CreationAdapter {
     const bool closed = spline_closed_ || Length(points.front() - points.back()) <= tolerance * 1e-3;
     if (closed && Length(points.front() - points.back()) <= tolerance) points.pop_back();
     Piece piece{std::move(points), closed, spline_layer_, {}};
-    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
+    Current().push_back(std::move(piece));
   }
   void addPolyline(const DL_PolylineData& d) override {
     FinishPending();
@@ -319,7 +319,7 @@ class Collector : public DL_CreationAdapter {
     }
     if (!polyline_closed_) points.push_back(vertices_.back());
     Piece piece{std::move(points), polyline_closed_, polyline_layer_, {}};
-    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
+    Current().push_back(std::move(piece));
   }
 
   // The drawing's pieces on the wanted layer (all layers if none was named),
@@ -337,10 +337,13 @@ class Collector : public DL_CreationAdapter {
  private:
   static double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
+  // The pieces of the block being defined, or of the drawing.
+  std::vector<Piece>& Current() { return block_ ? block_->pieces : pieces_; }
+
   // Into the current block or the drawing, with the entity's layer.
   void Add(std::vector<Vec2> points, bool closed, std::string unsupported = {}) {
     Piece piece{std::move(points), closed, getAttributes().getLayer(), std::move(unsupported)};
-    (block_ ? block_->pieces : pieces_).push_back(std::move(piece));
+    Current().push_back(std::move(piece));
   }
 
   // Piece p (drawn with `layer`) placed by `to`, if on the wanted layer.

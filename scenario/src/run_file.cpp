@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/scenario/sqlite.hpp"
 
 namespace crowdrecon::scenario {
@@ -31,9 +32,7 @@ std::string NumberText(double v) {
 // 64-bit FNV-1a of the WKT, as the geometry hash (JuPedSim uses Python's hash;
 // any integer identifying the geometry will do for readers).
 std::int64_t GeometryHash(const std::string& wkt) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : wkt) h = (h ^ c) * 1099511628211ull;
-  return static_cast<std::int64_t>(h >> 1);
+  return static_cast<std::int64_t>(Fnv1a(wkt.data(), wkt.size()) >> 1);
 }
 
 std::string PointsJson(const std::vector<Vec2>& points) {
