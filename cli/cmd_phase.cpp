@@ -17,6 +17,7 @@ struct PhaseArgs {
   std::string results;
   std::string output;
   bool no_heat_maps = false;
+  bool heat_maps_png_only = false;
 };
 
 void RunPhase(const PhaseArgs& args) {
@@ -24,6 +25,7 @@ void RunPhase(const PhaseArgs& args) {
   options.results = args.results;
   options.output_dir = args.output;
   options.heat_maps = !args.no_heat_maps;
+  options.heat_map_svg = !args.heat_maps_png_only;
   const sweep::PhaseSummary s = sweep::DrawPhaseDiagrams(options);
   std::printf("%s", s.BriefReport().c_str());
 }
@@ -39,6 +41,8 @@ void RegisterPhaseCommand(CLI::App& app) {
   cmd->add_option("DIR", args->results, "Sweep output folder (or its results.sqlite)")->required();
   cmd->add_option("-o,--output", args->output, "Folder for the pictures (default: DIR/phase)");
   cmd->add_flag("--no-heat-maps", args->no_heat_maps, "Phase diagrams only");
+  cmd->add_flag("--heat-maps-png-only", args->heat_maps_png_only,
+                "Heat maps as PNG only (about 200 kB each as SVG); index.html then links each to its PNG");
   cmd->callback([args] { RunPhase(*args); });
 }
 

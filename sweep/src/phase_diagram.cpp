@@ -484,7 +484,8 @@ std::string Html(const std::string& text) {
 
 std::string PhaseSummary::BriefReport() const {
   std::string r = "read " + std::to_string(runs) + " runs; drew " + std::to_string(diagrams) + " phase diagram(s) and " +
-                  std::to_string(heat_maps) + " heat map(s), PNG and SVG\n";
+                  std::to_string(heat_maps) + " heat map(s), " +
+                  (heat_maps == 0 || heat_map_svg ? "PNG and SVG\n" : "PNG and SVG (heat maps PNG only)\n");
   for (const std::string& n : notes) r += "note: " + n + "\n";
   r += "index: " + index.string() + "\n";
   return r;
@@ -566,6 +567,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
 
   PhaseSummary summary;
   summary.runs = t.rows.size();
+  summary.heat_map_svg = options.heat_map_svg;
   if (failed) summary.notes.push_back(std::to_string(failed) + " run(s) failed (drawn as triangles)");
   const std::size_t expected = x.positions.size() * y.positions.size();
   for (const Panel& p : panels)
@@ -583,8 +585,8 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
                      Html(sweep_name) + "</h1>\n<p>" + std::to_string(t.rows.size()) + " runs from <code>" +
                      Html(t.file.string()) +
                      "</code>. Markers as in the paper's Figure 5: lanes (disks), avalanches (crosses), clogging "
-                     "(squares); a ring shows each seed's regime where the seeds disagree. Click a picture for its "
-                     "SVG.</p>\n";
+                     "(squares); a ring shows each seed's regime where the seeds disagree. Click a picture for its " +
+                     std::string(options.heat_map_svg ? "SVG" : "full size (SVG for the phase diagrams)") + ".</p>\n";
   html += "<h2>Phase diagrams</h2>\n<div class=\"grid\">\n";
   for (const Panel& p : panels) {
     const fs::path png = out / (p.stem + ".png"), svg = out / (p.stem + ".svg");
@@ -604,11 +606,14 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
         const std::string stem = "heat-" + p.stem.substr(6) + "-" + m.name;
         const fs::path png = out / (stem + ".png"), svg = out / (stem + ".svg");
         DrawHeatMap(p, layout, m, sweep_name, png);
-        DrawHeatMap(p, layout, m, sweep_name, svg);
         summary.pictures.push_back(png);
-        summary.pictures.push_back(svg);
+        if (options.heat_map_svg) {
+          DrawHeatMap(p, layout, m, sweep_name, svg);
+          summary.pictures.push_back(svg);
+        }
         ++summary.heat_maps;
-        html += "<figure><a href=\"" + Html(svg.filename().string()) + "\"><img src=\"" +
+        const fs::path& link = options.heat_map_svg ? svg : png;
+        html += "<figure><a href=\"" + Html(link.filename().string()) + "\"><img src=\"" +
                 Html(png.filename().string()) + "\"></a><figcaption>" + Html(m.title) + "</figcaption></figure>\n";
       }
       html += "</div>\n";

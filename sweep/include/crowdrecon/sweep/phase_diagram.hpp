@@ -28,6 +28,7 @@ struct PhaseOptions {
   std::filesystem::path results;     // DIR, or DIR/results.sqlite
   std::filesystem::path output_dir;  // FIGDIR; "" = DIR/phase
   bool heat_maps = true;
+  bool heat_map_svg = true;  // false: heat maps as PNG only (each ~200 kB as SVG), linked to their PNG
 };
 
 struct PhaseSummary {
@@ -35,6 +36,7 @@ struct PhaseSummary {
   std::filesystem::path index;                  // FIGDIR/index.html
   std::size_t diagrams = 0;                     // phase diagrams (PNG + SVG each)
   std::size_t heat_maps = 0;
+  bool heat_map_svg = true;                      // heat maps written as SVG too
   std::size_t runs = 0;                         // rows read
   std::vector<std::string> notes;               // e.g. runs that failed, points without runs
   std::string BriefReport() const;
