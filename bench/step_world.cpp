@@ -2,7 +2,7 @@
 // instruction counts (callgrind) and for interleaved timings of two builds
 // with nothing else in the process (bench/README.md, "Steps of a saved world").
 //
-//   crowdrecon_step_world WORLD STATE [--steps=N] [--warm-up=N] [--threads=T]
+//   crowdrecon_step_world WORLD STATE [--steps=N] [--warm-up=N] [--threads=T] [--profile]
 //
 // WORLD and STATE are the files that `crowdrecon_bench_kernels
 // --dump_worlds=DIR` writes (engine/world_file.hpp, Simulation::SaveState).
@@ -16,7 +16,8 @@
 //
 // It prints one line: the wall time per measured step, the contact count
 // after them and a checksum of the bodies' positions (two builds that give
-// the same line did the same work).
+// the same line did the same work). --profile adds a second line: the
+// milliseconds per measured step of each stage (Simulation::profile()).
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -59,9 +60,10 @@ int ParseCount(const char* arg, const char* flag) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const char* usage = "usage: crowdrecon_step_world WORLD STATE [--steps=N] [--warm-up=N] [--threads=T]\n";
+  const char* usage = "usage: crowdrecon_step_world WORLD STATE [--steps=N] [--warm-up=N] [--threads=T] [--profile]\n";
   std::string world_path, state_path;
   int steps = 100, warm_up = 20, threads = 1;
+  bool profile = false;
   for (int i = 1; i < argc; ++i) {
     const char* arg = argv[i];
     if (std::strncmp(arg, "--steps=", 8) == 0) {
@@ -70,6 +72,8 @@ int main(int argc, char** argv) {
       warm_up = ParseCount(arg, "--warm-up=");
     } else if (std::strncmp(arg, "--threads=", 10) == 0) {
       threads = ParseCount(arg, "--threads=");
+    } else if (std::strcmp(arg, "--profile") == 0) {
+      profile = true;
     } else if (arg[0] == '-') {
       std::fprintf(stderr, "crowdrecon_step_world: unknown option '%s'\n%s", arg, usage);
       return 2;
@@ -99,6 +103,7 @@ int main(int argc, char** argv) {
     Simulation simulation(std::move(def));
     simulation.LoadState(state.str());
     for (int i = 0; i < warm_up; ++i) simulation.Step();
+    const crowdrecon::engine::Profile before = simulation.profile();
     const auto start = std::chrono::steady_clock::now();
     MeasuredSteps(simulation, steps);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -107,6 +112,17 @@ int main(int argc, char** argv) {
     const std::uint64_t hash = crowdrecon::Fnv1a(positions.data(), positions.size() * sizeof(positions[0]));
     std::printf("%.4f ms/step  %d steps  %zu contacts  positions %016llx\n", steps > 0 ? ms / steps : 0.0, steps,
                 simulation.contacts().size(), static_cast<unsigned long long>(hash));
+    if (profile && steps > 0) {
+      const crowdrecon::engine::Profile& after = simulation.profile();
+      const auto per_step = [&](double a, double b) { return (a - b) * 1e3 / steps; };
+      std::printf("ms/step by stage: pairs %.4f  place %.4f  collide %.4f  gather %.4f  drive %.4f  integrate %.4f"
+                  "  check %.4f  (pair rebuilds %llu)\n",
+                  per_step(after.update_pairs_s, before.update_pairs_s),
+                  per_step(after.place_shapes_s, before.place_shapes_s), per_step(after.collide_s, before.collide_s),
+                  per_step(after.gather_s, before.gather_s), per_step(after.drive_s, before.drive_s),
+                  per_step(after.integrate_s, before.integrate_s), per_step(after.check_s, before.check_s),
+                  static_cast<unsigned long long>(after.pair_rebuilds - before.pair_rebuilds));
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crowdrecon_step_world: %s\n", e.what());
     return 1;
