@@ -116,12 +116,13 @@ int main(int argc, char** argv) {
       const crowdrecon::engine::Profile& after = simulation.profile();
       const auto per_step = [&](double a, double b) { return (a - b) * 1e3 / steps; };
       std::printf("ms/step by stage: pairs %.4f  place %.4f  collide %.4f  gather %.4f  drive %.4f  integrate %.4f"
-                  "  check %.4f  (pair rebuilds %llu)\n",
+                  "  check %.4f  (pair rebuilds %llu, pairs measured per step %.1f)\n",
                   per_step(after.update_pairs_s, before.update_pairs_s),
                   per_step(after.place_shapes_s, before.place_shapes_s), per_step(after.collide_s, before.collide_s),
                   per_step(after.gather_s, before.gather_s), per_step(after.drive_s, before.drive_s),
                   per_step(after.integrate_s, before.integrate_s), per_step(after.check_s, before.check_s),
-                  static_cast<unsigned long long>(after.pair_rebuilds - before.pair_rebuilds));
+                  static_cast<unsigned long long>(after.pair_rebuilds - before.pair_rebuilds),
+                  static_cast<double>(after.pairs_measured - before.pairs_measured) / steps);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crowdrecon_step_world: %s\n", e.what());

@@ -386,6 +386,39 @@ TEST(EnginePhysics, RememberingWhatIsStillApartChangesNothing) {
   }
 }
 
+TEST(EnginePhysics, PeopleMovingTogetherAreNotMeasuredAgain) {
+  // Person pairs are skipped on a bound of how far their two bodies moved
+  // relative to each other (not of how far each moved): a crowd translating
+  // as one rigid block, apart, never needs its pairs measured again until the
+  // neighbour list is rebuilt. By the sum of the two travels, a pair 5 cm
+  // apart would be measured again every ~30 steps at these speeds.
+  WorldDef def = RandomGas(10, 0.5, 4, true);  // bounding circles 0.45 m: never touching
+  for (PersonDef& p : def.people) {
+    p.velocity_m_per_s = {1.5, 0.5};
+    p.angular_velocity_rad_per_s = 0.0;
+  }
+  Simulation sim(def);
+  ASSERT_GT(sim.neighbour_pair_count(), 0u);
+  std::size_t quiet_steps = 0;
+  while (sim.time_s() < 0.5) {
+    const Profile before = sim.profile();
+    sim.Step();
+    const Profile& after = sim.profile();
+    ASSERT_TRUE(sim.contacts().empty());
+    if (after.pair_rebuilds != before.pair_rebuilds) continue;  // a rebuild forgets what was known
+    EXPECT_EQ(after.pairs_measured, before.pairs_measured) << "t " << sim.time_s();
+    ++quiet_steps;
+  }
+  EXPECT_GT(quiet_steps, sim.step_count() / 2);
+  // The same crowd with everyone's velocity different: pairs must be
+  // measured again as they approach (the bound is not simply zero).
+  WorldDef mixed = RandomGas(10, 0.5, 4, true);
+  Simulation moving(mixed);
+  const std::uint64_t at_start = moving.profile().pairs_measured;
+  moving.AdvanceTo(0.1);
+  EXPECT_GT(moving.profile().pairs_measured - at_start, moving.neighbour_pair_count());
+}
+
 TEST(EnginePhysics, RestoredCheckpointContinuesBitForBit) {
   for (Integrator integrator : {Integrator::kVelocityVerlet, Integrator::kGear5}) {
     WorldDef def = RandomGas(6, 0.42, 9, true);

@@ -55,6 +55,9 @@ struct Profile {
   double update_pairs_s = 0, place_shapes_s = 0, collide_s = 0, gather_s = 0, drive_s = 0,
          integrate_s = 0, check_s = 0;
   std::uint64_t pair_rebuilds = 0;
+  // Pairs (person-person and person-wall) given to the narrow phase; the
+  // others were known to be still apart (pair clearances).
+  std::uint64_t pairs_measured = 0;
   // With the CUDA force computation: of collide_s, the seconds spent copying
   // to and from the device and in its kernels (as its events measured them).
   double device_copy_s = 0, device_kernels_s = 0;
