@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 #include <dxflib/dl_creationadapter.h>
 #include <dxflib/dl_dxf.h>
 
@@ -185,7 +187,8 @@ class Collector : public DL_CreationAdapter {
   }
   // A spline (NURBS): degree, flags (1 closed, 4 rational), then its knots
   // and control points (with weights) as separate calls; flattened by
-  // FinishSpline. Fit points alone (no control points) are not read.
+  // FinishSpline. A spline given by fit points only (no control points) is
+  // first interpolated through them (InterpolateFitPoints).
   void addSpline(const DL_SplineData& d) override {
     FinishPending();
     spline_active_ = true;
@@ -195,6 +198,10 @@ class Collector : public DL_CreationAdapter {
     knots_.clear();
     control_.clear();
     weights_.clear();
+    fit_.clear();
+  }
+  void addFitPoint(const DL_FitPointData& d) override {
+    if (spline_active_) fit_.push_back({d.x, d.y});
   }
   void addKnot(const DL_KnotData& d) override {
     if (spline_active_) knots_.push_back(d.k);
@@ -226,11 +233,95 @@ class Collector : public DL_CreationAdapter {
     return d[p] / w[p];
   }
 
+  // The non-zero B-spline basis functions N_{s-p..s, p}(u) of knot span s
+  // (The NURBS Book, algorithm A2.2).
+  static std::vector<double> BasisFunctions(const std::vector<double>& knots, std::size_t s, double u, std::size_t p) {
+    std::vector<double> n(p + 1), left(p + 1), right(p + 1);
+    n[0] = 1.0;
+    for (std::size_t j = 1; j <= p; ++j) {
+      left[j] = u - knots[s + 1 - j];
+      right[j] = knots[s + j] - u;
+      double saved = 0.0;
+      for (std::size_t r = 0; r < j; ++r) {
+        const double temp = n[r] / (right[r + 1] + left[j - r]);
+        n[r] = saved + right[r + 1] * temp;
+        saved = left[j - r] * temp;
+      }
+      n[j] = saved;
+    }
+    return n;
+  }
+
+  // A spline given by fit points only: the non-rational B-spline of its
+  // degree (3 if none is given, less if there are too few points) through
+  // them, by global interpolation (The NURBS Book, 9.2.1): parameters by
+  // chord length, knots by averaging them, control points from the linear
+  // system N P = Q (banded; sparse LU). Repeated points are dropped; a closed
+  // spline's first point is repeated at its end (the curve closes there with
+  // a corner of at most the points' turning angle). CAD programs compute
+  // their own end tangents for such splines: the ends may differ from the
+  // drawing program's curve by a little, never at the fit points themselves.
+  // Returns false (and leaves the spline as it was) if it cannot be done.
+  bool InterpolateFitPoints() {
+    std::vector<Vec2> q;
+    for (const Vec2& f : fit_)
+      if (q.empty() || Length(f - q.back()) > 0.0) q.push_back(f);
+    if (spline_closed_ && q.size() >= 3 && Length(q.front() - q.back()) > 0.0) q.push_back(q.front());
+    if (q.size() < 2) return false;
+    const std::size_t n = q.size() - 1;
+    const std::size_t p = std::min<std::size_t>(spline_degree_ >= 1 ? spline_degree_ : 3, n);
+    std::vector<double> u(n + 1, 0.0);
+    double total = 0.0;
+    for (std::size_t k = 1; k <= n; ++k) total += Length(q[k] - q[k - 1]);
+    for (std::size_t k = 1; k < n; ++k) u[k] = u[k - 1] + Length(q[k] - q[k - 1]) / total;
+    u[n] = 1.0;
+    std::vector<double> knots(n + p + 2, 0.0);
+    for (std::size_t k = n + 1; k < knots.size(); ++k) knots[k] = 1.0;
+    for (std::size_t j = 1; j + p <= n; ++j) {
+      double sum = 0.0;
+      for (std::size_t i = j; i < j + p; ++i) sum += u[i];
+      knots[j + p] = sum / static_cast<double>(p);
+    }
+    std::vector<Eigen::Triplet<double>> entries;
+    for (std::size_t k = 0; k <= n; ++k) {
+      std::size_t s = p;  // the span of u[k]: knots[s] <= u < knots[s + 1], the last for u = 1
+      while (s < n && knots[s + 1] <= u[k]) ++s;
+      const std::vector<double> basis = BasisFunctions(knots, s, u[k], p);
+      for (std::size_t j = 0; j <= p; ++j)
+        if (basis[j] != 0.0)
+          entries.emplace_back(static_cast<int>(k), static_cast<int>(s - p + j), basis[j]);
+    }
+    const int size = static_cast<int>(n + 1);
+    Eigen::SparseMatrix<double> a(size, size);
+    a.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    lu.compute(a);
+    if (lu.info() != Eigen::Success) return false;
+    Eigen::MatrixX2d rhs(size, 2);
+    for (int k = 0; k < size; ++k) rhs.row(k) << q[static_cast<std::size_t>(k)].x, q[static_cast<std::size_t>(k)].y;
+    const Eigen::MatrixX2d solution = lu.solve(rhs);
+    if (lu.info() != Eigen::Success || !solution.allFinite()) return false;
+    control_.clear();
+    for (int k = 0; k < size; ++k) control_.push_back({solution(k, 0), solution(k, 1)});
+    weights_.assign(control_.size(), 1.0);
+    knots_ = std::move(knots);
+    spline_degree_ = p;
+    return true;
+  }
+
   // Flattens the pending spline: each knot span is split until the middle
   // of every chord's arc lies within the tolerance of the chord.
   void FinishSpline() {
     if (!spline_active_) return;
     spline_active_ = false;
+    if (control_.empty() && !fit_.empty() && !InterpolateFitPoints()) {
+      Piece marker{{}, false, spline_layer_,
+                   "SPLINE with " + std::to_string(fit_.size()) +
+                       " fit points and no control points, through which no curve could be interpolated "
+                       "(expected at least 2 distinct points)"};
+      Current().push_back(std::move(marker));
+      return;
+    }
     const std::size_t p = spline_degree_, n = control_.size();
     if (p < 1 || n < p + 1 || knots_.size() != n + p + 1 ||
         !std::is_sorted(knots_.begin(), knots_.end())) {
@@ -408,6 +499,7 @@ class Collector : public DL_CreationAdapter {
   std::vector<double> knots_;
   std::vector<Vec2> control_;
   std::vector<double> weights_;
+  std::vector<Vec2> fit_;
   bool polyline_active_ = false;
   bool polyline_closed_ = false;
   std::string polyline_layer_;

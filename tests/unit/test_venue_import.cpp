@@ -378,6 +378,64 @@ TEST(VenueImport, DxfSplinesAreFlattened) {
   EXPECT_NEAR(ExtentX(round.obstacles[0]), 2.0, 1e-6);
 }
 
+// A SPLINE given by fit points only (group 11), as some CAD exporters write them.
+std::string DxfFitSpline(int degree, const std::vector<Vec2>& fit, bool closed) {
+  std::string e = "0\nSPLINE\n8\n0\n70\n" + std::to_string(8 + (closed ? 1 : 0)) + "\n71\n" + std::to_string(degree) +
+                  "\n72\n0\n73\n0\n74\n" + std::to_string(fit.size()) + "\n";
+  for (const Vec2& f : fit) e += "11\n" + Num(f.x) + "\n21\n" + Num(f.y) + "\n31\n0\n";
+  return e;
+}
+
+// Least distance from p to the closed polygon `ring`.
+double DistanceToRing(Vec2 p, const std::vector<Vec2>& ring) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const Vec2 a = ring[i], b = ring[(i + 1) % ring.size()];
+    const double t = std::clamp(Dot(p - a, b - a) / LengthSquared(b - a), 0.0, 1.0);
+    best = std::min(best, Length(p - (a + (b - a) * t)));
+  }
+  return best;
+}
+
+TEST(VenueImport, DxfFitPointSplinesAreInterpolated) {
+  const std::string room = DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true);
+  ImportOptions options;
+  options.dxf_arc_tolerance_m = 1e-5;
+  // 24 fit points on a circle of radius 1 around (7, 3), closed: the curve
+  // passes through every one of them, and encloses pi to the interpolation's
+  // accuracy (a cubic through points 15 degrees apart).
+  std::vector<Vec2> fit;
+  for (int k = 0; k < 24; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 24.0;
+    fit.push_back({7.0 + std::cos(t), 3.0 + std::sin(t)});
+  }
+  const Venue v = ImportDxf(WriteText("fit-circle.dxf", DxfFile(room + DxfFitSpline(3, fit, true))), options);
+  ASSERT_EQ(v.obstacles.size(), 1u);
+  for (const Vec2& f : fit) EXPECT_LT(DistanceToRing(f, v.obstacles[0].polygon), 2e-5) << f.x << " " << f.y;
+  EXPECT_NEAR(60.0 - WalkableArea_m2(v), std::numbers::pi, 2e-4);
+  // Between the fit points the curve bulges out like the circle, not along
+  // the chords: the polygon through the fit points alone has 3.106 m^2.
+  EXPECT_GT(60.0 - WalkableArea_m2(v), 3.13);
+  // An open fit spline (an arc of a pillar) closed by a line, and a
+  // degree-1 one (a polyline through its points).
+  const std::vector<Vec2> arc{{2, 2}, {2.5, 3}, {3.5, 3.4}, {4.5, 3}, {5, 2}};
+  const Venue open = ImportDxf(
+      WriteText("fit-arc.dxf", DxfFile(room + DxfFitSpline(3, arc, false) + DxfLine({5, 2}, {2, 2}))), options);
+  ASSERT_EQ(open.obstacles.size(), 1u);
+  for (const Vec2& f : arc) EXPECT_LT(DistanceToRing(f, open.obstacles[0].polygon), 2e-5);
+  const Venue linear = ImportDxf(
+      WriteText("fit-linear.dxf", DxfFile(room + DxfFitSpline(1, arc, false) + DxfLine({5, 2}, {2, 2}))), options);
+  ASSERT_EQ(linear.obstacles.size(), 1u);
+  double polygon_area = 0.0;
+  for (std::size_t i = 0; i < arc.size(); ++i) polygon_area += Cross(arc[i], arc[(i + 1) % arc.size()]) / 2.0;
+  EXPECT_NEAR(60.0 - WalkableArea_m2(linear), std::abs(polygon_area), 1e-9);
+  // One distinct fit point: an error that says so.
+  const std::string m = ErrorOf([&] {
+    ImportDxf(WriteText("fit-one.dxf", DxfFile(room + DxfFitSpline(3, {{1, 1}, {1, 1}}, false))), options);
+  });
+  EXPECT_NE(m.find("2 fit points and no control points"), std::string::npos) << m;
+}
+
 // --- raster -------------------------------------------------------------------
 
 // Draws a plan at `ppm` pixels per metre: black everywhere, a white 10 m x 4 m
