@@ -283,8 +283,8 @@ class Collector : public DL_CreationAdapter {
       knots[j + p] = sum / static_cast<double>(p);
     }
     std::vector<Eigen::Triplet<double>> entries;
+    std::size_t s = p;  // the span of u[k]: knots[s] <= u < knots[s + 1], the last for u = 1 (u increases with k)
     for (std::size_t k = 0; k <= n; ++k) {
-      std::size_t s = p;  // the span of u[k]: knots[s] <= u < knots[s + 1], the last for u = 1
       while (s < n && knots[s + 1] <= u[k]) ++s;
       const std::vector<double> basis = BasisFunctions(knots, s, u[k], p);
       for (std::size_t j = 0; j <= p; ++j)

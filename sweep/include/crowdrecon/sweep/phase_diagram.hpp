@@ -36,7 +36,7 @@ struct PhaseSummary {
   std::filesystem::path index;                  // FIGDIR/index.html
   std::size_t diagrams = 0;                     // phase diagrams (PNG + SVG each)
   std::size_t heat_maps = 0;
-  bool heat_map_svg = true;                      // heat maps written as SVG too
+  bool heat_map_svg = true;                     // heat maps written as SVG too
   std::size_t runs = 0;                         // rows read
   std::vector<std::string> notes;               // e.g. runs that failed, points without runs
   std::string BriefReport() const;
