@@ -7,6 +7,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace crowdrecon::engine {
 
 ShapeGeometry ShapeGeometry::Make(std::vector<Vec2> vertices, bool closed, double radius_m) {
@@ -150,7 +154,22 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     if (memory) {
       todo = 0;
       double least = least_skipped;
-      for (std::uint32_t k = 0; k < count; ++k) {
+      std::uint32_t k = 0;
+#if defined(__SSE2__)
+      // Two thresholds at a time (SSE2 is part of every x86-64): the same
+      // comparisons, and the least of the same set of values.
+      const __m128d moved2 = _mm_set1_pd(moved);
+      const __m128d none2 = _mm_set1_pd(std::numeric_limits<double>::infinity());
+      __m128d least2 = _mm_set1_pd(least);
+      for (; k + 2 <= count; k += 2) {
+        const __m128d threshold = _mm_loadu_pd(memory + base + k);
+        const __m128d skip = _mm_cmplt_pd(moved2, threshold);
+        least2 = _mm_min_pd(least2, _mm_or_pd(_mm_and_pd(skip, threshold), _mm_andnot_pd(skip, none2)));
+        todo |= static_cast<std::uint64_t>(~_mm_movemask_pd(skip) & 3) << k;
+      }
+      least = std::min(_mm_cvtsd_f64(least2), _mm_cvtsd_f64(_mm_unpackhi_pd(least2, least2)));
+#endif
+      for (; k < count; ++k) {
         const double threshold = memory[base + k];
         const bool skip = moved < threshold;
         least = std::min(least, skip ? threshold : std::numeric_limits<double>::infinity());
