@@ -105,8 +105,16 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     if (auto body = pop.Find("body")) {
       p.body_mode = geometry::PopulationModeFromString(
           body->Choice("mode", "paper", {"paper", "anthropometric", "circle"}), body->Where() + "/mode");
-      if (auto ref = body->Find("reference")) p.reference_body = Resolve(base_dir, ref->AsString());
-      if (auto ansur = body->Find("anthropometry")) p.anthropometry = Resolve(base_dir, ansur->AsString());
+      // The files are read when the world is built; one that cannot be opened
+      // is reported here, against the key that names it.
+      const auto readable = [&](const JsonReader& key, const std::string& expected) {
+        const std::filesystem::path file = Resolve(base_dir, key.AsString());
+        if (!std::ifstream(file)) key.Fail("cannot open \"" + file.string() + "\" for reading; expected " + expected);
+        return file;
+      };
+      if (auto ref = body->Find("reference")) p.reference_body = readable(*ref, "a body file (crowdrecon body JSON)");
+      if (auto ansur = body->Find("anthropometry"))
+        p.anthropometry = readable(*ansur, "an ANSUR II extract (CSV, docs/bodies.md)");
       p.female_fraction = body->Number("female_fraction", p.female_fraction, 0.0, 1.0);
       p.vertex_count = static_cast<std::size_t>(body->Integer("vertices", 18, 3, 200));
       body->Finish();
