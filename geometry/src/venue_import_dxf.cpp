@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <istream>
 #include <map>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -591,8 +593,38 @@ void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
 
 }  // namespace
 
+namespace {
+
+// A DXF file ends with the group "0" / "EOF". dxflib reads a file that stops
+// short (an interrupted copy or download) without complaint, as far as it
+// goes: such a file is refused here rather than imported in part. Returns the
+// number of lines and whether the last two that are not blank are 0 and EOF.
+std::pair<std::size_t, bool> EndsWithEof(std::istream& in) {
+  std::string line, last, before;
+  std::size_t lines = 0;
+  while (std::getline(in, line)) {
+    ++lines;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos) continue;
+    const auto end = line.find_last_not_of(" \t\r");
+    before = std::move(last);
+    last = line.substr(first, end - first + 1);
+  }
+  return {lines, before == "0" && last == "EOF"};
+}
+
+}  // namespace
+
 Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options) {
-  if (!std::ifstream(file)) throw InputError(file.string() + ": cannot open DXF file for reading");
+  {
+    std::ifstream in(file);
+    if (!in) throw InputError(file.string() + ": cannot open DXF file for reading");
+    const auto [lines, complete] = EndsWithEof(in);
+    if (!complete)
+      throw InputError(file.string() + ": the file ends at line " + std::to_string(lines) +
+                       " without the end-of-file group (0 / EOF) that closes every DXF file: it looks cut short; "
+                       "expected a complete ASCII DXF file");
+  }
   Collector collector(options.dxf_layer, options.dxf_arc_tolerance_m, options.scale_m_per_unit);
   DL_Dxf dxf;
   if (!dxf.in(file.string(), &collector)) throw InputError(file.string() + ": cannot read the file as DXF");

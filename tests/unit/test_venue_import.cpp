@@ -211,6 +211,24 @@ TEST(VenueImport, DxfWithoutClosedRegionIsAnError) {
   EXPECT_NE(m.find("no closed region found on layer \"nothing-here\""), std::string::npos) << m;
 }
 
+TEST(VenueImport, TruncatedDxfIsAnError) {
+  // The room cut short after its outline (its obstacle's lines and the end-of-file
+  // group lost): refused, not imported in part. With the last group present
+  // (blank lines and CR after it allowed) the same text imports.
+  std::ifstream in(kData / "room.dxf");
+  std::stringstream whole;
+  whole << in.rdbuf();
+  const std::string text = whole.str();
+  const std::size_t cut = text.find("\nLINE");
+  ASSERT_NE(cut, std::string::npos);
+  std::string m = ErrorOf([&] { ImportDxf(WriteText("cut.dxf", text.substr(0, cut))); });
+  EXPECT_NE(m.find("cut.dxf: the file ends at line "), std::string::npos) << m;
+  EXPECT_NE(m.find("without the end-of-file group (0 / EOF)"), std::string::npos) << m;
+  std::string crlf;
+  for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_NEAR(WalkableArea_m2(ImportDxf(WriteText("crlf.dxf", crlf + "\r\n\n"))), 39.0, 1e-6);
+}
+
 // A DXF file with a BLOCKS section before the entities.
 std::string DxfFileWithBlocks(const std::string& blocks, const std::string& entities) {
   return "0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n6\n0\nENDSEC\n0\nSECTION\n2\nBLOCKS\n" + blocks +
