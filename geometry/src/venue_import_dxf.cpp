@@ -197,6 +197,8 @@ class Collector : public DL_CreationAdapter {
     spline_layer_ = getAttributes().getLayer();
     spline_degree_ = d.degree;
     spline_closed_ = (d.flags & 1) != 0;
+    start_tangent_ = {d.tangentStartX, d.tangentStartY};  // groups 12/22, 13/23 (zero: not given)
+    end_tangent_ = {d.tangentEndX, d.tangentEndY};
     knots_.clear();
     control_.clear();
     weights_.clear();
@@ -260,9 +262,15 @@ class Collector : public DL_CreationAdapter {
   // chord length, knots by averaging them, control points from the linear
   // system N P = Q (banded; sparse LU). Repeated points are dropped; a closed
   // spline's first point is repeated at its end (the curve closes there with
-  // a corner of at most the points' turning angle). CAD programs compute
-  // their own end tangents for such splines: the ends may differ from the
-  // drawing program's curve by a little, never at the fit points themselves.
+  // a corner of at most the points' turning angle).
+  // An open spline whose start and end tangents are both given (groups 12,
+  // 13) is interpolated with them (9.2.2): two more control points, knots
+  // averaged over p parameters from the first (9.22), and the two equations
+  // C'(0) = D0, C'(1) = Dn. The file gives their directions; their length is
+  // taken as the total chord length, the speed of a curve whose parameter
+  // runs over [0, 1] by chord length. Without tangents, CAD programs choose
+  // their own: the ends may then differ from the drawing program's curve by
+  // a little, never at the fit points themselves.
   // Returns false (and leaves the spline as it was) if it cannot be done.
   bool InterpolateFitPoints() {
     std::vector<Vec2> q;
@@ -271,36 +279,55 @@ class Collector : public DL_CreationAdapter {
     if (spline_closed_ && q.size() >= 3 && Length(q.front() - q.back()) > 0.0) q.push_back(q.front());
     if (q.size() < 2) return false;
     const std::size_t n = q.size() - 1;
-    const std::size_t p = std::min<std::size_t>(spline_degree_ >= 1 ? spline_degree_ : 3, n);
+    const bool tangents = !spline_closed_ && Length(start_tangent_) > 0.0 && Length(end_tangent_) > 0.0;
+    const std::size_t extra = tangents ? 2 : 0;  // control points beyond the fit points
+    const std::size_t p = std::min<std::size_t>(spline_degree_ >= 1 ? spline_degree_ : 3, n + extra);
     std::vector<double> u(n + 1, 0.0);
     double total = 0.0;
     for (std::size_t k = 1; k <= n; ++k) total += Length(q[k] - q[k - 1]);
     for (std::size_t k = 1; k < n; ++k) u[k] = u[k - 1] + Length(q[k] - q[k - 1]) / total;
     u[n] = 1.0;
-    std::vector<double> knots(n + p + 2, 0.0);
-    for (std::size_t k = n + 1; k < knots.size(); ++k) knots[k] = 1.0;
-    for (std::size_t j = 1; j + p <= n; ++j) {
+    const std::size_t controls = n + 1 + extra;
+    std::vector<double> knots(controls + p + 1, 0.0);
+    for (std::size_t k = controls; k < knots.size(); ++k) knots[k] = 1.0;
+    // Interior knots knots[p + 1 .. controls - 1], each the mean of p parameters:
+    // from u[1] on without tangents (9.8), from u[0] on with them (9.22).
+    for (std::size_t j = p + 1; j < controls; ++j) {
+      const std::size_t from = tangents ? j - p - 1 : j - p;
       double sum = 0.0;
-      for (std::size_t i = j; i < j + p; ++i) sum += u[i];
-      knots[j + p] = sum / static_cast<double>(p);
+      for (std::size_t i = from; i < from + p; ++i) sum += u[i];
+      knots[j] = sum / static_cast<double>(p);
     }
     std::vector<Eigen::Triplet<double>> entries;
     std::size_t s = p;  // the span of u[k]: knots[s] <= u < knots[s + 1], the last for u = 1 (u increases with k)
     for (std::size_t k = 0; k <= n; ++k) {
-      while (s < n && knots[s + 1] <= u[k]) ++s;
+      while (s + 1 < controls && knots[s + 1] <= u[k]) ++s;
       const std::vector<double> basis = BasisFunctions(knots, s, u[k], p);
       for (std::size_t j = 0; j <= p; ++j)
         if (basis[j] != 0.0)
           entries.emplace_back(static_cast<int>(k), static_cast<int>(s - p + j), basis[j]);
     }
-    const int size = static_cast<int>(n + 1);
+    const int size = static_cast<int>(controls);
+    Eigen::MatrixX2d rhs(size, 2);
+    for (std::size_t k = 0; k <= n; ++k) rhs.row(static_cast<int>(k)) << q[k].x, q[k].y;
+    if (tangents) {
+      // C'(0) = p / knots[p + 1] (P1 - P0), C'(1) = p / (1 - knots[controls - 1]) (P_last - P_last-1).
+      const double a0 = static_cast<double>(p) / knots[p + 1];
+      const double a1 = static_cast<double>(p) / (1.0 - knots[controls - 1]);
+      const int r0 = static_cast<int>(n + 1), r1 = static_cast<int>(n + 2), last = size - 1;
+      entries.emplace_back(r0, 0, -a0);
+      entries.emplace_back(r0, 1, a0);
+      entries.emplace_back(r1, last - 1, -a1);
+      entries.emplace_back(r1, last, a1);
+      const Vec2 d0 = start_tangent_ / Length(start_tangent_) * total, d1 = end_tangent_ / Length(end_tangent_) * total;
+      rhs.row(r0) << d0.x, d0.y;
+      rhs.row(r1) << d1.x, d1.y;
+    }
     Eigen::SparseMatrix<double> a(size, size);
     a.setFromTriplets(entries.begin(), entries.end());
     Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
     lu.compute(a);
     if (lu.info() != Eigen::Success) return false;
-    Eigen::MatrixX2d rhs(size, 2);
-    for (int k = 0; k < size; ++k) rhs.row(k) << q[static_cast<std::size_t>(k)].x, q[static_cast<std::size_t>(k)].y;
     const Eigen::MatrixX2d solution = lu.solve(rhs);
     if (lu.info() != Eigen::Success || !solution.allFinite()) return false;
     control_.clear();
@@ -502,6 +529,7 @@ class Collector : public DL_CreationAdapter {
   std::vector<Vec2> control_;
   std::vector<double> weights_;
   std::vector<Vec2> fit_;
+  Vec2 start_tangent_, end_tangent_;
   bool polyline_active_ = false;
   bool polyline_closed_ = false;
   std::string polyline_layer_;

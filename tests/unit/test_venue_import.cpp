@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -397,9 +398,15 @@ TEST(VenueImport, DxfSplinesAreFlattened) {
 }
 
 // A SPLINE given by fit points only (group 11), as some CAD exporters write them.
-std::string DxfFitSpline(int degree, const std::vector<Vec2>& fit, bool closed) {
+// With `tangents` (start, end), also groups 12/22/32 and 13/23/33.
+std::string DxfFitSpline(int degree, const std::vector<Vec2>& fit, bool closed,
+                         std::optional<std::pair<Vec2, Vec2>> tangents = std::nullopt) {
   std::string e = "0\nSPLINE\n8\n0\n70\n" + std::to_string(8 + (closed ? 1 : 0)) + "\n71\n" + std::to_string(degree) +
                   "\n72\n0\n73\n0\n74\n" + std::to_string(fit.size()) + "\n";
+  if (tangents) {
+    e += "12\n" + Num(tangents->first.x) + "\n22\n" + Num(tangents->first.y) + "\n32\n0\n";
+    e += "13\n" + Num(tangents->second.x) + "\n23\n" + Num(tangents->second.y) + "\n33\n0\n";
+  }
   for (const Vec2& f : fit) e += "11\n" + Num(f.x) + "\n21\n" + Num(f.y) + "\n31\n0\n";
   return e;
 }
@@ -452,6 +459,52 @@ TEST(VenueImport, DxfFitPointSplinesAreInterpolated) {
     ImportDxf(WriteText("fit-one.dxf", DxfFile(room + DxfFitSpline(3, {{1, 1}, {1, 1}}, false))), options);
   });
   EXPECT_NE(m.find("2 fit points and no control points"), std::string::npos) << m;
+}
+
+TEST(VenueImport, DxfFitPointSplinesFollowTheirEndTangents) {
+  // A pillar shaped as a quarter disc of radius 1 around (7, 3): its arc is a
+  // fit spline through 4 points, its straight sides two lines. With the
+  // arc's own end tangents (of any length: the file gives directions) the
+  // curve hugs the circle much more closely than with the ends left free.
+  const std::string room = DxfPolyline({{0, 0}, {10, 0}, {10, 6}, {0, 6}}, true);
+  ImportOptions options;
+  options.dxf_arc_tolerance_m = 1e-5;
+  const Vec2 centre{7, 3};
+  std::vector<Vec2> fit;
+  for (int k = 0; k < 4; ++k) {
+    const double t = std::numbers::pi / 2.0 * k / 3.0;
+    fit.push_back(centre + Vec2{std::cos(t), std::sin(t)});
+  }
+  const std::string sides = DxfLine(fit.back(), centre) + DxfLine(centre, fit.front());
+  // Largest distance of the pillar's outline from the circle, its straight
+  // sides and their ends left out.
+  const auto deviation = [&](const Venue& v) {
+    double worst = 0.0;
+    for (const Vec2& p : v.obstacles.at(0).polygon)
+      if (p.x > centre.x + 1e-6 && p.y > centre.y + 1e-6) worst = std::max(worst, std::abs(Length(p - centre) - 1.0));
+    return worst;
+  };
+  const Venue free = ImportDxf(WriteText("quarter-free.dxf", DxfFile(room + DxfFitSpline(3, fit, false) + sides)), options);
+  const Venue tangent = ImportDxf(
+      WriteText("quarter-tangent.dxf",
+                DxfFile(room + DxfFitSpline(3, fit, false, std::pair{Vec2{0, 3}, Vec2{-0.5, 0}}) + sides)),
+      options);
+  ASSERT_EQ(free.obstacles.size(), 1u);
+  ASSERT_EQ(tangent.obstacles.size(), 1u);
+  for (const Vec2& f : fit) EXPECT_LT(DistanceToRing(f, tangent.obstacles[0].polygon), 2e-5);
+  const double free_deviation = deviation(free), tangent_deviation = deviation(tangent);
+  EXPECT_LT(tangent_deviation, 1e-3) << free_deviation;
+  EXPECT_LT(tangent_deviation, 0.25 * free_deviation) << free_deviation;
+  EXPECT_NEAR(60.0 - WalkableArea_m2(tangent), std::numbers::pi / 4.0, 2e-3);
+  // Two fit points and both tangents: a cubic (Hermite) arc, which a degree
+  // clamped to the point count alone would make a straight line.
+  const Venue two = ImportDxf(
+      WriteText("quarter-two.dxf", DxfFile(room + DxfFitSpline(3, {fit.front(), fit.back()}, false,
+                                                                 std::pair{Vec2{0, 1}, Vec2{-1, 0}}) +
+                                            sides)),
+      options);
+  ASSERT_EQ(two.obstacles.size(), 1u);
+  EXPECT_GT(60.0 - WalkableArea_m2(two), 0.7) << "chord triangle: 0.5 m^2, quarter disc: 0.785 m^2";
 }
 
 // --- raster -------------------------------------------------------------------
