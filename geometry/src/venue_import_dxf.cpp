@@ -619,10 +619,6 @@ void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
   *pieces = std::move(done);
 }
 
-}  // namespace
-
-namespace {
-
 // A DXF file ends with the group "0" / "EOF". dxflib reads a file that stops
 // short (an interrupted copy or download) without complaint, as far as it
 // goes: such a file is refused here rather than imported in part. Returns the
