@@ -13,6 +13,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "image_file.hpp"
 #include "outline_cgal.hpp"
 
 namespace crowdrecon::geometry {
@@ -202,6 +203,7 @@ std::vector<Vec2> ValidateOutlineRing(std::vector<Vec2> points, const std::strin
 Outline ReadOutlineImage(const std::filesystem::path& file, const ImageOutlineOptions& options) {
   const std::string name = file.string();
   if (!std::filesystem::exists(file)) throw InputError(name + ": cannot open file (it does not exist)");
+  detail::CheckImageFileComplete(file);
   cv::Mat image = cv::imread(name, cv::IMREAD_UNCHANGED);
   if (image.empty())
     throw InputError(name + ": not a readable image (empty or unknown format); expected a PNG, "

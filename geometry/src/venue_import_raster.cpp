@@ -32,6 +32,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "image_file.hpp"
 #include "venue_internal.hpp"
 
 namespace crowdrecon::geometry {
@@ -196,6 +197,7 @@ Venue ImportRasterPlan(const std::filesystem::path& file, const RasterImportOpti
     throw InputError(origin + ": dark threshold " + std::to_string(options.dark_threshold) +
                      " is out of range; expected a grey level in [1, 255]");
   if (!std::filesystem::exists(file)) throw InputError(origin + ": cannot open image file (it does not exist)");
+  detail::CheckImageFileComplete(file);
   const cv::Mat grey = cv::imread(origin, cv::IMREAD_GRAYSCALE);
   if (grey.empty()) throw InputError(origin + ": cannot read the file as an image (PNG, JPEG, BMP, TIFF, ...)");
 

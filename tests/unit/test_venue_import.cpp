@@ -16,6 +16,7 @@
 
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/geometry/outline.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 
 namespace crowdrecon::geometry {
@@ -570,6 +571,48 @@ TEST(VenueImport, RasterSeedAndErrors) {
   plain.pixels_per_metre = 0;
   m = ErrorOf([&] { ImportRasterPlan(path, plain); });
   EXPECT_NE(m.find("expected a positive scale"), std::string::npos) << m;
+}
+
+// Reads a file's bytes, or writes them.
+std::string Bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream all;
+  all << in.rdbuf();
+  return all.str();
+}
+std::filesystem::path WriteBytes(const std::string& name, const std::string& bytes) {
+  const auto path = TempFile(name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+TEST(VenueImport, PicturesCutShortAreErrors) {
+  // OpenCV decodes a JPEG that stops short (grey rows where data is missing)
+  // with only a warning from libjpeg; a PNG that stops short it refuses, with
+  // a message that does not say why. Both are refused, saying so.
+  RasterImportOptions options;
+  options.pixels_per_metre = 20;
+  const std::string png = Bytes(DrawPlan(20));
+  const cv::Mat plan = cv::imread(DrawPlan(20).string(), cv::IMREAD_GRAYSCALE);
+  const auto jpeg_path = TempFile("plan-20.jpg");
+  cv::imwrite(jpeg_path.string(), plan, {cv::IMWRITE_JPEG_QUALITY, 95});
+  const std::string jpeg = Bytes(jpeg_path);
+  const double exact = WalkableArea_m2(ImportRasterPlan(jpeg_path, options));
+  EXPECT_GT(exact, 35.0);
+  // Bytes after the end-of-image marker (some cameras append data) are fine.
+  EXPECT_NEAR(WalkableArea_m2(ImportRasterPlan(WriteBytes("tail.jpg", jpeg + std::string(64, '\x17')), options)), exact,
+              1e-12);
+  const std::string cut_jpeg = jpeg.substr(0, jpeg.size() * 2 / 3);
+  const auto cut_path = WriteBytes("cut.jpg", cut_jpeg);
+  ASSERT_FALSE(cv::imread(cut_path.string(), cv::IMREAD_GRAYSCALE).empty()) << "OpenCV decodes it, as said above";
+  std::string m = ErrorOf([&] { ImportRasterPlan(cut_path, options); });
+  EXPECT_NE(m.find("cut.jpg: JPEG whose image data stops without the end-of-image marker"), std::string::npos) << m;
+  EXPECT_NE(m.find("cut short"), std::string::npos) << m;
+  m = ErrorOf([&] { ImportRasterPlan(WriteBytes("cut.png", png.substr(0, png.size() - 20)), options); });
+  EXPECT_NE(m.find("cut.png: PNG without its closing IEND chunk"), std::string::npos) << m;
+  // Body outlines are read through the same check.
+  m = ErrorOf([&] { ReadOutlineImage(cut_path, ImageOutlineOptions{}); });
+  EXPECT_NE(m.find("cut.jpg: JPEG whose image data stops"), std::string::npos) << m;
 }
 
 }  // namespace
