@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_worlds.hpp"
+#include "stage_profile.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 
@@ -247,20 +248,8 @@ int Run(const Args& args) {
     for (std::size_t k = 0; k < args.steps; ++k) sim.Step();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double people = static_cast<double>(sim.bodies().size());
-    if (args.profile) {
-      // Milliseconds per timed step of each stage (the construction's first
-      // force evaluation left out), and the pairs measured per step.
-      const engine::Profile& after = sim.profile();
-      const double per = 1e3 / static_cast<double>(args.steps);
-      std::printf("PROFILE threads %d, ms/step: pairs %.4f place %.4f collide %.4f gather %.4f drive %.4f "
-                  "integrate %.4f check %.4f; pairs measured per step %.1f, pair rebuilds %llu\n",
-                  threads, (after.update_pairs_s - before.update_pairs_s) * per,
-                  (after.place_shapes_s - before.place_shapes_s) * per, (after.collide_s - before.collide_s) * per,
-                  (after.gather_s - before.gather_s) * per, (after.drive_s - before.drive_s) * per,
-                  (after.integrate_s - before.integrate_s) * per, (after.check_s - before.check_s) * per,
-                  static_cast<double>(after.pairs_measured - before.pairs_measured) / static_cast<double>(args.steps),
-                  static_cast<unsigned long long>(after.pair_rebuilds - before.pair_rebuilds));
-    }
+    if (args.profile)  // the construction's first force evaluation left out
+      std::printf("PROFILE threads %d, %s\n", threads, StageProfileText(before, sim.profile(), args.steps).c_str());
     std::printf("RESULT {\"code\": \"crowdrecon\", \"threads\": %d, \"steps\": %zu, \"people\": %zu, "
                 "\"seconds\": %.6g, \"agent_steps_per_s\": %.6g, \"contacts_start\": %zu, \"contacts_end\": %zu, "
                 "\"neighbour_pairs\": %zu, \"elastic_energy_start_j\": %.6g, \"elastic_energy_end_j\": %.6g, "

@@ -30,6 +30,7 @@
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
+#include "stage_profile.hpp"
 
 namespace {
 
@@ -112,18 +113,10 @@ int main(int argc, char** argv) {
     const std::uint64_t hash = crowdrecon::Fnv1a(positions.data(), positions.size() * sizeof(positions[0]));
     std::printf("%.4f ms/step  %d steps  %zu contacts  positions %016llx\n", steps > 0 ? ms / steps : 0.0, steps,
                 simulation.contacts().size(), static_cast<unsigned long long>(hash));
-    if (profile && steps > 0) {
-      const crowdrecon::engine::Profile& after = simulation.profile();
-      const auto per_step = [&](double a, double b) { return (a - b) * 1e3 / steps; };
-      std::printf("ms/step by stage: pairs %.4f  place %.4f  collide %.4f  gather %.4f  drive %.4f  integrate %.4f"
-                  "  check %.4f  (pair rebuilds %llu, pairs measured per step %.1f)\n",
-                  per_step(after.update_pairs_s, before.update_pairs_s),
-                  per_step(after.place_shapes_s, before.place_shapes_s), per_step(after.collide_s, before.collide_s),
-                  per_step(after.gather_s, before.gather_s), per_step(after.drive_s, before.drive_s),
-                  per_step(after.integrate_s, before.integrate_s), per_step(after.check_s, before.check_s),
-                  static_cast<unsigned long long>(after.pair_rebuilds - before.pair_rebuilds),
-                  static_cast<double>(after.pairs_measured - before.pairs_measured) / steps);
-    }
+    if (profile && steps > 0)
+      std::printf("%s\n", crowdrecon::bench::StageProfileText(before, simulation.profile(),
+                                                                static_cast<std::uint64_t>(steps))
+                               .c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crowdrecon_step_world: %s\n", e.what());
     return 1;
