@@ -8,7 +8,7 @@ set -euo pipefail
 
 packages=(
   # toolchain
-  build-essential cmake ninja-build pkg-config git python3
+  build-essential cmake ninja-build pkg-config git python3 ccache
   # numerics and geometry
   libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   # calibration
