@@ -21,6 +21,7 @@ struct SimulateArgs {
   std::string device = "cpu";
   bool resume = false;
   bool quiet = false;
+  bool fixed_threads = false;
   double stop_after_s = -1.0;
 };
 
@@ -31,6 +32,7 @@ int RunSimulate(const SimulateArgs& args) {
   options.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   if (!engine::FromString(args.device, &options.device))
     throw InputError("--device: \"" + args.device + "\", expected \"cpu\" or \"cuda\"");
+  options.adapt_threads = !args.fixed_threads;
   options.resume = args.resume;
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.stop_after_s = args.stop_after_s;
@@ -41,6 +43,7 @@ int RunSimulate(const SimulateArgs& args) {
               options.device != engine::ComputeDevice::kCuda ? ""
               : s.device_fallback.empty()                      ? ", person-pair forces on CUDA"
                                                                : ", person-pair forces on CUDA until it failed (see the note)");
+  if (!s.threads_report.empty()) std::printf("threads: %s\n", s.threads_report.c_str());
   std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());
@@ -73,6 +76,9 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("--device", args->device,
                   "Where person-pair forces are computed: cpu (default) or cuda (a build with CUDA and a GPU); "
                   "results do not depend on it");
+  cmd->add_flag("--fixed-threads", args->fixed_threads,
+                "Keep exactly --threads threads, even while fewer are faster (another program busy on a core); "
+                "for benchmarks. By default the count adapts; results do not depend on it");
   cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption");

@@ -275,6 +275,12 @@ TimeStepEstimate EstimateTimeStep(const WorldDef& def) {
 
 bool CudaAvailable(std::string* why) { return cuda::Available(why); }
 
+void Simulation::SetThreads(int threads) {
+  if (threads < 1 || threads > 1024)
+    throw InputError("threads = " + std::to_string(threads) + ", expected 1..1024");
+  def_.threads = threads;
+}
+
 Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
   std::string error;
   if (!def_.parameters.IsValid(&error)) throw InputError("model parameters: " + error);

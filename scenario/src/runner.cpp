@@ -14,6 +14,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/engine/thread_governor.hpp"
 #include "crowdrecon/scenario/run_file.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
 
@@ -169,12 +170,17 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   };
   if (last_frame < 0) write_frame(0);
 
+  engine::ThreadChoice::Options thread_options;
+  thread_options.max_threads = sim.definition().threads;
+  engine::ThreadGovernor governor(thread_options);
+  const bool adapt_threads = options.adapt_threads && thread_options.max_threads > 1;
   std::string status = "complete";
   bool device_fallback_reported = false;
   try {
     while (last_frame < total_frames) {
       for (std::int64_t k = 0; k < steps_per_frame; ++k) {
-        sim.Step();
+        if (adapt_threads) governor.Step(sim);
+        else sim.Step();
       }
       write_frame(last_frame + 1);
       if (!device_fallback_reported && !sim.device_fallback().empty()) {
@@ -239,6 +245,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   summary.frames = last_frame + 1;
   summary.profile = sim.profile();
   summary.device_fallback = sim.device_fallback();
+  if (adapt_threads) summary.threads_report = governor.summary().BriefReport();
   return summary;
 }
 

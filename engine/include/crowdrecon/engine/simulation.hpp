@@ -102,6 +102,10 @@ class Simulation {
   double time_step_s() const { return dt_s_; }
   const TimeStepEstimate& time_step_estimate() const { return dt_estimate_; }
   const WorldDef& definition() const { return def_; }
+  // Changes the number of worker threads from the next step on (1..1024).
+  // Results do not depend on it, so it may change between any two steps
+  // (ThreadGovernor does so on a busy machine).
+  void SetThreads(int threads);
   const BodyState& bodies() const { return bodies_; }
   // Contacts of the last force evaluation, in a fixed order.
   const std::vector<Contact>& contacts() const { return contacts_; }

@@ -19,6 +19,10 @@ namespace crowdrecon::scenario {
 struct RunOptions {
   std::filesystem::path output;  // RUN.sqlite
   int threads = 1;
+  // With more than one thread: true lets engine::ThreadGovernor use fewer
+  // while they are faster (a busy core); false keeps `threads` throughout
+  // (benchmarks). Results are the same either way.
+  bool adapt_threads = true;
   // Where the force computation of person pairs runs (engine::WorldDef::device);
   // results are the same on either.
   engine::ComputeDevice device = engine::ComputeDevice::kCpu;
@@ -44,6 +48,7 @@ struct RunSummary {
   double real_time_factor = 0.0;  // simulated / wall seconds (this invocation)
   engine::Profile profile;         // time per engine stage (this invocation)
   std::string device_fallback;     // why and when the GPU failed, if it did (engine::Simulation)
+  std::string threads_report;      // the thread governor's brief report (engine::ThreadChoice::Summary)
 };
 
 // Path of the checkpoint that belongs to a run file.
