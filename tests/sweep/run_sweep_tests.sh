@@ -5,7 +5,8 @@
 #       OUT/j1 with --jobs 1 (the reference), OUT/j2 with --jobs 2, and OUT/resume:
 #       stopped after 3 runs (--stop-after-runs 3, exit 130, runs in progress
 #       interrupted with their checkpoints), resumed, then run once more (nothing
-#       left to do); every results.csv equal to the reference but for wall_s.
+#       left to do); OUT/killed: killed with SIGKILL after 2 rows and started
+#       again; every results.csv equal to the reference but for wall_s.
 #       Also: the same DIR with another sweep file is refused.
 #   run_sweep_tests.sh CROWDRECON SWEEP OUT mpi
 #       OUT/mpi under `mpirun -np 2 --oversubscribe`, compared with OUT/j1
@@ -47,6 +48,25 @@ if [[ $mode == local ]]; then
   "$exe" sweep "$sweep" -o "$out/resume" -q >"$out/again.txt"
   grep -q "$rows done before, 0 now" "$out/again.txt" || { echo "FAIL: a finished sweep ran again"; cat "$out/again.txt"; exit 1; }
   [[ -z $(ls "$out/resume/runs") ]] || { echo "FAIL: run files left after resuming"; exit 1; }
+
+  # Killed outright (SIGKILL: no checkpoint written at the end) once two rows
+  # are in, then started again: the same table as the reference.
+  rm -rf "$out/killed"
+  "$exe" sweep "$sweep" -o "$out/killed" --jobs 2 -q >"$out/killed.txt" 2>&1 &
+  pid=$!
+  for _ in $(seq 600); do
+    n=$(sqlite3 "$out/killed/results.sqlite" "SELECT COUNT(*) FROM runs" 2>/dev/null || echo 0)
+    [[ ${n:-0} -ge 2 ]] && break
+    kill -0 $pid 2>/dev/null || break
+    sleep 0.1
+  done
+  kill -9 $pid 2>/dev/null || true
+  wait $pid 2>/dev/null || true
+  killed=$(sqlite3 "$out/killed/results.sqlite" "SELECT COUNT(*) FROM runs")
+  [[ $killed -lt $rows ]] || { echo "FAIL: the sweep finished before it could be killed"; exit 1; }
+  echo "killed with SIGKILL after $killed rows"
+  "$exe" sweep "$sweep" -o "$out/killed" --jobs 2 -q >/dev/null
+  same "$out/j1" "$out/killed" "killed (SIGKILL) and started again"
 
   # Another sweep into the same folder is refused.
   sed 's/"count": 2}/"count": 3}/' "$sweep" >"$out/other.json"

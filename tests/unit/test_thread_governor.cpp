@@ -120,9 +120,9 @@ TEST(ThreadGovernor, ChangingTheThreadCountBetweenStepsChangesNothing) {
   def.threads = 1;
   Simulation fixed(def);
   Simulation varied(def);
-  for (int k = 0; k < 120; ++k) {
+  for (int k = 0; k < 60; ++k) {
     fixed.Step();
-    varied.SetThreads(1 + (k / 7) % 3);
+    varied.SetThreads(1 + (k / 5) % 3);
     varied.Step();
   }
   const auto& a = fixed.bodies();
