@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Whole runs on an idle machine and with one core kept busy by another
 program: --threads 1 against --threads 2, with the thread governor (the
-default) and without it (--fixed-threads, the behaviour before the governor).
+default) and without it (--fixed-threads, the behaviour before the governor),
+and without it under OpenMP's passive waiting policy (for comparison).
 
     bench/busy_machine.py --exe build/release/cli/crowdrecon [--repeat 5] [--label L]
 
@@ -30,14 +31,17 @@ SCENARIOS = {
     "hallway-180": ("venues/madrid-arena/scenarios/hallway-5pm2-30cf.json", 10.0),
     "box-2000": ("bench/scenarios/box-2000.json", 2.0),
 }
+PASSIVE = {"OMP_WAIT_POLICY": "passive"}
 CONFIGS = [
-    # (name, busy core, --threads, extra options)
-    ("idle 1T", False, 1, []),
-    ("idle 2T fixed", False, 2, ["--fixed-threads"]),
-    ("idle 2T governor", False, 2, []),
-    ("busy 1T", True, 1, []),
-    ("busy 2T fixed", True, 2, ["--fixed-threads"]),
-    ("busy 2T governor", True, 2, []),
+    # (name, busy core, --threads, extra options, extra environment)
+    ("idle 1T", False, 1, [], {}),
+    ("idle 2T fixed", False, 2, ["--fixed-threads"], {}),
+    ("idle 2T governor", False, 2, [], {}),
+    ("idle 2T fixed passive", False, 2, ["--fixed-threads"], PASSIVE),
+    ("busy 1T", True, 1, [], {}),
+    ("busy 2T fixed", True, 2, ["--fixed-threads"], {}),
+    ("busy 2T governor", True, 2, [], {}),
+    ("busy 2T fixed passive", True, 2, ["--fixed-threads"], PASSIVE),
 ]
 
 
@@ -52,14 +56,14 @@ def scenario_copy(path, duration_s):
     return copy
 
 
-def run_once(exe, scenario, threads, extra, busy, folder):
+def run_once(exe, scenario, threads, extra, env, busy, folder):
     out = pathlib.Path(folder) / "run.sqlite"
     for leftover in (out, pathlib.Path(str(out) + "-wal"), pathlib.Path(str(out) + "-shm")):
         leftover.unlink(missing_ok=True)
     hog = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if busy else None
     try:
         result = subprocess.run([str(exe), "simulate", str(scenario), "-o", str(out), "-q", "--threads", str(threads)]
-                                + extra, capture_output=True, text=True)
+                                + extra, capture_output=True, text=True, env=dict(os.environ, **env))
     finally:
         if hog:
             hog.kill()
@@ -102,8 +106,8 @@ def main():
             for r in range(args.repeat):
                 order = [(s, c) for s in names for c in CONFIGS]
                 rng.shuffle(order)
-                for s, (cname, busy, threads, extra) in order:
-                    wall, report = run_once(exe, scenarios[s], threads, extra, busy, folder)
+                for s, (cname, busy, threads, extra, env) in order:
+                    wall, report = run_once(exe, scenarios[s], threads, extra, env, busy, folder)
                     times[(s, cname)].append(wall)
                     if report:
                         reports.setdefault((s, cname), []).append(report)
@@ -122,6 +126,10 @@ def main():
         rows.append([s, "**busy 2T / busy 1T, fixed (before)**", bc.fixed(med["busy 2T fixed"] / med["busy 1T"]), "", ""])
         rows.append([s, "**busy 2T / busy 1T, governor (after)**", bc.fixed(med["busy 2T governor"] / med["busy 1T"]), "", ""])
         rows.append([s, "**idle 2T governor / idle 2T fixed**", bc.fixed(med["idle 2T governor"] / med["idle 2T fixed"]), "", ""])
+        rows.append([s, "**busy 2T / busy 1T, fixed, OMP_WAIT_POLICY=passive**",
+                     bc.fixed(med["busy 2T fixed passive"] / med["busy 1T"]), "", ""])
+        rows.append([s, "**idle 2T fixed passive / idle 2T fixed**",
+                     bc.fixed(med["idle 2T fixed passive"] / med["idle 2T fixed"]), "", ""])
         rows.append([s, "**idle 1T / idle 2T governor**", bc.fixed(med["idle 1T"] / med["idle 2T governor"]), "", ""])
     table = bc.markdown_table(["scenario", "configuration", "median wall s", "spread", "governor (last round)"], rows)
     print(table)

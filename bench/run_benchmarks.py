@@ -114,13 +114,25 @@ def parse_time_v(text):
     return out
 
 
+_FIXED_THREADS = {}
+
+
+def fixed_threads_option(exe):
+    """["--fixed-threads"] where this build has the thread governor (whose
+    adaptation would blur a measurement of two-thread scaling), else []."""
+    if exe not in _FIXED_THREADS:
+        help_text = subprocess.run([str(exe), "simulate", "--help"], capture_output=True, text=True).stdout
+        _FIXED_THREADS[exe] = ["--fixed-threads"] if "--fixed-threads" in help_text else []
+    return _FIXED_THREADS[exe]
+
+
 def run_once(exe, scenario, threads, workdir, device="cpu"):
     run_file = pathlib.Path(workdir) / "run.sqlite"
     time_file = pathlib.Path(workdir) / "time.txt"
     for stale in (run_file, pathlib.Path(str(run_file) + ".checkpoint")):
         stale.unlink(missing_ok=True)
     cmd = [TIME, "-v", "-o", str(time_file), str(exe), "simulate", str(scenario), "-o", str(run_file),
-           "--threads", str(threads), "-q"]
+           "--threads", str(threads), "-q"] + fixed_threads_option(exe)
     if device != "cpu":
         cmd += ["--device", device]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=bc.ROOT)
