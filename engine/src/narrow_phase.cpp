@@ -54,7 +54,13 @@ ShapeGeometry ShapeGeometry::FromWorld(const std::vector<Vec2>& points, bool clo
   std::vector<Vec2> local;
   local.reserve(points.size());
   for (const Vec2& p : points) local.push_back(p - origin);
-  return Make(std::move(local), closed, radius_m);
+  ShapeGeometry g = Make(std::move(local), closed, radius_m);
+  // A wall is a line, whichever side a person is on: a closed wall keeps its
+  // closing edge but has no inside (a room walled all round holds people
+  // inside it). Crossing it is what the engine checks (WallCrossing).
+  g.closed = false;
+  g.reflex.clear();
+  return g;
 }
 
 namespace {

@@ -244,35 +244,6 @@ struct Simulation::Internals {
 // ---------------------------------------------------------------------------
 // Construction and validation
 
-TimeStepEstimate EstimateTimeStep(const WorldDef& def) {
-  // The stiffest mode: a contact at the farthest point of the lightest, most
-  // elongated body, against an equal body. Along the normal the effective
-  // inverse mass of one body is 1/m + l^2/I (translation plus the rotation
-  // that the lever arm l allows); two such bodies add. Two flat faces touch at
-  // up to four points (two vertices of each against the other's face),
-  // multiplying the stiffness by four. Hence
-  //   omega_max^2 = 4 k_n * 2 max_i (1/m_i + l_i^2 / I_i).
-  double w_max = 0.0;
-  for (const PersonDef& p : def.people) {
-    const BodyShape& s = def.shapes[p.shape];
-    double l = 0.0;
-    for (const Vec2& v : s.vertices) l = std::max(l, Length(v));
-    l += s.radius_m;
-    const double w = 1.0 / p.mass_kg + (p.inertia_kg_m2 > 0 ? l * l / p.inertia_kg_m2 : 0.0);
-    w_max = std::max(w_max, w);
-  }
-  TimeStepEstimate e;
-  if (w_max == 0.0) w_max = 1.0 / def.parameters.mass_min_kg;
-  e.omega_max_rad_per_s = std::sqrt(4.0 * def.parameters.normal_stiffness_n_per_m * 2.0 * w_max);
-  // Velocity Verlet is stable for omega dt < 2; the fifth-order Gear
-  // predictor-corrector only below about 0.2 for these damping ratios (ERRATA 12).
-  const double bound = def.parameters.integrator == Integrator::kVelocityVerlet ? 2.0 : 0.2;
-  e.stability_limit_s = bound / e.omega_max_rad_per_s;
-  e.chosen_s = def.parameters.time_step_s > 0.0 ? def.parameters.time_step_s
-                                                 : def.parameters.time_step_safety * e.stability_limit_s;
-  return e;
-}
-
 bool CudaAvailable(std::string* why) { return cuda::Available(why); }
 
 void Simulation::SetThreads(int threads) {
@@ -743,6 +714,27 @@ class PreviousContacts {
   std::uint32_t last_feature_ = 0;
 };
 
+// A wall is a line (its core, an open or closed polyline with no inside), so
+// the distance of a person's vertex from it never turns negative: a vertex
+// pressed through it would simply be pushed on from the other side. True when
+// the vertex of contact `now` (a person's vertex against a wall's core) went
+// through the wall since `before`, the same vertex's contact at the last
+// evaluation: it now lies behind the line it touched then (along that
+// contact's normal, from the closest point then) and the wall now pushes the
+// opposite way. The closest point of the core is point - n (r_w - delta/2),
+// the vertex reach - delta beyond it along n (narrow_phase.cpp). Going round
+// a convex corner or a wall's end does not count, unless within about one
+// step's travel of it (the core then practically touches it).
+// `separation(x, y)` is x - y (minimum image).
+template <typename Separation>
+bool WentThroughWall(const Contact& now, const Contact& before, double wall_radius_m, double reach_m,
+                     const Separation& separation) {
+  if ((now.feature & kVertexOfB) != 0) return false;  // a wall's vertex against the person's core
+  const auto closest = [&](const Contact& c) { return c.point_m - c.normal * (wall_radius_m - c.overlap_m / 2.0); };
+  const Vec2 vertex = closest(now) + now.normal * (reach_m - now.overlap_m);
+  return Dot(separation(vertex, closest(before)), before.normal) < 0.0 && Dot(now.normal, before.normal) < 0.0;
+}
+
 }  // namespace
 
 void Simulation::Collide() {
@@ -785,11 +777,14 @@ void Simulation::Collide() {
   // The contacts of one pair (persons a and b, or person a and wall b) at its
   // narrow-phase points, with the forces of `pair_law`; `relative_velocity(x)`
   // is a's velocity less b's at the point x. Returns true if a point overlaps
-  // beyond `radii`, the sum of the two sphero-radii: the cores interpenetrate,
-  // which Check() reports (and looks for only then).
-  const auto add_contacts = [](const std::vector<ContactPoint>& points, std::uint32_t a, std::uint32_t b, bool wall,
-                               const ContactLaw& pair_law, double mass, double radii, PreviousContacts& previous,
-                               std::vector<Contact>& out, const auto& relative_velocity) {
+  // beyond `radii`, the sum of the two sphero-radii, or, for a wall, if a
+  // vertex went through it (WentThroughWall): the cores interpenetrate, which
+  // Check() reports (and looks for only then).
+  const auto minimum_image = [this](Vec2 x, Vec2 y) { return Separation(x, y); };
+  const auto add_contacts = [&minimum_image](const std::vector<ContactPoint>& points, std::uint32_t a, std::uint32_t b,
+                                          bool wall, const ContactLaw& pair_law, double mass, double radii,
+                                          PreviousContacts& previous, std::vector<Contact>& out,
+                                          const auto& relative_velocity, double wall_radius_m = 0.0) {
     const std::uint64_t key = PairKey(wall, a, b);
     const auto [sum, k_eff] = OverlapShares(points);
     const ContactLaw::Rates rates = pair_law.PairRates(mass, k_eff);
@@ -800,7 +795,8 @@ void Simulation::Collide() {
       const ContactHistory history =
           before ? ContactHistory{true, before->tangential_spring_m, before->leading_fraction} : ContactHistory{};
       pair_law.Apply(c, relative_velocity(p.point), mass, history, p.overlap_m / sum, rates);
-      beyond = beyond || !(p.overlap_m <= radii);
+      beyond = beyond || !(p.overlap_m <= radii) ||
+               (wall && before && WentThroughWall(c, *before, wall_radius_m, radii, minimum_image));
     }
     return beyond;
   };
@@ -857,7 +853,7 @@ void Simulation::Collide() {
         if (points.empty()) continue;
         const auto relative_velocity = [&](Vec2 x) { return velocity_at(a, x - xa); };
         overlap_beyond = add_contacts(points, a, w, true, wall_law, bodies_.mass_kg[a], pa.scale + pw.geometry->radius_m,
-                                      previous, out, relative_velocity) ||
+                                      previous, out, relative_velocity, pw.geometry->radius_m) ||
                          overlap_beyond;
       }
     }
@@ -1307,9 +1303,22 @@ void Simulation::Check() {
                             FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")",
                             i, -1, time_s_);
   }
+  PreviousContacts previous(in_->previous_contacts);
   for (const Contact& c : contacts_) {
     const double ra = def_.shapes[bodies_.shape[c.a]].radius_m;
     const double rb = c.wall ? def_.walls[c.b].radius_m : def_.shapes[bodies_.shape[c.b]].radius_m;
+    const Contact* before = c.wall ? previous.Find(PairKey(c), c.feature) : nullptr;
+    const auto separation = [this](Vec2 x, Vec2 y) { return Separation(x, y); };
+    if (before && WentThroughWall(c, *before, rb, ra + rb, separation)) {
+      const Vec2 x = bodies_.position_m[c.a];
+      throw SimulationError(PersonText(c.a) + " went through wall " + std::to_string(c.b) + " at t = " +
+                            FormatNumber(time_s_) + " s near (" + FormatNumber(c.point_m.x) + ", " +
+                            FormatNumber(c.point_m.y) + "), centre at (" + FormatNumber(x.x) + ", " +
+                            FormatNumber(x.y) + "): the core crossed the wall line, a load beyond k_n (r_person + r_wall) = " +
+                            FormatNumber(def_.parameters.normal_stiffness_n_per_m * (ra + rb)) +
+                            " N on one point or too fast for the step (desired speed, time step)",
+                            c.a, -1, time_s_);
+    }
     if (!(c.overlap_m <= ra + rb)) {
       const std::string other = c.wall ? "wall " + std::to_string(c.b) : PersonText(c.b);
       throw SimulationError("overlap of " + PersonText(c.a) + " and " + other + " is " +

@@ -269,7 +269,9 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
   };
   for (std::size_t i = 0; i < count; ++i) {
     bool placed = false;
+    int attempts = 0, wall_blocked = 0;  // why places were refused, for the message
     for (int attempt = 0; attempt < 4000 && !placed; ++attempt) {
+      ++attempts;
       // Region chosen in proportion to its area.
       double u = Uniform(rng) * built.placement_area_m2;
       std::size_t r = 0;
@@ -288,6 +290,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
         engine::CollideShapes(me, ws, hits);
         if (!hits.empty()) { free = false; break; }
       }
+      if (!free) ++wall_blocked;
       const auto [cx, cy] = cell_of(at);
       for (std::size_t dy = 0; dy < 3 && free; ++dy)
         for (std::size_t dx = 0; dx < 3 && free; ++dx) {
@@ -319,6 +322,12 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
       grid[cy * gx + cx].push_back(static_cast<std::uint32_t>(i));
       placed = true;
     }
+    if (!placed && wall_blocked == attempts)
+      throw InputError(scenario.file.string() + ": /population: cannot place person " + std::to_string(i + 1) +
+                       " of " + std::to_string(count) + ": each of the " + std::to_string(attempts) +
+                       " places tried in the placement region (" + FormatNumber(built.placement_area_m2) +
+                       " m^2) touches a wall, even at " + FormatNumber(scale) +
+                       " of full size; expected a region wider than a body inside the walls (check the venue's walls)");
     if (!placed)
       throw InputError(scenario.file.string() + ": /population: cannot place person " + std::to_string(i + 1) +
                        " of " + std::to_string(count) + " in " + FormatNumber(built.placement_area_m2) +

@@ -48,7 +48,9 @@ struct CoreEdge {
 // A core polygon, polyline or point in its own frame, with what the narrow
 // phase needs precomputed. count 1 = disk; closed with count >= 3 = polygon
 // (counter-clockwise); open = polyline (count - 1 edges; a capsule is an open
-// polyline of 2 vertices; walls are open or closed polylines).
+// polyline of 2 vertices). Walls (FromWorld) are open or closed polylines
+// with no inside: `closed` is false for them, and a closed wall's edges
+// include the closing one.
 struct ShapeGeometry {
   std::vector<Vec2> vertices;
   std::vector<CoreEdge> edges;
@@ -78,7 +80,9 @@ struct ShapeGeometry {
   static ShapeGeometry Make(std::vector<Vec2> vertices, bool closed, double radius_m);
   // A core given in world coordinates (a wall): the frame's origin is put at
   // the centre of its bounding box; `origin` receives that point, which is
-  // the position of the shape's pose (angle 0).
+  // the position of the shape's pose (angle 0). With `closed` the last point
+  // joins the first, but the ring has no inside: a wall is a line on both
+  // sides (people may stand inside a room walled all round).
   static ShapeGeometry FromWorld(const std::vector<Vec2>& points, bool closed, double radius_m, Vec2& origin);
   // Builds the grid for contacts whose reach r_A + r_B is at most reach_m
   // (shapes with fewer than 6 edges get none: the full search is as cheap).

@@ -63,11 +63,14 @@ struct Profile {
   double device_copy_s = 0, device_kernels_s = 0;
 };
 
-// Time-step limits derived from the stiffest contact and the smallest body.
+// Time-step limits derived from every stiffness and rate of the model and
+// the smallest body (see docs/model.md, "ERRATA 12: time step").
 struct TimeStepEstimate {
-  double omega_max_rad_per_s = 0.0;  // highest contact frequency (see docs/model.md)
+  double omega_max_rad_per_s = 0.0;  // highest frequency (contact, torsion, or a damping rate)
+  std::string limited_by;            // the parameter that sets omega_max
   double stability_limit_s = 0.0;    // integrator's stability bound
-  double chosen_s = 0.0;             // safety * limit (or the user's value)
+  double accurate_s = 0.0;           // time_step_safety * limit: the engine's own choice
+  double chosen_s = 0.0;             // accurate_s, or the user's value
 };
 
 // A run that went numerically wrong. The message names the people (by id =
@@ -186,5 +189,12 @@ bool CudaAvailable(std::string* why = nullptr);
 
 // Time-step estimate for a world (used by the constructor; exposed for tests).
 TimeStepEstimate EstimateTimeStep(const WorldDef& def);
+
+// The error of the restitution that the integrator gives, at `time_step_s`,
+// to a collision in the stiffest contact mode of `def` (|eps_measured / eps
+// - 1|, worst over ten phases of the collision within a step), measured by
+// running a two-body head-on scene whose contact frequency is def's
+// omega_max (engine/src/time_step.cpp). About 0.02 at the engine's own step.
+double RestitutionErrorAtStep(const WorldDef& def, double time_step_s);
 
 }  // namespace crowdrecon::engine
