@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
 
@@ -72,7 +73,8 @@ void RegisterAnalyzeCommand(CLI::App& app) {
                 "store the results in the run file (tables metric_series, metric_summary, metric_avalanche, "
                 "metric_load_histogram; run values regime, regime_reason)");
   cmd->add_flag("--full", args->full, "print the full report (set-up, every avalanche, load histogram)");
-  cmd->add_option("--transient", args->transient_s, "start-up time left out of stationary averages, s (default 10)");
+  cmd->add_option("--transient", args->transient_s, "start-up time left out of stationary averages, s (default 10)")
+      ->check(NumberIn(0.0, 1e6, "s"));
   cmd->add_option("--line", args->line,
                   "measurement line X1,Y1,X2,Y2 in metres (default: the venue's first measurement line)");
   cmd->callback([args] { RunAnalyze(*args); });

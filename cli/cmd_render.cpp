@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 
@@ -65,10 +66,13 @@ void RegisterRenderCommand(CLI::App& app) {
                      "range T1:T2 in seconds");
   render->add_option("--video", args->video,
                      "also write a video: .mp4 (MPEG-4; falls back to .avi if unsupported) or .avi (Motion-JPEG)");
-  render->add_option("--fps", args->fps, "frames per second of the video (default: real time)");
-  render->add_option("--width", args->width_px, "picture width in pixels (default 1280)");
+  render->add_option("--fps", args->fps, "frames per second of the video (default: real time)")
+      ->check(NumberIn(0.01, 1000.0, "frames/s"));
+  render->add_option("--width", args->width_px, "picture width in pixels (default 1280)")
+      ->check(IntegerIn(320, 8000));
   render->add_option("--force-scale", args->force_n_per_px,
-                     "newtons per pixel of force-line width (default: the largest force ~0.12 m wide)");
+                     "newtons per pixel of force-line width (default: the largest force ~0.12 m wide)")
+      ->check(NumberIn(1e-6, 1e9, "N/px"));
   render->add_flag("--svg", args->svg, "also write frame_NNNNNN.svg");
   render->callback([args] { RunRender(*args); });
 }

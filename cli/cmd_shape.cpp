@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/anthropometry.hpp"
 #include "crowdrecon/geometry/body.hpp"
@@ -288,8 +289,10 @@ void RegisterShapeCommands(CLI::App& app) {
                     "Outline: image (.png, ...; largest dark/light region) or points (.json, .csv)")
         ->required();
     cmd->add_option("-o,--output", args->output, "Body JSON to write")->required();
-    cmd->add_option("--vertices", args->vertices, "Vertices of the core polygon")->capture_default_str();
-    cmd->add_option("--radius", args->radius_m, "Sphero-radius, m")->capture_default_str();
+    cmd->add_option("--vertices", args->vertices, "Vertices of the core polygon")
+        ->capture_default_str()
+        ->check(IntegerIn(3, 1000));
+    cmd->add_option("--radius", args->radius_m, "Sphero-radius, m")->capture_default_str()->check(NumberIn(1e-4, 1.0, "m"));
     CLI::Option* scale = cmd->add_option(
         "--scale", args->scale,
         "sternum:DEPTH_M | shoulder:WIDTH_M | ppm:PIXELS_PER_M | none "
@@ -305,10 +308,14 @@ void RegisterShapeCommands(CLI::App& app) {
     auto args = std::make_shared<PopulationArgs>();
     CLI::App* cmd = app.add_subcommand("population", "Draw a population of bodies with masses");
     cmd->add_option("--mode", args->mode, "paper | anthropometric | circle")->capture_default_str();
-    cmd->add_option("--count", args->count, "Number of people")->capture_default_str();
-    cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+    cmd->add_option("--count", args->count, "Number of people")
+        ->capture_default_str()
+        ->check(IntegerIn(1, static_cast<long long>(geometry::kMaxPeople)));
+    cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str()->check(IntegerIn(0, 1LL << 62));
     cmd->add_option("--female-fraction", args->female_fraction,
-                    "Anthropometric mode: fraction of women")->capture_default_str();
+                    "Anthropometric mode: fraction of women")
+        ->capture_default_str()
+        ->check(NumberIn(0.0, 1.0));
     cmd->add_option("--body", args->body, "Reference body (paper, circle modes)")->capture_default_str();
     cmd->add_option("--anthropometry", args->anthropometry, "ANSUR II extract (anthropometric mode)")
         ->capture_default_str();
@@ -324,9 +331,12 @@ void RegisterShapeCommands(CLI::App& app) {
         "reference", "Write the reference thorax outline (ANSUR II medians) and its body");
     cmd->add_option("--anthropometry", args->anthropometry, "ANSUR II extract")->capture_default_str();
     cmd->add_option("--female-fraction", args->female_fraction, "Fraction of women in the medians")
-        ->capture_default_str();
-    cmd->add_option("--vertices", args->vertices, "Vertices of the core polygon")->capture_default_str();
-    cmd->add_option("--radius", args->radius_m, "Sphero-radius, m")->capture_default_str();
+        ->capture_default_str()
+        ->check(NumberIn(0.0, 1.0));
+    cmd->add_option("--vertices", args->vertices, "Vertices of the core polygon")
+        ->capture_default_str()
+        ->check(IntegerIn(3, 1000));
+    cmd->add_option("--radius", args->radius_m, "Sphero-radius, m")->capture_default_str()->check(NumberIn(1e-4, 1.0, "m"));
     cmd->add_option("--outline", args->outline, "Outline JSON to write")->capture_default_str();
     cmd->add_option("-o,--output", args->output, "Body JSON to write")->capture_default_str();
     cmd->add_option("--picture", args->picture, "Picture to draw (.png, .svg, .pdf)");

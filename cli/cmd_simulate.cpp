@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 
@@ -72,7 +73,7 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_option("scenario", args->scenario, "Scenario file (JSON)")->required();
   cmd->add_option("-o,--output", args->output, "Run file to write (.sqlite)")->required();
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); results do not depend on it")
-      ->check(CLI::Range(0, 1024));
+      ->check(IntegerIn(0, 1024));
   cmd->add_option("--device", args->device,
                   "Where person-pair forces are computed: cpu (default) or cuda (a build with CUDA and a GPU); "
                   "results do not depend on it");
@@ -81,7 +82,8 @@ void RegisterSimulateCommand(CLI::App& app) {
                 "for benchmarks. By default the count adapts; results do not depend on it");
   cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
-  cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption");
+  cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption")
+      ->check(NumberIn(0.0, 1e9, "s"));
   cmd->callback([args] {
     const int rc = RunSimulate(*args);
     if (rc != 0) throw CLI::RuntimeError(rc);

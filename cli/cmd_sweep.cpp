@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
 
 namespace crowdrecon::cli {
@@ -49,11 +50,11 @@ void RegisterSweepCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Output folder DIR (results.sqlite, results.csv, runs/)")->required();
   cmd->add_option("--jobs", args->jobs,
                   "Runs at a time (default: all cores; under MPI: 1 per rank); results do not depend on it")
-      ->check(CLI::Range(0, 4096));
+      ->check(IntegerIn(0, 4096));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after-runs", args->stop_after_runs,
                   "Stop as if interrupted once this many runs have been written (for testing resumption)")
-      ->check(CLI::Range(0LL, 1LL << 40));
+      ->check(IntegerIn(0, 1LL << 40));
   cmd->callback([args] {
     const int rc = RunSweepCommand(*args);
     if (rc != 0) throw CLI::RuntimeError(rc);

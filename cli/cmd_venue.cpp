@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/navigation.hpp"
 #include "crowdrecon/geometry/venue.hpp"
@@ -195,7 +196,8 @@ void RegisterVenueCommands(CLI::App& app) {
   check->add_option("FILE", check_args->file, "venue file (JSON, see docs/venues.md)")->required();
   check->add_option("--picture", check_args->picture, "write a picture of the venue (.png, .svg or .pdf)");
   check->add_option("--grid-spacing", check_args->grid_spacing_m,
-                    "grid spacing of the navigation field in metres (default 0.1)");
+                    "grid spacing of the navigation field in metres (default 0.1)")
+      ->check(NumberIn(0.005, 10.0, "m"));
   check->callback([check_args] { RunCheck(*check_args); });
 
   auto import_args = std::make_shared<ImportArgs>();
@@ -204,17 +206,21 @@ void RegisterVenueCommands(CLI::App& app) {
   import->add_option("-o,--output", import_args->output, "venue file to write (JSON)")->required();
   import->add_option("--format", import_args->format, "input format (default: from the extension)")
       ->check(CLI::IsMember({"wkt", "dxf", "image"}));
-  import->add_option("--pixels-per-metre", import_args->pixels_per_metre, "image scale (required for images)");
+  import->add_option("--pixels-per-metre", import_args->pixels_per_metre, "image scale (required for images)")
+      ->check(NumberIn(1e-3, 1e6, "pixels per metre"));
   import->add_option("--dark-threshold", import_args->dark_threshold,
-                     "image: grey levels below this are walls (1-255, default 128)");
+                     "image: grey levels below this are walls (1-255, default 128)")
+      ->check(IntegerIn(1, 255));
   import->add_option("--seed", import_args->seed,
                      "image: X,Y in metres (from the lower-left corner) inside the wanted region");
   import->add_option("--name", import_args->name, "venue name (default: the input's file name)");
   import->add_option("--layer", import_args->layer, "DXF: import this layer only");
   import->add_option("--scale", import_args->scale_m_per_unit,
-                     "WKT/DXF: metres per drawing unit (default: DXF $INSUNITS, else 1)");
+                     "WKT/DXF: metres per drawing unit (default: DXF $INSUNITS, else 1)")
+      ->check(NumberIn(1e-9, 1e9, "m per unit"));
   import->add_option("--simplify-px", import_args->simplify_px,
-                     "image: contour simplification tolerance in pixels (default 0.75)");
+                     "image: contour simplification tolerance in pixels (default 0.75)")
+      ->check(NumberIn(0.0, 100.0, "px"));
   import->callback([import_args] { RunImport(*import_args); });
 }
 

@@ -1,6 +1,7 @@
 // crowdrecon: forensic reconstruction of crowd-crush incidents.
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -26,6 +27,14 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const crowdrecon::InputError& e) {
     std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // The limits on people, runs, nesting and image size should keep every
+    // input within memory; if one still is not, say so rather than "internal error".
+    std::fprintf(stderr,
+                 "crowdrecon: error: out of memory while running \"%s\"; the input is larger than this machine's "
+                 "memory allows: check its scale and counts (people, runs, pixels), or close other programs\n",
+                 app.get_subcommands().empty() ? "crowdrecon" : app.get_subcommands().front()->get_name().c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crowdrecon: internal error: %s\n", e.what());

@@ -211,11 +211,11 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
   std::vector<Person> people;
   {
     Statement q(db, "SELECT id, grp, target FROM person ORDER BY id");
+    q.Describe("person", {0});
     while (q.Next()) {
-      const std::int64_t id = q.Int(0);
-      if (id < 1 || id > 10'000'000) throw InputError(file + ": person id " + std::to_string(id) + " out of range");
+      const std::int64_t id = q.Integer(0, 1, scenario::run_limits::kPersonId);
       if (static_cast<std::size_t>(id) > people.size()) people.resize(static_cast<std::size_t>(id));
-      people[static_cast<std::size_t>(id - 1)] = {static_cast<std::uint32_t>(std::max<std::int64_t>(0, q.Int(1))),
+      people[static_cast<std::size_t>(id - 1)] = {static_cast<std::uint32_t>(q.Integer(1, 0, scenario::run_limits::kGroup)),
                                                   q.Text(2)};
     }
   }
@@ -224,9 +224,10 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
   std::vector<double> time_s;
   {
     Statement q(db, "SELECT frame, time_s FROM frame_time ORDER BY frame");
+    q.Describe("frame_time", {0});
     while (q.Next()) {
-      frame_numbers.push_back(q.Int(0));
-      time_s.push_back(q.Double(1));
+      frame_numbers.push_back(q.Integer(0, 0, scenario::run_limits::kFrame));
+      time_s.push_back(q.Real(1, 0.0, scenario::run_limits::kTime_s));
     }
   }
   const std::size_t n_frames = frame_numbers.size();
@@ -435,10 +436,13 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
 
   {
     Statement q(db,
-                "SELECT t.frame, t.id, t.pos_x, t.pos_y, s.vel_x, s.vel_y, s.load_n FROM trajectory_data t "
+                "SELECT t.frame AS frame, t.id AS id, t.pos_x AS pos_x, t.pos_y AS pos_y, "
+                "s.vel_x AS \"person_state.vel_x\", s.vel_y AS \"person_state.vel_y\", "
+                "s.load_n AS \"person_state.load_n\" FROM trajectory_data t "
                 "JOIN person_state s ON s.frame = t.frame AND s.id = t.id WHERE t.frame <= ?1 "
                 "ORDER BY t.frame, t.id");
-    q.Bind(1, frame_numbers.back());
+    q.Bind(1, frame_numbers.back()).Describe("trajectory_data", {0, 1});
+    using namespace scenario::run_limits;
     std::size_t k = 0;  // index of the frame being collected
     bool have_row = q.Next();
     while (k < n_frames) {
@@ -451,9 +455,9 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
         if (id >= 1 && static_cast<std::size_t>(id) <= n_people) {
           const std::size_t i = static_cast<std::size_t>(id - 1);
           present[i] = 1;
-          position[i] = {q.Double(2), q.Double(3)};
-          velocity[i] = {q.Double(4), q.Double(5)};
-          load[i] = q.Double(6);
+          position[i] = {q.Real(2, -kCoordinate_m, kCoordinate_m), q.Real(3, -kCoordinate_m, kCoordinate_m)};
+          velocity[i] = {q.Real(4, -kSpeed_m_per_s, kSpeed_m_per_s), q.Real(5, -kSpeed_m_per_s, kSpeed_m_per_s)};
+          load[i] = q.Real(6, 0.0, kForce_n);
         }
         have_row = q.Next();
       }

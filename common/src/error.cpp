@@ -11,6 +11,13 @@ std::string FormatNumber(double value) {
   return buffer;
 }
 
+std::string ShortText(std::string_view text, std::size_t max_chars) {
+  if (text.size() <= max_chars) return std::string(text);
+  std::size_t cut = max_chars > 3 ? max_chars - 3 : 0;
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;  // UTF-8 continuation byte
+  return std::string(text.substr(0, cut)) + "...";
+}
+
 std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds)) return "?";
   char buffer[32];

@@ -2,59 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
+#include "json_parse.hpp"
 
 namespace crowdrecon {
 
-namespace {
-
-// RFC 6901 escaping of one reference token.
-std::string EscapeToken(std::string_view key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
-
-std::pair<std::size_t, std::size_t> LineColumn(std::string_view text, std::size_t byte) {
-  std::size_t line = 1, column = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') { ++line; column = 1; } else { ++column; }
-  }
-  return {line, column};
-}
-
-}  // namespace
-
 JsonDocument JsonDocument::Load(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open file for reading");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return Parse(buffer.str(), file.string());
+  return Parse(ReadInputFile(file, "JSON file"), file.string());
 }
 
 JsonDocument JsonDocument::Parse(std::string_view text, std::string origin) {
   JsonDocument doc;
   doc.origin_ = std::move(origin);
-  try {
-    doc.json_ = std::make_shared<const nlohmann::json>(nlohmann::json::parse(text));
-  } catch (const nlohmann::json::parse_error& e) {
-    const auto [line, column] = LineColumn(text, e.byte > 0 ? e.byte - 1 : 0);
-    std::string what = e.what();
-    // nlohmann's message starts with "[json.exception.parse_error.101] parse error at ...".
-    if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
-    throw InputError(doc.origin_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                     ": invalid JSON: " + what);
-  }
+  doc.json_ = std::make_shared<const nlohmann::json>(detail::ParseJsonText(text, doc.origin_));
   return doc;
 }
 
@@ -73,9 +37,7 @@ std::string JsonReader::Where() const { return origin_ + ": " + (path_.empty() ?
 void JsonReader::Fail(const std::string& message) const { throw InputError(Where() + ": " + message); }
 
 std::string JsonReader::ValueText() const {
-  std::string text = value_->dump();
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
-  return text;
+  return detail::SketchJson(*value_);
 }
 
 bool JsonReader::IsObject() const { return value_->is_object(); }
@@ -84,7 +46,7 @@ bool JsonReader::IsNumber() const { return value_->is_number(); }
 bool JsonReader::IsString() const { return value_->is_string(); }
 
 JsonReader JsonReader::Child(std::string_view key, const nlohmann::json* value) const {
-  return JsonReader(root_, value, origin_, path_ + "/" + EscapeToken(key));
+  return JsonReader(root_, value, origin_, path_ + "/" + detail::EscapeToken(key));
 }
 
 void JsonReader::MarkUsed(std::string_view key) const { used_->emplace(key); }
@@ -129,13 +91,15 @@ double JsonReader::Number(std::string_view key, double fallback, double min, dou
 
 long long JsonReader::Integer(std::string_view key, long long min, long long max) const {
   const JsonReader child = At(key);
-  if (!child.value_->is_number_integer())
-    child.Fail("expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
-               "], found " + child.ValueText());
+  const std::string expected = "expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  if (!child.value_->is_number_integer()) child.Fail(expected + ", found " + child.ValueText());
+  // An unsigned value above the range of long long (18446744073709551615) is
+  // reported as written, not wrapped to a negative number.
+  if (child.value_->is_number_unsigned() &&
+      child.value_->get<unsigned long long>() > static_cast<unsigned long long>(max))
+    child.Fail("value " + std::to_string(child.value_->get<unsigned long long>()) + " is out of range; " + expected);
   const long long v = child.value_->get<long long>();
-  if (v < min || v > max)
-    child.Fail("value " + std::to_string(v) + " is out of range; expected an integer in [" +
-               std::to_string(min) + ", " + std::to_string(max) + "]");
+  if (v < min || v > max) child.Fail("value " + std::to_string(v) + " is out of range; " + expected);
   return v;
 }
 
@@ -162,7 +126,7 @@ std::string JsonReader::Choice(std::string_view key, const std::vector<std::stri
   if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "\"" : ", \"") + a + "\"";
-    child.Fail("unknown value \"" + v + "\"; expected one of " + list);
+    child.Fail("unknown value \"" + ShortText(v) + "\"; expected one of " + list);
   }
   return v;
 }
@@ -190,7 +154,7 @@ void JsonReader::Finish() const {
   if (!value_->is_object()) return;
   std::string unknown;
   for (const auto& key : Keys())
-    if (!used_->contains(key)) unknown += (unknown.empty() ? "\"" : ", \"") + key + "\"";
+    if (!used_->contains(key)) unknown += (unknown.empty() ? "\"" : ", \"") + ShortText(key) + "\"";
   if (!unknown.empty()) Fail("unknown key(s) " + unknown + " (misspelt or not supported here)");
 }
 

@@ -20,6 +20,7 @@
 
 #include "binary_io.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 
 namespace crowdrecon::engine {
 
@@ -347,11 +348,7 @@ void SaveWorldFile(const WorldDef& def, const std::filesystem::path& path) {
 }
 
 WorldDef LoadWorldFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open world file");
-  std::string data{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError(path.string() + ": cannot read world file");
-  return LoadWorld(data, path.string());
+  return LoadWorld(ReadInputFile(path, "world file"), path.string());
 }
 
 }  // namespace crowdrecon::engine

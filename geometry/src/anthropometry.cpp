@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 
 namespace crowdrecon::geometry {
 
@@ -91,6 +92,7 @@ std::vector<AnsurRecord> ReadAnsurExtract(const std::filesystem::path& file) {
   if (!in)
     throw InputError(file.string() + ": cannot open the ANSUR II extract (regenerate it with "
                                      "scripts/make-ansur-extract.py, see docs/bodies.md)");
+  CheckInputFile(file, "ANSUR II extract (CSV)");  // a directory opens, and reads as empty
   const std::vector<std::string> expected = {"subjectid", "sex", "chestbreadth", "chestdepth",
                                              "biacromialbreadth", "bideltoidbreadth", "weightkg",
                                              "stature"};

@@ -9,13 +9,13 @@
 #include <vector>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 
 namespace crowdrecon::geometry::detail {
 
 void CheckImageFileComplete(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open image file for reading");
-  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string data = ReadInputFile(file, "image file");
+  const std::vector<std::uint8_t> bytes(data.begin(), data.end());
   const auto cut_short = [&](const std::string& what) {
     throw InputError(file.string() + ": " + what + " (" + std::to_string(bytes.size()) +
                      " bytes): the file looks cut short; expected a complete picture");

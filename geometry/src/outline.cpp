@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "image_file.hpp"
 #include "outline_cgal.hpp"
@@ -83,8 +84,8 @@ Outline ParseJsonOutline(const std::filesystem::path& file) {
 }
 
 Outline ParseCsvOutline(const std::filesystem::path& file) {
+  CheckInputFile(file, "CSV outline file");
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open file for reading");
   Outline outline;
   outline.source = file.string();
   std::string line;

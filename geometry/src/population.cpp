@@ -34,8 +34,9 @@ PopulationMode PopulationModeFromString(const std::string& text, const std::stri
 }
 
 std::string PopulationOptions::Validate() const {
-  if (count < 1 || count > 1000000)
-    return "count (" + std::to_string(count) + ") out of range; expected 1 to 1000000";
+  if (count < 1 || count > kMaxPeople)
+    return "count (" + std::to_string(count) + ") out of range; expected 1 to " + std::to_string(kMaxPeople) +
+           " (check the count)";
   if (!(mass_min_kg > 0.0 && mass_min_kg <= mass_max_kg && std::isfinite(mass_max_kg)))
     return "mass range [" + FormatNumber(mass_min_kg) + ", " + FormatNumber(mass_max_kg) +
            "] kg; expected 0 < min <= max";

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "venue_internal.hpp"
 
@@ -356,11 +357,7 @@ Venue ParseVenue(std::string_view json_text, const std::string& origin) {
 }
 
 Venue LoadVenue(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open venue file for reading");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return ParseVenue(buffer.str(), file.string());
+  return ParseVenue(ReadInputFile(file, "venue file"), file.string());
 }
 
 // ---------------------------------------------------------------------------

@@ -19,6 +19,7 @@
 #include <dxflib/dl_dxf.h>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "venue_internal.hpp"
 
@@ -641,8 +642,8 @@ std::pair<std::size_t, bool> EndsWithEof(std::istream& in) {
 
 Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options) {
   {
+    CheckInputFile(file, "DXF file");
     std::ifstream in(file);
-    if (!in) throw InputError(file.string() + ": cannot open DXF file for reading");
     const auto [lines, complete] = EndsWithEof(in);
     if (!complete)
       throw InputError(file.string() + ": the file ends at line " + std::to_string(lines) +

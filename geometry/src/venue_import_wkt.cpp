@@ -9,6 +9,7 @@
 #include <string>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "venue_internal.hpp"
 
@@ -184,11 +185,7 @@ Venue ParseWkt(std::string_view text, const std::string& origin, const ImportOpt
 }
 
 Venue ImportWkt(const std::filesystem::path& file, const ImportOptions& options) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open WKT file for reading");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return ParseWkt(buffer.str(), file.string(), options);
+  return ParseWkt(ReadInputFile(file, "WKT file"), file.string(), options);
 }
 
 }  // namespace crowdrecon::geometry

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <exception>
 #include <limits>
@@ -41,14 +42,36 @@ std::string PointsJson(const std::vector<Vec2>& points) {
   return j.dump();
 }
 
-std::vector<Vec2> PointsFromJson(const std::string& text, const std::string& file) {
+// A JSON point list [[x, y], ...] of column `column` of the row of `table`
+// named `row`; anything else is a damaged file.
+std::vector<Vec2> PointsFromJson(const std::string& text, const std::string& file, const std::string& table,
+                                 const std::string& row, const std::string& column) {
   std::vector<Vec2> points;
   try {
-    for (const auto& p : nlohmann::json::parse(text)) points.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+    for (const auto& p : nlohmann::json::parse(text)) {
+      points.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+      if (!(std::abs(points.back().x) <= run_limits::kCoordinate_m && std::abs(points.back().y) <= run_limits::kCoordinate_m))
+        throw std::out_of_range("a coordinate beyond +-" + FormatNumber(run_limits::kCoordinate_m) + " m");
+    }
   } catch (const std::exception& e) {
-    throw InputError(file + ": malformed point list in run file: " + e.what());
+    throw InputError(file + ": table " + table + ", row " + row + ", column " + column +
+                     ": malformed point list (" + ShortText(e.what(), 120) + "): " + ShortText(text) +
+                     "; expected [[x, y], ...] in metres");
   }
   return points;
+}
+
+// The number in the text column `value` of the key-value row `key` of `table`
+// (run, metadata); anything else is a damaged file.
+double NumberFromText(const std::string& text, const std::string& file, const std::string& table,
+                      const std::string& key, double min, double max) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(v >= min && v <= max))
+    throw InputError(file + ": table " + table + ", row key " + key + ", column value: found \"" + ShortText(text) +
+                     "\"; expected a number in [" + FormatNumber(min) + ", " + FormatNumber(max) +
+                     "] (the run file is damaged or was not written by crowdrecon)");
+  return v;
 }
 
 // The writer's connection is used by one thread at a time (the caller, or
@@ -467,10 +490,16 @@ std::string RunFileReader::RunValue(const std::string& key) const {
   return s.Next() ? s.Text(0) : "";
 }
 
+double RunFileReader::RunNumber(const std::string& key, double fallback, double min, double max) const {
+  Statement s(*impl_->db, "SELECT value FROM run WHERE key = ?");
+  s.Bind(1, key);
+  return s.Next() ? NumberFromText(s.Text(0), impl_->file, "run", key, min, max) : fallback;
+}
+
 double RunFileReader::fps() const {
   Statement s(*impl_->db, "SELECT value FROM metadata WHERE key = 'fps'");
   if (!s.Next()) throw InputError(impl_->file + ": run file has no fps in metadata");
-  return std::stod(s.Text(0));
+  return NumberFromText(s.Text(0), impl_->file, "metadata", "fps", 1e-6, 1e6);
 }
 
 std::string RunFileReader::walkable_wkt() const {
@@ -481,7 +510,8 @@ std::string RunFileReader::walkable_wkt() const {
 std::vector<std::int64_t> RunFileReader::Frames() const {
   std::vector<std::int64_t> frames;
   Statement s(*impl_->db, "SELECT frame FROM frame_time ORDER BY frame");
-  while (s.Next()) frames.push_back(s.Int(0));
+  s.Describe("frame_time", {0});
+  while (s.Next()) frames.push_back(s.Integer(0, 0, run_limits::kFrame));
   return frames;
 }
 
@@ -489,32 +519,34 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
   RunFrame f;
   f.frame = frame;
   {
-    Statement t(*impl_->db, "SELECT time_s FROM frame_time WHERE frame = ?");
-    t.Bind(1, frame);
+    Statement t(*impl_->db, "SELECT frame, time_s FROM frame_time WHERE frame = ?");
+    t.Bind(1, frame).Describe("frame_time", {0});
     if (!t.Next()) throw InputError(impl_->file + ": no frame " + std::to_string(frame));
-    f.time_s = t.Double(0);
+    f.time_s = t.Real(1, 0.0, run_limits::kTime_s);
   }
-  Statement s(*impl_->db, "SELECT id, pos_x, pos_y, ori_x, ori_y FROM trajectory_data WHERE frame = ? ORDER BY id");
-  s.Bind(1, frame);
+  using namespace run_limits;
+  Statement s(*impl_->db,
+              "SELECT frame, id, pos_x, pos_y, ori_x, ori_y FROM trajectory_data WHERE frame = ? ORDER BY id");
+  s.Bind(1, frame).Describe("trajectory_data", {0, 1});
   while (s.Next()) {
-    f.ids.push_back(s.Int(0));
-    f.position_m.push_back({s.Double(1), s.Double(2)});
-    f.orientation.push_back({s.Double(3), s.Double(4)});
+    f.ids.push_back(s.Integer(1, 1, kPersonId));
+    f.position_m.push_back({s.Real(2, -kCoordinate_m, kCoordinate_m), s.Real(3, -kCoordinate_m, kCoordinate_m)});
+    f.orientation.push_back({s.Real(4, -kUnit, kUnit), s.Real(5, -kUnit, kUnit)});
   }
   Statement c(*impl_->db,
-              "SELECT a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m, normal_force_n, "
+              "SELECT frame, rowid, a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m, normal_force_n, "
               "tangential_force_n FROM contact WHERE frame = ? ORDER BY rowid");
-  c.Bind(1, frame);
+  c.Bind(1, frame).Describe("contact", {0, 1});
   while (c.Next()) {
     engine::Contact k;
-    k.a = static_cast<std::uint32_t>(c.Int(0) - 1);
-    k.wall = c.Int(2) != 0;
-    k.b = static_cast<std::uint32_t>(k.wall ? c.Int(1) : c.Int(1) - 1);
-    k.point_m = {c.Double(3), c.Double(4)};
-    k.normal = {c.Double(5), c.Double(6)};
-    k.overlap_m = c.Double(7);
-    k.normal_force_n = c.Double(8);
-    k.tangential_force_n = c.Double(9);
+    k.a = static_cast<std::uint32_t>(c.Integer(2, 1, kPersonId) - 1);
+    k.wall = c.Integer(4, 0, 1) != 0;
+    k.b = static_cast<std::uint32_t>(k.wall ? c.Integer(3, 0, kPersonId) : c.Integer(3, 1, kPersonId) - 1);
+    k.point_m = {c.Real(5, -kCoordinate_m, kCoordinate_m), c.Real(6, -kCoordinate_m, kCoordinate_m)};
+    k.normal = {c.Real(7, -kUnit, kUnit), c.Real(8, -kUnit, kUnit)};
+    k.overlap_m = c.Real(9, -kCoordinate_m, kCoordinate_m);
+    k.normal_force_n = c.Real(10, -kForce_n, kForce_n);
+    k.tangential_force_n = c.Real(11, -kForce_n, kForce_n);
     f.contacts.push_back(k);
   }
   return f;
@@ -522,11 +554,12 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
 
 std::vector<engine::BodyShape> RunFileReader::Shapes() const {
   std::vector<engine::BodyShape> shapes;
-  Statement s(*impl_->db, "SELECT radius_m, vertices FROM shape ORDER BY id");
+  Statement s(*impl_->db, "SELECT id, radius_m, vertices FROM shape ORDER BY id");
+  s.Describe("shape", {0});
   while (s.Next()) {
     engine::BodyShape shape;
-    shape.radius_m = s.Double(0);
-    shape.vertices = PointsFromJson(s.Text(1), impl_->file);
+    shape.radius_m = s.Real(1, 0.0, run_limits::kRadius_m);
+    shape.vertices = PointsFromJson(s.Text(2), impl_->file, "shape", "id " + s.Text(0), "vertices");
     shapes.push_back(std::move(shape));
   }
   return shapes;
@@ -534,26 +567,29 @@ std::vector<engine::BodyShape> RunFileReader::Shapes() const {
 
 std::vector<std::uint32_t> RunFileReader::PersonShapes() const {
   std::vector<std::uint32_t> out;
-  Statement s(*impl_->db, "SELECT shape FROM person ORDER BY id");
-  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Int(0)));
+  Statement s(*impl_->db, "SELECT id, shape, (SELECT COUNT(*) FROM shape) FROM person ORDER BY id");
+  s.Describe("person", {0});
+  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Integer(1, 0, s.Int(2) - 1)));
   return out;
 }
 
 std::vector<std::uint32_t> RunFileReader::PersonGroups() const {
   std::vector<std::uint32_t> out;
-  Statement s(*impl_->db, "SELECT grp FROM person ORDER BY id");
-  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Int(0)));
+  Statement s(*impl_->db, "SELECT id, grp FROM person ORDER BY id");
+  s.Describe("person", {0});
+  while (s.Next()) out.push_back(static_cast<std::uint32_t>(s.Integer(1, 0, run_limits::kGroup)));
   return out;
 }
 
 std::vector<engine::Wall> RunFileReader::Walls() const {
   std::vector<engine::Wall> walls;
-  Statement s(*impl_->db, "SELECT closed, radius_m, points FROM wall ORDER BY id");
+  Statement s(*impl_->db, "SELECT id, closed, radius_m, points FROM wall ORDER BY id");
+  s.Describe("wall", {0});
   while (s.Next()) {
     engine::Wall w;
-    w.closed = s.Int(0) != 0;
-    w.radius_m = s.Double(1);
-    w.points = PointsFromJson(s.Text(2), impl_->file);
+    w.closed = s.Integer(1, 0, 1) != 0;
+    w.radius_m = s.Real(2, 0.0, run_limits::kRadius_m);
+    w.points = PointsFromJson(s.Text(3), impl_->file, "wall", "id " + s.Text(0), "points");
     walls.push_back(std::move(w));
   }
   return walls;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 
 namespace crowdrecon::scenario {
@@ -90,7 +91,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     PopulationSpec& p = s.population;
     if (pop.Has("count") == pop.Has("density_per_m2"))
       pop.Fail("give exactly one of \"count\" and \"density_per_m2\"");
-    if (pop.Has("count")) p.count = static_cast<std::size_t>(pop.Integer("count", 1, 1000000));
+    if (pop.Has("count")) p.count = static_cast<std::size_t>(pop.Integer("count", 1, static_cast<long long>(geometry::kMaxPeople)));
     if (pop.Has("density_per_m2")) p.density_per_m2 = pop.Number("density_per_m2", 0.01, 12.0);
     p.counter_flow_fraction = pop.Number("counter_flow_fraction", 0.0, 0.0, 1.0);
     p.target = pop.String("target");
@@ -110,6 +111,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
       const auto readable = [&](const JsonReader& key, const std::string& expected) {
         const std::filesystem::path file = Resolve(base_dir, key.AsString());
         if (!std::ifstream(file)) key.Fail("cannot open \"" + file.string() + "\" for reading; expected " + expected);
+        if (std::filesystem::is_directory(file)) key.Fail("\"" + file.string() + "\" is a directory; expected " + expected);
         return file;
       };
       if (auto ref = body->Find("reference")) p.reference_body = readable(*ref, "a body file (crowdrecon body JSON)");
@@ -157,11 +159,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
 }
 
 Scenario LoadScenario(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open scenario file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  Scenario s = ParseScenario(buffer.str(), file.string(), file.parent_path());
+  Scenario s = ParseScenario(ReadInputFile(file, "scenario file"), file.string(), file.parent_path());
   s.file = file;
   return s;
 }

@@ -139,8 +139,13 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     regions.push_back(geometry::AreaTriangulation::OfWalkableArea(venue));
   }
   for (const auto& r : regions) built.placement_area_m2 += r.area_m2();
-  const std::size_t count = spec.count ? *spec.count
-                                       : static_cast<std::size_t>(std::llround(*spec.density_per_m2 * built.placement_area_m2));
+  const double wanted = spec.count ? static_cast<double>(*spec.count) : *spec.density_per_m2 * built.placement_area_m2;
+  if (!spec.count && !(wanted <= static_cast<double>(geometry::kMaxPeople)))  // before any allocation; NaN too
+    throw InputError(scenario.file.string() + ": /population/density_per_m2: " + FormatNumber(*spec.density_per_m2) +
+                     " /m^2 over " + FormatNumber(built.placement_area_m2) + " m^2 gives " + FormatNumber(wanted) +
+                     " people; expected at most " + std::to_string(geometry::kMaxPeople) +
+                     " (check the venue's scale: is it drawn in metres?)");
+  const std::size_t count = spec.count ? *spec.count : static_cast<std::size_t>(std::llround(wanted));
   if (count == 0) throw InputError(scenario.file.string() + ": /population: the density gives 0 people in " +
                                    FormatNumber(built.placement_area_m2) + " m^2");
 

@@ -4,12 +4,14 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 
 namespace crowdrecon::sweep {
@@ -38,13 +40,6 @@ std::vector<std::string> SplitPath(const std::string& path) {
   return parts;
 }
 
-std::string ReadText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open file for reading");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 // The raw JSON value a reader stands for (JsonReader keeps it private; its
 // path is an RFC 6901 pointer into the same document).
@@ -235,8 +230,12 @@ std::string AxisValueText(const Axis& axis, std::size_t index) {
 }
 
 std::size_t SweepSpec::RunCount() const {
-  std::size_t n = variants.size() * seeds.size();
-  for (const Axis& a : axes) n *= a.values.size();
+  std::size_t n = variants.size();
+  const auto times = [&n](std::size_t k) {
+    n = k != 0 && n > std::numeric_limits<std::size_t>::max() / k ? std::numeric_limits<std::size_t>::max() : n * k;
+  };
+  times(seeds.size());
+  for (const Axis& a : axes) times(a.values.size());
   return n;
 }
 
@@ -260,17 +259,12 @@ SweepSpec ParseSweep(const std::string& json_text, const std::string& origin, co
     const fs::path given = scenario.AsString();
     s.scenario_file = (given.is_absolute() ? given : sweep_dir / given).lexically_normal();
     try {
-      s.scenario_text = ReadText(s.scenario_file);
-    } catch (const InputError&) {
-      scenario.Fail("cannot open the scenario file " + s.scenario_file.string());
+      s.scenario_text = ReadInputFile(s.scenario_file, "scenario file");
+    } catch (const InputError& e) {
+      scenario.Fail("cannot open the scenario file " + s.scenario_file.string() + " (" + e.what() + ")");
     }
-    json base;
-    try {
-      base = json::parse(s.scenario_text);
-    } catch (const json::parse_error&) {
-      // The scenario parser names the line and column.
-      (void)scenario::ParseScenario(s.scenario_text, s.scenario_file.string(), s.scenario_file.parent_path());
-    }
+    // Parsed with the readers' checks (syntax, nesting, duplicate keys), which name the line and column.
+    const json base = JsonDocument::Parse(s.scenario_text, s.scenario_file.string()).Json();
     if (!base.is_object()) scenario.Fail("the scenario " + s.scenario_file.string() + " is not a JSON object");
     s.scenario_canonical_json = base.dump();
   }
@@ -359,20 +353,19 @@ SweepSpec ParseSweep(const std::string& json_text, const std::string& origin, co
   }
   s.keep_runs = root.Bool("keep_runs", false);
   root.Finish();
-  if (s.RunCount() > 10000000) root.Fail("the sweep has " + std::to_string(s.RunCount()) + " runs; expected at most 10^7");
+  if (s.RunCount() > kMaxSweepRuns) {
+    std::string sizes = std::to_string(s.variants.size()) + " variant(s) x ";
+    for (const Axis& a : s.axes) sizes += std::to_string(a.values.size()) + " (" + a.path + ") x ";
+    root.Fail("the sweep has " + (s.RunCount() == std::numeric_limits<std::size_t>::max() ? std::string("more than 10^19")
+                                                                                         : std::to_string(s.RunCount())) +
+              " runs (" + sizes + std::to_string(s.seeds.size()) + " seed(s)); expected at most " +
+              std::to_string(kMaxSweepRuns) + ": check the axes' counts, or split the study into several sweeps");
+  }
   return s;
 }
 
 SweepSpec LoadSweep(const fs::path& file) {
-  std::string text;
-  {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file.string() + ": cannot open sweep file");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    text = buffer.str();
-  }
-  SweepSpec s = ParseSweep(text, file.string(), file.parent_path());
+  SweepSpec s = ParseSweep(ReadInputFile(file, "sweep file"), file.string(), file.parent_path());
   s.file = file;
   return s;
 }

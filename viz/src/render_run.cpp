@@ -639,12 +639,7 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
     throw InputError(file + ": the run has no frames to draw" + (status.empty() ? "" : " (status: " + status + ")"));
   }
   // Frame times exceed their nominal times by less than one time step.
-  double time_step_s = 0.0;
-  try {
-    time_step_s = std::stod(run.RunValue("time_step_s"));
-  } catch (const std::exception&) {
-    // absent or unreadable: exact times assumed
-  }
+  const double time_step_s = run.RunNumber("time_step_s", 0.0, 0.0, 1.0);  // absent: exact times assumed
   const std::vector<std::int64_t> frames =
       SelectFrames(options.frames, all_frames, [&](std::int64_t f) { return run.Frame(f).time_s; },
                    std::max(1e-6, std::isfinite(time_step_s) ? time_step_s : 0.0));

@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace crowdrecon {
 
@@ -23,6 +24,10 @@ class GeometryError : public InputError {
 
 // Formats a double compactly for messages ("0.05", "1e+05").
 std::string FormatNumber(double value);
+
+// `text` cut to at most `max_chars` characters ("..." marks a cut; a UTF-8
+// sequence is never split), for echoing what a user gave in a message.
+std::string ShortText(std::string_view text, std::size_t max_chars = 60);
 
 // Formats a duration in seconds for progress lines: "42s", "3m07s", "1h05m";
 // "?" if not finite.

@@ -35,6 +35,8 @@ class JsonDocument {
 
   JsonReader Root() const;
   const std::string& origin() const { return origin_; }
+  // The parsed value itself, for code that copies or edits raw JSON (sweeps).
+  const nlohmann::json& Json() const { return *json_; }
 
  private:
   std::shared_ptr<const nlohmann::json> json_;

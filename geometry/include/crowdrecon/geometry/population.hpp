@@ -36,6 +36,14 @@ enum class PopulationMode { kPaper, kAnthropometric, kCircle };
 std::string ToString(PopulationMode mode);  // "paper", "anthropometric", "circle"
 PopulationMode PopulationModeFromString(const std::string& text, const std::string& what = "mode");
 
+// The most people one population (a scenario, `crowdrecon population --count`)
+// may hold. A simulated person costs about PEOPLE_KB kB (bodies, hot state,
+// neighbour lists, navigation, output buffers; measured on the hallway at
+// 6 /m^2), so the limit keeps a run within a few GB; the largest shipped
+// scenarios hold 10,000 (benchmarks) and 6,800 (evacuation). A larger count is
+// almost always a typo or a venue drawn in the wrong unit.
+inline constexpr std::size_t kMaxPeople = 200000;
+
 struct PopulationOptions {
   PopulationMode mode = PopulationMode::kPaper;
   std::size_t count = 100;

@@ -136,6 +136,22 @@ class FrameWriterThread {
   std::unique_ptr<Impl> impl_;
 };
 
+// What the readers accept in a run file. A value outside (or text, NULL, NaN
+// where a number belongs) is a damaged file, reported with the table, row and
+// column, never analysed or drawn. The bounds are far beyond any run: twice
+// the venue coordinate limit, a hundred times the speed of a rifle bullet.
+namespace run_limits {
+inline constexpr double kCoordinate_m = 2e7;     // positions, contact points, wall points, lengths
+inline constexpr double kUnit = 1.0 + 1e-6;      // components of orientations and normals
+inline constexpr double kSpeed_m_per_s = 1e5;
+inline constexpr double kForce_n = 1e12;         // contact forces, loads
+inline constexpr double kTime_s = 1e9;
+inline constexpr double kRadius_m = 10.0;        // sphero-radii of bodies and walls
+inline constexpr std::int64_t kFrame = std::int64_t{1} << 53;
+inline constexpr std::int64_t kPersonId = 10'000'000;
+inline constexpr std::int64_t kGroup = 1023;
+}  // namespace run_limits
+
 // Reading a run back (render, reports, tests).
 struct RunFrame {
   std::int64_t frame = 0;
@@ -153,6 +169,8 @@ class RunFileReader {
   ~RunFileReader();
 
   std::string RunValue(const std::string& key) const;  // "" if absent
+  // A run value that must be a number in [min, max]; absent: `fallback`.
+  double RunNumber(const std::string& key, double fallback, double min, double max) const;
   double fps() const;
   std::string walkable_wkt() const;
   std::vector<std::int64_t> Frames() const;

@@ -89,6 +89,32 @@ class Statement {
     if (rc != SQLITE_DONE) Fail();
     return false;
   }
+  // Names the rows of this query in messages about bad values: the table, and
+  // the columns (by index) that identify a row. A column whose name is
+  // qualified ("person_state.vel_x", an SQL alias) names its own table.
+  Statement& Describe(std::string table, std::vector<int> key_columns) {
+    table_ = std::move(table);
+    key_columns_ = std::move(key_columns);
+    return *this;
+  }
+  // A number in [min, max] from column `col`. Text, NULL, a blob, NaN or a
+  // value out of range is a corrupted file: an InputError naming the file,
+  // table, row and column, the value and the range.
+  double Real(int col, double min, double max) const {
+    const int type = Type(col);
+    const double v = Double(col);
+    if ((type != SQLITE_FLOAT && type != SQLITE_INTEGER) || !(v >= min && v <= max))
+      BadValue(col, type, "a number in [" + FormatNumber(min) + ", " + FormatNumber(max) + "]");
+    return v;
+  }
+  // A whole number in [min, max] from column `col` (checked as Real is).
+  std::int64_t Integer(int col, std::int64_t min, std::int64_t max) const {
+    const int type = Type(col);  // before any conversion by the reads below
+    const std::int64_t v = Int(col);
+    if (type != SQLITE_INTEGER || v < min || v > max)
+      BadValue(col, type, "a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+    return v;
+  }
   double Double(int col) const { return sqlite3_column_double(stmt_, col); }
   std::int64_t Int(int col) const { return sqlite3_column_int64(stmt_, col); }
   // SQLITE_INTEGER, SQLITE_FLOAT, SQLITE_TEXT, SQLITE_BLOB or SQLITE_NULL.
@@ -105,8 +131,26 @@ class Statement {
     if (rc != SQLITE_OK) Fail();
   }
   [[noreturn]] void Fail() const { throw InputError(db_.file() + ": SQLite error: " + sqlite3_errmsg(db_.get())); }
+  // `type`: the column's type as read before any conversion.
+  [[noreturn]] void BadValue(int col, int type, const std::string& expected) const {
+    std::string table = table_, column = ColumnName(col);
+    if (const auto dot = column.find('.'); dot != std::string::npos) {
+      table = column.substr(0, dot);
+      column = column.substr(dot + 1);
+    }
+    std::string row;
+    for (int k : key_columns_) row += (row.empty() ? "" : ", ") + ColumnName(k) + " " + ShortText(Text(k), 24);
+    static constexpr const char* kTypes[] = {"", "integer", "real", "text", "blob", "NULL"};
+    const std::string found = type == SQLITE_NULL ? "NULL"
+                              : type == SQLITE_BLOB ? "a blob"
+                                                    : std::string(kTypes[type]) + " " + ShortText(Text(col), 40);
+    throw InputError(db_.file() + ": table " + table + (row.empty() ? "" : ", row " + row) + ", column " + column +
+                     ": found " + found + "; expected " + expected + " (the run file is damaged or was not written by crowdrecon)");
+  }
   const Database& db_;
   sqlite3_stmt* stmt_ = nullptr;
+  std::string table_ = "?";
+  std::vector<int> key_columns_;
 };
 
 // Inserts rows of numbers into one table, many rows per INSERT statement

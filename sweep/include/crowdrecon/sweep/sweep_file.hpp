@@ -81,8 +81,14 @@ struct SweepSpec {
   std::string diagram_x, diagram_y;     // axis paths ("" if the sweep has fewer axes)
   bool keep_runs = false;               // keep each run's file in DIR/runs/
 
+  // variants x axis values x seeds, saturating at SIZE_MAX (never wraps).
   std::size_t RunCount() const;
 };
+
+// The most runs a sweep file may ask for. Every run's scenario is built and
+// checked before the first run starts (about 1 ms each), so this keeps the
+// start under a couple of minutes; a larger study is several sweep files.
+inline constexpr std::size_t kMaxSweepRuns = 100000;
 
 // One run of a sweep.
 struct RunPlan {

@@ -1,0 +1,44 @@
+#include "option_checks.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::cli {
+
+CLI::Validator NumberIn(double min, double max, const std::string& unit) {
+  const std::string range = "[" + FormatNumber(min) + ", " + FormatNumber(max) + "]" + (unit.empty() ? "" : " " + unit);
+  return CLI::Validator(
+      [min, max, range](std::string& input) -> std::string {
+        const char* begin = input.c_str();
+        char* end = nullptr;
+        const double v = std::strtod(begin, &end);
+        if (input.empty() || end != begin + input.size())
+          return "\"" + ShortText(input) + "\" is not a number; expected a number in " + range;
+        if (!std::isfinite(v)) return "value " + ShortText(input) + " is not finite; expected a number in " + range;
+        if (v < min || v > max) return "value " + ShortText(input) + " is out of range; expected a number in " + range;
+        return "";
+      },
+      "NUMBER in " + range);
+}
+
+CLI::Validator IntegerIn(long long min, long long max) {
+  const std::string range = "[" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  return CLI::Validator(
+      [min, max, range](std::string& input) -> std::string {
+        long long v = 0;
+        const char* begin = input.data() + (input.starts_with('+') ? 1 : 0);
+        const auto [end, error] = std::from_chars(begin, input.data() + input.size(), v);
+        if (error == std::errc::result_out_of_range)
+          return "value " + ShortText(input) + " is out of range; expected a whole number in " + range;
+        if (error != std::errc{} || end != input.data() + input.size())
+          return "\"" + ShortText(input) + "\" is not a whole number; expected a whole number in " + range;
+        if (v < min || v > max) return "value " + input + " is out of range; expected a whole number in " + range;
+        return "";
+      },
+      "INTEGER in " + range);
+}
+
+}  // namespace crowdrecon::cli

@@ -1,0 +1,32 @@
+#include "crowdrecon/common/input_file.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon {
+
+void CheckInputFile(const std::filesystem::path& file, std::string_view what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(file.string() + ": is a directory; expected a " + std::string(what));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    const int error = errno;
+    throw InputError(file.string() + ": cannot open " + std::string(what) + " for reading (" +
+                     std::strerror(error) + ")");
+  }
+}
+
+std::string ReadInputFile(const std::filesystem::path& file, std::string_view what) {
+  CheckInputFile(file, what);
+  std::ifstream in(file, std::ios::binary);
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw InputError(file.string() + ": cannot read " + std::string(what) + " (read error)");
+  return text;
+}
+
+}  // namespace crowdrecon
