@@ -1,12 +1,16 @@
 # The two commands of crowdrecon (see README.md):
 #   make demo   install what is missing, build, run the Madrid Arena case into out/
 #   make test   install what is missing, build, run the whole suite with ctest
+#   make fuzz   build the libFuzzer harnesses (clang) and run each for
+#               FUZZ_SECONDS (default 60) s; FUZZ_HARNESSES picks some (docs/fuzzing.md)
 PRESET ?= release
 BUILD  := build/$(PRESET)
 JOBS   ?= $(shell nproc)
 CROWDRECON := $(BUILD)/cli/crowdrecon
+FUZZ_SECONDS ?= 60
+FUZZ_HARNESSES ?=
 
-.PHONY: all deps build test test-long demo clean sanitize
+.PHONY: all deps build test test-long demo clean sanitize fuzz
 
 all: build
 
@@ -29,6 +33,13 @@ demo: build
 
 sanitize:
 	@$(MAKE) test PRESET=sanitize
+
+# The fuzz preset builds only the harnesses and the libraries they need.
+fuzz: deps
+	@bash scripts/install-fuzz-deps.sh
+	@cmake --preset fuzz >/dev/null
+	@cmake --build --preset fuzz -j $(JOBS)
+	@bash scripts/fuzz.sh build/fuzz $(FUZZ_SECONDS) $(FUZZ_HARNESSES)
 
 clean:
 	rm -rf build out

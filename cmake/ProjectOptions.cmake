@@ -21,6 +21,18 @@ if(CROWDRECON_SANITIZE)
     $<$<COMPILE_LANGUAGE:CXX>:-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined>)
   target_link_options(crowdrecon_options INTERFACE -fsanitize=address,undefined)
 endif()
+if(CROWDRECON_FUZZ)
+  # Every project library instrumented for libFuzzer's coverage and checked by
+  # ASan and UBSan (any undefined behaviour aborts: a crash to the fuzzer);
+  # the harnesses add -fsanitize=fuzzer (libFuzzer's main) when linked.
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "CROWDRECON_FUZZ needs clang (libFuzzer): use the `fuzz` preset (docs/fuzzing.md)")
+  endif()
+  target_compile_options(crowdrecon_options INTERFACE
+    $<$<COMPILE_LANGUAGE:CXX>:-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
+    -fno-omit-frame-pointer -Wno-unknown-warning-option>)
+  target_link_options(crowdrecon_options INTERFACE -fsanitize=address,undefined)
+endif()
 
 # Mark a third-party target's include directories as system includes.
 function(crowdrecon_system_includes target)

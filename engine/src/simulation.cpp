@@ -829,7 +829,10 @@ void Simulation::Collide() {
         ++measured;
         in.pair_clear.Collide(k, moved, pa, pb, points, in.pair_memory);
         if (points.empty()) continue;
-        const auto relative_velocity = [&](Vec2 x) { return velocity_at(a, x - xa) - velocity_at(b, x - xb_image); };
+        // (a and b captured by init-capture: clang 14, the fuzz build's compiler, cannot capture structured bindings)
+        const auto relative_velocity = [&, a = a, b = b](Vec2 x) {
+          return velocity_at(a, x - xa) - velocity_at(b, x - xb_image);
+        };
         overlap_beyond = add_contacts(points, a, b, false, law, effective_mass(a, b), pa.scale + pb.scale,  // (family radius 1)
                                       previous, out, relative_velocity) ||
                          overlap_beyond;
@@ -851,7 +854,7 @@ void Simulation::Collide() {
         ++measured;
         in.wall_pair_clear.Collide(k, moved, pa, pw, points, in.pair_memory);
         if (points.empty()) continue;
-        const auto relative_velocity = [&](Vec2 x) { return velocity_at(a, x - xa); };
+        const auto relative_velocity = [&, a = a](Vec2 x) { return velocity_at(a, x - xa); };  // (init-capture: as above)
         overlap_beyond = add_contacts(points, a, w, true, wall_law, bodies_.mass_kg[a], pa.scale + pw.geometry->radius_m,
                                       previous, out, relative_velocity, pw.geometry->radius_m) ||
                          overlap_beyond;

@@ -1,0 +1,8 @@
+// WKT walkable areas (geometry::ParseWkt, as `venue import x.wkt`), from memory.
+#include "crowdrecon/geometry/venue.hpp"
+#include "fuzz_harness.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace crowdrecon;
+  return fuzz::Parse([&] { (void)geometry::ParseWkt(fuzz::Text(data, size), "fuzz.wkt"); });
+}
