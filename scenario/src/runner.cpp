@@ -200,11 +200,14 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   std::string status = "complete";
   bool device_fallback_reported = false;
   try {
+    std::vector<Vec2> centres = sim.bodies().position_m;
     while (last_frame < total_frames) {
       for (std::int64_t k = 0; k < steps_per_frame; ++k) {
         if (adapt_threads) governor.Step(sim);
         else sim.Step();
       }
+      engine::CheckCentresStayInsideWalls(sim, centres);  // nobody went through a wall
+      centres = sim.bodies().position_m;
       write_frame(last_frame + 1);
       if (!device_fallback_reported && !sim.device_fallback().empty()) {
         // The GPU failed and the processor took over (same results): say so,

@@ -197,4 +197,11 @@ TimeStepEstimate EstimateTimeStep(const WorldDef& def);
 // omega_max (engine/src/time_step.cpp). About 0.02 at the engine's own step.
 double RestitutionErrorAtStep(const WorldDef& def, double time_step_s);
 
+// Throws SimulationError if the straight path of a person's centre from
+// `centres_before` (positions at an earlier time) to now crosses a wall's
+// core line: a safety net behind the contact check (a core vertex crossing a
+// wall line), for the run loop once per output frame (walls x people
+// segment tests; engine/src/wall_passage.cpp).
+void CheckCentresStayInsideWalls(const Simulation& sim, const std::vector<Vec2>& centres_before);
+
 }  // namespace crowdrecon::engine
