@@ -22,6 +22,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "crowdrecon/geometry/input_limits.hpp"
 #include "outline_cgal.hpp"
 
 namespace crowdrecon::geometry {
@@ -129,6 +130,19 @@ double MetresPerUnit(const Outline& outline, const ScaleRule& rule, Vec2 front,
   return 1.0;
 }
 
+// Refuses an outline far larger than a person (input_limits.hpp) before any
+// work that grows with its size: an outline in the wrong units would sample
+// millions of boundary points.
+void CheckBodySize(const std::vector<Vec2>& ring_m, const Outline& outline, const ScaleRule& rule,
+                   double metres_per_unit, const std::string& what) {
+  const double across_m = std::max(ExtentAlongAxis(ring_m, {1.0, 0.0}), ExtentAlongAxis(ring_m, {0.0, 1.0}));
+  if (across_m <= kMaxBodyExtentM) return;
+  throw GeometryError(what + ": the outline is " + FormatNumber(across_m) + " m across (scale " + ToString(rule) +
+                      ", " + FormatNumber(metres_per_unit) + " m per " + (outline.from_image ? "pixel" : "unit") +
+                      "); a body is 0.2-1 m across and at most " + FormatNumber(kMaxBodyExtentM) +
+                      " m is accepted: check the scale/units (--scale)");
+}
+
 std::string Join(const std::vector<std::string>& items, const std::string& sep) {
   std::string out;
   for (std::size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
@@ -232,6 +246,7 @@ Body BuildBody(const Outline& outline, const BodyOptions& options) {
   std::vector<Vec2> dense_m;
   dense_m.reserve(points.size());
   for (const Vec2& p : points) dense_m.push_back(Rotated((p - centre) * metres_per_unit, to_body_frame_rad));
+  CheckBodySize(dense_m, outline, options.scale, metres_per_unit, what);
 
   // 3. Light pre-simplification: removes a raster's staircase and points that
   // carry no shape, so that the straight skeleton (superlinear in the vertex
@@ -394,6 +409,12 @@ Body ReadBodyJson(const std::filesystem::path& file) {
   root.Choice("front_axis", {"+x"});
   const JsonReader vertices_json = root.At("vertices_m");
   const std::vector<Vec2> vertices = vertices_json.AsPoints(1);
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    for (const double c : {vertices[i].x, vertices[i].y})
+      if (!(std::abs(c) <= kMaxBodyExtentM))
+        vertices_json.Element(i).Fail("coordinate " + FormatNumber(c) + " m is beyond " +
+                                      FormatNumber(kMaxBodyExtentM) +
+                                      " m from the centroid; expected a body 0.2-1 m across, in metres: check the units");
   const double radius_m = root.Number("radius_m", 1e-9, 10.0);
   const double area_m2 = root.Number("area_m2", 0.0, 1e3);
   const Vec2 centroid_m = root.At("centroid_m").AsPoint();

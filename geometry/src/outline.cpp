@@ -14,6 +14,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "crowdrecon/geometry/input_limits.hpp"
 #include "image_file.hpp"
 #include "outline_cgal.hpp"
 
@@ -60,6 +61,56 @@ std::string DescribeSelfIntersection(const std::vector<Vec2>& ring) {
   return "an edge folds back onto its neighbour";
 }
 
+// Throws GeometryError, naming `where`, if a coordinate is not finite or is
+// too large for a body outline in any unit (input_limits.hpp): beyond it the
+// squared lengths the geometry is built on overflow or lose every digit.
+void CheckOutlinePoint(Vec2 p, const std::string& where) {
+  for (const double c : {p.x, p.y}) {
+    if (!std::isfinite(c))
+      throw GeometryError(where + ": coordinate " + FormatNumber(c) + " is not finite; expected finite x, y");
+    if (std::abs(c) > kMaxOutlineCoordinate)
+      throw GeometryError(where + ": coordinate " + FormatNumber(c) + " is beyond " +
+                          FormatNumber(kMaxOutlineCoordinate) +
+                          " in magnitude; expected a body outline a few thousand units across at most "
+                          "(metres, millimetres or pixels): check the scale/units");
+  }
+}
+
+// Points of a JSON array [[x, y], ...], each checked where it stands.
+std::vector<Vec2> JsonOutlinePoints(const JsonReader& array) {
+  std::vector<Vec2> points = array.AsPoints(0);
+  for (std::size_t i = 0; i < points.size(); ++i) CheckOutlinePoint(points[i], array.Element(i).Where());
+  return points;
+}
+
+// Drops the vertices that lie exactly on the straight line between their
+// neighbours (a densely sampled straight edge): the polygon is the same, but
+// the polyline simplification of BuildBody slows down with the cube of the
+// number of collinear vertices (a 2.9 m square given every 0.15 mm: over a
+// minute). Vertices where the ring turns back (spikes) stay, for the
+// self-intersection check to name.
+std::vector<Vec2> WithoutStraightRuns(std::vector<Vec2> ring) {
+  const auto straight = [](Vec2 a, Vec2 b, Vec2 c) { return Cross(b - a, c - b) == 0.0 && Dot(b - a, c - b) > 0.0; };
+  std::vector<Vec2> out;
+  out.reserve(ring.size());
+  for (const Vec2& p : ring) {
+    while (out.size() >= 2 && straight(out[out.size() - 2], out.back(), p)) out.pop_back();
+    out.push_back(p);
+  }
+  // Across the closing edge: the last and the first vertices.
+  std::size_t first = 0;
+  while (out.size() - first >= 4) {
+    if (straight(out[out.size() - 2], out.back(), out[first])) {
+      out.pop_back();
+    } else if (straight(out.back(), out[first], out[first + 1])) {
+      ++first;
+    } else {
+      break;
+    }
+  }
+  return {out.begin() + static_cast<std::ptrdiff_t>(first), out.end()};
+}
+
 // Extracts {"points": ...} or a bare array.
 Outline ParseJsonOutline(const std::filesystem::path& file) {
   const JsonDocument doc = JsonDocument::Load(file);
@@ -67,9 +118,9 @@ Outline ParseJsonOutline(const std::filesystem::path& file) {
   Outline outline;
   outline.source = file.string();
   if (root.IsArray()) {
-    outline.points = root.AsPoints(0);
+    outline.points = JsonOutlinePoints(root);
   } else if (root.IsObject()) {
-    outline.points = root.At("points").AsPoints(0);
+    outline.points = JsonOutlinePoints(root.At("points"));
     if (root.Has("front")) {
       const JsonReader front = root.At("front");
       outline.front = FrontAxisFromString(front.AsString(), front.Where());
@@ -119,6 +170,7 @@ Outline ParseCsvOutline(const std::filesystem::path& file) {
       throw InputError(where + ": expected two numbers \"x,y\", found \"" + line + "\"");
     }
     seen_data = true;
+    CheckOutlinePoint({x, y}, where);
     outline.points.push_back({x, y});
   }
   return outline;
@@ -178,15 +230,14 @@ Vec2 RingCentroid(const std::vector<Vec2>& ring) {
 }
 
 std::vector<Vec2> ValidateOutlineRing(std::vector<Vec2> points, const std::string& what) {
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (!std::isfinite(points[i].x) || !std::isfinite(points[i].y))
-      throw GeometryError(what + ": point " + std::to_string(i) + " is not finite; expected finite x, y");
+  for (std::size_t i = 0; i < points.size(); ++i) CheckOutlinePoint(points[i], what + ": point " + std::to_string(i));
   // Drop consecutive repeats and an explicit closing point.
   std::vector<Vec2> ring;
   ring.reserve(points.size());
   for (const Vec2& p : points)
     if (ring.empty() || !(ring.back() == p)) ring.push_back(p);
   while (ring.size() > 1 && ring.back() == ring.front()) ring.pop_back();
+  ring = WithoutStraightRuns(std::move(ring));
   if (ring.size() < 3)
     throw GeometryError(what + ": too few points (" + std::to_string(ring.size()) +
                         " distinct); expected at least 3 forming a closed outline");
@@ -203,9 +254,7 @@ std::vector<Vec2> ValidateOutlineRing(std::vector<Vec2> points, const std::strin
 
 Outline ReadOutlineImage(const std::filesystem::path& file, const ImageOutlineOptions& options) {
   const std::string name = file.string();
-  if (!std::filesystem::exists(file)) throw InputError(name + ": cannot open file (it does not exist)");
-  detail::CheckImageFileComplete(file);
-  cv::Mat image = cv::imread(name, cv::IMREAD_UNCHANGED);
+  cv::Mat image = detail::ReadImage(file, cv::IMREAD_UNCHANGED);
   if (image.empty())
     throw InputError(name + ": not a readable image (empty or unknown format); expected a PNG, "
                             "JPEG, BMP or TIFF picture");
@@ -240,8 +289,12 @@ Outline ReadOutlineImage(const std::filesystem::path& file, const ImageOutlineOp
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN,
                    cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
 
+  // Straight runs of the border (horizontal, vertical, diagonal) keep only
+  // their ends: the same polygon, but the polyline simplification of
+  // BuildBody slows down with the cube of the number of collinear vertices
+  // (a 2000 x 2000 dark square: 31 s with every border pixel kept).
   std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
   const std::string region = ToString(options.region);
   if (contours.empty())
     throw GeometryError(name + ": no " + region + " region (grey level " +
@@ -285,6 +338,7 @@ Outline ReadOutlineImage(const std::filesystem::path& file, const ImageOutlineOp
 Outline ReadOutlinePoints(const std::filesystem::path& file) {
   const std::string ext = Lower(file.extension().string());
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": cannot open file (it does not exist)");
+  CheckInputFile(file, ext == ".csv" ? "point list (CSV)" : "point list (JSON)");
   Outline outline = ext == ".csv" ? ParseCsvOutline(file) : ParseJsonOutline(file);
   outline.points = ValidateOutlineRing(std::move(outline.points), file.string());
   return outline;

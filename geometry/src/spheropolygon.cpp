@@ -236,6 +236,18 @@ bool SegmentsIntersect(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
   return false;
 }
 
+// True if every vertex lies within `tolerance` of the line through the first
+// vertex and the vertex farthest from it.
+bool AllCollinear(const std::vector<Vec2>& v, double tolerance) {
+  std::size_t far = 0;
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (LengthSquared(v[i] - v[0]) > LengthSquared(v[far] - v[0])) far = i;
+  const Vec2 d = v[far] - v[0];
+  const double length = Length(d);
+  if (length == 0.0) return true;
+  return std::all_of(v.begin(), v.end(), [&](Vec2 p) { return std::abs(Cross(d, p - v[0])) / length <= tolerance; });
+}
+
 void ValidatePolygon(const std::vector<Vec2>& v, const std::string& what) {
   const std::size_t n = v.size();
   double extent = 0.0;
@@ -248,8 +260,12 @@ void ValidatePolygon(const std::vector<Vec2>& v, const std::string& what) {
                           " repeats vertex " + std::to_string(i) +
                           "; consecutive vertices must be distinct");
   }
+  // Zero area is either a degenerate polygon (every vertex on one line) or one
+  // whose parts cancel (a bow tie): the second is a self-intersection, named
+  // by the check below.
   const double area = SignedArea(v);
-  if (std::abs(area) <= tiny * std::max(extent, 1.0))
+  const bool zero_area = std::abs(area) <= tiny * std::max(extent, 1.0);
+  if (zero_area && AllCollinear(v, tiny))
     throw GeometryError(what + ": the polygon has zero area (all vertices collinear)");
   // Simple: no two non-adjacent edges meet; adjacent edges meet only at their
   // shared vertex (no fold-back).
@@ -277,6 +293,7 @@ void ValidatePolygon(const std::vector<Vec2>& v, const std::string& what) {
                             PointText(d) + " intersect; the polygon must be simple");
     }
   }
+  if (zero_area) throw GeometryError(what + ": the polygon has zero area; expected a polygon enclosing some area");
   if (area < 0)
     throw GeometryError(what + ": vertices are clockwise (signed area " + FormatNumber(area) +
                         " m^2); give them counter-clockwise");
@@ -463,20 +480,6 @@ std::vector<Vec2> Spheropolygon::SampleBoundary(double spacing_m) const {
   for (const Vec2& p : candidates)
     if (SignedDistanceToCore(p) >= radius_ - tolerance) boundary.push_back(p);
   return boundary;
-}
-
-double HausdorffDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
-  const auto directed = [](const std::vector<Vec2>& from, const std::vector<Vec2>& to) {
-    double worst = 0.0;
-    for (const Vec2& p : from) {
-      double best = std::numeric_limits<double>::infinity();
-      for (const Vec2& q : to) best = std::min(best, LengthSquared(p - q));
-      worst = std::max(worst, best);
-    }
-    return std::sqrt(worst);
-  };
-  if (a.empty() || b.empty()) return std::numeric_limits<double>::infinity();
-  return std::max(directed(a, b), directed(b, a));
 }
 
 }  // namespace crowdrecon::geometry

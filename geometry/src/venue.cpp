@@ -177,8 +177,6 @@ std::vector<WallSegment> WallSegments(const Venue& venue) {
 
 namespace {
 
-constexpr double kMaxCoordinate = 1e7;  // metres; beyond this a unit is surely wrong
-
 // Drops a closing vertex equal to the first (WKT and GeoJSON style rings).
 Ring OpenRing(std::vector<Vec2> points) {
   if (points.size() >= 2 && points.front() == points.back()) points.pop_back();
@@ -245,7 +243,7 @@ class VenueReader {
     ForEachObject("periodic", [&](const JsonReader& p, std::size_t) {
       PeriodicDirection periodic;
       periodic.direction = ReadDirection(p.At("direction"));
-      periodic.period_m = p.Number("period_m", 1e-3, kMaxCoordinate);
+      periodic.period_m = p.Number("period_m", 1e-3, kVenueMaxCoordinate_m);
       v.periodic.push_back(periodic);
     });
     ForEachObject("targets", [&](const JsonReader& t, std::size_t) {
@@ -315,12 +313,8 @@ class VenueReader {
   }
 
   Ring ReadRing(const JsonReader& ring) const {
-    Ring points = OpenRing(Scaled(ring.AsPoints(3)));
-    for (Vec2 p : points)
-      if (std::abs(p.x) > kMaxCoordinate || std::abs(p.y) > kMaxCoordinate)
-        ring.Fail("coordinate (" + FormatNumber(p.x) + ", " + FormatNumber(p.y) +
-                  ") is beyond 1e7 m; expected metres (or set metadata.scale_m_per_unit)");
-    return points;
+    // (Coordinates beyond kVenueMaxCoordinate_m are reported by ValidateVenue.)
+    return OpenRing(Scaled(ring.AsPoints(3)));
   }
 
   void ReadSegment(const JsonReader& segment, Vec2* a, Vec2* b) const {

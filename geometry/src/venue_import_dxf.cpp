@@ -4,6 +4,8 @@
 // decides what is walkable (even depth) and what is an obstacle (odd depth),
 // which is how a plan drawn as "outline plus pillars" reads.
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <fstream>
 #include <istream>
@@ -19,8 +21,9 @@
 #include <dxflib/dl_dxf.h>
 
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/geometry/input_limits.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "venue_internal.hpp"
 
 namespace crowdrecon::geometry {
@@ -39,6 +42,7 @@ struct Piece {
 // along the rotated axes).
 struct Insert {
   std::string name, layer;
+  std::size_t line = 0;  // line of the file where the entity starts (0: unknown)
   Vec2 at;
   double scale_x = 1.0, scale_y = 1.0, angle_deg = 0.0;
   int columns = 1, rows = 1;
@@ -108,8 +112,15 @@ class Collector : public DL_CreationAdapter {
   // The arc tolerance is in metres; the drawing unit is known once the header
   // ($INSUNITS) has been read, which in a DXF file precedes the entities.
   // Not copyable: dxflib's interface base owns a raw pointer.
-  Collector(std::string layer, double tolerance_m, double scale_override)
-      : layer_(std::move(layer)), tolerance_m_(tolerance_m), scale_override_(scale_override) {}
+  // `insert_lines`: the line of every INSERT entity of the file, in order
+  // (dxflib does not say where an entity was read).
+  Collector(std::string file, std::string layer, double tolerance_m, double scale_override,
+            std::vector<std::size_t> insert_lines)
+      : layer_(std::move(layer)),
+        tolerance_m_(tolerance_m),
+        scale_override_(scale_override),
+        insert_lines_(std::move(insert_lines)),
+        file_(std::move(file)) {}
   Collector(const Collector&) = delete;
   Collector& operator=(const Collector&) = delete;
 
@@ -136,6 +147,8 @@ class Collector : public DL_CreationAdapter {
     Insert insert;
     insert.name = d.name;
     insert.layer = getAttributes().getLayer();
+    if (inserts_seen_ < insert_lines_.size()) insert.line = insert_lines_[inserts_seen_];
+    ++inserts_seen_;
     insert.at = {d.ipx, d.ipy};
     insert.scale_x = d.sx;
     insert.scale_y = d.sy;
@@ -349,7 +362,7 @@ class Collector : public DL_CreationAdapter {
                    "SPLINE with " + std::to_string(fit_.size()) +
                        " fit points and no control points, through which no curve could be interpolated "
                        "(expected at least 2 distinct points)"};
-      Current().push_back(std::move(marker));
+      Push(std::move(marker));
       return;
     }
     const std::size_t p = spline_degree_, n = control_.size();
@@ -358,7 +371,7 @@ class Collector : public DL_CreationAdapter {
       Piece marker{{}, false, spline_layer_,
                    "SPLINE of degree " + std::to_string(p) + " with " + std::to_string(n) + " control points and " +
                        std::to_string(knots_.size()) + " knots (expected degree + control points + 1)"};
-      Current().push_back(std::move(marker));
+      Push(std::move(marker));
       return;
     }
     const double tolerance = Tolerance();
@@ -388,7 +401,7 @@ class Collector : public DL_CreationAdapter {
     const bool closed = spline_closed_ || Length(points.front() - points.back()) <= tolerance * 1e-3;
     if (closed && Length(points.front() - points.back()) <= tolerance) points.pop_back();
     Piece piece{std::move(points), closed, spline_layer_, {}};
-    Current().push_back(std::move(piece));
+    Push(std::move(piece));
   }
   void addPolyline(const DL_PolylineData& d) override {
     FinishPending();
@@ -440,13 +453,14 @@ class Collector : public DL_CreationAdapter {
     }
     if (!polyline_closed_) points.push_back(vertices_.back());
     Piece piece{std::move(points), polyline_closed_, polyline_layer_, {}};
-    Current().push_back(std::move(piece));
+    Push(std::move(piece));
   }
 
   // The drawing's pieces on the wanted layer (all layers if none was named),
   // with every INSERT expanded, in drawing units. Entities in a block on
   // layer "0" take the layer of the INSERT that places them (DXF's rule).
   std::vector<Piece> Collect(const std::string& file) {
+    CheckLoad(file);
     std::vector<Piece> out;
     for (const Piece& p : pieces_) Keep(p, p.layer, Affine{}, "", file, out);
     for (const Insert& insert : inserts_) Expand(insert, Affine{}, insert.layer, 0, file, out);
@@ -461,10 +475,23 @@ class Collector : public DL_CreationAdapter {
   // The pieces of the block being defined, or of the drawing.
   std::vector<Piece>& Current() { return block_ ? block_->pieces : pieces_; }
 
+  // Into the current block or the drawing. The points read so far are
+  // counted here, so that a drawing of many finely flattened curves is
+  // refused while it is read rather than once it fills the memory.
+  void Push(Piece piece) {
+    points_read_ += piece.points.size();
+    if (points_read_ > kMaxDxfPoints)
+      throw InputError(file_ + ": the drawing holds more than " + std::to_string(kMaxDxfPoints) +
+                       " points once its curves are flattened (" + std::to_string(blocks_.size()) +
+                       " blocks read so far); at most that many are accepted: check the drawing's unit ($INSUNITS, "
+                       "--scale), or import one layer (--layer)");
+    Current().push_back(std::move(piece));
+  }
+
   // Into the current block or the drawing, with the entity's layer.
   void Add(std::vector<Vec2> points, bool closed, std::string unsupported = {}) {
     Piece piece{std::move(points), closed, getAttributes().getLayer(), std::move(unsupported)};
-    Current().push_back(std::move(piece));
+    Push(std::move(piece));
   }
 
   // Piece p (drawn with `layer`) placed by `to`, if on the wanted layer.
@@ -513,6 +540,76 @@ class Collector : public DL_CreationAdapter {
       }
   }
 
+  // What a drawing or block expands to: entities and their points, every
+  // INSERT and MINSERT array multiplied out (in double: 1e5 x 1e5 copies of
+  // a nested array overflow any integer, and only the order matters).
+  struct Load {
+    double entities = 0.0, points = 0.0;
+    Load& operator+=(const Load& o) {
+      entities += o.entities;
+      points += o.points;
+      return *this;
+    }
+  };
+
+  Load PiecesLoad(const std::vector<Piece>& pieces) const {
+    Load load;
+    for (const Piece& p : pieces) load += {1.0, static_cast<double>(p.points.size())};
+    return load;
+  }
+
+  // One INSERT with its copies. Blocks are memoised, so that a chain of
+  // blocks each inserting the next twice costs no more than its length.
+  Load InsertLoad(const Insert& insert, int depth, const std::string& file, std::map<std::string, Load>& memo) const {
+    const auto found = blocks_.find(insert.name);
+    if (found == blocks_.end()) return {};  // reported by Expand
+    if (depth >= kMaxBlockDepth)
+      throw InputError(file + ": block \"" + insert.name + "\" is inserted more than " +
+                       std::to_string(kMaxBlockDepth) + " levels deep (does a block insert itself?)");
+    auto known = memo.find(insert.name);
+    if (known == memo.end()) {
+      Load block = PiecesLoad(found->second.pieces);
+      for (const Insert& inner : found->second.inserts) block += InsertLoad(inner, depth + 1, file, memo);
+      known = memo.emplace(insert.name, block).first;
+    }
+    const double copies = static_cast<double>(insert.columns) * static_cast<double>(insert.rows);
+    return {copies * known->second.entities, copies * known->second.points};
+  }
+
+  // Refuses a drawing whose expansion exceeds kMaxDxfEntities or
+  // kMaxDxfPoints (input_limits.hpp) before anything is expanded, naming the
+  // INSERT that contributes most.
+  void CheckLoad(const std::string& file) const {
+    std::map<std::string, Load> memo;
+    Load total = PiecesLoad(pieces_);
+    const Insert* worst = nullptr;
+    Load worst_load;
+    for (const Insert& insert : inserts_) {
+      const Load load = InsertLoad(insert, 0, file, memo);
+      total += load;
+      if (!worst || load.entities > worst_load.entities) {
+        worst = &insert;
+        worst_load = load;
+      }
+    }
+    const double max_entities = static_cast<double>(kMaxDxfEntities);
+    const double max_points = static_cast<double>(kMaxDxfPoints);
+    if (total.entities <= max_entities && total.points <= max_points) return;
+    std::string message = file;
+    if (worst && worst_load.entities > 0.5 * total.entities)
+      message += ":" + std::to_string(worst->line) + ": the INSERT of block \"" + worst->name + "\" (" +
+                 std::to_string(worst->columns) + " x " + std::to_string(worst->rows) + " copies) expands to " +
+                 FormatNumber(worst_load.entities) + " entities with " + FormatNumber(worst_load.points) +
+                 " points; the drawing";
+    else
+      message += ": the drawing";
+    throw InputError(message + " has " + FormatNumber(total.entities) + " entities with " +
+                     FormatNumber(total.points) + " points once blocks are expanded; at most " +
+                     std::to_string(kMaxDxfEntities) + " entities and " + std::to_string(kMaxDxfPoints) +
+                     " points are accepted: check the MINSERT column and row counts and the curve tolerance, "
+                     "or import one layer (--layer)");
+  }
+
   // Drawing units. Curves in blocks are flattened 16 times finer, since an
   // INSERT may scale them up.
   double Tolerance() const { return tolerance_m_ / Scale() / (block_ ? 16.0 : 1.0); }
@@ -540,6 +637,10 @@ class Collector : public DL_CreationAdapter {
   std::vector<Insert> inserts_;
   std::map<std::string, Block> blocks_;
   Block* block_ = nullptr;  // the block being defined, or null
+  std::vector<std::size_t> insert_lines_;
+  std::size_t inserts_seen_ = 0;
+  std::string file_;
+  std::size_t points_read_ = 0;
   std::size_t skipped_ = 0;
 };
 
@@ -550,6 +651,42 @@ std::vector<Vec2> WithoutRepeats(const std::vector<Vec2>& points, double toleran
   return out;
 }
 
+// Points hashed into square cells of side `tolerance`, so that the points
+// within the tolerance of a query are found in the 3 x 3 cells around it.
+// Cells are keyed by the bits of their (floored) coordinates, so that
+// infinite or huge coordinates share a cell rather than overflow an integer.
+class NodeGrid {
+ public:
+  explicit NodeGrid(double tolerance) : tolerance_(tolerance > 0.0 ? tolerance : 1e-300) {}
+
+  // The lowest-numbered node within the tolerance of p, or nodes.size().
+  std::size_t Find(Vec2 p, const std::vector<Vec2>& nodes) const {
+    std::size_t best = nodes.size();
+    const double cx = std::floor(p.x / tolerance_), cy = std::floor(p.y / tolerance_);
+    for (double dx = -1.0; dx <= 1.0; dx += 1.0)
+      for (double dy = -1.0; dy <= 1.0; dy += 1.0) {
+        const auto cell = cells_.find(Key(cx + dx, cy + dy));
+        if (cell == cells_.end()) continue;
+        for (const std::size_t k : cell->second)
+          if (k < best && Length(nodes[k] - p) <= tolerance_) best = k;
+      }
+    return best;
+  }
+
+  void Add(Vec2 p, std::size_t id) {
+    cells_[Key(std::floor(p.x / tolerance_), std::floor(p.y / tolerance_))].push_back(id);
+  }
+
+ private:
+  static std::pair<std::uint64_t, std::uint64_t> Key(double x, double y) {
+    // (+ 0.0 turns -0.0 into 0.0, whose bits differ.)
+    return {std::bit_cast<std::uint64_t>(x + 0.0), std::bit_cast<std::uint64_t>(y + 0.0)};
+  }
+
+  double tolerance_;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, std::vector<std::size_t>> cells_;
+};
+
 // Joins open pieces whose endpoints meet into rings. Endpoints within
 // `tolerance` are one node; a connected set of pieces in which every node has
 // exactly two piece ends is a cycle and becomes a ring. Pieces of other sets
@@ -557,8 +694,8 @@ std::vector<Vec2> WithoutRepeats(const std::vector<Vec2>& points, double toleran
 void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
   std::vector<Piece> open, done;
   for (Piece& p : *pieces) (p.closed ? done : open).push_back(std::move(p));
-  // Cluster endpoints: node id per end (2 per piece), O(n^2) over ends, fine
-  // for the few thousand lines of a floor plan.
+  // Cluster endpoints: node id per end (2 per piece); an end joins the first
+  // node within the tolerance, found through a grid of tolerance-sized cells.
   const std::size_t ends = 2 * open.size();
   std::vector<Vec2> end_point(ends);
   for (std::size_t i = 0; i < open.size(); ++i) {
@@ -567,11 +704,13 @@ void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
   }
   std::vector<std::size_t> node(ends);
   std::vector<Vec2> node_point;
+  NodeGrid grid(tolerance);
   for (std::size_t e = 0; e < ends; ++e) {
-    std::size_t found = node_point.size();
-    for (std::size_t k = 0; k < node_point.size(); ++k)
-      if (Length(node_point[k] - end_point[e]) <= tolerance) { found = k; break; }
-    if (found == node_point.size()) node_point.push_back(end_point[e]);
+    std::size_t found = grid.Find(end_point[e], node_point);
+    if (found == node_point.size()) {
+      grid.Add(end_point[e], found);
+      node_point.push_back(end_point[e]);
+    }
     node[e] = found;
   }
   std::vector<std::vector<std::size_t>> ends_at(node_point.size());
@@ -620,37 +759,49 @@ void ChainPieces(std::vector<Piece>* pieces, double tolerance) {
   *pieces = std::move(done);
 }
 
-// A DXF file ends with the group "0" / "EOF". dxflib reads a file that stops
-// short (an interrupted copy or download) without complaint, as far as it
-// goes: such a file is refused here rather than imported in part. Returns the
-// number of lines and whether the last two that are not blank are 0 and EOF.
-std::pair<std::size_t, bool> EndsWithEof(std::istream& in) {
-  std::string line, last, before;
+// What a first pass over the file finds: its number of lines, whether it
+// ends with the group "0" / "EOF" that closes every DXF file (dxflib reads a
+// file that stops short, an interrupted copy or download, without complaint,
+// as far as it goes: such a file is refused rather than imported in part),
+// and the line of every INSERT entity (group 0 / INSERT), for messages.
+struct DxfScan {
   std::size_t lines = 0;
+  bool ends_with_eof = false;
+  std::vector<std::size_t> insert_lines;
+};
+
+DxfScan ScanDxf(std::istream& in) {
+  DxfScan scan;
+  std::string line, last, before;
   while (std::getline(in, line)) {
-    ++lines;
+    ++scan.lines;
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos) continue;
     const auto end = line.find_last_not_of(" \t\r");
     before = std::move(last);
     last = line.substr(first, end - first + 1);
+    if (before == "0" && last == "INSERT") scan.insert_lines.push_back(scan.lines - 1);
   }
-  return {lines, before == "0" && last == "EOF"};
+  scan.ends_with_eof = before == "0" && last == "EOF";
+  return scan;
 }
 
 }  // namespace
 
 Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options) {
+  CheckInputFile(file, "DXF file");
+  DxfScan scan;
   {
-    CheckInputFile(file, "DXF file");
     std::ifstream in(file);
-    const auto [lines, complete] = EndsWithEof(in);
-    if (!complete)
-      throw InputError(file.string() + ": the file ends at line " + std::to_string(lines) +
+    if (!in) throw InputError(file.string() + ": cannot open DXF file for reading");
+    scan = ScanDxf(in);
+    if (!scan.ends_with_eof)
+      throw InputError(file.string() + ": the file ends at line " + std::to_string(scan.lines) +
                        " without the end-of-file group (0 / EOF) that closes every DXF file: it looks cut short; "
                        "expected a complete ASCII DXF file");
   }
-  Collector collector(options.dxf_layer, options.dxf_arc_tolerance_m, options.scale_m_per_unit);
+  Collector collector(file.string(), options.dxf_layer, options.dxf_arc_tolerance_m, options.scale_m_per_unit,
+                      std::move(scan.insert_lines));
   DL_Dxf dxf;
   if (!dxf.in(file.string(), &collector)) throw InputError(file.string() + ": cannot read the file as DXF");
   collector.FinishPending();
@@ -689,10 +840,23 @@ Venue ImportDxf(const std::filesystem::path& file, const ImportOptions& options)
   std::vector<std::size_t> depth(n, 0);
   std::vector<std::size_t> parent(n, n);
   std::vector<double> area(n);
-  for (std::size_t i = 0; i < n; ++i) area[i] = std::abs(RingSignedArea_m2(rings[i]));
+  std::vector<std::pair<Vec2, Vec2>> bounds(n);  // a cheap test before the point-in-ring one
+  for (std::size_t i = 0; i < n; ++i) {
+    area[i] = std::abs(RingSignedArea_m2(rings[i]));
+    Vec2 lo = rings[i][0], hi = rings[i][0];
+    for (const Vec2 p : rings[i]) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    bounds[i] = {lo, hi};
+  }
+  const auto in_bounds = [&](std::size_t j, Vec2 p) {
+    return bounds[j].first.x <= p.x && p.x <= bounds[j].second.x && bounds[j].first.y <= p.y &&
+           p.y <= bounds[j].second.y;
+  };
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j)
-      if (i != j && area[j] > area[i] && PointInRing(rings[j], rings[i][0])) {
+      if (i != j && area[j] > area[i] && in_bounds(j, rings[i][0]) && PointInRing(rings[j], rings[i][0])) {
         ++depth[i];
         if (parent[i] == n || area[j] < area[parent[i]]) parent[i] = j;
       }

@@ -196,9 +196,7 @@ Venue ImportRasterPlan(const std::filesystem::path& file, const RasterImportOpti
   if (options.dark_threshold < 1 || options.dark_threshold > 255)
     throw InputError(origin + ": dark threshold " + std::to_string(options.dark_threshold) +
                      " is out of range; expected a grey level in [1, 255]");
-  if (!std::filesystem::exists(file)) throw InputError(origin + ": cannot open image file (it does not exist)");
-  detail::CheckImageFileComplete(file);
-  const cv::Mat grey = cv::imread(origin, cv::IMREAD_GRAYSCALE);
+  const cv::Mat grey = detail::ReadImage(file, cv::IMREAD_GRAYSCALE);
   if (grey.empty()) throw InputError(origin + ": cannot read the file as an image (PNG, JPEG, BMP, TIFF, ...)");
 
   // 1. Free pixels and their 4-connected components.

@@ -3,14 +3,15 @@
 // CGAL's WKT reader, because a user needs the line and column of a syntax error,
 // which CGAL's reader does not report.
 #include <cctype>
+#include <cmath>
 #include <charconv>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "venue_internal.hpp"
 
 namespace crowdrecon::geometry {
@@ -117,8 +118,15 @@ class WktParser {
     // from_chars does not accept a leading '+'; WKT writers never emit one.
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(begin, end, value);
-    if (ec != std::errc() || ptr == begin) Fail("expected a number but found " + Found());
-    pos_ += static_cast<std::size_t>(ptr - begin);
+    if (ptr == begin) Fail("expected a number but found " + Found());
+    // from_chars reads "nan" and "inf" too, and gives up on 1e400.
+    const std::string_view token(begin, static_cast<std::size_t>(ptr - begin));
+    const std::string shown(token.substr(0, 40));
+    if (ec == std::errc::result_out_of_range)
+      Fail("the number " + shown + " is out of range; expected a finite coordinate");
+    if (ec != std::errc()) Fail("expected a number but found " + Found());
+    if (!std::isfinite(value)) Fail("the number " + shown + " is not finite; expected a finite coordinate");
+    pos_ += token.size();
     return value;
   }
 

@@ -13,6 +13,8 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -78,6 +80,40 @@ std::optional<Vec2> RingsMeet(const Ring& a, const Ring& b) {
   return std::nullopt;
 }
 
+// The first vertex i (and the next j > i at the same place) that the ring
+// repeats, found by sorting (a plan's ring may have 1e5 vertices).
+std::optional<std::pair<std::size_t, std::size_t>> FirstRepeatedVertex(const Ring& ring) {
+  std::vector<std::size_t> order(ring.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto key = [&](std::size_t i) { return std::make_tuple(ring[i].x, ring[i].y, i); };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  std::optional<std::pair<std::size_t, std::size_t>> first;
+  for (std::size_t k = 0; k + 1 < order.size(); ++k)
+    if (ring[order[k]] == ring[order[k + 1]] && (!first || order[k] < first->first))
+      first = std::make_pair(order[k], order[k + 1]);
+  return first;
+}
+
+// The pairs (i < j) of rings whose bounding boxes overlap, in order: only
+// these can meet or nest. A sweep along x finds them without testing every
+// pair (a plan of 10000 pillars has 5e7 pairs, of which a few thousand are
+// neighbours).
+std::vector<std::pair<std::size_t, std::size_t>> OverlappingPairs(const std::vector<Ring>& rings) {
+  std::vector<Box> boxes;
+  boxes.reserve(rings.size());
+  for (const Ring& r : rings) boxes.push_back(r.empty() ? Box{} : BoundsOf(r));
+  std::vector<std::size_t> order(rings.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return boxes[a].lo.x < boxes[b].lo.x; });
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t k = 0; k < order.size(); ++k)
+    for (std::size_t m = k + 1; m < order.size() && boxes[order[m]].lo.x <= boxes[order[k]].hi.x; ++m)
+      if (boxes[order[k]].Overlaps(boxes[order[m]]))
+        pairs.emplace_back(std::min(order[k], order[m]), std::max(order[k], order[m]));
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
 // Strictly inside (a ring's interior, by exact predicate).
 bool StrictlyInside(const Ring& ring, Vec2 p) {
   std::vector<Point> pts;
@@ -91,6 +127,8 @@ class Checker {
   explicit Checker(const Venue& v) : v_(v) {}
 
   std::vector<std::string> Run() {
+    // Everything below squares coordinates: refuse absurd ones first.
+    if (!CheckCoordinates()) return problems_;
     CheckIds();
     std::vector<bool> outer_ok, obstacle_ok;
     for (std::size_t i = 0; i < v_.walkable_area.size(); ++i)
@@ -128,6 +166,41 @@ class Checker {
     problems_.push_back((v_.origin.empty() ? std::string("venue") : v_.origin) + ": " + path + ": " + what);
   }
 
+  // Finite and within kVenueMaxCoordinate_m; one problem per list of points.
+  bool CheckPoints(const std::vector<Vec2>& points, const std::string& path) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec2 p = points[i];
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) <= kVenueMaxCoordinate_m &&
+          std::abs(p.y) <= kVenueMaxCoordinate_m)
+        continue;
+      Problem(path + "/" + Index(i), "coordinate " + PointText(p) + " is beyond " +
+                                         FormatNumber(kVenueMaxCoordinate_m) +
+                                         " m; expected metres: check the scale/units (metadata.scale_m_per_unit, "
+                                         "or --scale when importing)");
+      return false;
+    }
+    return true;
+  }
+
+  bool CheckCoordinates() {
+    bool ok = true;
+    for (std::size_t i = 0; i < v_.walkable_area.size(); ++i)
+      ok &= CheckPoints(v_.walkable_area[i], "/walkable_area/" + Index(i));
+    for (std::size_t i = 0; i < v_.obstacles.size(); ++i) ok &= CheckPoints(v_.obstacles[i].polygon, ObstaclePath(i));
+    for (std::size_t i = 0; i < v_.walls.size(); ++i)
+      ok &= CheckPoints(v_.walls[i].points, "/walls/" + Index(i) + (v_.walls[i].closed ? "/polygon" : "/polyline"));
+    for (std::size_t i = 0; i < v_.exits.size(); ++i)
+      ok &= CheckPoints({v_.exits[i].a, v_.exits[i].b}, "/exits/" + Index(i) + "/segment");
+    for (std::size_t i = 0; i < v_.entries.size(); ++i)
+      ok &= CheckPoints(v_.entries[i].polygon, "/entries/" + Index(i) + "/polygon");
+    for (std::size_t i = 0; i < v_.measurement_areas.size(); ++i)
+      ok &= CheckPoints(v_.measurement_areas[i].polygon, "/measurement_areas/" + Index(i) + "/polygon");
+    for (std::size_t i = 0; i < v_.measurement_lines.size(); ++i)
+      ok &= CheckPoints({v_.measurement_lines[i].a, v_.measurement_lines[i].b},
+                        "/measurement_lines/" + Index(i) + "/segment");
+    return ok;
+  }
+
   // Checks one ring; returns true if it is a simple polygon of positive area.
   bool CheckRing(const Ring& ring, const std::string& path, const std::string& what) {
     if (ring.size() < 3) {
@@ -136,13 +209,11 @@ class Checker {
     }
     // Repeated vertices make a ring non-simple in CGAL's sense; name them
     // separately because the fix (delete a vertex) differs from a crossing.
-    for (std::size_t i = 0; i < ring.size(); ++i)
-      for (std::size_t j = i + 1; j < ring.size(); ++j)
-        if (ring[i] == ring[j]) {
-          Problem(path, what + " repeats a vertex: vertices " + Index(i) + " and " + Index(j) + " are both at " +
-                            PointText(ring[i]) + "; expected distinct vertices");
-          return false;
-        }
+    if (const auto repeat = FirstRepeatedVertex(ring)) {
+      Problem(path, what + " repeats a vertex: vertices " + Index(repeat->first) + " and " + Index(repeat->second) +
+                        " are both at " + PointText(ring[repeat->first]) + "; expected distinct vertices");
+      return false;
+    }
     std::vector<Point> pts;
     pts.reserve(ring.size());
     for (Vec2 p : ring) pts.push_back(ToCgal(p));
@@ -195,18 +266,17 @@ class Checker {
 
   void CheckAreaLayout(const std::vector<bool>& outer_ok, const std::vector<bool>& obstacle_ok) {
     const auto& outer = v_.walkable_area;
-    for (std::size_t i = 0; i < outer.size(); ++i)
-      for (std::size_t j = i + 1; j < outer.size(); ++j) {
-        if (!outer_ok[i] || !outer_ok[j]) continue;
-        if (auto p = RingsMeet(outer[i], outer[j]))
-          Problem("/walkable_area/" + Index(j), "outer ring meets outer ring /walkable_area/" + Index(i) +
-                                                    " at " + PointText(*p) +
-                                                    "; expected disjoint outer rings (merge them into one)");
-        else if (StrictlyInside(outer[i], outer[j][0]) || StrictlyInside(outer[j], outer[i][0]))
-          Problem("/walkable_area/" + Index(j), "outer rings /walkable_area/" + Index(i) + " and /walkable_area/" +
-                                                    Index(j) + " are nested; expected disjoint outer rings "
-                                                    "(an enclosed non-walkable region is an obstacle)");
-      }
+    for (const auto& [i, j] : OverlappingPairs(outer)) {
+      if (!outer_ok[i] || !outer_ok[j]) continue;
+      if (auto p = RingsMeet(outer[i], outer[j]))
+        Problem("/walkable_area/" + Index(j), "outer ring meets outer ring /walkable_area/" + Index(i) +
+                                                  " at " + PointText(*p) +
+                                                  "; expected disjoint outer rings (merge them into one)");
+      else if (StrictlyInside(outer[i], outer[j][0]) || StrictlyInside(outer[j], outer[i][0]))
+        Problem("/walkable_area/" + Index(j), "outer rings /walkable_area/" + Index(i) + " and /walkable_area/" +
+                                                  Index(j) + " are nested; expected disjoint outer rings "
+                                                  "(an enclosed non-walkable region is an obstacle)");
+    }
     for (std::size_t k = 0; k < v_.obstacles.size(); ++k) {
       if (!obstacle_ok[k]) continue;
       const Ring& hole = v_.obstacles[k].polygon;
@@ -226,19 +296,21 @@ class Checker {
         Problem(ObstaclePath(k), "obstacle \"" + v_.obstacles[k].id + "\" near " + PointText(hole[0]) +
                                      " lies outside the walkable area; expected it inside an outer ring");
     }
-    for (std::size_t a = 0; a < v_.obstacles.size(); ++a)
-      for (std::size_t b = a + 1; b < v_.obstacles.size(); ++b) {
-        if (!obstacle_ok[a] || !obstacle_ok[b]) continue;
-        const Ring& ra = v_.obstacles[a].polygon;
-        const Ring& rb = v_.obstacles[b].polygon;
-        if (auto p = RingsMeet(ra, rb))
-          Problem(ObstaclePath(b), "obstacles \"" + v_.obstacles[a].id + "\" (" + ObstaclePath(a) + ") and \"" +
-                                       v_.obstacles[b].id + "\" overlap or touch at " + PointText(*p) +
-                                       "; expected disjoint obstacles (merge them into one)");
-        else if (StrictlyInside(ra, rb[0]) || StrictlyInside(rb, ra[0]))
-          Problem(ObstaclePath(b), "obstacles \"" + v_.obstacles[a].id + "\" and \"" + v_.obstacles[b].id +
-                                       "\" are nested; expected disjoint obstacles");
-      }
+    std::vector<Ring> obstacle_rings;
+    obstacle_rings.reserve(v_.obstacles.size());
+    for (const Obstacle& o : v_.obstacles) obstacle_rings.push_back(o.polygon);
+    for (const auto& [a, b] : OverlappingPairs(obstacle_rings)) {
+      if (!obstacle_ok[a] || !obstacle_ok[b]) continue;
+      const Ring& ra = v_.obstacles[a].polygon;
+      const Ring& rb = v_.obstacles[b].polygon;
+      if (auto p = RingsMeet(ra, rb))
+        Problem(ObstaclePath(b), "obstacles \"" + v_.obstacles[a].id + "\" (" + ObstaclePath(a) + ") and \"" +
+                                     v_.obstacles[b].id + "\" overlap or touch at " + PointText(*p) +
+                                     "; expected disjoint obstacles (merge them into one)");
+      else if (StrictlyInside(ra, rb[0]) || StrictlyInside(rb, ra[0]))
+        Problem(ObstaclePath(b), "obstacles \"" + v_.obstacles[a].id + "\" and \"" + v_.obstacles[b].id +
+                                     "\" are nested; expected disjoint obstacles");
+    }
   }
 
   void CheckWalls() {

@@ -91,8 +91,8 @@ double SignedArea(const std::vector<Vec2>& polygon);
 // Area, centroid and polar moment of a simple polygon (no sweeping), closed form.
 AreaProperties PolygonProperties(const std::vector<Vec2>& polygon);
 
-// Hausdorff distance between two point sets (brute force; for outlines of a few
-// thousand points).
+// Hausdorff distance between two point sets; infinite if either is empty.
+// Nearest neighbours through a k-d tree: O((|a| + |b|) log(|a| + |b|)).
 double HausdorffDistance(const std::vector<Vec2>& a, const std::vector<Vec2>& b);
 
 }  // namespace crowdrecon::geometry

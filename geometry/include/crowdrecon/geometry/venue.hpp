@@ -150,7 +150,7 @@ void WriteVenueJson(const Venue& venue, const std::filesystem::path& file);
 // --- validation --------------------------------------------------------------
 
 // Every problem of the venue's geometry, one message each ("origin: /path: ...").
-// Checks: rings with at least 3 distinct vertices and non-zero area, simple (no
+// Checks: finite coordinates within kVenueMaxCoordinate_m, rings with at least 3 distinct vertices and non-zero area, simple (no
 // self-intersection, no repeated vertex), obstacles strictly inside one outer
 // ring and disjoint from each other, outer rings disjoint, a walkable area of
 // positive area, exits, entries, measurement areas and lines inside the
@@ -159,6 +159,11 @@ void WriteVenueJson(const Venue& venue, const std::filesystem::path& file);
 std::vector<std::string> FindVenueProblems(const Venue& venue);
 // Throws GeometryError with every problem (one per line) if there is any.
 void ValidateVenue(const Venue& venue);
+
+// Largest magnitude of a venue coordinate (m): beyond it a unit is surely
+// wrong, and squared lengths lose the digits the geometry needs. Checked by
+// FindVenueProblems, so by `venue check` and by every importer alike.
+inline constexpr double kVenueMaxCoordinate_m = 1e7;
 
 // Distance (m) within which a point counts as on the boundary of the walkable
 // area, and an exit's endpoints may lie outside it (drawing rounding).
