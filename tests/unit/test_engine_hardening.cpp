@@ -12,10 +12,7 @@
 namespace crowdrecon::engine {
 namespace {
 
-using testing::DiskShape;
-using testing::PassiveWorld;
-using testing::RandomGas;
-using testing::SetMassFromShape;
+using namespace testing;  // the scenes of engine_scenes.hpp (crowdrecon::engine::testing)
 
 // A disk (one contact point) resting on a straight wall of sphero-radius
 // `wall_radius_m`, pressed onto it by a force that grows slowly (1 kN/s,
@@ -73,7 +70,7 @@ TEST(EngineHardening, APersonPressedOntoAWallStopsTheRunWhenItsCoreReachesTheWal
 // engine reports (before issue 17 it came out on the other side, unnoticed).
 TEST(EngineHardening, APersonRunningThroughAWallIsReported) {
   WorldDef def = PassiveWorld();
-  def.shapes.push_back(testing::ThoraxLikeShape());
+  def.shapes.push_back(ThoraxLikeShape());
   PersonDef p;
   SetMassFromShape(def.shapes[0], 1000.0, p);
   p.position_m = {-0.5, 0.0};
