@@ -82,6 +82,12 @@ geometry_case(wkt_inf none fail "bad-inf.wkt:1:31: invalid WKT: the number inf i
 geometry_case(wkt_1e400 none fail "bad-1e400.wkt:1:16: invalid WKT: the number 1e400 is out of range" 10
   venue import ${V}/bad-1e400.wkt -o @TMP@/out.json)
 
+# A self-intersecting outline of 400000 points: the edges that cross are
+# found by a sweep (every pair of edges before: 8e10 tests).
+geometry_case(bowtie_outline_400k "bowtie 0.5 100000 bowtie.json" fail
+  "bowtie.json: the outline intersects itself \\(edge [0-9]+ .* crosses edge [0-9]+ .*\\); expected a simple closed outline" 10
+  shape @TMP@/bowtie.json -o @TMP@/out.json)
+
 # 6. A bow-tie body file is a self-intersection, not "all vertices collinear".
 geometry_case(bowtie_body_file none fail "bowtie-body.json: /vertices_m: edges 0 .* and 2 .* intersect; the polygon must be simple" 10
   population --mode paper --body ${B}/bowtie-body.json --count 2 -o @TMP@/out.json)

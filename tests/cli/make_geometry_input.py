@@ -10,6 +10,7 @@ that no large file is committed.
   make_geometry_input.py pgm-header WIDTH HEIGHT OUT   the same as a netpbm (PGM) file
   make_geometry_input.py square SIDE [POINTS] OUT      point-list square of SIDE
                                                         units (JSON), POINTS per edge
+  make_geometry_input.py bowtie SIDE POINTS OUT        the same with two corners swapped
   make_geometry_input.py minsert COLUMNS ROWS OUT      DXF: a room and a MINSERT
                                                         of COLUMNS x ROWS pillars
 """
@@ -45,8 +46,8 @@ def dark_png(width, height):
     return png(width, height, b"".join(parts))
 
 
-def square(side, per_edge):
-    corners = [(0, 0), (side, 0), (side, side), (0, side)]
+def square(side, per_edge, bowtie=False):
+    corners = [(0, 0), (side, side), (side, 0), (0, side)] if bowtie else [(0, 0), (side, 0), (side, side), (0, side)]
     points = []
     for k in range(4):
         (x0, y0), (x1, y1) = corners[k], corners[(k + 1) % 4]
@@ -83,6 +84,8 @@ def main():
         data, out = f"P5\n{args[0]} {args[1]}\n255\n".encode() + b"\0" * 16, args[2]
     elif kind == "square":
         data, out = square(float(args[0]), int(args[1]) if len(args) > 2 else 1).encode(), args[-1]
+    elif kind == "bowtie":
+        data, out = square(float(args[0]), int(args[1]), bowtie=True).encode(), args[2]
     elif kind == "minsert":
         data, out = minsert(int(args[0]), int(args[1])).encode(), args[2]
     else:
