@@ -441,8 +441,12 @@ std::vector<std::string> FindVenueProblems(const Venue& venue) { return Checker(
 void ValidateVenue(const Venue& venue) {
   const std::vector<std::string> problems = FindVenueProblems(venue);
   if (problems.empty()) return;
+  // Every problem up to a screenful: a plan in the wrong unit has one per ring.
+  constexpr std::size_t kShown = 20;
   std::string message = problems.front();
-  for (std::size_t i = 1; i < problems.size(); ++i) message += "\n" + problems[i];
+  for (std::size_t i = 1; i < std::min(problems.size(), kShown); ++i) message += "\n" + problems[i];
+  if (problems.size() > kShown)
+    message += "\n(and " + std::to_string(problems.size() - kShown) + " more problems of the same venue)";
   throw GeometryError(message);
 }
 

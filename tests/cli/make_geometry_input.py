@@ -11,6 +11,8 @@ that no large file is committed.
   make_geometry_input.py square SIDE [POINTS] OUT      point-list square of SIDE
                                                         units (JSON), POINTS per edge
   make_geometry_input.py bowtie SIDE POINTS OUT        the same with two corners swapped
+  make_geometry_input.py circles COUNT OUT              DXF: COUNT circles of radius 1e5 m
+                                                        (7000 points each at 1 cm)
   make_geometry_input.py minsert COLUMNS ROWS OUT      DXF: a room and a MINSERT
                                                         of COLUMNS x ROWS pillars
 """
@@ -73,6 +75,14 @@ def minsert(columns, rows):
             + pairs((0, "ENDSEC"), (0, "EOF")))
 
 
+def circles(count):
+    def pairs(*items):
+        return "".join(f"{code}\n{value}\n" for code, value in items)
+
+    body = "".join(pairs((0, "CIRCLE"), (8, "0"), (10, 3e5 * k), (20, 0), (40, 1e5)) for k in range(count))
+    return pairs((0, "SECTION"), (2, "ENTITIES")) + body + pairs((0, "ENDSEC"), (0, "EOF"))
+
+
 def main():
     kind = sys.argv[1]
     args = sys.argv[2:]
@@ -86,6 +96,8 @@ def main():
         data, out = square(float(args[0]), int(args[1]) if len(args) > 2 else 1).encode(), args[-1]
     elif kind == "bowtie":
         data, out = square(float(args[0]), int(args[1]), bowtie=True).encode(), args[2]
+    elif kind == "circles":
+        data, out = circles(int(args[0])).encode(), args[1]
     elif kind == "minsert":
         data, out = minsert(int(args[0]), int(args[1])).encode(), args[2]
     else:
