@@ -15,6 +15,7 @@
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/geometry/input_limits.hpp"
+#include "box_pairs.hpp"
 #include "image_file.hpp"
 #include "outline_cgal.hpp"
 
@@ -45,18 +46,17 @@ bool SegmentsCross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
 }
 
 // Names the first pair of non-adjacent edges that cross (for the error message;
-// only called once CGAL has said the ring is not simple).
+// only called once CGAL has said the ring is not simple; only edges whose
+// bounding boxes overlap are compared, so a ring of 1e6 points takes no longer
+// than its sorting).
 std::string DescribeSelfIntersection(const std::vector<Vec2>& ring) {
   const std::size_t n = ring.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-      if (adjacent) continue;
-      if (SegmentsCross(ring[i], ring[(i + 1) % n], ring[j], ring[(j + 1) % n]))
-        return "edge " + std::to_string(i) + " " + PointText(ring[i]) + "-" +
-               PointText(ring[(i + 1) % n]) + " crosses edge " + std::to_string(j) + " " +
-               PointText(ring[j]) + "-" + PointText(ring[(j + 1) % n]);
-    }
+  for (const auto& [i, j] : detail::OverlappingPairs(detail::EdgeBoxes(ring))) {
+    const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+    if (adjacent) continue;
+    if (SegmentsCross(ring[i], ring[(i + 1) % n], ring[j], ring[(j + 1) % n]))
+      return "edge " + std::to_string(i) + " " + PointText(ring[i]) + "-" + PointText(ring[(i + 1) % n]) +
+             " crosses edge " + std::to_string(j) + " " + PointText(ring[j]) + "-" + PointText(ring[(j + 1) % n]);
   }
   return "an edge folds back onto its neighbour";
 }

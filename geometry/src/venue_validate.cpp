@@ -23,11 +23,16 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "box_pairs.hpp"
 
 namespace crowdrecon::geometry {
 
 namespace {
 
+using detail::BoundsOf;
+using detail::Box;
+using detail::EdgeBoxes;
+using detail::OverlappingPairs;
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_2;
 using Segment = Kernel::Segment_2;
@@ -49,22 +54,6 @@ Vec2 IntersectionPoint(const Segment& s, const Segment& t) {
 
 Segment Edge(const Ring& ring, std::size_t i) {
   return {ToCgal(ring[i]), ToCgal(ring[(i + 1) % ring.size()])};
-}
-
-struct Box {
-  Vec2 lo, hi;
-  bool Overlaps(const Box& o) const {
-    return lo.x <= o.hi.x && o.lo.x <= hi.x && lo.y <= o.hi.y && o.lo.y <= hi.y;
-  }
-};
-
-Box BoundsOf(const std::vector<Vec2>& points) {
-  Box b{points.front(), points.front()};
-  for (Vec2 p : points) {
-    b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y)};
-    b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y)};
-  }
-  return b;
 }
 
 // First place where the boundaries of two rings meet (cross or touch).
@@ -94,24 +83,14 @@ std::optional<std::pair<std::size_t, std::size_t>> FirstRepeatedVertex(const Rin
   return first;
 }
 
-// The pairs (i < j) of rings whose bounding boxes overlap, in order: only
-// these can meet or nest. A sweep along x finds them without testing every
-// pair (a plan of 10000 pillars has 5e7 pairs, of which a few thousand are
-// neighbours).
-std::vector<std::pair<std::size_t, std::size_t>> OverlappingPairs(const std::vector<Ring>& rings) {
+// The pairs (i < j) of rings whose bounding boxes overlap: only these can
+// meet or nest (a plan of 10000 pillars has 5e7 pairs, of which a few
+// thousand are neighbours).
+std::vector<std::pair<std::size_t, std::size_t>> OverlappingRings(const std::vector<Ring>& rings) {
   std::vector<Box> boxes;
   boxes.reserve(rings.size());
   for (const Ring& r : rings) boxes.push_back(r.empty() ? Box{} : BoundsOf(r));
-  std::vector<std::size_t> order(rings.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return boxes[a].lo.x < boxes[b].lo.x; });
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t k = 0; k < order.size(); ++k)
-    for (std::size_t m = k + 1; m < order.size() && boxes[order[m]].lo.x <= boxes[order[k]].hi.x; ++m)
-      if (boxes[order[k]].Overlaps(boxes[order[m]]))
-        pairs.emplace_back(std::min(order[k], order[m]), std::max(order[k], order[m]));
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
+  return OverlappingPairs(boxes);
 }
 
 // Strictly inside (a ring's interior, by exact predicate).
@@ -237,36 +216,35 @@ class Checker {
     return true;
   }
 
-  // Names the first pair of non-adjacent edges that meet (O(n^2); only run
-  // once a ring is known not to be simple).
+  // Names the first pair of non-adjacent edges that meet (only run once a
+  // ring is known not to be simple; edges whose boxes overlap only).
   static std::string DescribeSelfIntersection(const Ring& ring) {
     const std::size_t n = ring.size();
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = i + 1; j < n; ++j) {
-        const Segment s = Edge(ring, i), t = Edge(ring, j);
-        const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-        if (adjacent) {
-          // Adjacent edges share a vertex; they only overlap if they fold back.
-          if (CGAL::collinear(s.source(), s.target(), t.target()) &&
-              CGAL::collinear(t.source(), t.target(), s.source())) {
-            const auto r = CGAL::intersection(s, t);
-            if (r && boost::get<Segment>(&*r))
-              return "edges " + Index(i) + " and " + Index(j) + " fold back on each other at " +
-                     PointText(IntersectionPoint(s, t));
-          }
-          continue;
+    for (const auto& [i, j] : OverlappingPairs(EdgeBoxes(ring))) {
+      const Segment s = Edge(ring, i), t = Edge(ring, j);
+      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+      if (adjacent) {
+        // Adjacent edges share a vertex; they only overlap if they fold back.
+        if (CGAL::collinear(s.source(), s.target(), t.target()) &&
+            CGAL::collinear(t.source(), t.target(), s.source())) {
+          const auto r = CGAL::intersection(s, t);
+          if (r && boost::get<Segment>(&*r))
+            return "edges " + Index(i) + " and " + Index(j) + " fold back on each other at " +
+                   PointText(IntersectionPoint(s, t));
         }
-        if (CGAL::do_intersect(s, t))
-          return "edges " + Index(i) + " " + PointText(ring[i]) + "-" + PointText(ring[(i + 1) % n]) +
-                 " and " + Index(j) + " " + PointText(ring[j]) + "-" + PointText(ring[(j + 1) % n]) +
-                 " cross at " + PointText(IntersectionPoint(s, t));
+        continue;
       }
+      if (CGAL::do_intersect(s, t))
+        return "edges " + Index(i) + " " + PointText(ring[i]) + "-" + PointText(ring[(i + 1) % n]) +
+               " and " + Index(j) + " " + PointText(ring[j]) + "-" + PointText(ring[(j + 1) % n]) +
+               " cross at " + PointText(IntersectionPoint(s, t));
+    }
     return "its edges intersect";
   }
 
   void CheckAreaLayout(const std::vector<bool>& outer_ok, const std::vector<bool>& obstacle_ok) {
     const auto& outer = v_.walkable_area;
-    for (const auto& [i, j] : OverlappingPairs(outer)) {
+    for (const auto& [i, j] : OverlappingRings(outer)) {
       if (!outer_ok[i] || !outer_ok[j]) continue;
       if (auto p = RingsMeet(outer[i], outer[j]))
         Problem("/walkable_area/" + Index(j), "outer ring meets outer ring /walkable_area/" + Index(i) +
@@ -299,7 +277,7 @@ class Checker {
     std::vector<Ring> obstacle_rings;
     obstacle_rings.reserve(v_.obstacles.size());
     for (const Obstacle& o : v_.obstacles) obstacle_rings.push_back(o.polygon);
-    for (const auto& [a, b] : OverlappingPairs(obstacle_rings)) {
+    for (const auto& [a, b] : OverlappingRings(obstacle_rings)) {
       if (!obstacle_ok[a] || !obstacle_ok[b]) continue;
       const Ring& ra = v_.obstacles[a].polygon;
       const Ring& rb = v_.obstacles[b].polygon;
@@ -463,8 +441,12 @@ std::vector<std::string> FindVenueProblems(const Venue& venue) { return Checker(
 void ValidateVenue(const Venue& venue) {
   const std::vector<std::string> problems = FindVenueProblems(venue);
   if (problems.empty()) return;
+  // Every problem up to a screenful: a plan in the wrong unit has one per ring.
+  constexpr std::size_t kShown = 20;
   std::string message = problems.front();
-  for (std::size_t i = 1; i < problems.size(); ++i) message += "\n" + problems[i];
+  for (std::size_t i = 1; i < std::min(problems.size(), kShown); ++i) message += "\n" + problems[i];
+  if (problems.size() > kShown)
+    message += "\n(and " + std::to_string(problems.size() - kShown) + " more problems of the same venue)";
   throw GeometryError(message);
 }
 

@@ -73,6 +73,9 @@ geometry_case(dxf_minsert_under_limit "minsert 100 100 plan.dxf" ok "10000 obsta
 geometry_case(dxf_too_many_points none fail
   "many-points.dxf:39: the INSERT of block \"C\" \\(20 x 20 copies\\) expands to 400 entities with 2513600 points.*at most 20000 entities and 1000000 points" 10
   venue import ${V}/many-points.dxf -o @TMP@/out.json)
+geometry_case(dxf_too_many_curve_points "circles 200 plan.dxf" fail
+  "plan.dxf: the drawing holds more than 1000000 points once its curves are flattened.*check the drawing's unit" 10
+  venue import @TMP@/plan.dxf -o @TMP@/out.json)
 
 # 5. Non-finite and out-of-range numbers in WKT, with line and column.
 geometry_case(wkt_nan none fail "bad-nan.wkt:2:6: invalid WKT: the number nan is not finite; expected a finite coordinate" 10
@@ -81,6 +84,12 @@ geometry_case(wkt_inf none fail "bad-inf.wkt:1:31: invalid WKT: the number inf i
   venue import ${V}/bad-inf.wkt -o @TMP@/out.json)
 geometry_case(wkt_1e400 none fail "bad-1e400.wkt:1:16: invalid WKT: the number 1e400 is out of range" 10
   venue import ${V}/bad-1e400.wkt -o @TMP@/out.json)
+
+# A self-intersecting outline of 400000 points: the edges that cross are
+# found by a sweep (every pair of edges before: 8e10 tests).
+geometry_case(bowtie_outline_400k "bowtie 0.5 100000 bowtie.json" fail
+  "bowtie.json: the outline intersects itself \\(edge [0-9]+ .* crosses edge [0-9]+ .*\\); expected a simple closed outline" 10
+  shape @TMP@/bowtie.json -o @TMP@/out.json)
 
 # 6. A bow-tie body file is a self-intersection, not "all vertices collinear".
 geometry_case(bowtie_body_file none fail "bowtie-body.json: /vertices_m: edges 0 .* and 2 .* intersect; the polygon must be simple" 10
@@ -92,6 +101,10 @@ geometry_case(wkt_1e300 none fail
   venue import ${V}/bad-1e300.wkt -o @TMP@/out.json)
 geometry_case(dxf_scale_1e300 none fail "room.dxf: /walkable_area/0/1: coordinate \\(1e\\+304, 0\\) is beyond 10000000 m" 10
   venue import ${V}/room.dxf --scale 1e300 -o @TMP@/out.json)
+# 150 circles 3e5 m apart: 232 problems (116 rings and their walls beyond 1e7 m), the first 20 shown.
+geometry_case(dxf_many_problems_shortened "circles 150 plan.dxf" fail
+  "\\(and 212 more problems of the same venue\\)" 10
+  venue import @TMP@/plan.dxf -o @TMP@/out.json)
 geometry_case(check_huge_coordinate none fail
   "bad-huge-coordinate.json: /measurement_lines/0/segment/1: coordinate \\(9, 1e\\+300\\) is beyond 10000000 m" 10
   venue check ${V}/bad-huge-coordinate.json)

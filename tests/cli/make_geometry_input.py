@@ -10,6 +10,9 @@ that no large file is committed.
   make_geometry_input.py pgm-header WIDTH HEIGHT OUT   the same as a netpbm (PGM) file
   make_geometry_input.py square SIDE [POINTS] OUT      point-list square of SIDE
                                                         units (JSON), POINTS per edge
+  make_geometry_input.py bowtie SIDE POINTS OUT        the same with two corners swapped
+  make_geometry_input.py circles COUNT OUT              DXF: COUNT circles of radius 1e5 m
+                                                        (7000 points each at 1 cm)
   make_geometry_input.py minsert COLUMNS ROWS OUT      DXF: a room and a MINSERT
                                                         of COLUMNS x ROWS pillars
 """
@@ -45,8 +48,8 @@ def dark_png(width, height):
     return png(width, height, b"".join(parts))
 
 
-def square(side, per_edge):
-    corners = [(0, 0), (side, 0), (side, side), (0, side)]
+def square(side, per_edge, bowtie=False):
+    corners = [(0, 0), (side, side), (side, 0), (0, side)] if bowtie else [(0, 0), (side, 0), (side, side), (0, side)]
     points = []
     for k in range(4):
         (x0, y0), (x1, y1) = corners[k], corners[(k + 1) % 4]
@@ -72,6 +75,14 @@ def minsert(columns, rows):
             + pairs((0, "ENDSEC"), (0, "EOF")))
 
 
+def circles(count):
+    def pairs(*items):
+        return "".join(f"{code}\n{value}\n" for code, value in items)
+
+    body = "".join(pairs((0, "CIRCLE"), (8, "0"), (10, 3e5 * k), (20, 0), (40, 1e5)) for k in range(count))
+    return pairs((0, "SECTION"), (2, "ENTITIES")) + body + pairs((0, "ENDSEC"), (0, "EOF"))
+
+
 def main():
     kind = sys.argv[1]
     args = sys.argv[2:]
@@ -83,6 +94,10 @@ def main():
         data, out = f"P5\n{args[0]} {args[1]}\n255\n".encode() + b"\0" * 16, args[2]
     elif kind == "square":
         data, out = square(float(args[0]), int(args[1]) if len(args) > 2 else 1).encode(), args[-1]
+    elif kind == "bowtie":
+        data, out = square(float(args[0]), int(args[1]), bowtie=True).encode(), args[2]
+    elif kind == "circles":
+        data, out = circles(int(args[0])).encode(), args[1]
     elif kind == "minsert":
         data, out = minsert(int(args[0]), int(args[1])).encode(), args[2]
     else:
