@@ -16,7 +16,7 @@
 # FUZZ_TIMEOUT_S (10 s); runaway memory one above FUZZ_RSS_MB (2048 MB).
 set -euo pipefail
 
-build=${1:?usage: scripts/fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
+build=$(cd "${1:?usage: scripts/fuzz.sh BUILD_DIR SECONDS [HARNESS...]}" && pwd)
 seconds=${2:?usage: scripts/fuzz.sh BUILD_DIR SECONDS [HARNESS...]}
 shift 2
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

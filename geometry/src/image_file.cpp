@@ -95,6 +95,11 @@ void CheckComplete(const std::filesystem::path& file, const Bytes& bytes) {
     throw InputError(file.string() + ": " + what + " (" + std::to_string(bytes.size()) +
                      " bytes): the file looks cut short; expected a complete picture");
   };
+  // OpenCV hands a file with "DICM" at byte 128 to GDCM (DICOM), whose
+  // assertions abort the whole program on a damaged one (found by fuzzing,
+  // docs/fuzzing.md); a floor plan or body outline is never a DICOM file.
+  if (bytes.size() >= 132 && std::string(bytes.begin() + 128, bytes.begin() + 132) == "DICM")
+    throw InputError(file.string() + ": a DICOM (medical) image (\"DICM\" at byte 128); expected a picture (PNG, JPEG, BMP, TIFF, ...)");
   if (IsPng(bytes)) {
     // Walk the chunks (length, type, data, CRC) to IEND.
     std::size_t at = kPng.size();

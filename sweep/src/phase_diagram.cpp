@@ -308,7 +308,7 @@ void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_nam
     const double cy = L.PY(L.y->positions[cell.second]);
     const Category m = Majority(point.votes);
     ++majority_count[m];
-    const bool unanimous = std::all_of(point.votes.begin(), point.votes.end(), [&](Category c) { return c == point.votes[0]; });
+    const bool unanimous = std::all_of(point.votes.begin(), point.votes.end(), [&votes = point.votes](Category c) { return c == votes[0]; });
     if (!unanimous) {
       ++disagreeing;
       page.canvas.Circle(page.P(cx, cy), 1.75 * r, Color::White(), Color::Hex(0x999999), 0.8);
