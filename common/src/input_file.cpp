@@ -11,8 +11,14 @@ namespace crowdrecon {
 
 void CheckInputFile(const std::filesystem::path& file, std::string_view what) {
   std::error_code ec;
-  if (std::filesystem::is_directory(file, ec))
+  const std::filesystem::file_status status = std::filesystem::status(file, ec);
+  if (std::filesystem::is_directory(status))
     throw InputError(file.string() + ": is a directory; expected a " + std::string(what));
+  // A device (/dev/zero, a terminal) or a socket never ends or never answers;
+  // a pipe (a shell's <(...)) ends, and is read like a file.
+  if (std::filesystem::is_character_file(status) || std::filesystem::is_block_file(status) ||
+      std::filesystem::is_socket(status))
+    throw InputError(file.string() + ": is a device or socket, not a file; expected a " + std::string(what));
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     const int error = errno;
