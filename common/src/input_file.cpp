@@ -12,7 +12,9 @@ namespace crowdrecon {
 void CheckInputFile(const std::filesystem::path& file, std::string_view what) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec))
-    throw InputError(file.string() + ": is a directory; expected a " + std::string(what));
+    throw InputError(file.string() + ": is a directory; expected " +
+                     (std::string_view("AEIOUaeiou").find(what.front()) != std::string_view::npos ? "an " : "a ") +
+                     std::string(what));
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     const int error = errno;
