@@ -12,13 +12,15 @@ namespace crowdrecon {
 void CheckInputFile(const std::filesystem::path& file, std::string_view what) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(file, ec);
-  if (std::filesystem::is_directory(status))
-    throw InputError(file.string() + ": is a directory; expected a " + std::string(what));
+  const std::string expected =
+      std::string(std::string_view("AEIOUaeiou").find(what.front()) != std::string_view::npos ? "an " : "a ") +
+      std::string(what);
+  if (std::filesystem::is_directory(status)) throw InputError(file.string() + ": is a directory; expected " + expected);
   // A device (/dev/zero, a terminal) or a socket never ends or never answers;
   // a pipe (a shell's <(...)) ends, and is read like a file.
   if (std::filesystem::is_character_file(status) || std::filesystem::is_block_file(status) ||
       std::filesystem::is_socket(status))
-    throw InputError(file.string() + ": is a device or socket, not a file; expected a " + std::string(what));
+    throw InputError(file.string() + ": is a device or socket, not a file; expected " + expected);
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     const int error = errno;

@@ -94,9 +94,9 @@ foreach(case
   list(GET parts 2 file)
   crowdrecon_cli_test(shape.invalid.${name} fail "${regex}" shape ${file} -o @TMP@/body.json)
 endforeach()
-crowdrecon_cli_test(shape.invalid.vertices fail "vertex count \\(2\\) is too small.+expected at least 3"
+crowdrecon_cli_test(shape.invalid.vertices fail "--vertices: value 2 is out of range. expected a whole number in \\[3, 1000\\]"
                     shape venues/bodies/thorax-reference.json --vertices 2 -o @TMP@/body.json)
-crowdrecon_cli_test(shape.invalid.radius fail "sphero-radius \\(-0.05 m\\) must be positive"
+crowdrecon_cli_test(shape.invalid.radius fail "--radius: value -0.05 is out of range. expected a number in \\[0.0001, 1\\] m"
                     shape venues/bodies/thorax-reference.json --radius -0.05 -o @TMP@/body.json)
 crowdrecon_cli_test(shape.invalid.scale fail "--scale: unknown scale rule \"width\""
                     shape venues/bodies/thorax-reference.json --scale width:0.3 -o @TMP@/body.json)
@@ -140,7 +140,7 @@ crowdrecon_cli_test(render.unwritable_output fail "expect.sh/frames: cannot crea
                     render ${render_data}/run.sqlite -o tests/cli/expect.sh/frames)
 crowdrecon_cli_test(render.bad_video fail "--video .*run.gif: unknown video format \".gif\", expected .mp4 or .avi"
                     render ${render_data}/run.sqlite -o @TMP@/frames --video @TMP@/run.gif)
-crowdrecon_cli_test(render.bad_width fail "--width: 100 px, expected 320 .. 8000"
+crowdrecon_cli_test(render.bad_width fail "--width: value 100 is out of range. expected a whole number in \\[320, 8000\\]"
                     render ${render_data}/run.sqlite -o @TMP@/frames --width 100)
 get_property(render_tests DIRECTORY PROPERTY TESTS)
 list(FILTER render_tests INCLUDE REGEX "^cli\\.render\\.")

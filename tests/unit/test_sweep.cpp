@@ -156,8 +156,9 @@ TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
     std::string expected;
   } cases[] = {
       {R"("axs": [])", "test.json: /: unknown key(s) \"axs\""},
-      {R"("format": "crowdrecon-scenario")", "test.json: /format: \"crowdrecon-scenario\" is not a sweep"},
-      {R"("version": 2)", "test.json: /version: value 2 is out of range; expected an integer in [1, 1]"},
+      // A key given twice is an error (the head already gives format and version).
+      {R"("format": "crowdrecon-scenario")", "test.json:1:97: /format: key given twice"},
+      {R"("version": 2)", "test.json:1:98: /version: key given twice (first at line 1 with value 1, again at line 1 with value 2)"},
       {R"("axes": [{"path": "population.density_per_m2"}])",
        "test.json: /axes/0: give either \"values\": [...] or \"from\", \"to\" and \"count\""},
       {R"("axes": [{"path": "population.density_per_m2", "values": [1], "from": 1}])", "/axes/0: give either"},
@@ -192,6 +193,13 @@ TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
     const std::string m = ErrorOf("{" + kHead + ", " + c.body + "}");
     EXPECT_NE(m.find(c.expected), std::string::npos) << c.body << "\n  gave: " << m;
   }
+  const std::string scenario = R"("scenario": "../scenarios/sweep-tiny.json")";
+  EXPECT_NE(ErrorOf(R"({"format": "crowdrecon-scenario", )" + scenario + "}")
+                .find("test.json: /format: \"crowdrecon-scenario\" is not a sweep"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(R"({"version": 2, )" + scenario + "}")
+                .find("test.json: /version: value 2 is out of range; expected an integer in [1, 1]"),
+            std::string::npos);
   EXPECT_NE(ErrorOf(R"({"format": "crowdrecon-sweep", "scenario": "nope.json"})")
                 .find("test.json: /scenario: cannot open the scenario file"),
             std::string::npos);

@@ -645,14 +645,7 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
                    std::max(1e-6, std::isfinite(time_step_s) ? time_step_s : 0.0));
   const Scene scene = LoadScene(run, file);
 
-  // 2. The output folder.
-  std::error_code ec;
-  std::filesystem::create_directories(options.output_dir, ec);
-  if (ec || !std::filesystem::is_directory(options.output_dir))
-    throw InputError(options.output_dir.string() + ": cannot create the output folder" +
-                     (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
-
-  // 3. First pass over the selected frames: the region people occupy and the
+  // 2. First pass over the selected frames: the region people occupy and the
   //    largest force, so that every frame shares one layout and one force scale.
   RenderSummary summary;
   if (!scene.floor_note.empty()) summary.notes.push_back(scene.floor_note);
@@ -711,6 +704,14 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
       : summary.max_contact_force_n > 0.0
           ? summary.max_contact_force_n / std::max(4.0, kAutoMaxLineWidth_m * layout.ppm)
           : 100.0;  // no contact anywhere: any scale will do; 100 N/px puts the paper's 400 N at 4 px
+
+  // 3. The output folder, made only once every selected frame has been read
+  //    and checked (step 2), so that a damaged run file leaves nothing behind.
+  std::error_code ec;
+  std::filesystem::create_directories(options.output_dir, ec);
+  if (ec || !std::filesystem::is_directory(options.output_dir))
+    throw InputError(options.output_dir.string() + ": cannot create the output folder" +
+                     (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
 
   // 4. The video, opened before any drawing so that a bad path fails early.
   std::optional<VideoOut> video;

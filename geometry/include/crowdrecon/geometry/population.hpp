@@ -37,11 +37,13 @@ std::string ToString(PopulationMode mode);  // "paper", "anthropometric", "circl
 PopulationMode PopulationModeFromString(const std::string& text, const std::string& what = "mode");
 
 // The most people one population (a scenario, `crowdrecon population --count`)
-// may hold. A simulated person costs about PEOPLE_KB kB (bodies, hot state,
-// neighbour lists, navigation, output buffers; measured on the hallway at
-// 6 /m^2), so the limit keeps a run within a few GB; the largest shipped
-// scenarios hold 10,000 (benchmarks) and 6,800 (evacuation). A larger count is
-// almost always a typo or a venue drawn in the wrong unit.
+// may hold. Measured: a run's peak memory grows by about 3.4 kB per person
+// (84 MB at 2,000 people, 111 MB at 10,000: bench/scenarios/box-*.json, 0.2 s,
+// one thread), and the 1,000,000-person scenario of issue 17 reached 5.7 GB
+// (about 6 kB per person) before std::bad_alloc; 200,000 people thus stay near
+// 1 GB. The largest shipped scenarios hold 10,000 (benchmarks) and 6,800
+// (evacuation); a larger count is almost always a typo or a venue drawn in the
+// wrong unit.
 inline constexpr std::size_t kMaxPeople = 200000;
 
 struct PopulationOptions {
