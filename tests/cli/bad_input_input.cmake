@@ -43,6 +43,10 @@ crowdrecon_refused_test(dir.body 2 "bodies: is a directory. expected a JSON file
   -- ${EXE} population --body tests/data/bodies -o @OUT@/p.json)
 crowdrecon_refused_test(dir.anthropometry 2 "bodies: is a directory. expected an ANSUR II extract"
   -- ${EXE} population --mode anthropometric --anthropometry tests/data/bodies -o @OUT@/p.json)
+crowdrecon_refused_test(device.scenario 2 "/dev/zero: is a device or socket, not a file. expected a scenario file"
+  -- ${EXE} simulate /dev/zero -o @OUT@/x.sqlite -q)
+crowdrecon_refused_test(device.venue 2 "/dev/null: is a device or socket, not a file. expected a venue file"
+  -- ${EXE} venue check /dev/null)
 crowdrecon_refused_test(dir.scenario_body_reference 2 "bad-body-directory.json: /population/body/reference: \".*bodies\" is a directory. expected a body file"
   -- ${EXE} simulate ${S}/bad-body-directory.json -o @OUT@/x.sqlite -q)
 
