@@ -119,7 +119,13 @@ RunFileWriter::~RunFileWriter() {
 
 RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
                                     const engine::Simulation& sim) {
+  // The caller checked the path (CheckOutputs): only a previous run file is
+  // replaced here, never a folder or a foreign file.
   std::error_code ec;
+  if (std::filesystem::exists(file, ec) && !(std::filesystem::is_regular_file(file, ec) &&
+                                              std::filesystem::file_size(file, ec) == 0) && !IsRunFile(file))
+    throw InputError(file.string() + ": exists and is " + DescribeExisting(file) +
+                     ", not a crowdrecon run file; it is not replaced");
   std::filesystem::remove(file, ec);
   for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
   RunFileWriter w;
@@ -459,6 +465,19 @@ RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::mak
   if (!ok) throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
 }
 RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
+
+bool IsRunFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec) || !FileStartsWith(file, std::string("SQLite format 3\0", 16)))
+    return false;
+  try {
+    return RunFileReader(file).RunValue("format") == "crowdrecon-run";
+  } catch (const std::exception&) {  // unreadable or foreign: not ours
+    return false;
+  }
+}
+
+OutputKind RunFileOutput() { return {"a crowdrecon run file", false, IsRunFile}; }
 RunFileReader::~RunFileReader() = default;
 
 std::string RunFileReader::RunValue(const std::string& key) const {
