@@ -119,13 +119,12 @@ RunFileWriter::~RunFileWriter() {
 
 RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
                                     const engine::Simulation& sim) {
-  // The caller checked the path (CheckOutputs): only a previous run file is
-  // replaced here, never a folder or a foreign file.
+  // The caller checked the path (CheckOutputs: a previous run file, or a
+  // file --force lets us replace); a folder is never removed here.
   std::error_code ec;
-  if (std::filesystem::exists(file, ec) && !(std::filesystem::is_regular_file(file, ec) &&
-                                              std::filesystem::file_size(file, ec) == 0) && !IsRunFile(file))
+  if (std::filesystem::is_directory(file, ec))
     throw InputError(file.string() + ": exists and is " + DescribeExisting(file) +
-                     ", not a crowdrecon run file; it is not replaced");
+                     ", not a crowdrecon run file; a folder is never replaced by a file");
   std::filesystem::remove(file, ec);
   for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
   RunFileWriter w;
