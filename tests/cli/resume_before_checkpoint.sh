@@ -11,14 +11,7 @@
 set -euo pipefail
 exe=$1; scenario=$2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-dump() {  # the tables a run writes per frame, as in run_determinism.sh
-  for q in "SELECT * FROM trajectory_data ORDER BY frame, id" \
-           "SELECT * FROM person_state ORDER BY frame, id" \
-           "SELECT * FROM contact ORDER BY frame, rowid" \
-           "SELECT * FROM frame_time ORDER BY frame"; do
-    sqlite3 -separator ' ' "$1" ".mode quote" "$q"
-  done | sha256sum | cut -d' ' -f1
-}
+source "$(dirname "$0")/run_tables.sh"  # dump RUN.sqlite: hash of its per-frame tables
 fail() { echo "FAIL: $*"; exit 1; }
 # The scenario with no periodic checkpoint: a kill always comes before the first.
 # (Its relative paths made absolute, as the copy lives elsewhere.)
