@@ -43,9 +43,9 @@ echo "killed + resumed: identical"
 #    (interval 0.5 s), its stop checkpoint lost.
 "$exe" simulate "$scenario" -o "$tmp/s.sqlite" -q --stop-after 0.2 >/dev/null 2>&1 && fail "--stop-after did not stop"
 rm -f "$tmp/s.sqlite.checkpoint"
-"$exe" simulate "$scenario" -o "$tmp/full3.sqlite" -q >/dev/null
 "$exe" simulate "$scenario" -o "$tmp/s.sqlite" -q --resume >/dev/null 2>&1 || fail "resume after stop"
-[[ $(dump "$tmp/s.sqlite") == $(dump "$tmp/full3.sqlite") ]] || fail "stopped + resumed differs"
+# (Checkpoints do not change results: the uninterrupted run above is the reference.)
+[[ $(dump "$tmp/s.sqlite") == "$ref" ]] || fail "stopped + resumed differs"
 echo "stopped (checkpoint lost) + resumed: identical"
 
 # 3. What cannot be resumed is said exactly.
