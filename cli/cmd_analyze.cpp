@@ -1,7 +1,6 @@
 // `crowdrecon analyze`: time series, summary metrics and the regime (lanes /
 // avalanches / clogging) of a run (analysis/run_analysis.hpp, docs/analysis.md).
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -12,6 +11,7 @@
 #include "option_checks.hpp"
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 
 namespace crowdrecon::cli {
 
@@ -23,6 +23,7 @@ struct AnalyzeArgs {
   std::string line;
   bool write = false;
   bool full = false;
+  bool force = false;
   double transient_s = -1.0;
 };
 
@@ -41,16 +42,14 @@ analysis::MeasurementLine ParseLine(const std::string& text) {
 }
 
 void RunAnalyze(const AnalyzeArgs& args) {
+  CheckOutputs({{"--json", args.json, analysis::AnalysisJsonOutput()}}, {{"the run file", args.run_file}}, args.force);
   analysis::AnalysisOptions options;
   if (args.transient_s >= 0.0) options.regime.transient_s = args.transient_s;
   if (!args.line.empty()) options.line = ParseLine(args.line);
   const analysis::RunAnalysis result = analysis::AnalyzeRun(args.run_file, options);
   std::printf("%s", args.full ? result.FullReport().c_str() : result.BriefReport().c_str());
   if (!args.json.empty()) {
-    std::ofstream out(args.json);
-    if (!out) throw InputError(args.json + ": cannot write the JSON file");
-    out << result.ToJson() << "\n";
-    if (!out) throw InputError(args.json + ": cannot write the JSON file");
+    WriteFileAtomically(args.json, result.ToJson() + "\n");
     std::printf("json: %s\n", args.json.c_str());
   }
   if (args.write) {
@@ -72,6 +71,7 @@ void RegisterAnalyzeCommand(CLI::App& app) {
   cmd->add_flag("--write", args->write,
                 "store the results in the run file (tables metric_series, metric_summary, metric_avalanche, "
                 "metric_load_histogram; run values regime, regime_reason)");
+  AddForceFlag(cmd, &args->force);
   cmd->add_flag("--full", args->full, "print the full report (set-up, every avalanche, load histogram)");
   cmd->add_option("--transient", args->transient_s, "start-up time left out of stationary averages, s (default 10)")
       ->check(NumberIn(0.0, 1e6, "s"));

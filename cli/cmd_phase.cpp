@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/sweep/phase_diagram.hpp"
 
 namespace crowdrecon::cli {
@@ -18,6 +19,7 @@ struct PhaseArgs {
   std::string output;
   bool no_heat_maps = false;
   bool heat_maps_png_only = false;
+  bool force = false;
 };
 
 void RunPhase(const PhaseArgs& args) {
@@ -26,6 +28,8 @@ void RunPhase(const PhaseArgs& args) {
   options.output_dir = args.output;
   options.heat_maps = !args.no_heat_maps;
   options.heat_map_svg = !args.heat_maps_png_only;
+  CheckOutputs({{"-o", sweep::PhaseOutputFolder(options), sweep::PhaseFolderOutput()}},
+               {{"the sweep results", args.results}}, args.force);
   const sweep::PhaseSummary s = sweep::DrawPhaseDiagrams(options);
   std::printf("%s", s.BriefReport().c_str());
 }
@@ -40,6 +44,7 @@ void RegisterPhaseCommand(CLI::App& app) {
       "Figure 5) and heat maps of its metrics, as PNG and SVG with an index.html");
   cmd->add_option("DIR", args->results, "Sweep output folder (or its results.sqlite)")->required();
   cmd->add_option("-o,--output", args->output, "Folder for the pictures (default: DIR/phase)");
+  AddForceFlag(cmd, &args->force);
   cmd->add_flag("--no-heat-maps", args->no_heat_maps, "Phase diagrams only");
   cmd->add_flag("--heat-maps-png-only", args->heat_maps_png_only,
                 "Heat maps as PNG only (about 200 kB each as SVG); index.html then links each to its PNG");

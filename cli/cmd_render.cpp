@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 
 namespace crowdrecon::cli {
@@ -26,9 +27,17 @@ struct RenderArgs {
   int width_px = 1280;
   double force_n_per_px = 0.0;
   bool svg = false;
+  bool force = false;
 };
 
 void RunRender(const RenderArgs& args) {
+  const std::filesystem::path video = args.video;
+  const bool mp4 = video.extension() == ".mp4";  // may fall back to .avi (viz/render_run.hpp)
+  CheckOutputs({{"-o", args.output_dir, viz::FramesFolderOutput()},
+                {"--video", video, VideoOutputKind()},
+                {"--video (its AVI fallback)", mp4 ? std::filesystem::path(video).replace_extension(".avi") : "",
+                 VideoOutputKind()}},
+               {{"the run file", args.run_file}}, args.force);
   viz::RenderOptions options;
   options.output_dir = args.output_dir;
   options.frames = viz::ParseFrameSelection(args.frames);
@@ -59,7 +68,7 @@ void RegisterRenderCommand(CLI::App& app) {
   CLI::App* render = app.add_subcommand(
       "render", "Draw a run's frames: bodies, walls and the contact force network (paper, Figure 6)");
   render->add_option("RUN", args->run_file, "run file (.sqlite) written by `crowdrecon simulate`")->required();
-  render->add_option("-o,--output", args->output_dir, "folder for frame_NNNNNN.png (created if missing)")
+  render->add_option("-o,--output", args->output_dir, "folder for frame_NNNNNN.png (created if missing; an existing one must be empty or hold only frames and videos)")
       ->required();
   render->add_option("--frames", args->frames,
                      "which frames: all (default), a list such as first,last or 0,50,last, every:N, or a time "
@@ -74,6 +83,7 @@ void RegisterRenderCommand(CLI::App& app) {
                      "newtons per pixel of force-line width (default: the largest force ~0.12 m wide)")
       ->check(NumberIn(1e-6, 1e9, "N/px"));
   render->add_flag("--svg", args->svg, "also write frame_NNNNNN.svg");
+  AddForceFlag(render, &args->force);
   render->callback([args] { RunRender(*args); });
 }
 

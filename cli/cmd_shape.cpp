@@ -147,9 +147,12 @@ struct ShapeArgs {
   std::string outline, output, picture, scale, front, region = "dark";
   std::size_t vertices = 18;
   double radius_m = 0.05;
+  bool force = false;
 };
 
 void RunShape(const ShapeArgs& a, bool scale_given, bool front_given) {
+  CheckOutputs({{"-o", a.output, geometry::BodyJsonOutput()}, {"--picture", a.picture, PictureOutputKind()}},
+               {{"the outline", a.outline}}, a.force);
   geometry::ImageOutlineOptions image;
   image.region = geometry::ImageRegionFromString(a.region, "--region");
   const geometry::Outline outline = geometry::ReadOutline(a.outline, image);
@@ -182,9 +185,12 @@ struct PopulationArgs {
   std::size_t count = 100;
   std::uint64_t seed = 1;
   double female_fraction = 0.5;
+  bool force = false;
 };
 
 void RunPopulation(const PopulationArgs& a) {
+  CheckOutputs({{"-o", a.output, geometry::PopulationJsonOutput()}, {"--picture", a.picture, PictureOutputKind()}},
+               {{"the reference body", a.body}, {"the anthropometry extract", a.anthropometry}}, a.force);
   geometry::PopulationOptions options;
   options.mode = geometry::PopulationModeFromString(a.mode, "--mode");
   options.count = a.count;
@@ -239,9 +245,14 @@ struct ReferenceArgs {
   double female_fraction = 0.5;
   std::size_t vertices = 18;
   double radius_m = 0.05;
+  bool force = false;
 };
 
 void RunReference(const ReferenceArgs& a) {
+  CheckOutputs({{"--outline", a.outline, geometry::OutlineJsonOutput()},
+                {"-o", a.output, geometry::BodyJsonOutput()},
+                {"--picture", a.picture, PictureOutputKind()}},
+               {{"the anthropometry extract", a.anthropometry}}, a.force);
   const auto records = geometry::ReadAnsurExtract(a.anthropometry);
   const geometry::ThoraxDimensions d = geometry::MedianThoraxDimensions(records, a.female_fraction);
   const geometry::ThoraxModel model;
@@ -302,6 +313,7 @@ void RegisterShapeCommands(CLI::App& app) {
     cmd->add_option("--region", args->region, "dark|light: which image region is the body")
         ->capture_default_str();
     cmd->add_option("--picture", args->picture, "Picture to draw (.png, .svg, .pdf)");
+    AddForceFlag(cmd, &args->force);
     cmd->callback([args, scale, front] { RunShape(*args, scale->count() > 0, front->count() > 0); });
   }
   {
@@ -321,6 +333,7 @@ void RegisterShapeCommands(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("-o,--output", args->output, "Population JSON to write")->required();
     cmd->add_option("--picture", args->picture, "Picture of the first bodies (.png, .svg, .pdf)");
+    AddForceFlag(cmd, &args->force);
     cmd->callback([args] { RunPopulation(*args); });
   }
   {
@@ -340,6 +353,7 @@ void RegisterShapeCommands(CLI::App& app) {
     cmd->add_option("--outline", args->outline, "Outline JSON to write")->capture_default_str();
     cmd->add_option("-o,--output", args->output, "Body JSON to write")->capture_default_str();
     cmd->add_option("--picture", args->picture, "Picture to draw (.png, .svg, .pdf)");
+    AddForceFlag(cmd, &args->force);
     cmd->callback([args] { RunReference(*args); });
   }
 }

@@ -9,6 +9,8 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 
 namespace crowdrecon::cli {
@@ -21,6 +23,7 @@ struct SimulateArgs {
   int threads = 0;
   std::string device = "cpu";
   bool resume = false;
+  bool force = false;
   bool quiet = false;
   bool fixed_threads = false;
   double stop_after_s = -1.0;
@@ -28,6 +31,12 @@ struct SimulateArgs {
 
 int RunSimulate(const SimulateArgs& args) {
   const scenario::Scenario sc = scenario::LoadScenario(args.scenario);
+  CheckOutputs({{"-o", args.output, scenario::RunFileOutput()}},
+               {{"the scenario", sc.file},
+                {"the venue", sc.venue_file},
+                {"the reference body", sc.population.reference_body},
+                {"the anthropometry extract", sc.population.anthropometry}},
+               args.force);
   scenario::RunOptions options;
   options.output = args.output;
   options.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -81,6 +90,7 @@ void RegisterSimulateCommand(CLI::App& app) {
                 "Keep exactly --threads threads, even while fewer are faster (another program busy on a core); "
                 "for benchmarks. By default the count adapts; results do not depend on it");
   cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption")
       ->check(NumberIn(0.0, 1e9, "s"));

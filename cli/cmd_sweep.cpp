@@ -10,6 +10,8 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
 
 namespace crowdrecon::cli {
@@ -21,10 +23,12 @@ struct SweepArgs {
   std::string output;
   int jobs = 0;
   bool quiet = false;
+  bool force = false;
   long long stop_after_runs = -1;
 };
 
 int RunSweepCommand(const SweepArgs& args) {
+  CheckOutputs({{"-o", args.output, sweep::SweepFolderOutput()}}, {{"the sweep file", args.sweep_file}}, args.force);
   sweep::SweepOptions options;
   options.sweep_file = args.sweep_file;
   options.output_dir = args.output;
@@ -51,6 +55,8 @@ void RegisterSweepCommand(CLI::App& app) {
   cmd->add_option("--jobs", args->jobs,
                   "Runs at a time (default: all cores; under MPI: 1 per rank); results do not depend on it")
       ->check(IntegerIn(0, 4096));
+
+  AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after-runs", args->stop_after_runs,
                   "Stop as if interrupted once this many runs have been written (for testing resumption)")

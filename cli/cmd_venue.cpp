@@ -39,9 +39,11 @@ struct CheckArgs {
   std::string file;
   std::string picture;
   double grid_spacing_m = 0.1;
+  bool force = false;
 };
 
 void RunCheck(const CheckArgs& args) {
+  CheckOutputs({{"--picture", args.picture, PictureOutputKind()}}, {{"the venue", args.file}}, args.force);
   const geo::Venue v = geo::LoadVenue(args.file);
   geo::NavigationOptions nav;
   nav.grid_spacing_m = args.grid_spacing_m;
@@ -130,6 +132,7 @@ struct ImportArgs {
   std::string layer;
   double scale_m_per_unit = 0.0;
   double simplify_px = 0.75;
+  bool force = false;
 };
 
 std::string FormatFromExtension(const std::string& input) {
@@ -158,6 +161,7 @@ Vec2 ParseSeed(const std::string& text) {
 }
 
 void RunImport(const ImportArgs& args) {
+  CheckOutputs({{"-o", args.output, geo::VenueJsonOutput()}}, {{"the floor plan", args.input}}, args.force);
   const std::string format = args.format.empty() ? FormatFromExtension(args.input) : args.format;
   geo::Venue venue;
   if (format == "image") {
@@ -198,6 +202,7 @@ void RegisterVenueCommands(CLI::App& app) {
   check->add_option("--grid-spacing", check_args->grid_spacing_m,
                     "grid spacing of the navigation field in metres (default 0.1)")
       ->check(NumberIn(0.005, 10.0, "m"));
+  AddForceFlag(check, &check_args->force);
   check->callback([check_args] { RunCheck(*check_args); });
 
   auto import_args = std::make_shared<ImportArgs>();
@@ -221,6 +226,7 @@ void RegisterVenueCommands(CLI::App& app) {
   import->add_option("--simplify-px", import_args->simplify_px,
                      "image: contour simplification tolerance in pixels (default 0.75)")
       ->check(NumberIn(0.0, 100.0, "px"));
+  AddForceFlag(import, &import_args->force);
   import->callback([import_args] { RunImport(*import_args); });
 }
 

@@ -17,4 +17,9 @@ void RegisterAnalyzeCommand(CLI::App& app);  // analyze (metrics and regime of a
 void RegisterSweepCommand(CLI::App& app);  // sweep (grids of runs, local or MPI)
 void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat maps of a sweep)
 
+// The --force flag of every command that writes: replace a file, or write into
+// a folder, that is not a previous output of the command (see
+// common/output_path.hpp; inputs and folders are never overwritten).
+void AddForceFlag(CLI::App* cmd, bool* force);
+
 }  // namespace crowdrecon::cli

@@ -290,4 +290,10 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
   }
 }
 
+OutputKind AnalysisJsonOutput() {
+  return JsonOutputKind("an analysis JSON (run_file, regime, summary)", [](const nlohmann::json& j) {
+    return j.contains("run_file") && j.contains("regime") && j.contains("summary");
+  });
+}
+
 }  // namespace crowdrecon::analysis

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/geometry/input_limits.hpp"
 #include "outline_cgal.hpp"
@@ -394,10 +395,12 @@ void WriteBodyJson(const Body& body, const std::filesystem::path& file) {
   source["notes"] = body.notes;
   source["outline_m"] = PointsJson(body.outline_m);
   j["source"] = source;
-  std::ofstream out(file);
-  if (!out) throw InputError(file.string() + ": cannot open file for writing");
-  out << j.dump(1) << '\n';
-  if (!out) throw InputError(file.string() + ": cannot write file");
+  WriteFileAtomically(file, j.dump(1) + '\n');
+}
+
+OutputKind BodyJsonOutput() {
+  return JsonOutputKind("a body JSON (format crowdrecon-body)",
+                        [](const nlohmann::json& j) { return j.contains("format") && j["format"] == "crowdrecon-body"; });
 }
 
 Body ReadBodyJson(const std::filesystem::path& file) {

@@ -13,6 +13,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/geometry/input_limits.hpp"
 #include "box_pairs.hpp"
@@ -350,6 +351,15 @@ Outline ReadOutline(const std::filesystem::path& file, const ImageOutlineOptions
   return ReadOutlineImage(file, options);
 }
 
+OutputKind OutlineJsonOutput() {
+  return JsonOutputKind("an outline JSON (points)", [](const nlohmann::json& j) {
+    if (!j.contains("points")) return false;
+    for (const auto& [key, value] : j.items())
+      if (key != "points" && key != "description" && key != "front") return false;
+    return true;
+  });
+}
+
 void WriteOutlineJson(const Outline& outline, const std::filesystem::path& file) {
   nlohmann::ordered_json j;
   if (!outline.description.empty()) j["description"] = outline.description;
@@ -360,10 +370,7 @@ void WriteOutlineJson(const Outline& outline, const std::filesystem::path& file)
     points.push_back({std::round(p.x * 1e7) / 1e7, std::round(p.y * 1e7) / 1e7});
   }
   j["points"] = points;
-  std::ofstream out(file);
-  if (!out) throw InputError(file.string() + ": cannot open file for writing");
-  out << j.dump(1) << '\n';
-  if (!out) throw InputError(file.string() + ": cannot write file");
+  WriteFileAtomically(file, j.dump(1) + '\n');
 }
 
 }  // namespace crowdrecon::geometry

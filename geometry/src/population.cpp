@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 
 namespace crowdrecon::geometry {
 
@@ -160,6 +161,12 @@ Population MakePopulation(const PopulationOptions& options, const Spheropolygon&
   return population;
 }
 
+OutputKind PopulationJsonOutput() {
+  return JsonOutputKind("a population JSON (format crowdrecon-population)", [](const nlohmann::json& j) {
+    return j.contains("format") && j["format"] == "crowdrecon-population";
+  });
+}
+
 void WritePopulationJson(const Population& population, const std::filesystem::path& file) {
   const PopulationOptions& o = population.options;
   nlohmann::ordered_json j;
@@ -192,10 +199,7 @@ void WritePopulationJson(const Population& population, const std::filesystem::pa
     people.push_back(q);
   }
   j["people"] = people;
-  std::ofstream out(file);
-  if (!out) throw InputError(file.string() + ": cannot open file for writing");
-  out << j.dump(1) << '\n';
-  if (!out) throw InputError(file.string() + ": cannot write file");
+  WriteFileAtomically(file, j.dump(1) + '\n');
 }
 
 }  // namespace crowdrecon::geometry

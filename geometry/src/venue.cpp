@@ -12,6 +12,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "venue_internal.hpp"
 
@@ -522,12 +523,14 @@ std::string VenueToJson(const Venue& v) {
   return out;
 }
 
+OutputKind VenueJsonOutput() {
+  return JsonOutputKind("a venue JSON (version, walkable_area)", [](const nlohmann::json& j) {
+    return j.contains("version") && j.contains("walkable_area");
+  });
+}
+
 void WriteVenueJson(const Venue& venue, const std::filesystem::path& file) {
-  const std::string text = VenueToJson(venue);
-  std::ofstream out(file, std::ios::binary);
-  if (!out) throw InputError(file.string() + ": cannot open file for writing");
-  out << text;
-  if (!out) throw InputError(file.string() + ": error while writing");
+  WriteFileAtomically(file, VenueToJson(venue));
 }
 
 }  // namespace crowdrecon::geometry

@@ -142,7 +142,12 @@ RunFileWriter::~RunFileWriter() {
 
 RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
                                     const engine::Simulation& sim) {
+  // The caller checked the path (CheckOutputs: a previous run file, or a
+  // file --force lets us replace); a folder is never removed here.
   std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(file.string() + ": exists and is " + DescribeExisting(file) +
+                     ", not a crowdrecon run file; a folder is never replaced by a file");
   std::filesystem::remove(file, ec);
   for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
   RunFileWriter w;
@@ -482,6 +487,19 @@ RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::mak
   if (!ok) throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
 }
 RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
+
+bool IsRunFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec) || !FileStartsWith(file, std::string("SQLite format 3\0", 16)))
+    return false;
+  try {
+    return RunFileReader(file).RunValue("format") == "crowdrecon-run";
+  } catch (const std::exception&) {  // unreadable or foreign: not ours
+    return false;
+  }
+}
+
+OutputKind RunFileOutput() { return {"a crowdrecon run file", false, IsRunFile}; }
 RunFileReader::~RunFileReader() = default;
 
 std::string RunFileReader::RunValue(const std::string& key) const {

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/thread_governor.hpp"
 #include "crowdrecon/scenario/run_file.hpp"
@@ -60,7 +61,7 @@ struct Checkpoint {
 
 Checkpoint ReadCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": no checkpoint to resume from (was the run started with this output file?)");
+  if (!in) throw InputError(file.string() + ": cannot read the checkpoint");
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string data = buffer.str();
@@ -92,6 +93,29 @@ std::string TimeStepWarning(const Scenario& scenario, const engine::WorldDef& wo
          " s): collisions then rebound with a restitution off by up to " + FormatNumber(100.0 * error) +
          " % (measured on a head-on collision in the stiffest contact mode, against about 2 % at the engine's step), and "
          "results change with the step; give 0 to let the engine choose";
+}
+
+// Why a run without a checkpoint cannot be resumed, or "" if it can be
+// started again from the beginning: the run file is ours, was written for
+// this scenario and is unfinished (the run stopped before its first
+// checkpoint, which gives the same result as starting it again).
+std::string NothingToResume(const std::filesystem::path& run_file, const Scenario& scenario) {
+  const std::string file = run_file.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(run_file, ec))
+    return file + ": nothing to resume: the run file does not exist; start the run without --resume";
+  if (!IsRunFile(run_file))
+    return file + ": nothing to resume: it is " + DescribeExisting(run_file) + ", not a crowdrecon run file";
+  const RunFileReader reader(run_file);
+  if (reader.RunValue("scenario") != scenario.json_text)
+    return file + ": nothing to resume: the run file was written for a different scenario (" +
+           reader.RunValue("scenario_file") + ", or the scenario file changed); start the run without --resume";
+  const std::string status = reader.RunValue("status");
+  if (status == "complete")
+    return file + ": nothing to resume: the run is complete; run without --resume to run it again";
+  if (status.rfind("failed", 0) == 0)
+    return file + ": nothing to resume: the run " + status + " (its state is in " + file + ".failed-state)";
+  return "";
 }
 
 }  // namespace
@@ -147,16 +171,21 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
   std::int64_t last_frame = -1;
   RunFileWriter writer = [&] {
-    if (!options.resume) {
-      std::error_code ec;
-      std::filesystem::remove(checkpoint, ec);
-      return RunFileWriter::Create(options.output, header, sim);
+    std::error_code ec;
+    if (options.resume && !std::filesystem::exists(checkpoint, ec)) {
+      const std::string why = NothingToResume(options.output, scenario);
+      if (!why.empty()) throw InputError(why);
+      std::fprintf(stderr, "crowdrecon: note: %s has no checkpoint yet (the run stopped before its first one); "
+                   "starting it again from the beginning\n", options.output.string().c_str());
+    } else if (options.resume) {
+      const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
+      sim.LoadState(c.state);
+      last_frame = c.last_frame;
+      say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
+      return RunFileWriter::Resume(options.output, last_frame);
     }
-    const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
-    sim.LoadState(c.state);
-    last_frame = c.last_frame;
-    say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
-    return RunFileWriter::Resume(options.output, last_frame);
+    std::filesystem::remove(checkpoint, ec);
+    return RunFileWriter::Create(options.output, header, sim);
   }();
   writer.SetRunValue("people", std::to_string(sim.bodies().size()));
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <regex>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -491,10 +492,24 @@ std::string PhaseSummary::BriefReport() const {
   return r;
 }
 
+fs::path PhaseOutputFolder(const PhaseOptions& options) {
+  const fs::path dir = options.results.extension() == ".sqlite" ? options.results.parent_path() : options.results;
+  return options.output_dir.empty() ? dir / "phase" : options.output_dir;
+}
+
+OutputKind PhaseFolderOutput() {
+  return {"a phase folder (phase-*, heat-* pictures and index.html only)", true, [](const fs::path& dir) {
+    const std::regex picture(R"((phase|heat)-.*\.(png|svg)|index\.html)");
+    return FolderHoldsOnly(dir, [&](const fs::directory_entry& e) {
+      std::error_code ec;
+      return e.is_regular_file(ec) && std::regex_match(e.path().filename().string(), picture);
+    });
+  }};
+}
+
 PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   const ResultsTable t = ReadResults(options.results);
-  const fs::path dir = options.results.extension() == ".sqlite" ? options.results.parent_path() : options.results;
-  const fs::path out = options.output_dir.empty() ? dir / "phase" : options.output_dir;
+  const fs::path out = PhaseOutputFolder(options);
   const std::string x_path = t.sweep.count("diagram_x") ? t.sweep.at("diagram_x") : "";
   const std::string y_path = t.sweep.count("diagram_y") ? t.sweep.at("diagram_y") : "";
   if (x_path.empty() || y_path.empty())
@@ -621,9 +636,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   }
   html += "</body></html>\n";
   summary.index = out / "index.html";
-  std::ofstream index(summary.index);
-  index << html;
-  if (!index) throw InputError(summary.index.string() + ": cannot write the index");
+  WriteFileAtomically(summary.index, html);
   return summary;
 }
 

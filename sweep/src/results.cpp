@@ -324,4 +324,20 @@ ResultsTable ReadResults(const fs::path& dir_or_file) {
   return t;
 }
 
+OutputKind SweepFolderOutput() {
+  return {"a sweep folder (results.sqlite of a crowdrecon sweep)", true, [](const fs::path& dir) {
+    const fs::path file = dir / "results.sqlite";
+    std::error_code ec;
+    if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == 0) return true;
+    if (!FileStartsWith(file, std::string("SQLite format 3\0", 16))) return false;
+    try {
+      sqlite::Database db(file.string(), SQLITE_OPEN_READONLY);
+      sqlite::Statement format(db, "SELECT value FROM sweep WHERE key = 'format'");
+      return format.Next() && format.Text(0) == kFormat;
+    } catch (const std::exception&) {  // unreadable or foreign: not ours
+      return false;
+    }
+  }};
+}
+
 }  // namespace crowdrecon::sweep

@@ -10,14 +10,7 @@
 set -euo pipefail
 exe=$1; scenario=$2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-dump() {  # every table that the run writes per frame, in a fixed order
-  for q in "SELECT * FROM trajectory_data ORDER BY frame, id" \
-           "SELECT * FROM person_state ORDER BY frame, id" \
-           "SELECT * FROM contact ORDER BY frame, rowid" \
-           "SELECT * FROM frame_time ORDER BY frame"; do
-    sqlite3 -separator ' ' "$1" ".mode quote" "$q"
-  done | sha256sum | cut -d' ' -f1
-}
+source "$(dirname "$0")/run_tables.sh"  # dump RUN.sqlite: hash of its per-frame tables
 "$exe" simulate "$scenario" -o "$tmp/t1.sqlite" --threads 1 -q >/dev/null
 "$exe" simulate "$scenario" -o "$tmp/t2.sqlite" --threads 2 -q >/dev/null
 h1=$(dump "$tmp/t1.sqlite"); h2=$(dump "$tmp/t2.sqlite")

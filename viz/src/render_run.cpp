@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <regex>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
@@ -607,6 +608,18 @@ std::filesystem::path FramePicturePath(const std::filesystem::path& dir, std::in
   char name[64];
   std::snprintf(name, sizeof name, "frame_%06lld%s", static_cast<long long>(frame), extension.c_str());
   return dir / name;
+}
+
+OutputKind FramesFolderOutput() {
+  return {"a frames folder (frame_NNNNNN.png, .svg and videos only)", true, [](const std::filesystem::path& dir) {
+    const std::regex frame_name(R"(frame_[0-9]{6,}\.(png|svg))");
+    const OutputKind video = VideoOutputKind();
+    return FolderHoldsOnly(dir, [&](const std::filesystem::directory_entry& e) {
+      std::error_code ec;
+      return e.is_regular_file(ec) &&
+             (std::regex_match(e.path().filename().string(), frame_name) || video.is_previous(e.path()));
+    });
+  }};
 }
 
 std::string RenderSummary::BriefReport() const {

@@ -39,6 +39,7 @@
 
 #include "crowdrecon/analysis/metrics.hpp"
 #include "crowdrecon/analysis/regime.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::analysis {
@@ -173,5 +174,9 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& ana
 
 // The options as JSON (stored with the results).
 std::string OptionsToJson(const AnalysisOptions& options);
+
+// A previous `analyze --json` file (keys run_file, regime, summary), which
+// --json may replace (common/output_path.hpp).
+OutputKind AnalysisJsonOutput();
 
 }  // namespace crowdrecon::analysis

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/geometry/outline.hpp"
 #include "crowdrecon/geometry/spheropolygon.hpp"
@@ -110,6 +111,8 @@ inline constexpr double kPaperDensityKgPerM2 = 1000.0;
 
 // Body JSON (format "crowdrecon-body", version 1): see docs/bodies.md.
 void WriteBodyJson(const Body& body, const std::filesystem::path& file);
+// A previous body JSON, which an output may replace (common/output_path.hpp).
+OutputKind BodyJsonOutput();
 // Reads and validates a body file (unknown keys, ranges, a valid spheropolygon
 // whose stored area/centroid/polar moment match the recomputed ones).
 Body ReadBodyJson(const std::filesystem::path& file);

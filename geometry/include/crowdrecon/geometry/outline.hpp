@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::geometry {
@@ -76,6 +77,8 @@ std::vector<Vec2> ValidateOutlineRing(std::vector<Vec2> points, const std::strin
 
 // Writes a point-list outline as JSON ({"description", "front", "points"}).
 void WriteOutlineJson(const Outline& outline, const std::filesystem::path& file);
+// A previous outline JSON (keys description, front, points and no others).
+OutputKind OutlineJsonOutput();
 
 // Area centroid of a ring (use SignedArea of spheropolygon.hpp for its area).
 Vec2 RingCentroid(const std::vector<Vec2>& ring);

@@ -88,6 +88,8 @@ Population MakePopulation(const PopulationOptions& options, const Spheropolygon&
 
 // Population JSON (format "crowdrecon-population"): see docs/bodies.md.
 void WritePopulationJson(const Population& population, const std::filesystem::path& file);
+// A previous population JSON, which an output may replace.
+OutputKind PopulationJsonOutput();
 
 // Uniform double in [0, 1) from the top 53 bits of one draw (exact, portable).
 inline double UniformUnit(std::uint64_t draw) {

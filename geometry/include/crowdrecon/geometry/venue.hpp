@@ -29,6 +29,7 @@
 #include <string_view>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::geometry {
@@ -146,6 +147,8 @@ Venue ParseVenue(std::string_view json_text, const std::string& origin);
 std::string VenueToJson(const Venue& venue);
 // Writes VenueToJson to a file; throws InputError if it cannot.
 void WriteVenueJson(const Venue& venue, const std::filesystem::path& file);
+// A previous venue JSON (version and walkable_area), which an output may replace.
+OutputKind VenueJsonOutput();
 
 // --- validation --------------------------------------------------------------
 

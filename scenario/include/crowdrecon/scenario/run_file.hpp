@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 
 namespace crowdrecon::scenario {
@@ -185,5 +186,11 @@ class RunFileReader {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// A previous crowdrecon run file (SQLite whose run table says format
+// crowdrecon-run), which `simulate -o` may replace (common/output_path.hpp).
+OutputKind RunFileOutput();
+// True if `file` is a crowdrecon run file (false for anything else, no error).
+bool IsRunFile(const std::filesystem::path& file);
 
 }  // namespace crowdrecon::scenario

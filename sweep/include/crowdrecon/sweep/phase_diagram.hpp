@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
+
 namespace crowdrecon::sweep {
 
 struct PhaseOptions {
@@ -45,5 +47,12 @@ struct PhaseSummary {
 // Throws InputError if the results are missing or not a sweep's, or the sweep
 // has fewer than two axes (no diagram).
 PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options);
+
+// The folder the pictures go to: options.output_dir, or DIR/phase.
+std::filesystem::path PhaseOutputFolder(const PhaseOptions& options);
+
+// A previous phase folder: only phase-*.png/.svg, heat-*.png/.svg and
+// index.html, which `phase -o` writes into (common/output_path.hpp).
+OutputKind PhaseFolderOutput();
 
 }  // namespace crowdrecon::sweep

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
 
 namespace crowdrecon::sweep {
@@ -102,5 +103,10 @@ struct ResultsTable {
 // Reads DIR/results.sqlite (or a results.sqlite file given directly).
 // Throws InputError if it is missing or not a sweep's results.
 ResultsTable ReadResults(const std::filesystem::path& dir_or_file);
+
+// A previous sweep folder: its results.sqlite holds a crowdrecon sweep's
+// results (or is still empty, a sweep killed while starting); `sweep -o`
+// continues it (common/output_path.hpp).
+OutputKind SweepFolderOutput();
 
 }  // namespace crowdrecon::sweep

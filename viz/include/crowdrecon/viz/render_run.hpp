@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::viz {
@@ -138,5 +139,9 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
 // The picture file of a frame in `dir`: dir/frame_000123.png (extension ".png" or ".svg").
 std::filesystem::path FramePicturePath(const std::filesystem::path& dir, std::int64_t frame,
                                        const std::string& extension);
+
+// A previous frames folder: only frame_NNNNNN.png / .svg pictures and videos,
+// which render -o writes into (common/output_path.hpp).
+OutputKind FramesFolderOutput();
 
 }  // namespace crowdrecon::viz

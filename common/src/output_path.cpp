@@ -1,0 +1,200 @@
+#include "crowdrecon/common/output_path.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The first `n` bytes of a file ("" if unreadable).
+std::string Head(const fs::path& file, std::size_t n) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes(n, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(n));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+  return bytes;
+}
+
+// A name for messages, cut to a sensible length.
+std::string Shortened(const std::string& text, std::size_t max = 60) {
+  return text.size() <= max ? text : text.substr(0, max - 3) + "...";
+}
+
+bool IsSvg(const std::string& head) {
+  const auto first = head.find_first_not_of(" \t\r\n");
+  return first != std::string::npos && head[first] == '<' && head.find("<svg") != std::string::npos;
+}
+
+std::string DescribeFile(const fs::path& file) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (!ec && size == 0) return "an empty file";
+  const std::string head = Head(file, 1024);
+  if (head.rfind(std::string("SQLite format 3\0", 16), 0) == 0) return "a SQLite file";
+  if (head.rfind("\x89PNG", 0) == 0) return "a PNG picture";
+  if (head.rfind("%PDF", 0) == 0) return "a PDF file";
+  if (head.rfind("RIFF", 0) == 0 && head.compare(8, 4, "AVI ") == 0) return "an AVI video";
+  if (head.size() >= 8 && head.compare(4, 4, "ftyp") == 0) return "an MP4 video";
+  if (IsSvg(head)) return "an SVG picture";
+  const auto first = head.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && (head[first] == '{' || head[first] == '[')) return "a JSON file";
+  if (first != std::string::npos && head[first] == '<') return "an XML or HTML file";
+  const bool text = std::all_of(head.begin(), head.end(), [](unsigned char c) { return c >= 0x20 || c == '\n' || c == '\r' || c == '\t'; });
+  return std::string(text ? "a text file" : "a binary file") + " of " + std::to_string(ec ? 0 : size) + " bytes";
+}
+
+std::string DescribeFolder(const fs::path& folder) {
+  std::error_code ec;
+  std::vector<std::string> names;
+  std::size_t count = 0;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    if (names.size() < 3) names.push_back(Shortened(it->path().filename().string(), 40));
+    ++count;
+  }
+  if (count == 0) return "an empty folder";
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  if (count > names.size()) list += ", ...";
+  return "a folder holding " + std::to_string(count) + (count == 1 ? " entry (" : " entries (") + list + ")";
+}
+
+// Same file or folder: through links where both exist, else by their
+// absolute, normalised paths (outputs not yet written).
+bool SamePath(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    return !ec && same;
+  }
+  std::error_code ea, eb;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ea), ea), cb = fs::weakly_canonical(fs::absolute(b, eb), eb);
+  return !ea && !eb && ca == cb;
+}
+
+void CheckOne(const PlannedOutput& out, const std::vector<NamedInput>& inputs, bool force) {
+  const std::string where = out.option + " " + Shortened(out.path.string(), 200);
+  for (const NamedInput& in : inputs)
+    if (!in.path.empty() && SamePath(out.path, in.path))
+      throw InputError(where + ": is " + in.what + " (" + Shortened(in.path.string(), 200) +
+                       "), an input of this command; an input is never overwritten, not even with --force; "
+                       "choose another name");
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(out.path, ec);
+  if (!fs::exists(link)) return;  // nothing there: nothing to lose
+  const std::string there = DescribeExisting(out.path);
+  const bool folder = fs::is_directory(out.path, ec);
+  const bool empty_folder = folder && fs::is_empty(out.path, ec);
+  if (!out.kind.folder && folder)
+    throw InputError(where + ": exists and is " + there + ", not " + out.kind.name +
+                     "; a folder is never replaced by a file, not even with --force; give a file name");
+  if (out.kind.folder && !folder)
+    throw InputError(where + ": exists and is " + there + ", not a folder for " + out.kind.name +
+                     "; choose another name");
+  if (!folder && !fs::is_regular_file(out.path, ec))
+    throw InputError(where + ": exists and is " + there + ", not " + out.kind.name + "; choose another name");
+  // An empty file or folder holds nothing to lose (a run killed as it began leaves one).
+  const bool empty_file = !folder && fs::file_size(out.path, ec) == 0 && !ec;
+  if (empty_folder || empty_file || (out.kind.is_previous && out.kind.is_previous(out.path)) || force) return;
+  throw InputError(where + ": exists and is " + there + ", not " + out.kind.name + "; choose another name or --force" +
+                   (folder ? " (which writes into the folder and deletes nothing in it)" : " (which replaces it)"));
+}
+
+}  // namespace
+
+void CheckOutputs(const std::vector<PlannedOutput>& outputs, const std::vector<NamedInput>& inputs, bool force) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i].path.empty()) continue;
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].path.empty() && SamePath(outputs[i].path, outputs[j].path))
+        throw InputError(outputs[j].option + " and " + outputs[i].option + " both name " +
+                         Shortened(outputs[i].path.string(), 200) + "; give each output its own name");
+    CheckOne(outputs[i], inputs, force);
+  }
+}
+
+std::string DescribeExisting(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (!fs::exists(link)) return "nothing";
+  const fs::file_status target = fs::status(path, ec);
+  if (!fs::exists(target)) return "a broken symbolic link";
+  if (fs::is_directory(target)) return DescribeFolder(path);
+  if (fs::is_regular_file(target)) return DescribeFile(path);
+  return "a special file (a device, pipe or socket)";
+}
+
+fs::path PartialPath(const fs::path& file) {
+  return file.parent_path() /
+         ("." + file.stem().string() + ".partial-" + std::to_string(::getpid()) + file.extension().string());
+}
+
+void WriteFileAtomically(const fs::path& file, const std::string& text) {
+  const fs::path partial = PartialPath(file);
+  std::error_code ec;
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(file.string() + ": cannot open a file for writing next to it (" + partial.string() + ")");
+    out << text;
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(partial, ec);
+      throw InputError(file.string() + ": error while writing (disk full?)");
+    }
+  }
+  fs::rename(partial, file, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(partial, ignored);
+    throw InputError(file.string() + ": cannot write: " + ec.message());
+  }
+}
+
+bool FileStartsWith(const fs::path& file, const std::string& magic, std::size_t offset) {
+  const std::string head = Head(file, offset + magic.size());
+  return head.size() == offset + magic.size() && head.compare(offset, magic.size(), magic) == 0;
+}
+
+bool FolderHoldsOnly(const fs::path& folder, const std::function<bool(const fs::directory_entry&)>& ours) {
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
+    if (!ours(*it)) return false;
+  return !ec;
+}
+
+OutputKind JsonOutputKind(std::string name, std::function<bool(const nlohmann::json&)> matches) {
+  return {std::move(name), false, [matches = std::move(matches)](const fs::path& file) {
+            const std::string head = Head(file, 64);
+            const auto first = head.find_first_not_of(" \t\r\n");
+            if (first == std::string::npos || head[first] != '{') return false;
+            std::ifstream in(file, std::ios::binary);
+            const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+            const nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+            return j.is_object() && matches(j);
+          }};
+}
+
+OutputKind PictureOutputKind() {
+  return {"a picture (PNG, SVG or PDF)", false, [](const fs::path& file) {
+            return FileStartsWith(file, "\x89PNG") || FileStartsWith(file, "%PDF") || IsSvg(Head(file, 1024));
+          }};
+}
+
+OutputKind VideoOutputKind() {
+  return {"a video (MP4 or AVI)", false, [](const fs::path& file) {
+            return FileStartsWith(file, "ftyp", 4) || (FileStartsWith(file, "RIFF") && FileStartsWith(file, "AVI ", 8));
+          }};
+}
+
+}  // namespace crowdrecon
