@@ -28,8 +28,8 @@ import bench_common as bc
 
 SCENARIOS = {
     # name: (scenario file relative to the repository, simulated seconds)
-    "hallway-180": ("venues/madrid-arena/scenarios/hallway-5pm2-30cf.json", 10.0),
-    "box-2000": ("bench/scenarios/box-2000.json", 2.0),
+    "hallway-180": ("venues/madrid-arena/scenarios/hallway-5pm2-30cf.json", 3.0),
+    "box-2000": ("bench/scenarios/box-2000.json", 0.5),
 }
 PASSIVE = {"OMP_WAIT_POLICY": "passive"}
 CONFIGS = [
