@@ -31,6 +31,9 @@ test-long: build
 demo: build
 	@bash scripts/demo.sh $(CROWDRECON) out
 
+# The unit and command-line tests (all but `long`) under AddressSanitizer and
+# UndefinedBehaviorSanitizer: -O1, no benchmarks (CMakePresets.json). CI runs it
+# after `make test`.
 sanitize:
 	@$(MAKE) test PRESET=sanitize
 

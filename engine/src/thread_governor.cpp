@@ -8,17 +8,6 @@
 
 namespace crowdrecon::engine {
 
-namespace {
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
-}  // namespace
-
 bool ThreadChoice::Options::IsValid(std::string* error) const {
   const auto fail = [&](const std::string& what) {
     if (error) *error = what;
@@ -27,7 +16,7 @@ bool ThreadChoice::Options::IsValid(std::string* error) const {
   if (max_threads < 1 || max_threads > 1024) return fail("max_threads = " + std::to_string(max_threads) + ", expected 1..1024");
   if (warmup_steps < 0) return fail("warmup_steps must be >= 0");
   if (probe_steps < 2) return fail("probe_steps must be >= 2 (the first step of a probe is not counted)");
-  if (window_steps < 1) return fail("window_steps must be >= 1");
+  if (!(window_s > 0) || !(probe_s > 0)) return fail("window_s and probe_s must be > 0");
   if (!(probe_interval_s > 0) || !(max_probe_interval_s >= probe_interval_s))
     return fail("expected 0 < probe_interval_s <= max_probe_interval_s");
   if (!(switch_ratio > 0 && switch_ratio <= 1)) return fail("switch_ratio must be in (0, 1]");
@@ -77,20 +66,27 @@ void ThreadChoice::StartProbe(double now_s) {
   last_direction_ = candidate < home_ ? -1 : +1;
   probing_ = true;
   probe_taken_ = 0;
-  probe_times_.clear();
+  probe_counted_s_ = 0;
   probe_spent_s_ = 0;
   threads_ = candidate;
   ++summary_.probes;
 }
 
+double ThreadChoice::ReferenceStepS() const {
+  return recent_.empty() ? 0.0 : recent_sum_s_ / static_cast<double>(recent_.size());
+}
+
 void ThreadChoice::EndProbe(double now_s) {
   probing_ = false;
+  const int counted = probe_taken_ - 1;
   const bool wins =
-      !probe_times_.empty() && Median(probe_times_) < options_.switch_ratio * Median(recent_);
+      counted > 0 && probe_counted_s_ / counted < options_.switch_ratio * ReferenceStepS();
   if (wins) {
     home_ = threads_;
-    recent_ = probe_times_;  // the new count's reference until its own window fills
-    recent_next_ = recent_.size() % static_cast<std::size_t>(options_.window_steps);
+    recent_.clear();  // the new count's reference: the probe until its own window fills
+    recent_sum_s_ = 0;
+    recent_.push_back(probe_counted_s_ / counted);
+    recent_sum_s_ = recent_.back();
     interval_s_ = options_.probe_interval_s;
     ++summary_.switches;
   } else {
@@ -107,24 +103,25 @@ void ThreadChoice::Record(double seconds, double now_s) {
   if (options_.max_threads == 1) return;
   if (probing_) {
     ++probe_taken_;
-    if (probe_taken_ > 1) probe_times_.push_back(seconds);  // the first step wakes the threads up
+    if (probe_taken_ > 1) probe_counted_s_ += seconds;  // the first step wakes the threads up
+    probe_spent_s_ += seconds;
     // A probe that is already far slower than the current count ends early:
     // on a busy core one step can take a whole time slice of the scheduler.
-    probe_spent_s_ += seconds;
-    const double reference = Median(recent_) * static_cast<double>(probe_taken_);
-    const bool hopeless = probe_taken_ >= 2 && probe_spent_s_ > options_.abandon_ratio * reference;
-    if (probe_taken_ >= options_.probe_steps || hopeless) EndProbe(now_s);
+    const bool hopeless =
+        probe_taken_ >= 2 && probe_spent_s_ > options_.abandon_ratio * ReferenceStepS() * probe_taken_;
+    const bool done = probe_taken_ >= options_.probe_steps && probe_spent_s_ >= options_.probe_s;
+    if (done || hopeless) EndProbe(now_s);
     return;
   }
-  const auto window = static_cast<std::size_t>(options_.window_steps);
-  if (recent_.size() < window) {
-    recent_.push_back(seconds);
-  } else {
-    recent_[recent_next_] = seconds;
+  recent_.push_back(seconds);
+  recent_sum_s_ += seconds;
+  while (recent_.size() > 1 && recent_sum_s_ - recent_.front() >= options_.window_s) {
+    recent_sum_s_ -= recent_.front();
+    recent_.pop_front();
   }
-  recent_next_ = (recent_next_ + 1) % window;
-  if (steps_ < static_cast<std::uint64_t>(options_.warmup_steps) || recent_.size() < window) return;
-  if (next_probe_s_ < 0) next_probe_s_ = now_s;  // first probe right after the warm-up
+  const bool window_full = recent_sum_s_ >= options_.window_s;
+  if (steps_ < static_cast<std::uint64_t>(options_.warmup_steps) || !window_full) return;
+  if (next_probe_s_ < 0) next_probe_s_ = now_s;  // first probe once the warm-up and a window are done
   if (now_s >= next_probe_s_) StartProbe(now_s);
 }
 

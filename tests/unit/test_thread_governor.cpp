@@ -61,6 +61,21 @@ TEST(ThreadGovernor, BusyCoreMovesToOneThreadAndCostsLittle) {
   EXPECT_LT((wall - start) / (steps * 2e-3), 1.05);
 }
 
+TEST(ThreadGovernor, StallsThatAMedianWouldHideAreCounted) {
+  ThreadChoice choice(TwoThreads());
+  // What a busy core does: most two-thread steps are fast (0.5 ms), but every
+  // eighth waits a scheduler slice for the thread on the busy core (6 ms);
+  // one thread is steady at 0.9 ms. The median step says two threads (0.5
+  // against 0.9 ms), the mean says one (1.19 against 0.9 ms): one is right.
+  int step = 0;
+  Drive(choice, 20000, 0.0, [&](int t) {
+    ++step;
+    return t == 1 ? 0.9e-3 : step % 8 == 0 ? 6e-3 : 0.5e-3;
+  });
+  EXPECT_EQ(choice.threads(), 1);
+  EXPECT_GE(choice.summary().switches, 1u);
+}
+
 TEST(ThreadGovernor, ReturnsToTwoThreadsWhenTheMachineIsIdleAgain) {
   ThreadChoice choice(TwoThreads());
   double wall = Drive(choice, 200, 0.0, [](int t) { return t == 2 ? 28e-3 : 2e-3; });

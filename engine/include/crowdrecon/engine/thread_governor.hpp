@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -35,11 +36,15 @@ class ThreadChoice {
   struct Options {
     int max_threads = 1;               // the count asked for; never exceeded
     int warmup_steps = 16;             // steps before the first probe (first steps are untypical)
-    int probe_steps = 8;               // steps a probe lasts at most (its first is not counted: wake-up)
-    int window_steps = 16;             // recent steps at the current count that form its reference time
+    // A busy core shows as the scheduler's time slices (milliseconds), not in
+    // every step: steps are compared by their mean over stated wall times, long
+    // enough to hold several slices, never by a median (which hides the stalls).
+    double window_s = 0.1;             // recent wall time at the current count that forms its reference
+    double probe_s = 0.05;             // wall time a probe lasts (at least probe_steps steps)
+    int probe_steps = 8;               // steps a probe lasts at least (its first is not counted: wake-up)
     double probe_interval_s = 1.0;     // wall time between probes, at first and after a switch
     double max_probe_interval_s = 60.0;  // after losing probes the interval doubles up to this
-    double switch_ratio = 0.9;         // switch when the other count's median step < ratio x the current's
+    double switch_ratio = 0.9;         // switch when the other count's mean step < ratio x the current's
     double abandon_ratio = 4.0;        // end a probe early once it has taken this x the current's time for as many steps
     bool IsValid(std::string* error) const;
   };
@@ -62,6 +67,7 @@ class ThreadChoice {
   const Summary& summary() const { return summary_; }
 
  private:
+  double ReferenceStepS() const;
   void StartProbe(double now_s);
   void EndProbe(double now_s);
   int ProbeCandidate() const;
@@ -71,10 +77,10 @@ class ThreadChoice {
   int home_ = 1;                      // count outside a probe
   bool probing_ = false;
   int probe_taken_ = 0;               // steps of the current probe so far
-  std::vector<double> probe_times_;   // its counted step times
+  double probe_counted_s_ = 0;        // its steps' time, the first (wake-up) left out
   double probe_spent_s_ = 0;          // all its steps' time, the first included
-  std::vector<double> recent_;        // ring of recent step times at home_
-  std::size_t recent_next_ = 0;
+  std::deque<double> recent_;         // step times at home_ over the last window_s
+  double recent_sum_s_ = 0;
   std::uint64_t steps_ = 0;
   double interval_s_ = 0;
   double next_probe_s_ = -1;          // < 0: not yet scheduled
