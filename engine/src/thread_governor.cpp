@@ -83,10 +83,9 @@ void ThreadChoice::EndProbe(double now_s) {
       counted > 0 && probe_counted_s_ / counted < options_.switch_ratio * ReferenceStepS();
   if (wins) {
     home_ = threads_;
-    recent_.clear();  // the new count's reference: the probe until its own window fills
-    recent_sum_s_ = 0;
-    recent_.push_back(probe_counted_s_ / counted);
-    recent_sum_s_ = recent_.back();
+    // The new count's reference: the probe's mean until its own window fills.
+    recent_.assign(1, probe_counted_s_ / counted);
+    recent_sum_s_ = recent_.front();
     interval_s_ = options_.probe_interval_s;
     ++summary_.switches;
   } else {
