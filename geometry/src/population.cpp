@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <thread>
 #include <fstream>
 #include <map>
@@ -125,7 +126,11 @@ Population MakePopulation(const PopulationOptions& options, const Spheropolygon&
     if (slot_of.emplace(record->subject_id, distinct.size()).second) distinct.push_back(record);
   }
   std::vector<std::optional<Spheropolygon>> shapes(distinct.size());
-  std::vector<std::string> errors(distinct.size());
+  // Each slot keeps its own failure as an exception_ptr (no allocation for a
+  // std::bad_alloc): the first one in slot order is rethrown on this thread
+  // unchanged, so an out-of-memory reaches the caller as std::bad_alloc and
+  // a bad outline as its GeometryError, never std::terminate on a worker.
+  std::vector<std::exception_ptr> errors(distinct.size());
   std::atomic<std::size_t> next{0};
   const auto worker = [&] {
     for (std::size_t k = next++; k < distinct.size(); k = next++) {
@@ -134,8 +139,8 @@ Population MakePopulation(const PopulationOptions& options, const Spheropolygon&
         outline.source = "ANSUR II subject " + std::to_string(distinct[k]->subject_id);
         outline.points = ThoraxOutline(distinct[k]->thorax, options.thorax);
         shapes[k] = BuildBody(outline, body_options).shape;
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
+      } catch (...) {
+        errors[k] = std::current_exception();
       }
     }
   };
@@ -145,8 +150,14 @@ Population MakePopulation(const PopulationOptions& options, const Spheropolygon&
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
-  for (const std::string& error : errors)
-    if (!error.empty()) throw GeometryError("population: " + error);
+  for (const std::exception_ptr& error : errors) {
+    if (!error) continue;
+    try {
+      std::rethrow_exception(error);
+    } catch (const GeometryError& e) {
+      throw GeometryError(std::string("population: ") + e.what());
+    }
+  }
 
   for (const AnsurRecord* record : drawn) {
     const Spheropolygon& shape = *shapes[slot_of.at(record->subject_id)];

@@ -38,7 +38,7 @@ TEST(ThreadGovernor, IdleMachineKeepsTwoThreads) {
   Drive(choice, 30000, 0.0, [](int t) { return t == 2 ? 1e-3 : 2e-3; });
   EXPECT_EQ(choice.threads(), 2);
   EXPECT_EQ(choice.summary().switches, 0u);
-  // Probes back off: 1, 2, 4, ... s apart, so few in 30 s, and the steps
+  // Probes back off: 0.25, 0.5, 1, ... s apart, so few in 30 s, and the steps
   // spent at one thread are a tiny share.
   EXPECT_LE(choice.summary().probes, 7u);
   EXPECT_LT(static_cast<double>(choice.summary().steps_at[1]), 0.01 * 30000);

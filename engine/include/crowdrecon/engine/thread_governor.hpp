@@ -42,7 +42,10 @@ class ThreadChoice {
     double window_s = 0.1;             // recent wall time at the current count that forms its reference
     double probe_s = 0.05;             // wall time a probe lasts (at least probe_steps steps)
     int probe_steps = 8;               // steps a probe lasts at least (its first is not counted: wake-up)
-    double probe_interval_s = 1.0;     // wall time between probes, at first and after a switch
+    // Wall time between probes, at first and after a switch. Short, so that a
+    // first probe spoiled by a scheduler stall is retried within a second, not
+    // after seconds at the slow count; a probe that loses doubles it.
+    double probe_interval_s = 0.25;
     double max_probe_interval_s = 60.0;  // after losing probes the interval doubles up to this
     double switch_ratio = 0.9;         // switch when the other count's mean step < ratio x the current's
     double abandon_ratio = 4.0;        // end a probe early once it has taken this x the current's time for as many steps
