@@ -23,7 +23,8 @@ namespace geo = crowdrecon::geometry;
 
 // Densities for the capacity line (persons per m^2): 4.7 is the UK maximum
 // for standing terraces after Hillsborough, 6 is beyond Fruin's 5.6 /m^2
-// threshold of dangerous crowd forces (docs/venues.md, ERRATA "facts").
+// threshold of dangerous crowd forces (docs/venues.md; docs/decisions.md,
+// "Facts from other sources").
 constexpr double kGuidanceDensity = 4.7;
 constexpr double kDangerDensity = 6.0;
 
