@@ -41,13 +41,8 @@ inline void TimeSteps(benchmark::State& state, engine::Simulation& sim, const st
   // Where the time goes: milliseconds per step in each stage (Profile).
   const engine::Profile& after = sim.profile();
   const double per_step_ms = 1e3 / steps;
-  state.counters["pairs_ms"] = (after.update_pairs_s - before.update_pairs_s) * per_step_ms;
-  state.counters["place_ms"] = (after.place_shapes_s - before.place_shapes_s) * per_step_ms;
-  state.counters["collide_ms"] = (after.collide_s - before.collide_s) * per_step_ms;
-  state.counters["gather_ms"] = (after.gather_s - before.gather_s) * per_step_ms;
-  state.counters["drive_ms"] = (after.drive_s - before.drive_s) * per_step_ms;
-  state.counters["integrate_ms"] = (after.integrate_s - before.integrate_s) * per_step_ms;
-  state.counters["check_ms"] = (after.check_s - before.check_s) * per_step_ms;
+  for (const engine::StageInfo& stage : engine::kStages)
+    state.counters[std::string(stage.name) + "_ms"] = (after.seconds(stage.stage) - before.seconds(stage.stage)) * per_step_ms;
   if (sim.definition().device == engine::ComputeDevice::kCuda) {
     // Of collide_ms: copies to and from the GPU, and its kernels.
     state.counters["device_copy_ms"] = (after.device_copy_s - before.device_copy_s) * per_step_ms;

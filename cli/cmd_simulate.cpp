@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <string>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -58,13 +59,18 @@ int RunSimulate(const SimulateArgs& args) {
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());
   const engine::Profile& p = s.profile;
-  const double total = p.update_pairs_s + p.place_shapes_s + p.collide_s + p.gather_s + p.drive_s + p.integrate_s + p.check_s;
+  const double total = p.total_s();
   if (total > 0) {
-    const auto pct = [&](double v) { return 100.0 * v / total; };
-    std::printf("engine time %.2f s: pairs %.0f %% (%llu rebuilds), shapes %.0f %%, collide %.0f %%, gather %.0f %%, "
-                "drive %.0f %%, integrate %.0f %%, check %.0f %%\n",
-                total, pct(p.update_pairs_s), static_cast<unsigned long long>(p.pair_rebuilds), pct(p.place_shapes_s),
-                pct(p.collide_s), pct(p.gather_s), pct(p.drive_s), pct(p.integrate_s), pct(p.check_s));
+    std::string stages;
+    for (const engine::StageInfo& stage : engine::kStages) {
+      char share[64];
+      std::snprintf(share, sizeof share, "%s%s %.0f %%", stages.empty() ? "" : ", ", stage.name,
+                    100.0 * p.seconds(stage.stage) / total);
+      stages += share;
+      if (stage.stage == engine::Stage::kUpdatePairs)
+        stages += " (" + std::to_string(p.pair_rebuilds) + " rebuilds)";
+    }
+    std::printf("engine time %.2f s: %s\n", total, stages.c_str());
   }
   if (s.status != "complete") {
     std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s -o %s --resume\n",

@@ -32,7 +32,9 @@ TimeStepEstimate EstimateTimeStep(const WorldDef& def) {
     mw_max = std::max(mw_max, p.mass_kg * w);
   }
   TimeStepEstimate e;
-  if (w_max == 0.0) w_max = 1.0 / mp.mass_min_kg;
+  // A world with no one in it: the step of the lightest person the paper
+  // draws (40 kg, a point mass), so that the estimate stays finite.
+  if (w_max == 0.0) w_max = 1.0 / 40.0;
   const double k = std::max(mp.normal_stiffness_n_per_m, mp.tangential_stiffness_n_per_m);
   e.omega_max_rad_per_s = std::sqrt(4.0 * k * 2.0 * w_max);
   e.limited_by = mp.tangential_stiffness_n_per_m > mp.normal_stiffness_n_per_m ? "tangential_stiffness_n_per_m"

@@ -21,12 +21,15 @@
 #include "binary_io.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/engine/parameter_table.hpp"
 
 namespace crowdrecon::engine {
 
 namespace {
 
-constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', '1'};
+// Version 2: the parameter block follows the parameter table (five population
+// fields that the engine never used left ModelParameters).
+constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', '2'};
 
 // The bytes are the machine's; the development machine and the GPU machines
 // are little-endian, so a file moves between them unchanged. A big-endian
@@ -37,7 +40,7 @@ static_assert(sizeof(Vec2) == 2 * sizeof(double));
 // Tripwires for the definition structs. A new field changes their size and
 // stops the build here: add it to the Fields function below and change the
 // magic (the old files would be read wrongly otherwise).
-static_assert(sizeof(ModelParameters) == 176, "ModelParameters changed: update ParameterFields and the magic");
+static_assert(sizeof(ModelParameters) == 136, "ModelParameters changed: update the parameter table (parameter_table.cpp) and the magic");
 static_assert(sizeof(PersonDef) == 96, "PersonDef changed: update PersonFields and the magic");
 static_assert(sizeof(PeriodicBox) == 40, "PeriodicBox changed: update the world file and the magic");
 static_assert(sizeof(FloorSlope) == 24, "FloorSlope changed: update the world file and the magic");
@@ -59,6 +62,7 @@ class WorldWriter : public detail::BinaryWriter {
   void Count(std::size_t n) { Put(static_cast<std::uint64_t>(n)); }
   // One byte, whatever the size of the type in memory.
   void Flag(const bool& v, const char*) { Put(static_cast<std::uint8_t>(v ? 1 : 0)); }
+  void Choice(const ModelParameters& p, const ParameterInfo& info) { Put(static_cast<std::uint8_t>(info.get_choice(p))); }
   template <typename E>
   void Enum(const E& v, E, const char*) {
     static_assert(std::is_enum_v<E>);
@@ -94,6 +98,11 @@ class WorldReader : public detail::BinaryReader {
     if (byte > 1) Bad(name, byte, "0 or 1");
     v = byte == 1;
   }
+  void Choice(ModelParameters& p, const ParameterInfo& info) {
+    const auto byte = Get<std::uint8_t>();
+    if (byte >= info.choice_count) Bad(info.name, byte, "0 to " + std::to_string(info.choice_count - 1));
+    info.set_choice(p, byte);
+  }
   // Enumerators are numbered from 0 to `last` without gaps.
   template <typename E>
   void Enum(E& v, E last, const char* name) {
@@ -126,30 +135,15 @@ class WorldReader : public detail::BinaryReader {
 
 template <typename Io, typename P>
 void ParameterFields(Io& io, P& p) {
+  // Every parameter of the table (parameter_table.hpp), in its order.
   io.At("parameters", WorldReader::kWhole);
-  io.Field(p.normal_stiffness_n_per_m);
-  io.Field(p.tangential_stiffness_n_per_m);
-  io.Field(p.friction_coefficient);
-  io.Field(p.restitution);
-  io.Field(p.wall_restitution);
-  io.Enum(p.tangential_damping, TangentialDamping::kFixed, "tangential_damping");
-  io.Field(p.tangential_damping_rate_per_s);
-  io.Flag(p.allow_tensile_normal_force, "allow_tensile_normal_force");
-  io.Flag(p.ground_reaction, "ground_reaction");
-  io.Field(p.relaxation_time_s);
-  io.Field(p.desired_speed_min_m_per_s);
-  io.Field(p.desired_speed_max_m_per_s);
-  io.Field(p.back_force_gamma);
-  io.Field(p.torsion_stiffness_lambda);
-  io.Field(p.rotation_relaxation_time_s);
-  io.Enum(p.facing_target, FacingTarget::kDesiredDirection, "facing_target");
-  io.Field(p.surface_density_kg_per_m2);
-  io.Field(p.mass_min_kg);
-  io.Field(p.mass_max_kg);
-  io.Field(p.gravity_m_per_s2);
-  io.Enum(p.integrator, Integrator::kGear5, "integrator");
-  io.Field(p.time_step_s);
-  io.Field(p.time_step_safety);
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    switch (info.kind) {
+      case ParameterInfo::Kind::kNumber: io.Field(p.*info.number); break;
+      case ParameterInfo::Kind::kFlag: io.Flag(p.*info.flag, info.name); break;
+      case ParameterInfo::Kind::kChoice: io.Choice(p, info); break;
+    }
+  }
 }
 
 template <typename Io, typename P>

@@ -1,5 +1,6 @@
 #include "crowdrecon/scenario/scenario.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -7,6 +8,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "crowdrecon/engine/parameter_table.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -22,41 +24,27 @@ std::filesystem::path Resolve(const std::filesystem::path& base, const std::stri
   return p.is_absolute() ? p : (base / p).lexically_normal();
 }
 
-// Reads every ModelParameters field present in `model`, range-checked.
+// Reads every parameter of the table (engine/parameter_table.hpp) present in
+// `model`, with the table's range; an absent one keeps its default, or takes
+// the value of the parameter it defaults from (wall_restitution: restitution).
 void ReadModel(const JsonReader& model, engine::ModelParameters& m) {
-  m.normal_stiffness_n_per_m = model.Number("normal_stiffness_n_per_m", m.normal_stiffness_n_per_m, 1.0, 1e9);
-  m.tangential_stiffness_n_per_m =
-      model.Number("tangential_stiffness_n_per_m", m.tangential_stiffness_n_per_m, 1.0, 1e9);
-  m.friction_coefficient = model.Number("friction_coefficient", m.friction_coefficient, 0.0, 5.0);
-  m.restitution = model.Number("restitution", m.restitution, 0.01, 1.0);
-  m.wall_restitution = model.Number("wall_restitution", m.restitution, 0.01, 1.0);
-  {
-    const std::string mode = model.Choice("tangential_damping", engine::ToString(m.tangential_damping),
-                                          {"from_restitution", "equal_to_normal", "fixed"});
-    engine::FromString(mode, &m.tangential_damping);
+  for (const engine::ParameterInfo& info : engine::ModelParameterTable()) {
+    switch (info.kind) {
+      case engine::ParameterInfo::Kind::kNumber: {
+        const double fallback =
+            info.default_from ? m.*(engine::FindModelParameter(info.default_from)->number) : m.*info.number;
+        m.*info.number = model.Number(info.name, fallback, info.min, info.max);
+        break;
+      }
+      case engine::ParameterInfo::Kind::kFlag: m.*info.flag = model.Bool(info.name, m.*info.flag); break;
+      case engine::ParameterInfo::Kind::kChoice: {
+        const std::vector<std::string> allowed(info.choices, info.choices + info.choice_count);
+        const std::string chosen = model.Choice(info.name, info.ValueText(m), allowed);
+        info.set_choice(m, static_cast<int>(std::find(allowed.begin(), allowed.end(), chosen) - allowed.begin()));
+        break;
+      }
+    }
   }
-  m.tangential_damping_rate_per_s =
-      model.Number("tangential_damping_rate_per_s", m.tangential_damping_rate_per_s, 0.0, 1e6);
-  m.allow_tensile_normal_force = model.Bool("allow_tensile_normal_force", m.allow_tensile_normal_force);
-  m.ground_reaction = model.Bool("ground_reaction", m.ground_reaction);
-  m.relaxation_time_s = model.Number("relaxation_time_s", m.relaxation_time_s, 0.01, 100.0);
-  m.back_force_gamma = model.Number("back_force_gamma", m.back_force_gamma, 0.0, 100.0);
-  m.torsion_stiffness_lambda = model.Number("torsion_stiffness_lambda", m.torsion_stiffness_lambda, 0.0, 1e4);
-  m.rotation_relaxation_time_s =
-      model.Number("rotation_relaxation_time_s", m.relaxation_time_s, 0.01, 100.0);
-  {
-    const std::string facing =
-        model.Choice("facing_target", engine::ToString(m.facing_target), {"velocity", "desired_direction"});
-    engine::FromString(facing, &m.facing_target);
-  }
-  m.gravity_m_per_s2 = model.Number("gravity_m_per_s2", m.gravity_m_per_s2, 0.0, 100.0);
-  {
-    const std::string integrator =
-        model.Choice("integrator", engine::ToString(m.integrator), {"velocity_verlet", "gear5"});
-    engine::FromString(integrator, &m.integrator);
-  }
-  m.time_step_s = model.Number("time_step_s", m.time_step_s, 0.0, 0.1);
-  m.time_step_safety = model.Number("time_step_safety", m.time_step_safety, 1e-4, 1.0);
   model.Finish();
 }
 
@@ -140,8 +128,6 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
   }
 
   if (auto model = root.Find("model")) ReadModel(*model, s.model);
-  s.model.desired_speed_min_m_per_s = s.population.desired_speed_min_m_per_s;
-  s.model.desired_speed_max_m_per_s = s.population.desired_speed_max_m_per_s;
   {
     std::string error;
     if (!s.model.IsValid(&error)) root.At("model").Fail(error);

@@ -163,9 +163,6 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
   options.mode = spec.body_mode;
   options.count = count;
   options.seed = spec.seed;
-  options.mass_min_kg = scenario.model.mass_min_kg;
-  options.mass_max_kg = scenario.model.mass_max_kg;
-  options.density_kg_m2 = scenario.model.surface_density_kg_per_m2;
   options.female_fraction = spec.female_fraction;
   options.vertex_count = spec.vertex_count;
   const geometry::Body reference = geometry::ReadBodyJson(spec.reference_body);

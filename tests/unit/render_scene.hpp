@@ -31,7 +31,7 @@ inline WorldDef CounterFlowCorridor(const BodyShape& shape, const CorridorScene&
     for (int i = 0; i < c.columns; ++i) {
       PersonDef p;
       p.shape = 0;
-      SetMassFromShape(shape, def.parameters.surface_density_kg_per_m2, p);
+      SetMassFromShape(shape, 1000.0, p);  // rho of the paper (kg/m^2)
       p.group = static_cast<std::uint32_t>((i + j) % 2);
       p.target = p.group;
       p.position_m = {(i + 0.5) * dx, (j + 0.5) * dy};

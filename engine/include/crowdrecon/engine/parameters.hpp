@@ -1,6 +1,7 @@
-// ModelParameters: every physical parameter of the pedestrian model, with its
-// unit, the paper's value as default and its source (Table 1 and the text of
-// Alonso-Marroquin et al.; decisions on inconsistencies in docs/model.md).
+// ModelParameters: every physical parameter of the pedestrian model, with the
+// paper's value as default (Table 1 and the text of Alonso-Marroquin et al.;
+// decisions on its inconsistencies in docs/decisions.md). Names, units,
+// ranges, sources and meanings: the parameter table (parameter_table.hpp).
 #pragma once
 
 #include <string>
@@ -51,8 +52,8 @@ struct ModelParameters {
   // slope force), as needed by the verification scenes (collisions, momentum).
   bool ground_reaction = true;
   double relaxation_time_s = 2.0 / 3.0;  // tau, text: "tau = 2/3 s"
-  double desired_speed_min_m_per_s = 0.8;  // v0 ~ U(0.8, 1.2) m/s, text
-  double desired_speed_max_m_per_s = 1.2;
+  // (Desired speeds v0 ~ U(0.8, 1.2) m/s are drawn per person: the
+  // scenario's population, scenario::PopulationSpec; PersonDef holds each.)
   double back_force_gamma = 1.2;  // Gamma, Table 1 (fitted to footage)
 
   // --- Torques (eqs. 16-17) --------------------------------------------
@@ -62,10 +63,8 @@ struct ModelParameters {
   double rotation_relaxation_time_s = 2.0 / 3.0;
   FacingTarget facing_target = FacingTarget::kVelocity;
 
-  // --- Bodies -----------------------------------------------------------
-  double surface_density_kg_per_m2 = 1000.0;  // rho, text (eq. 13)
-  double mass_min_kg = 40.0;                  // text: masses uniform in 40-70 kg
-  double mass_max_kg = 70.0;
+  // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
+  // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
 
   // --- Floor --------------------------------------------------------------
   double gravity_m_per_s2 = 9.81;  // for the optional floor slope body force
@@ -83,14 +82,19 @@ struct ModelParameters {
   // (tests/unit/test_engine_physics.cpp; docs/model.md).
   double time_step_safety = 0.08;
 
-  // Returns false and fills *error with "name: value, expected ..." if a value
-  // is out of its physical range.
+  // Returns false and fills *error with "name = value, expected in [min,
+  // max]" if a value is outside its range in the parameter table
+  // (parameter_table.hpp, the one place the ranges are written).
   bool IsValid(std::string* error) const;
 };
 
 // Normal damping rate gamma_n (1/s) that gives restitution epsilon for a
 // contact of stiffness k and effective mass m_ij, by inverting eq. (19):
-//   gamma = 2 L sqrt(k / m) / sqrt(pi^2 + L^2),  L = -ln(epsilon).
+//   gamma = 2 L sqrt(k / m) / sqrt(pi^2 + L^2),  L = -ln(epsilon)
+// (ERRATA 2), written as RestitutionDampingFactor(epsilon) * sqrt(k / m): the
+// engine computes the factor once per run and the rest per contact
+// (ContactLaw::PairRates).
+double RestitutionDampingFactor(double restitution);
 double DampingRateFromRestitution(double restitution, double stiffness_n_per_m, double mass_kg);
 // Eq. (19) itself: restitution of a linear spring-dashpot contact.
 double RestitutionFromDampingRate(double gamma_per_s, double stiffness_n_per_m, double mass_kg);

@@ -1,20 +1,14 @@
 // Simulation: Newton-Euler dynamics of spheropolygon pedestrians (paper,
-// eqs. 1-19). One Step() runs a fixed list of named stages, each timed into
-// the Profile (in the manner of Box2D v3):
-//
-//   1. update_pairs   Verlet neighbour list (cells + skin) when people moved
-//   2. place_shapes   body-frame vertices -> world frame
-//   3. collide        narrow phase + contact forces per pair (eqs. 7-14, 19), parallel
-//   4. gather         contact forces and torques onto bodies in a fixed order (eq. 18)
-//   5. drive          self-driven force (3), back force (15), torques (16-17), slope
-//   6. integrate      velocity Verlet or Gear 5th-order predictor-corrector
-//   7. check          non-finite state, or an overlap beyond the sum of radii (which
-//                     collide flags as it computes the contacts) -> SimulationError
+// eqs. 1-19). One Step() runs the named stages of stages.hpp (update_pairs,
+// place_shapes, collide, gather, drive, integrate, check), each in a file of
+// its own (engine/src/stage_*.cpp) and each timed into the Profile, in the
+// manner of Box2D v3.
 //
 // Forces read only the current state and every sum runs in a fixed order, so
 // results are identical whatever the number of threads. With
-// WorldDef::device = kCuda, stage 3 for person pairs and their part of stage
-// 4 run on a CUDA device, with the same results (engine/src/cuda_collide.hpp).
+// WorldDef::device = kCuda, the collide stage for person pairs and their part
+// of gather run on a CUDA device, with the same results
+// (engine/src/cuda_collide.hpp).
 #pragma once
 
 #include <array>
@@ -25,6 +19,7 @@
 #include <vector>
 
 #include "crowdrecon/engine/contact.hpp"
+#include "crowdrecon/engine/stages.hpp"
 #include "crowdrecon/engine/world.hpp"
 
 namespace crowdrecon::engine {
@@ -50,18 +45,7 @@ struct BodyState {
   std::size_t size() const { return position_m.size(); }
 };
 
-struct Profile {
-  // Accumulated wall-clock seconds per stage since construction.
-  double update_pairs_s = 0, place_shapes_s = 0, collide_s = 0, gather_s = 0, drive_s = 0,
-         integrate_s = 0, check_s = 0;
-  std::uint64_t pair_rebuilds = 0;
-  // Pairs (person-person and person-wall) given to the narrow phase; the
-  // others were known to be still apart (pair clearances).
-  std::uint64_t pairs_measured = 0;
-  // With the CUDA force computation: of collide_s, the seconds spent copying
-  // to and from the device and in its kernels (as its events measured them).
-  double device_copy_s = 0, device_kernels_s = 0;
-};
+// Profile (seconds per stage, counters): stages.hpp.
 
 // Time-step limits derived from every stiffness and rate of the model and
 // the smallest body (see docs/model.md, "ERRATA 12: time step").
@@ -87,6 +71,11 @@ class SimulationError : public std::runtime_error {
   std::int64_t person_, other_;
   double time_s_;
 };
+
+namespace detail {
+class PairCollider;  // engine/src/stage_collide.cpp
+struct ContactLaw;   // engine/src/contact_law.hpp
+}  // namespace detail
 
 class Simulation {
  public:
@@ -160,6 +149,11 @@ class Simulation {
   void UpdatePairs();
   void PlaceShapes();
   void Collide();
+  // The collide stage's other two ways: person pairs on the CUDA device, and
+  // several threads with work stealing (stage_collide.cpp).
+  bool CollideOnDevice(const detail::PairCollider& collider, const detail::ContactLaw& law);
+  void CollideOnThreads(const detail::PairCollider& collider);
+  friend class detail::PairCollider;
   void Gather();
   void Drive();
   void ComputeForces();
@@ -168,7 +162,6 @@ class Simulation {
   void GearPredict();
   void GearCorrect();
   void Check();
-  void Wrap(Vec2& p) const;
 
   WorldDef def_;
   BodyState bodies_;

@@ -7,8 +7,8 @@
 //
 // The format, in the machine's byte order (little-endian on every machine the
 // project runs on; world_file.cpp refuses to build elsewhere):
-//   "CRWORLD1"
-//   the model parameters, field by field, in the order of parameters.hpp
+//   "CRWORLD2"
+//   the model parameters, in the order of the parameter table (parameter_table.hpp)
 //     (doubles; enums as uint8; bools as uint8 0 or 1)
 //   shapes  (count; per shape: vertices, radius_m, core_radius_m)
 //   people  (count; per person: every field of PersonDef in order)

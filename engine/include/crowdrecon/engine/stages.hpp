@@ -1,0 +1,66 @@
+// The stages of one engine step, listed once. Simulation::Step runs them in
+// this order (engine/src/simulation.cpp), each in a file of its own, and
+// times each into Profile::stage_s; the command line's summary, the stage
+// profile and the step benchmarks iterate this list (never their own copy).
+//
+//   stage          file                              what it does
+//   update_pairs   engine/src/stage_update_pairs.cpp  Verlet neighbour lists (cells + skin), when people moved
+//   place_shapes   engine/src/stage_place_shapes.cpp  body-frame vertices -> world frame (sin, cos of each angle)
+//   collide        engine/src/stage_collide.cpp       narrow phase + contact forces per pair (eqs. 7-14, 19)
+//   gather         engine/src/stage_gather.cpp        contact forces and torques onto bodies, fixed order (eq. 18)
+//   drive          engine/src/stage_drive.cpp         self-driven force (3), back force (15), torques (16-17), slope
+//   integrate      engine/src/stage_integrate.cpp     velocity Verlet or Gear 5th-order predictor-corrector
+//   check          engine/src/stage_check.cpp         non-finite state, cores interpenetrating -> SimulationError
+//
+// With the velocity Verlet integrator a step is: integrate (kick + drift),
+// then the force stages 1-5, then integrate (kick), then check. With Gear:
+// integrate (predict), force stages, integrate (correct), check.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace crowdrecon::engine {
+
+enum class Stage : std::uint8_t { kUpdatePairs, kPlaceShapes, kCollide, kGather, kDrive, kIntegrate, kCheck };
+inline constexpr std::size_t kStageCount = 7;
+
+struct StageInfo {
+  Stage stage;
+  const char* name;     // as printed and in benchmark counters ("<name>_ms")
+  const char* summary;  // one line
+};
+
+inline constexpr std::array<StageInfo, kStageCount> kStages{{
+    {Stage::kUpdatePairs, "update_pairs", "Verlet neighbour lists (cells + skin), rebuilt when people moved"},
+    {Stage::kPlaceShapes, "place_shapes", "body-frame vertices to the world frame"},
+    {Stage::kCollide, "collide", "narrow phase and contact forces per pair (eqs. 7-14, 19)"},
+    {Stage::kGather, "gather", "contact forces and torques onto bodies in a fixed order (eq. 18)"},
+    {Stage::kDrive, "drive", "self-driven force (3), back force (15), torques (16-17), slope"},
+    {Stage::kIntegrate, "integrate", "velocity Verlet or Gear 5th-order predictor-corrector"},
+    {Stage::kCheck, "check", "non-finite state or interpenetrating cores: SimulationError"},
+}};
+
+constexpr std::size_t Index(Stage s) { return static_cast<std::size_t>(s); }
+
+// Wall-clock seconds spent in each stage, and what the stages counted.
+struct Profile {
+  std::array<double, kStageCount> stage_s{};  // indexed by Index(Stage)
+  std::uint64_t pair_rebuilds = 0;
+  // Pairs (person-person and person-wall) given to the narrow phase; the
+  // others were known to be still apart (pair clearances).
+  std::uint64_t pairs_measured = 0;
+  // With the CUDA force computation: of the collide stage's time, the seconds
+  // spent copying to and from the device and in its kernels (its events).
+  double device_copy_s = 0, device_kernels_s = 0;
+
+  double seconds(Stage s) const { return stage_s[Index(s)]; }
+  double total_s() const {
+    double total = 0;
+    for (double s : stage_s) total += s;
+    return total;
+  }
+};
+
+}  // namespace crowdrecon::engine

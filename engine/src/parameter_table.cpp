@@ -1,0 +1,177 @@
+#include "crowdrecon/engine/parameter_table.hpp"
+
+#include <array>
+#include <cmath>
+#include <type_traits>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::engine {
+
+namespace {
+
+using P = ModelParameters;
+using Kind = ParameterInfo::Kind;
+
+constexpr const char* kTangentialDampingChoices[] = {"from_restitution", "equal_to_normal", "fixed"};
+constexpr const char* kFacingChoices[] = {"velocity", "desired_direction"};
+constexpr const char* kIntegratorChoices[] = {"velocity_verlet", "gear5"};
+
+ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
+                     const char* meaning, const char* default_from = nullptr) {
+  ParameterInfo info;
+  info.kind = Kind::kNumber;
+  info.name = name;
+  info.number = field;
+  info.unit = unit;
+  info.min = min;
+  info.max = max;
+  info.source = source;
+  info.meaning = meaning;
+  info.default_from = default_from;
+  return info;
+}
+
+ParameterInfo Flag(const char* name, bool P::*field, const char* source, const char* meaning) {
+  ParameterInfo info;
+  info.kind = Kind::kFlag;
+  info.name = name;
+  info.flag = field;
+  info.source = source;
+  info.meaning = meaning;
+  return info;
+}
+
+// An enumeration whose values are 0..N-1, named `choices`.
+template <auto Field, std::size_t N>
+ParameterInfo Choice(const char* name, const char* const (&choices)[N], const char* source, const char* meaning) {
+  ParameterInfo info;
+  info.kind = Kind::kChoice;
+  info.name = name;
+  info.choices = choices;
+  info.choice_count = N;
+  info.source = source;
+  info.meaning = meaning;
+  info.get_choice = [](const P& p) { return static_cast<int>(p.*Field); };
+  info.set_choice = [](P& p, int value) { p.*Field = static_cast<std::remove_reference_t<decltype(p.*Field)>>(value); };
+  return info;
+}
+
+std::array<ParameterInfo, 18> MakeTable() {
+  std::array<ParameterInfo, 18> t{
+      // --- Contact forces (eqs. 7-14, 19) ---
+      Number("normal_stiffness_n_per_m", &P::normal_stiffness_n_per_m, "N/m", 1.0, 1e9, "Table 1",
+             "k_n, normal stiffness of contacts (thorax deformation data)"),
+      Number("tangential_stiffness_n_per_m", &P::tangential_stiffness_n_per_m, "N/m", 1.0, 1e9, "Table 1; ERRATA 3",
+             "k_t, tangential stiffness of contacts (the text's \"k_6\")"),
+      Number("friction_coefficient", &P::friction_coefficient, "", 0.0, 5.0, "Table 1",
+             "mu, Coulomb friction of contacts (cloth on cloth)"),
+      Number("restitution", &P::restitution, "", 0.01, 1.0, "Table 1; ERRATA 1",
+             "epsilon, restitution of person-person contacts; gamma_n follows per contact (ERRATA 2)"),
+      Number("wall_restitution", &P::wall_restitution, "", 0.01, 1.0, "Table 1; ERRATA 1",
+             "epsilon of person-wall contacts (a scenario without it uses restitution)", "restitution"),
+      Choice<&P::tangential_damping>("tangential_damping", kTangentialDampingChoices, "ERRATA 2",
+             "how gamma_t is set: from the restitution with k_t, equal to gamma_n, or fixed"),
+      Number("tangential_damping_rate_per_s", &P::tangential_damping_rate_per_s, "1/s", 0.0, 1e6, "ERRATA 2",
+             "gamma_t when tangential_damping is fixed"),
+      Flag("allow_tensile_normal_force", &P::allow_tensile_normal_force, "eq. 19",
+           "let the dashpot pull at the end of a contact (false: normal force clamped at zero)"),
+      // --- Ground reaction forces (eqs. 3, 15) ---
+      Flag("ground_reaction", &P::ground_reaction, "eqs. 3, 15-17",
+           "people walk (self-driven force, back force, torques); false: passive rigid bodies"),
+      Number("relaxation_time_s", &P::relaxation_time_s, "s", 0.01, 100.0, "text",
+             "tau, relaxation time of the self-driven force (eq. 3)"),
+      Number("back_force_gamma", &P::back_force_gamma, "", 0.0, 100.0, "Table 1 (fitted to footage)",
+             "Gamma, back force of people pushed from behind (eq. 15)"),
+      // --- Torques (eqs. 16-17) ---
+      Number("torsion_stiffness_lambda", &P::torsion_stiffness_lambda, "", 0.0, 1e4, "Table 1 (fitted to footage)",
+             "lambda, torsion stiffness of the motive torque (eq. 16; ERRATA 4)"),
+      Number("rotation_relaxation_time_s", &P::rotation_relaxation_time_s, "s", 0.01, 100.0, "ERRATA 8",
+             "relaxation time of rotation in eq. 17 (a scenario without it uses relaxation_time_s)",
+             "relaxation_time_s"),
+      Choice<&P::facing_target>("facing_target", kFacingChoices, "ERRATA 5",
+             "theta_D of eq. 16: the walking velocity's angle, or the desired direction's"),
+      // --- Floor ---
+      Number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", 0.0, 100.0, "physics",
+             "g, for the body force of a sloping floor"),
+      // --- Time integration ---
+      Choice<&P::integrator>("integrator", kIntegratorChoices, "ERRATA 12",
+             "velocity Verlet (default) or Gear's fifth-order predictor-corrector (the paper's code)"),
+      Number("time_step_s", &P::time_step_s, "s", 0.0, 0.1, "ERRATA 12",
+             "time step; 0: chosen by the engine from every stiffness and the lightest body"),
+      Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
+             "the engine's step as a fraction of the integrator's stability limit"),
+  };
+  return t;
+}
+
+}  // namespace
+
+std::span<const ParameterInfo> ModelParameterTable() {
+  static const std::array<ParameterInfo, 18> table = MakeTable();
+  return table;
+}
+
+const ParameterInfo* FindModelParameter(const std::string& name) {
+  for (const ParameterInfo& info : ModelParameterTable())
+    if (name == info.name) return &info;
+  return nullptr;
+}
+
+std::string ParameterInfo::ValueText(const ModelParameters& p) const {
+  switch (kind) {
+    case Kind::kNumber: return FormatNumber(p.*number);
+    case Kind::kFlag: return p.*flag ? "true" : "false";
+    case Kind::kChoice: {
+      const int value = get_choice(p);
+      return value >= 0 && static_cast<std::size_t>(value) < choice_count ? choices[value] : "?";
+    }
+  }
+  return "?";
+}
+
+std::string ParameterInfo::Expected() const {
+  switch (kind) {
+    case Kind::kNumber: return "in [" + FormatNumber(min) + ", " + FormatNumber(max) + "]";
+    case Kind::kFlag: return "true or false";
+    case Kind::kChoice: {
+      std::string text = "one of ";
+      for (std::size_t k = 0; k < choice_count; ++k) text += (k ? ", " : "") + std::string(choices[k]);
+      return text;
+    }
+  }
+  return "";
+}
+
+std::string ModelParameterTableMarkdown() {
+  const ModelParameters defaults;
+  std::string text = "| parameter | unit | default | allowed | source | meaning |\n| --- | --- | --- | --- | --- | --- |\n";
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    std::string value = info.ValueText(defaults);
+    if (info.default_from) value += " (or " + std::string(info.default_from) + ")";
+    text += "| `" + std::string(info.name) + "` | " + info.unit + " | " + value + " | " + info.Expected() + " | " +
+            info.source + " | " + info.meaning + " |\n";
+  }
+  return text;
+}
+
+bool ModelParameters::IsValid(std::string* error) const {
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    if (info.kind == Kind::kNumber) {
+      const double v = this->*info.number;
+      if (!(std::isfinite(v) && v >= info.min && v <= info.max)) {
+        if (error) *error = std::string(info.name) + " = " + FormatNumber(v) + ", expected " + info.Expected();
+        return false;
+      }
+    } else if (info.kind == Kind::kChoice) {
+      const int value = info.get_choice(*this);
+      if (value < 0 || static_cast<std::size_t>(value) >= info.choice_count) {
+        if (error) *error = std::string(info.name) + " = " + std::to_string(value) + ", expected " + info.Expected();
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace crowdrecon::engine

@@ -1,0 +1,96 @@
+// The model's parameter table (engine/parameter_table.hpp): one definition of
+// every parameter, from which validation, the scenario reader, the world file
+// and the table in docs/model.md are derived.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "crowdrecon/engine/parameter_table.hpp"
+
+namespace crowdrecon::engine {
+namespace {
+
+TEST(ParameterTable, NamesAreUniqueAndDefaultsAreValid) {
+  std::set<std::string> names;
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    EXPECT_TRUE(names.insert(info.name).second) << info.name;
+    EXPECT_NE(std::string(info.meaning), "") << info.name;
+    EXPECT_NE(std::string(info.source), "") << info.name;
+    if (info.default_from) {
+      EXPECT_NE(FindModelParameter(info.default_from), nullptr) << info.name;
+    }
+  }
+  std::string error;
+  EXPECT_TRUE(ModelParameters{}.IsValid(&error)) << error;
+}
+
+TEST(ParameterTable, EveryFieldOfModelParametersIsInTheTable) {
+  // Changing each entry's field changes that parameter's value (each entry
+  // reaches its own field).
+  std::size_t bytes = 0;
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    ModelParameters p;
+    switch (info.kind) {
+      case ParameterInfo::Kind::kNumber: p.*info.number = info.max; bytes += sizeof(double); break;
+      case ParameterInfo::Kind::kFlag: p.*info.flag = !(p.*info.flag); bytes += sizeof(bool); break;
+      case ParameterInfo::Kind::kChoice:
+        info.set_choice(p, (info.get_choice(p) + 1) % static_cast<int>(info.choice_count));
+        bytes += 1;
+        break;
+    }
+    EXPECT_NE(info.ValueText(p), info.ValueText(ModelParameters{})) << info.name;
+  }
+  (void)bytes;
+  // A new field changes the size: add it to the table (the world file asserts the same).
+  EXPECT_EQ(sizeof(ModelParameters), 136u) << "ModelParameters changed: update the parameter table";
+}
+
+TEST(ParameterTable, IsValidUsesTheTableRanges) {
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    if (info.kind != ParameterInfo::Kind::kNumber) continue;
+    for (double bad : {info.min - 1e-9 * (1.0 + std::abs(info.min)), info.max * (1 + 1e-9) + 1e-12}) {
+      ModelParameters p;
+      p.*info.number = bad;
+      std::string error;
+      EXPECT_FALSE(p.IsValid(&error)) << info.name << " = " << bad;
+      EXPECT_NE(error.find(info.name), std::string::npos) << error;
+      EXPECT_NE(error.find(info.Expected()), std::string::npos) << error;
+    }
+    ModelParameters p;
+    p.*info.number = info.min;
+    std::string error;
+    EXPECT_TRUE(p.IsValid(&error)) << error;
+  }
+}
+
+// With CROWDRECON_UPDATE_DOCS=1 in the environment, the test writes the
+// table into docs/model.md instead of failing (then review the diff).
+TEST(ParameterTable, DocsMatchTheTable) {
+  const std::string file = std::string(CROWDRECON_SOURCE_DIR) + "/docs/model.md";
+  std::ifstream in(file);
+  ASSERT_TRUE(in) << "docs/model.md";
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string doc = buffer.str();
+  const std::string begin = "<!-- parameter-table: generated from engine::ModelParameterTableMarkdown() -->\n";
+  const std::string end = "<!-- /parameter-table -->";
+  const std::size_t a = doc.find(begin), b = doc.find(end);
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  const std::string in_doc = doc.substr(a + begin.size(), b - a - begin.size());
+  if (const char* update = std::getenv("CROWDRECON_UPDATE_DOCS"); update && std::string(update) == "1") {
+    std::ofstream(file, std::ios::binary) << doc.substr(0, a + begin.size()) << ModelParameterTableMarkdown()
+                                          << doc.substr(b);
+    GTEST_SKIP() << "docs/model.md updated";
+  }
+  EXPECT_EQ(in_doc, ModelParameterTableMarkdown())
+      << "docs/model.md's parameter table differs from the engine's; replace it with the text above";
+}
+
+}  // namespace
+}  // namespace crowdrecon::engine
