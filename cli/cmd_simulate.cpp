@@ -55,6 +55,7 @@ int RunSimulate(const SimulateArgs& args) {
               : s.device_fallback.empty()                      ? ", person-pair forces on CUDA"
                                                                : ", person-pair forces on CUDA until it failed (see the note)");
   if (!s.threads_report.empty()) std::printf("threads: %s\n", s.threads_report.c_str());
+  if (!s.systems_report.empty()) std::printf("run loop: %s\n", s.systems_report.c_str());
   std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());

@@ -17,7 +17,9 @@
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/thread_governor.hpp"
 #include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
+#include "run_systems.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -35,29 +37,46 @@ std::uint64_t ScenarioFingerprint(const Scenario& s) {
   return h;
 }
 
-constexpr char kCheckpointMagic[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '1'};
+// Checkpoint: magic, the scenario's fingerprint, the last frame written, the
+// engine's state (Simulation::SaveState), then each run-loop system's state
+// (count; per system its name and state, each as a length and bytes).
+// Version 1 (no system states) is still read.
+constexpr char kCheckpointMagic[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '2'};
+constexpr char kCheckpointMagicV1[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '1'};
 
-void WriteCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint, std::int64_t last_frame,
-                     const engine::Simulation& sim) {
-  const std::string state = sim.SaveState();
+struct Checkpoint {
+  std::int64_t last_frame = -1;
+  std::string state;
+  std::vector<std::pair<std::string, std::string>> systems;
+};
+
+void PutBytes(std::string& out, const std::string& bytes) {
+  const std::uint64_t n = bytes.size();
+  out.append(reinterpret_cast<const char*>(&n), sizeof n);
+  out += bytes;
+}
+
+void WriteCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint, const Checkpoint& c) {
+  std::string data(kCheckpointMagic, sizeof kCheckpointMagic);
+  data.append(reinterpret_cast<const char*>(&fingerprint), sizeof fingerprint);
+  data.append(reinterpret_cast<const char*>(&c.last_frame), sizeof c.last_frame);
+  PutBytes(data, c.state);
+  const std::uint64_t count = c.systems.size();
+  data.append(reinterpret_cast<const char*>(&count), sizeof count);
+  for (const auto& [name, state] : c.systems) {
+    PutBytes(data, name);
+    PutBytes(data, state);
+  }
   const std::filesystem::path tmp = file.string() + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(tmp.string() + ": cannot write checkpoint");
-    out.write(kCheckpointMagic, sizeof kCheckpointMagic);
-    out.write(reinterpret_cast<const char*>(&fingerprint), sizeof fingerprint);
-    out.write(reinterpret_cast<const char*>(&last_frame), sizeof last_frame);
-    out.write(state.data(), static_cast<std::streamsize>(state.size()));
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
     out.flush();
     if (!out) throw InputError(tmp.string() + ": cannot write checkpoint (disk full?)");
   }
   std::filesystem::rename(tmp, file);  // atomic: a crash never leaves a half-written checkpoint
 }
-
-struct Checkpoint {
-  std::int64_t last_frame = -1;
-  std::string state;
-};
 
 Checkpoint ReadCheckpoint(const std::filesystem::path& file, std::uint64_t fingerprint) {
   std::ifstream in(file, std::ios::binary);
@@ -66,15 +85,45 @@ Checkpoint ReadCheckpoint(const std::filesystem::path& file, std::uint64_t finge
   buffer << in.rdbuf();
   const std::string data = buffer.str();
   const std::size_t header = sizeof kCheckpointMagic + 16;
-  if (data.size() < header || data.compare(0, sizeof kCheckpointMagic, kCheckpointMagic, sizeof kCheckpointMagic) != 0)
-    throw InputError(file.string() + ": not a crowdrecon checkpoint");
+  const auto magic_is = [&](const char* magic) {
+    return data.size() >= header && data.compare(0, sizeof kCheckpointMagic, magic, sizeof kCheckpointMagic) == 0;
+  };
+  const bool v1 = magic_is(kCheckpointMagicV1);
+  if (!v1 && !magic_is(kCheckpointMagic)) throw InputError(file.string() + ": not a crowdrecon checkpoint");
   std::uint64_t stored;
   Checkpoint c;
   std::memcpy(&stored, data.data() + 8, 8);
   std::memcpy(&c.last_frame, data.data() + 16, 8);
   if (stored != fingerprint)
     throw InputError(file.string() + ": the checkpoint belongs to a different scenario (the scenario file changed?)");
-  c.state = data.substr(header);
+  if (v1) {
+    c.state = data.substr(header);
+    return c;
+  }
+  std::size_t at = header;
+  const auto damaged = [&] { return InputError(file.string() + ": the checkpoint is damaged (cut short?)"); };
+  const auto get_count = [&] {
+    std::uint64_t n;
+    if (data.size() - at < sizeof n) throw damaged();
+    std::memcpy(&n, data.data() + at, sizeof n);
+    at += sizeof n;
+    return n;
+  };
+  const auto get_bytes = [&] {
+    const std::uint64_t n = get_count();
+    if (n > data.size() - at) throw damaged();
+    std::string bytes = data.substr(at, n);
+    at += n;
+    return bytes;
+  };
+  c.state = get_bytes();
+  const std::uint64_t systems = get_count();
+  if (systems > 1000) throw damaged();
+  for (std::uint64_t k = 0; k < systems; ++k) {
+    std::string name = get_bytes();
+    c.systems.emplace_back(std::move(name), get_bytes());
+  }
+  if (at != data.size()) throw damaged();
   return c;
 }
 
@@ -170,6 +219,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
   std::int64_t last_frame = -1;
+  std::vector<std::pair<std::string, std::string>> resumed_systems;
   RunFileWriter writer = [&] {
     std::error_code ec;
     if (options.resume && !std::filesystem::exists(checkpoint, ec)) {
@@ -181,6 +231,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
       const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
       sim.LoadState(c.state);
       last_frame = c.last_frame;
+      resumed_systems = c.systems;
       say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
       return RunFileWriter::Resume(options.output, last_frame);
     }
@@ -204,7 +255,6 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   summary.time_step_s = sim.time_step_s();
   const auto start = Clock::now();
   const double start_sim = sim.time_s();
-  auto last_print = start;
 
   // Frames are written by a thread of their own while the next ones are
   // simulated, if the engine leaves a core free (see FrameWriterThread);
@@ -212,67 +262,55 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   // the last frame, an event, the status) waits for them with Flush.
   const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
   FrameWriterThread frames(writer, core_free);
-  const auto write_frame = [&](std::int64_t frame) {
-    frames.Write(frame, sim, {}, scenario.run.write_contacts);
-    last_frame = frame;
-  };
-  const auto checkpoint_now = [&](const std::filesystem::path& file) {
-    frames.Flush();
-    WriteCheckpoint(file, fingerprint, last_frame, sim);
-  };
-  if (last_frame < 0) write_frame(0);
+  if (last_frame < 0) {
+    frames.Write(0, sim, {}, scenario.run.write_contacts);
+    last_frame = 0;
+  }
 
   engine::ThreadChoice::Options thread_options;
   thread_options.max_threads = sim.definition().threads;
   engine::ThreadGovernor governor(thread_options);
   const bool adapt_threads = options.adapt_threads && thread_options.max_threads > 1;
+
+  // The run loop: the engine step and the systems (run_systems.hpp), in order.
+  RunLoop::Options loop_options;
+  loop_options.steps_per_frame = steps_per_frame;
+  loop_options.step = [&](engine::Simulation& s) {
+    if (adapt_threads) governor.Step(s);
+    else s.Step();
+  };
+  loop_options.write_event = [&](const Event& event, std::int64_t frame) {
+    frames.Flush();  // an event follows its frame in the file
+    writer.WriteEvent(frame, event);
+  };
+  RunLoop loop(sim, loop_options);
+  const auto checkpoint_at = [&](const std::filesystem::path& file, std::int64_t frame) {
+    frames.Flush();
+    WriteCheckpoint(file, fingerprint, Checkpoint{frame, sim.SaveState(), loop.SaveStates()});
+  };
+  loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
+  loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts));
+  loop.Add(std::make_unique<detail::DeviceFallbackSystem>(options.show_progress));
+  loop.Add(std::make_unique<detail::CheckpointSystem>(
+      checkpoint_every, [&](std::int64_t frame) { checkpoint_at(checkpoint, frame); }));
+  loop.Add(std::make_unique<detail::StopRequestSystem>(g_stop_requested, options.stop_flag, options.stop_after_s));
+  if (options.show_progress)
+    loop.Add(std::make_unique<detail::ProgressSystem>(scenario.run.duration_s, start_sim));
+  loop.LoadStates(resumed_systems);
+
   std::string status = "complete";
-  bool device_fallback_reported = false;
   try {
-    std::vector<Vec2> centres = sim.bodies().position_m;
-    while (last_frame < total_frames) {
-      for (std::int64_t k = 0; k < steps_per_frame; ++k) {
-        if (adapt_threads) governor.Step(sim);
-        else sim.Step();
-      }
-      engine::CheckCentresStayInsideWalls(sim, centres);  // nobody went through a wall
-      centres = sim.bodies().position_m;
-      write_frame(last_frame + 1);
-      if (!device_fallback_reported && !sim.device_fallback().empty()) {
-        // The GPU failed and the processor took over (same results): say so,
-        // on the terminal and in the run file, once.
-        device_fallback_reported = true;
-        frames.Flush();
-        Event event;
-        event.time_s = sim.time_s();
-        event.kind = "device_fallback";
-        event.detail = sim.device_fallback();
-        writer.WriteEvent(last_frame, event);
-        std::fprintf(stderr, "%scrowdrecon: note: %s\n", options.show_progress ? "\n" : "", sim.device_fallback().c_str());
-      }
-      if (checkpoint_every > 0 && last_frame % checkpoint_every == 0) checkpoint_now(checkpoint);
-      const bool stop = g_stop_requested.load() || (options.stop_flag && options.stop_flag->load()) ||
-                        (options.stop_after_s >= 0 && sim.time_s() >= options.stop_after_s - 1e-9);
-      const auto now = Clock::now();
-      if (options.show_progress && (now - last_print > std::chrono::milliseconds(500) || stop || last_frame == total_frames)) {
-        last_print = now;
-        const double wall = std::chrono::duration<double>(now - start).count();
-        const double rtf = wall > 0 ? (sim.time_s() - start_sim) / wall : 0.0;
-        const double left = rtf > 0 ? (scenario.run.duration_s - sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
-        std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", sim.time_s(),
-                     scenario.run.duration_s, rtf, FormatDuration(left).c_str());
-        std::fflush(stderr);
-      }
-      if (stop && last_frame < total_frames) {
-        checkpoint_now(checkpoint);
-        status = "interrupted";
-        break;
-      }
+    loop.Run(last_frame, total_frames);
+    last_frame = loop.summary().last_frame;
+    if (loop.summary().stopped) {
+      checkpoint_at(checkpoint, last_frame);
+      status = "interrupted";
     }
   } catch (const engine::SimulationError& e) {
+    last_frame = loop.summary().last_frame;
     // Save the state in which the run failed, next to the run file, and say so.
     const std::filesystem::path failed = options.output.string() + ".failed-state";
-    checkpoint_now(failed);
+    checkpoint_at(failed, last_frame);
     Event event;
     event.time_s = sim.time_s();
     event.kind = "numerical_failure";
@@ -293,6 +331,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     std::error_code ec;
     std::filesystem::remove(checkpoint, ec);
   }
+  summary.systems_report = loop.summary().BriefReport();
   summary.status = status;
   summary.simulated_s = sim.time_s();
   summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();

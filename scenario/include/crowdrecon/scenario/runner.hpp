@@ -49,6 +49,7 @@ struct RunSummary {
   engine::Profile profile;         // time per engine stage (this invocation)
   std::string device_fallback;     // why and when the GPU failed, if it did (engine::Simulation)
   std::string threads_report;      // the thread governor's brief report (engine::ThreadChoice::Summary)
+  std::string systems_report;      // wall time of the engine steps and of each run-loop system (RunLoop::Summary)
 };
 
 // Path of the checkpoint that belongs to a run file.

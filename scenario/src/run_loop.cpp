@@ -1,0 +1,106 @@
+#include "crowdrecon/scenario/run_loop.hpp"
+
+#include <chrono>
+#include <cstdio>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
+
+namespace crowdrecon::scenario {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+}  // namespace
+
+bool RunLoop::Options::IsValid(std::string* error) const {
+  if (steps_per_frame < 1) {
+    if (error) *error = "steps_per_frame = " + std::to_string(steps_per_frame) + ", expected >= 1";
+    return false;
+  }
+  if (!step || !write_event) {
+    if (error) *error = "step and write_event must be set";
+    return false;
+  }
+  return true;
+}
+
+std::string RunLoop::Summary::BriefReport() const {
+  char text[64];
+  std::snprintf(text, sizeof text, "engine %.2f s", engine_s);
+  std::string report = text;
+  for (std::size_t k = 0; k < system_s.size(); ++k) {
+    std::snprintf(text, sizeof text, "%s%s %.3f s", k == 0 ? "; " : ", ", system_s[k].first.c_str(), system_s[k].second);
+    report += text;
+  }
+  return report;
+}
+
+RunLoop::RunLoop(engine::Simulation& sim, Options options) : sim_(sim), options_(std::move(options)) {
+  std::string error;
+  if (!options_.IsValid(&error)) throw std::logic_error("RunLoop: " + error);
+}
+
+void RunLoop::Add(std::unique_ptr<RunSystem> system) {
+  summary_.system_s.emplace_back(std::string(system->name()), 0.0);
+  systems_.push_back(std::move(system));
+}
+
+void RunLoop::Run(std::int64_t first_frame, std::int64_t last_frame) {
+  summary_.last_frame = first_frame;
+  summary_.stopped = false;
+  for (std::int64_t frame = first_frame + 1; frame <= last_frame; ++frame) {
+    // The frame's engine steps, with the per-step systems around each.
+    for (std::int64_t k = 0; k < options_.steps_per_frame; ++k) {
+      for (std::size_t s = 0; s < systems_.size(); ++s) {
+        const auto start = Clock::now();
+        systems_[s]->BeforeStep(sim_);
+        summary_.system_s[s].second += Since(start);
+      }
+      const auto start = Clock::now();
+      options_.step(sim_);
+      summary_.engine_s += Since(start);
+      for (std::size_t s = 0; s < systems_.size(); ++s) {
+        const auto after = Clock::now();
+        systems_[s]->AfterStep(sim_);
+        summary_.system_s[s].second += Since(after);
+      }
+    }
+    // The per-frame systems, in order.
+    FrameContext context{sim_, frame, last_frame,
+                         [&](const Event& event) { options_.write_event(event, frame); }, false};
+    for (std::size_t s = 0; s < systems_.size(); ++s) {
+      const auto start = Clock::now();
+      systems_[s]->AtFrame(context);
+      summary_.system_s[s].second += Since(start);
+    }
+    summary_.last_frame = frame;
+    if (context.stop && frame < last_frame) {
+      summary_.stopped = true;
+      return;
+    }
+  }
+}
+
+std::vector<std::pair<std::string, std::string>> RunLoop::SaveStates() const {
+  std::vector<std::pair<std::string, std::string>> states;
+  for (const auto& system : systems_) states.emplace_back(std::string(system->name()), system->SaveState());
+  return states;
+}
+
+void RunLoop::LoadStates(const std::vector<std::pair<std::string, std::string>>& states) {
+  for (const auto& [name, state] : states) {
+    bool found = false;
+    for (const auto& system : systems_) {
+      if (system->name() != name) continue;
+      system->LoadState(state);
+      found = true;
+    }
+    if (!found) throw InputError("the checkpoint holds the state of a system \"" + name + "\" that this run does not have");
+  }
+}
+
+}  // namespace crowdrecon::scenario

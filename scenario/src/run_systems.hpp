@@ -1,0 +1,130 @@
+// The built-in systems of the run loop (run_loop.hpp), in the order
+// RunScenario adds them (runner.cpp):
+//
+//   wall_check      every person's centre stayed inside the walls (engine::CheckCentresStayInsideWalls)
+//   frames          the frame into the run file (FrameWriterThread: on a core of its own when one is free)
+//   device_fallback a GPU that failed: an event and a note, once
+//   checkpoint      the periodic checkpoint (run.checkpoint_interval_s)
+//   stop_request    Ctrl-C, SIGTERM, a caller's flag, --stop-after: stop here (a checkpoint follows)
+//   progress        the progress line on a terminal
+//
+// The incident timeline's systems (inflow, exits, timed events, falls) come
+// before them, acting around the engine steps.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/vec2.hpp"
+#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_loop.hpp"
+
+namespace crowdrecon::scenario::detail {
+
+// Nobody went through a wall between two frames (a safety net behind the
+// engine's contact check: walls x people segment tests per frame).
+class WallCheckSystem : public RunSystem {
+ public:
+  explicit WallCheckSystem(const engine::Simulation& sim) : centres_(sim.bodies().position_m) {}
+  std::string_view name() const override { return "wall_check"; }
+  void AtFrame(FrameContext& c) override {
+    engine::CheckCentresStayInsideWalls(c.sim, centres_);
+    centres_ = c.sim.bodies().position_m;
+  }
+
+ private:
+  std::vector<Vec2> centres_;  // at the last frame (a checkpoint is taken at a frame: they are the positions then)
+};
+
+class FrameOutputSystem : public RunSystem {
+ public:
+  FrameOutputSystem(FrameWriterThread& frames, bool with_contacts) : frames_(frames), with_contacts_(with_contacts) {}
+  std::string_view name() const override { return "frames"; }
+  void AtFrame(FrameContext& c) override { frames_.Write(c.frame, c.sim, {}, with_contacts_); }
+
+ private:
+  FrameWriterThread& frames_;
+  bool with_contacts_;
+};
+
+// The GPU failed and the processor took over (same results): say so, on the
+// terminal and in the run file, once.
+class DeviceFallbackSystem : public RunSystem {
+ public:
+  explicit DeviceFallbackSystem(bool progress_line) : progress_line_(progress_line) {}
+  std::string_view name() const override { return "device_fallback"; }
+  void AtFrame(FrameContext& c) override {
+    if (reported_ || c.sim.device_fallback().empty()) return;
+    reported_ = true;
+    Event event;
+    event.time_s = c.sim.time_s();
+    event.kind = "device_fallback";
+    event.detail = c.sim.device_fallback();
+    c.write_event(event);
+    std::fprintf(stderr, "%scrowdrecon: note: %s\n", progress_line_ ? "\n" : "", c.sim.device_fallback().c_str());
+  }
+
+ private:
+  bool progress_line_;
+  bool reported_ = false;
+};
+
+class CheckpointSystem : public RunSystem {
+ public:
+  // `write(frame)` writes the checkpoint of the run at `frame`; every `every` frames (0: never).
+  CheckpointSystem(std::int64_t every, std::function<void(std::int64_t)> write) : every_(every), write_(std::move(write)) {}
+  std::string_view name() const override { return "checkpoint"; }
+  void AtFrame(FrameContext& c) override {
+    if (every_ > 0 && c.frame % every_ == 0) write_(c.frame);
+  }
+
+ private:
+  std::int64_t every_;
+  std::function<void(std::int64_t)> write_;
+};
+
+class StopRequestSystem : public RunSystem {
+ public:
+  StopRequestSystem(const std::atomic<bool>& signal, const std::atomic<bool>* flag, double stop_after_s)
+      : signal_(signal), flag_(flag), stop_after_s_(stop_after_s) {}
+  std::string_view name() const override { return "stop_request"; }
+  void AtFrame(FrameContext& c) override {
+    c.stop = signal_.load() || (flag_ && flag_->load()) || (stop_after_s_ >= 0 && c.sim.time_s() >= stop_after_s_ - 1e-9);
+  }
+
+ private:
+  const std::atomic<bool>& signal_;
+  const std::atomic<bool>* flag_;
+  double stop_after_s_;
+};
+
+// Simulated time, real-time factor and time left, twice a second (and at a
+// stop and at the end), on stderr.
+class ProgressSystem : public RunSystem {
+ public:
+  ProgressSystem(double duration_s, double start_sim_s) : duration_s_(duration_s), start_sim_s_(start_sim_s) {}
+  std::string_view name() const override { return "progress"; }
+  void AtFrame(FrameContext& c) override {
+    const auto now = Clock::now();
+    if (!(now - last_print_ > std::chrono::milliseconds(500) || c.stop || c.frame == c.last_frame)) return;
+    last_print_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double rtf = wall > 0 ? (c.sim.time_s() - start_sim_s_) / wall : 0.0;
+    const double left = rtf > 0 ? (duration_s_ - c.sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
+    std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", c.sim.time_s(),
+                 duration_s_, rtf, FormatDuration(left).c_str());
+    std::fflush(stderr);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  double duration_s_, start_sim_s_;
+  Clock::time_point start_ = Clock::now(), last_print_ = Clock::now();
+};
+
+}  // namespace crowdrecon::scenario::detail
