@@ -118,6 +118,230 @@ std::string WalkableAreaWkt(const geometry::Venue& venue) {
   return wkt + ")";
 }
 
+Placement PlaceSequentially(const engine::WorldDef& def, const std::vector<geometry::AreaTriangulation>& regions,
+                            double area_m2, double scale, double max_bound, Vec2 lo, Vec2 hi, std::mt19937_64& rng,
+                            const std::string& origin) {
+  const std::size_t count = def.people.size();
+  // Random sequential placement at the reduced size, checked with the engine's
+  // narrow phase against people already placed (cell grid) and walls.
+  std::vector<Vec2> world;
+  Placement placed;
+  std::vector<Vec2>& position = placed.position;
+  std::vector<double>& angle = placed.angle;
+  position.resize(count);
+  angle.resize(count);
+  const double cell = 2.0 * max_bound * scale + 1e-9;
+  std::vector<std::vector<std::uint32_t>> grid;
+  Vec2 grid_lo = lo - Vec2{cell, cell};
+  const auto gx = static_cast<std::size_t>(std::ceil((hi.x - lo.x) / cell)) + 3;
+  const auto gy = static_cast<std::size_t>(std::ceil((hi.y - lo.y) / cell)) + 3;
+  grid.assign(gx * gy, {});
+  const auto cell_of = [&](Vec2 p) {
+    const auto cx = static_cast<std::size_t>(std::clamp((p.x - grid_lo.x) / cell, 0.0, double(gx - 1)));
+    const auto cy = static_cast<std::size_t>(std::clamp((p.y - grid_lo.y) / cell, 0.0, double(gy - 1)));
+    return std::pair{cx, cy};
+  };
+  // Shapes at this growth stage's scale, and the walls, in their own frames.
+  std::vector<engine::ShapeGeometry> scaled_shapes;
+  for (const engine::BodyShape& s : def.shapes) {
+    std::vector<Vec2> vertices;
+    for (const Vec2& v : s.vertices) vertices.push_back(v * scale);
+    scaled_shapes.push_back(engine::ShapeGeometry::Make(std::move(vertices), s.vertices.size() >= 3, s.radius_m * scale));
+  }
+  std::vector<engine::ShapeGeometry> wall_shapes;
+  std::vector<Vec2> wall_origins(def.walls.size());
+  for (std::size_t w = 0; w < def.walls.size(); ++w)
+    wall_shapes.push_back(engine::ShapeGeometry::FromWorld(def.walls[w].points, def.walls[w].closed,
+                                                           def.walls[w].radius_m, wall_origins[w]));
+  const auto placed_shape = [&](std::size_t i, Vec2 at, double theta) {
+    engine::PlacedShape p;
+    p.geometry = &scaled_shapes[def.people[i].shape];
+    p.position = at;
+    p.cos_angle = std::cos(theta);
+    p.sin_angle = std::sin(theta);
+    return p;
+  };
+  std::vector<engine::ContactPoint> hits;
+  const auto periodic_image = [&](Vec2 d) {
+    if (def.periodic.x) d.x -= (def.periodic.max_m.x - def.periodic.min_m.x) * std::nearbyint(d.x / (def.periodic.max_m.x - def.periodic.min_m.x));
+    if (def.periodic.y) d.y -= (def.periodic.max_m.y - def.periodic.min_m.y) * std::nearbyint(d.y / (def.periodic.max_m.y - def.periodic.min_m.y));
+    return d;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    bool done = false;
+    int attempts = 0, wall_blocked = 0;  // why places were refused, for the message
+    for (int attempt = 0; attempt < 4000 && !done; ++attempt) {
+      ++attempts;
+      // Region chosen in proportion to its area.
+      double u = Uniform(rng) * area_m2;
+      std::size_t r = 0;
+      while (r + 1 < regions.size() && u > regions[r].area_m2()) u -= regions[r++].area_m2();
+      const Vec2 at = regions[r].Sample(rng);
+      const Vec2 e = def.targets[def.people[i].target].Direction(at);
+      const double theta = (e.x != 0.0 || e.y != 0.0 ? std::atan2(e.y, e.x) : 2.0 * kPi * Uniform(rng)) +
+                           0.3 * (Uniform(rng) - 0.5);
+      const engine::PlacedShape me = placed_shape(i, at, theta);
+      bool free = true;
+      for (std::size_t w = 0; w < def.walls.size(); ++w) {
+        engine::PlacedShape ws;
+        ws.geometry = &wall_shapes[w];
+        ws.position = wall_origins[w];
+        hits.clear();
+        engine::CollideShapes(me, ws, hits);
+        if (!hits.empty()) { free = false; break; }
+      }
+      if (!free) ++wall_blocked;
+      const auto [cx, cy] = cell_of(at);
+      for (std::size_t dy = 0; dy < 3 && free; ++dy)
+        for (std::size_t dx = 0; dx < 3 && free; ++dx) {
+          const std::size_t x = cx + dx - 1, y = cy + dy - 1;
+          if (x >= gx || y >= gy) continue;
+          for (std::uint32_t j : grid[y * gx + x]) {
+            hits.clear();
+            engine::CollideShapes(me, placed_shape(j, position[j], angle[j]), hits);
+            if (!hits.empty()) { free = false; break; }
+          }
+        }
+      // Across a periodic seam, compare with the nearest images too (only a
+      // person within reach of a seam can meet someone's image).
+      const double seam_reach = 2.0 * max_bound * scale;
+      const bool near_seam =
+          (def.periodic.x && std::min(at.x - def.periodic.min_m.x, def.periodic.max_m.x - at.x) < seam_reach) ||
+          (def.periodic.y && std::min(at.y - def.periodic.min_m.y, def.periodic.max_m.y - at.y) < seam_reach);
+      if (free && near_seam)
+        for (std::size_t j = 0; j < i && free; ++j) {
+          const Vec2 d = periodic_image(position[j] - at);
+          if (Length(d) > 2.0 * max_bound * scale || Length(position[j] - at - d) < 1e-9) continue;
+          hits.clear();
+          engine::CollideShapes(me, placed_shape(j, at + d, angle[j]), hits);
+          if (!hits.empty()) free = false;
+        }
+      if (!free) continue;
+      position[i] = at;
+      angle[i] = theta;
+      grid[cy * gx + cx].push_back(static_cast<std::uint32_t>(i));
+      done = true;
+    }
+    if (!done && wall_blocked == attempts)
+      throw InputError(origin + ": /population: cannot place person " + std::to_string(i + 1) +
+                       " of " + std::to_string(count) + ": each of the " + std::to_string(attempts) +
+                       " places tried in the placement region (" + FormatNumber(area_m2) +
+                       " m^2) touches a wall, even at " + FormatNumber(scale) +
+                       " of full size; expected a region wider than a body inside the walls (check the venue's walls)");
+    if (!done)
+      throw InputError(origin + ": /population: cannot place person " + std::to_string(i + 1) +
+                       " of " + std::to_string(count) + " in " + FormatNumber(area_m2) +
+                       " m^2 even at " + FormatNumber(scale) + " of full size; the density is too high");
+  }
+
+  return placed;
+}
+
+void NumberAlongCurve(engine::WorldDef& def, Placement& placement, Vec2 lo, Vec2 hi) {
+  // Number the people along a space-filling curve through their places, so
+  // that people close in the crowd are close in the engine's arrays: the
+  // narrow phase of neighbours then reads memory that is close too (the
+  // placement's random order scattered every neighbour's data). The crowd is
+  // the same; only who is person 1, 2, ... changes.
+  {
+    std::vector<Vec2>& position = placement.position;
+    std::vector<double>& angle = placement.angle;
+    const std::size_t count = def.people.size();
+    const std::vector<std::size_t> order = SpatialOrder(position, lo, hi);
+    std::vector<engine::PersonDef> people(count);
+    std::vector<engine::BodyShape> shapes(count);  // one shape per person, in the same order
+    std::vector<Vec2> placed_position(count);
+    std::vector<double> placed_angle(count);
+    for (std::size_t k = 0; k < count; ++k) {
+      people[k] = def.people[order[k]];
+      shapes[k] = def.shapes[people[k].shape];
+      people[k].shape = static_cast<std::uint32_t>(k);
+      placed_position[k] = position[order[k]];
+      placed_angle[k] = angle[order[k]];
+    }
+    def.people = std::move(people);
+    def.shapes = std::move(shapes);
+    position = std::move(placed_position);
+    angle = std::move(placed_angle);
+  }
+
+}
+
+Relaxation GrowAndRelax(const engine::WorldDef& def, Placement& placement, double initial_scale, double tolerance,
+                        const std::string& origin, const std::function<void(const std::string&)>& say) {
+  // Grow to full size in stages with a passive, quenched relaxation after each.
+  const int stages = initial_scale < 1.0 ? 8 : 1;
+  const double s0 = initial_scale;
+  Relaxation result;
+  double& residual = result.residual;
+  std::vector<Vec2>& position = placement.position;
+  std::vector<double>& angle = placement.angle;
+  const std::size_t count = def.people.size();
+  for (int stage = 1; stage <= stages; ++stage) {
+    const double scale = stages == 1 ? 1.0 : s0 + (1.0 - s0) * stage / stages;
+    engine::WorldDef relax = def;
+    relax.parameters.ground_reaction = false;
+    relax.parameters.restitution = relax.parameters.wall_restitution = 0.05;
+    relax.parameters.time_step_s = 0.0;
+    // The placement is not part of the dynamics: relax with velocity Verlet
+    // whatever the run's integrator (Gear's step is ten times shorter).
+    relax.parameters.integrator = engine::Integrator::kVelocityVerlet;
+    for (engine::BodyShape& s : relax.shapes) {
+      for (Vec2& v : s.vertices) v *= scale;
+      s.radius_m *= scale;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      relax.people[i].position_m = position[i];
+      relax.people[i].angle_rad = angle[i];
+    }
+    std::optional<engine::Simulation> relaxing;
+    try {
+      relaxing.emplace(relax);
+    } catch (const engine::SimulationError& e) {
+      throw InputError(origin + ": /population: placement failed while relaxing: " + e.what());
+    }
+    engine::Simulation& sim = *relaxing;
+    const bool last = stage == stages;
+    const double goal = last ? tolerance : std::max(tolerance, 0.02 * scale);
+    // Budgets in simulated time, so that the placement does not depend on
+    // the step the engine chooses: quench every 5 ms, judge progress every
+    // 0.25 s, at most 5 s for the full size (0.8 s for a growing stage).
+    const double h = sim.time_step_s();
+    const int quench_steps = std::max(1, static_cast<int>(std::lround(0.005 / h)));
+    const int window_quenches = std::max(1, static_cast<int>(std::lround(0.25 / (quench_steps * h))));
+    const int budget_quenches = static_cast<int>(std::lround((last ? 5.0 : 0.8) / (quench_steps * h)));
+    int steps = 0;
+    residual = MaxOverlap(sim);
+    // Quenched relaxation; give up early once the largest overlap stops
+    // falling (a jammed packing), judged over the windows.
+    double window_start = residual;
+    for (int quench = 1; residual > goal && quench <= budget_quenches; ++quench) {
+      try {
+        for (int k = 0; k < quench_steps; ++k) sim.Step();
+      } catch (const engine::SimulationError& e) {
+        throw InputError(origin + ": /population: placement failed while relaxing (the density may be too high): " +
+                         e.what());
+      }
+      steps += quench_steps;
+      sim.Quench();
+      residual = MaxOverlap(sim);
+      if (quench % window_quenches == 0) {
+        if (residual > 0.95 * window_start) break;
+        window_start = residual;
+      }
+    }
+    result.steps += static_cast<std::size_t>(steps);
+    for (std::size_t i = 0; i < count; ++i) {
+      position[i] = sim.bodies().position_m[i];
+      angle[i] = sim.bodies().angle_rad[i];
+    }
+    say("placement stage " + std::to_string(stage) + "/" + std::to_string(stages) + ": size x" +
+        FormatNumber(scale) + ", largest overlap " + FormatNumber(residual) + " m after " + std::to_string(steps) +
+        " relaxation steps");
+  }
+  return result;
+}
+
 BuiltWorld BuildWorld(const Scenario& scenario, int threads,
                       const std::function<void(const std::string&)>& progress) {
   const auto say = [&](const std::string& line) {
@@ -224,215 +448,23 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
     max_bound = std::max(max_bound, bound + person.shape.radius());
   }
   const double fraction = body_area / built.placement_area_m2;
-  double scale = std::min(1.0, std::sqrt(0.25 / fraction));
+  const double scale = std::min(1.0, std::sqrt(0.25 / fraction));
   say("placing at area fraction " + FormatNumber(fraction) + ", initial size x" + FormatNumber(scale));
 
-  // Random sequential placement at the reduced size, checked with the engine's
-  // narrow phase against people already placed (cell grid) and walls.
-  std::vector<Vec2> world;
-  std::vector<Vec2> position(count);
-  std::vector<double> angle(count);
-  const double cell = 2.0 * max_bound * scale + 1e-9;
-  std::vector<std::vector<std::uint32_t>> grid;
-  Vec2 grid_lo = lo - Vec2{cell, cell};
-  const auto gx = static_cast<std::size_t>(std::ceil((hi.x - lo.x) / cell)) + 3;
-  const auto gy = static_cast<std::size_t>(std::ceil((hi.y - lo.y) / cell)) + 3;
-  grid.assign(gx * gy, {});
-  const auto cell_of = [&](Vec2 p) {
-    const auto cx = static_cast<std::size_t>(std::clamp((p.x - grid_lo.x) / cell, 0.0, double(gx - 1)));
-    const auto cy = static_cast<std::size_t>(std::clamp((p.y - grid_lo.y) / cell, 0.0, double(gy - 1)));
-    return std::pair{cx, cy};
-  };
-  // Shapes at this growth stage's scale, and the walls, in their own frames.
-  std::vector<engine::ShapeGeometry> scaled_shapes;
-  for (const engine::BodyShape& s : def.shapes) {
-    std::vector<Vec2> vertices;
-    for (const Vec2& v : s.vertices) vertices.push_back(v * scale);
-    scaled_shapes.push_back(engine::ShapeGeometry::Make(std::move(vertices), s.vertices.size() >= 3, s.radius_m * scale));
-  }
-  std::vector<engine::ShapeGeometry> wall_shapes;
-  std::vector<Vec2> wall_origins(def.walls.size());
-  for (std::size_t w = 0; w < def.walls.size(); ++w)
-    wall_shapes.push_back(engine::ShapeGeometry::FromWorld(def.walls[w].points, def.walls[w].closed,
-                                                           def.walls[w].radius_m, wall_origins[w]));
-  const auto placed_shape = [&](std::size_t i, Vec2 at, double theta) {
-    engine::PlacedShape p;
-    p.geometry = &scaled_shapes[def.people[i].shape];
-    p.position = at;
-    p.cos_angle = std::cos(theta);
-    p.sin_angle = std::sin(theta);
-    return p;
-  };
-  std::vector<engine::ContactPoint> hits;
-  const auto periodic_image = [&](Vec2 d) {
-    if (def.periodic.x) d.x -= (def.periodic.max_m.x - def.periodic.min_m.x) * std::nearbyint(d.x / (def.periodic.max_m.x - def.periodic.min_m.x));
-    if (def.periodic.y) d.y -= (def.periodic.max_m.y - def.periodic.min_m.y) * std::nearbyint(d.y / (def.periodic.max_m.y - def.periodic.min_m.y));
-    return d;
-  };
-  for (std::size_t i = 0; i < count; ++i) {
-    bool placed = false;
-    int attempts = 0, wall_blocked = 0;  // why places were refused, for the message
-    for (int attempt = 0; attempt < 4000 && !placed; ++attempt) {
-      ++attempts;
-      // Region chosen in proportion to its area.
-      double u = Uniform(rng) * built.placement_area_m2;
-      std::size_t r = 0;
-      while (r + 1 < regions.size() && u > regions[r].area_m2()) u -= regions[r++].area_m2();
-      const Vec2 at = regions[r].Sample(rng);
-      const Vec2 e = def.targets[def.people[i].target].Direction(at);
-      const double theta = (e.x != 0.0 || e.y != 0.0 ? std::atan2(e.y, e.x) : 2.0 * kPi * Uniform(rng)) +
-                           0.3 * (Uniform(rng) - 0.5);
-      const engine::PlacedShape me = placed_shape(i, at, theta);
-      bool free = true;
-      for (std::size_t w = 0; w < def.walls.size(); ++w) {
-        engine::PlacedShape ws;
-        ws.geometry = &wall_shapes[w];
-        ws.position = wall_origins[w];
-        hits.clear();
-        engine::CollideShapes(me, ws, hits);
-        if (!hits.empty()) { free = false; break; }
-      }
-      if (!free) ++wall_blocked;
-      const auto [cx, cy] = cell_of(at);
-      for (std::size_t dy = 0; dy < 3 && free; ++dy)
-        for (std::size_t dx = 0; dx < 3 && free; ++dx) {
-          const std::size_t x = cx + dx - 1, y = cy + dy - 1;
-          if (x >= gx || y >= gy) continue;
-          for (std::uint32_t j : grid[y * gx + x]) {
-            hits.clear();
-            engine::CollideShapes(me, placed_shape(j, position[j], angle[j]), hits);
-            if (!hits.empty()) { free = false; break; }
-          }
-        }
-      // Across a periodic seam, compare with the nearest images too (only a
-      // person within reach of a seam can meet someone's image).
-      const double seam_reach = 2.0 * max_bound * scale;
-      const bool near_seam =
-          (def.periodic.x && std::min(at.x - def.periodic.min_m.x, def.periodic.max_m.x - at.x) < seam_reach) ||
-          (def.periodic.y && std::min(at.y - def.periodic.min_m.y, def.periodic.max_m.y - at.y) < seam_reach);
-      if (free && near_seam)
-        for (std::size_t j = 0; j < i && free; ++j) {
-          const Vec2 d = periodic_image(position[j] - at);
-          if (Length(d) > 2.0 * max_bound * scale || Length(position[j] - at - d) < 1e-9) continue;
-          hits.clear();
-          engine::CollideShapes(me, placed_shape(j, at + d, angle[j]), hits);
-          if (!hits.empty()) free = false;
-        }
-      if (!free) continue;
-      position[i] = at;
-      angle[i] = theta;
-      grid[cy * gx + cx].push_back(static_cast<std::uint32_t>(i));
-      placed = true;
-    }
-    if (!placed && wall_blocked == attempts)
-      throw InputError(scenario.file.string() + ": /population: cannot place person " + std::to_string(i + 1) +
-                       " of " + std::to_string(count) + ": each of the " + std::to_string(attempts) +
-                       " places tried in the placement region (" + FormatNumber(built.placement_area_m2) +
-                       " m^2) touches a wall, even at " + FormatNumber(scale) +
-                       " of full size; expected a region wider than a body inside the walls (check the venue's walls)");
-    if (!placed)
-      throw InputError(scenario.file.string() + ": /population: cannot place person " + std::to_string(i + 1) +
-                       " of " + std::to_string(count) + " in " + FormatNumber(built.placement_area_m2) +
-                       " m^2 even at " + FormatNumber(scale) + " of full size; the density is too high");
-  }
-
-  // Number the people along a space-filling curve through their places, so
-  // that people close in the crowd are close in the engine's arrays: the
-  // narrow phase of neighbours then reads memory that is close too (the
-  // placement's random order scattered every neighbour's data). The crowd is
-  // the same; only who is person 1, 2, ... changes.
-  {
-    const std::vector<std::size_t> order = SpatialOrder(position, lo, hi);
-    std::vector<engine::PersonDef> people(count);
-    std::vector<engine::BodyShape> shapes(count);  // one shape per person, in the same order
-    std::vector<Vec2> placed_position(count);
-    std::vector<double> placed_angle(count);
-    for (std::size_t k = 0; k < count; ++k) {
-      people[k] = def.people[order[k]];
-      shapes[k] = def.shapes[people[k].shape];
-      people[k].shape = static_cast<std::uint32_t>(k);
-      placed_position[k] = position[order[k]];
-      placed_angle[k] = angle[order[k]];
-    }
-    def.people = std::move(people);
-    def.shapes = std::move(shapes);
-    position = std::move(placed_position);
-    angle = std::move(placed_angle);
-  }
-
-  // Grow to full size in stages with a passive, quenched relaxation after each.
+  Placement placement = PlaceSequentially(def, regions, built.placement_area_m2, scale, max_bound, lo, hi, rng,
+                                          scenario.file.string());
+  NumberAlongCurve(def, placement, lo, hi);
   const double tolerance = spec.max_initial_overlap_m;
-  const int stages = scale < 1.0 ? 8 : 1;
-  const double s0 = scale;
-  double residual = 0.0;
-  for (int stage = 1; stage <= stages; ++stage) {
-    scale = stages == 1 ? 1.0 : s0 + (1.0 - s0) * stage / stages;
-    engine::WorldDef relax = def;
-    relax.parameters.ground_reaction = false;
-    relax.parameters.restitution = relax.parameters.wall_restitution = 0.05;
-    relax.parameters.time_step_s = 0.0;
-    // The placement is not part of the dynamics: relax with velocity Verlet
-    // whatever the run's integrator (Gear's step is ten times shorter).
-    relax.parameters.integrator = engine::Integrator::kVelocityVerlet;
-    for (engine::BodyShape& s : relax.shapes) {
-      for (Vec2& v : s.vertices) v *= scale;
-      s.radius_m *= scale;
-    }
-    for (std::size_t i = 0; i < count; ++i) {
-      relax.people[i].position_m = position[i];
-      relax.people[i].angle_rad = angle[i];
-    }
-    std::optional<engine::Simulation> relaxing;
-    try {
-      relaxing.emplace(relax);
-    } catch (const engine::SimulationError& e) {
-      throw InputError(scenario.file.string() + ": /population: placement failed while relaxing: " + e.what());
-    }
-    engine::Simulation& sim = *relaxing;
-    const bool last = stage == stages;
-    const double goal = last ? tolerance : std::max(tolerance, 0.02 * scale);
-    // Budgets in simulated time, so that the placement does not depend on
-    // the step the engine chooses: quench every 5 ms, judge progress every
-    // 0.25 s, at most 5 s for the full size (0.8 s for a growing stage).
-    const double h = sim.time_step_s();
-    const int quench_steps = std::max(1, static_cast<int>(std::lround(0.005 / h)));
-    const int window_quenches = std::max(1, static_cast<int>(std::lround(0.25 / (quench_steps * h))));
-    const int budget_quenches = static_cast<int>(std::lround((last ? 5.0 : 0.8) / (quench_steps * h)));
-    int steps = 0;
-    residual = MaxOverlap(sim);
-    // Quenched relaxation; give up early once the largest overlap stops
-    // falling (a jammed packing), judged over the windows.
-    double window_start = residual;
-    for (int quench = 1; residual > goal && quench <= budget_quenches; ++quench) {
-      try {
-        for (int k = 0; k < quench_steps; ++k) sim.Step();
-      } catch (const engine::SimulationError& e) {
-        throw InputError(scenario.file.string() + ": /population: placement failed while relaxing (the density may be too high): " +
-                         e.what());
-      }
-      steps += quench_steps;
-      sim.Quench();
-      residual = MaxOverlap(sim);
-      if (quench % window_quenches == 0) {
-        if (residual > 0.95 * window_start) break;
-        window_start = residual;
-      }
-    }
-    built.relaxation_steps += static_cast<std::size_t>(steps);
-    for (std::size_t i = 0; i < count; ++i) {
-      position[i] = sim.bodies().position_m[i];
-      angle[i] = sim.bodies().angle_rad[i];
-    }
-    say("placement stage " + std::to_string(stage) + "/" + std::to_string(stages) + ": size x" +
-        FormatNumber(scale) + ", largest overlap " + FormatNumber(residual) + " m after " + std::to_string(steps) +
-        " relaxation steps");
-  }
+  const Relaxation relaxed = GrowAndRelax(def, placement, scale, tolerance, scenario.file.string(), say);
+  const double residual = relaxed.residual;
+  built.relaxation_steps += relaxed.steps;
+  const std::vector<Vec2>& position = placement.position;
+  const std::vector<double>& angle = placement.angle;
   if (residual > tolerance)
     throw InputError(scenario.file.string() + ": /population: " + std::to_string(count) + " people (" +
                      FormatNumber(double(count) / built.placement_area_m2) + " /m^2) cannot be placed: after relaxation the largest overlap is " +
                      FormatNumber(residual) + " m, above the tolerance " + FormatNumber(tolerance) +
                      " m (/population/placement/max_overlap_m); the crowd is jammed at this density");
-  for (const geometry::Exit& exit : venue.exits) (void)exit;
   for (std::size_t i = 0; i < count; ++i) {
     def.people[i].position_m = position[i];
     def.people[i].angle_rad = angle[i];

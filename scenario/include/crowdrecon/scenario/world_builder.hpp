@@ -15,11 +15,13 @@
 #pragma once
 
 #include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "crowdrecon/engine/world.hpp"
 #include "crowdrecon/geometry/population.hpp"
+#include "crowdrecon/geometry/triangulation.hpp"
 #include "crowdrecon/scenario/scenario.hpp"
 
 namespace crowdrecon::scenario {
@@ -32,6 +34,37 @@ struct BuiltWorld {
   double max_initial_overlap_m = 0.0;     // after relaxation
   std::size_t relaxation_steps = 0;
 };
+
+// Placement, in three named steps that BuildWorld runs in turn (and that the
+// incident timeline's arrivals reuse).
+struct Placement {
+  std::vector<Vec2> position;  // per person of the WorldDef, centres
+  std::vector<double> angle;   // orientations (rad)
+};
+// 1. Random sequential placement of every person of `def` (its shapes at
+//    `scale` of full size, `max_bound` the largest body reach at full size)
+//    at uniformly random points of `regions` (total area_m2), facing their
+//    target's direction, without touching a wall or anyone placed before
+//    (the engine's narrow phase; periodic images near a seam). Draws from
+//    `rng`. Throws InputError (naming `origin`, /population) when a person
+//    finds no free place: a wall in every place tried, or a density too high.
+Placement PlaceSequentially(const engine::WorldDef& def, const std::vector<geometry::AreaTriangulation>& regions,
+                            double area_m2, double scale, double max_bound, Vec2 lo, Vec2 hi, std::mt19937_64& rng,
+                            const std::string& origin);
+// 2. Numbers people along a Hilbert curve through their places (the box
+//    [lo, hi]): def.people, def.shapes (one per person) and the placement
+//    are reordered together.
+void NumberAlongCurve(engine::WorldDef& def, Placement& placement, Vec2 lo, Vec2 hi);
+// 3. Grows the bodies from `initial_scale` to full size in stages, each
+//    followed by a passive, quenched relaxation, until the largest overlap is
+//    at most `tolerance` (or stops falling). Returns the largest overlap left
+//    and the relaxation steps taken; `say` receives a line per stage.
+struct Relaxation {
+  double residual = 0.0;
+  std::size_t steps = 0;
+};
+Relaxation GrowAndRelax(const engine::WorldDef& def, Placement& placement, double initial_scale, double tolerance,
+                        const std::string& origin, const std::function<void(const std::string&)>& say);
 
 // `progress` (optional) receives short status lines.
 BuiltWorld BuildWorld(const Scenario& scenario, int threads,
