@@ -12,6 +12,7 @@
 #include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/navigation.hpp"
+#include "crowdrecon/geometry/capacity.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/viz/draw_venue.hpp"
 
@@ -20,13 +21,6 @@ namespace crowdrecon::cli {
 namespace {
 
 namespace geo = crowdrecon::geometry;
-
-// Densities for the capacity line (persons per m^2): 4.7 is the UK maximum
-// for standing terraces after Hillsborough, 6 is beyond Fruin's 5.6 /m^2
-// threshold of dangerous crowd forces (docs/venues.md; docs/decisions.md,
-// "Facts from other sources").
-constexpr double kGuidanceDensity = 4.7;
-constexpr double kDangerDensity = 6.0;
 
 std::string Fixed(double value, int decimals) {
   char buffer[64];
@@ -101,8 +95,9 @@ void RunCheck(const CheckArgs& args) {
                 v.slope->enabled ? "enabled" : "disabled");
   else
     std::printf("  slope: none (level floor)\n");
-  std::printf("  capacity: %.0f persons at %.1f /m2, %.0f at %.1f /m2\n", std::floor(area * kGuidanceDensity),
-              kGuidanceDensity, std::floor(area * kDangerDensity), kDangerDensity);
+  const geo::Capacity capacity = geo::VenueCapacity(v);
+  std::printf("  capacity: %.0f persons at %.1f /m2, %.0f at %.1f /m2\n", capacity.at_guidance,
+              geo::kGuidanceDensity_per_m2, capacity.at_danger, geo::kDangerDensity_per_m2);
 
   if (!args.picture.empty()) {
     viz::VenuePictureOptions picture;
