@@ -53,7 +53,7 @@ endfunction()
 # Optimisation of the hot code. The presets compile the project's glue
 # (command line, tests, sweeps, analysis, pictures) at a cheaper level and the
 # code where runs and tests spend their time (the engine, the geometry
-# kernels) at CROWDRECON_HOT_FLAGS: release -O2 / -O3, sanitize -O0 / -O1.
+# kernels, the JSON parsing of common) at CROWDRECON_HOT_FLAGS: release -O2 / -O3, sanitize -O0 / -O1.
 # The results do not depend on it: no -ffast-math anywhere, no contraction.
 set(CROWDRECON_HOT_FLAGS "" CACHE STRING "Compiler flags for the hot libraries (engine, geometry), after the build type's")
 function(crowdrecon_hot_code target)

@@ -192,14 +192,9 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   in_->wall_restitution_factor = RestitutionDampingFactor(def_.parameters.wall_restitution);
 
   dt_estimate_ = EstimateTimeStep(def_);
-  if (def_.parameters.time_step_s > dt_estimate_.stability_limit_s)
-    throw InputError("time_step_s = " + FormatNumber(def_.parameters.time_step_s) +
-                     " s is above the stability limit of the " +
-                     ToString(def_.parameters.integrator) + " integrator, " +
-                     FormatNumber(dt_estimate_.stability_limit_s) +
-                     " s, for the stiffest contact (omega_max = " +
-                     FormatNumber(dt_estimate_.omega_max_rad_per_s) +
-                     " rad/s); use a smaller step or 0 for automatic");
+  if (const std::string unstable = TimeStepAboveLimit(def_.parameters.time_step_s, def_.parameters.integrator, dt_estimate_);
+      !unstable.empty())
+    throw InputError("time_step_s: " + unstable);
   dt_s_ = dt_estimate_.chosen_s;
 
   if (def_.device == ComputeDevice::kCuda)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 
 namespace crowdrecon::engine {
@@ -113,6 +114,14 @@ double RestitutionErrorAtStep(const WorldDef& def, double time_step_s) {
     worst = std::max(worst, std::abs(restitution / def.parameters.restitution - 1.0));
   }
   return worst;
+}
+
+std::string TimeStepAboveLimit(double time_step_s, Integrator integrator, const TimeStepEstimate& estimate) {
+  if (!(time_step_s > estimate.stability_limit_s)) return "";
+  return FormatNumber(time_step_s) + " s is above the stability limit of the " + ToString(integrator) +
+         " integrator for these bodies, " + FormatNumber(estimate.stability_limit_s) + " s (omega_max = " +
+         FormatNumber(estimate.omega_max_rad_per_s) + " rad/s, set by " + estimate.limited_by +
+         "); give a smaller step, or 0 to let the engine choose";
 }
 
 }  // namespace crowdrecon::engine

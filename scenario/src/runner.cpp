@@ -193,12 +193,10 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   std::string step_warning;
   {
     const engine::TimeStepEstimate estimate = engine::EstimateTimeStep(built.world);
-    if (scenario.model.time_step_s > estimate.stability_limit_s)
-      throw InputError(scenario.file.string() + ": /model/time_step_s: " + FormatNumber(scenario.model.time_step_s) +
-                       " s is above the stability limit of the " + engine::ToString(scenario.model.integrator) +
-                       " integrator for these bodies, " + FormatNumber(estimate.stability_limit_s) +
-                       " s (omega_max = " + FormatNumber(estimate.omega_max_rad_per_s) + " rad/s, set by /model/" +
-                       estimate.limited_by + "); give a smaller step, or 0 to let the engine choose");
+    if (const std::string unstable =
+            engine::TimeStepAboveLimit(scenario.model.time_step_s, scenario.model.integrator, estimate);
+        !unstable.empty())
+      throw InputError(scenario.file.string() + ": /model/time_step_s: " + unstable);
     const double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
     built.world.parameters.time_step_s = frame_dt / steps;
     step_warning = TimeStepWarning(scenario, built.world, estimate);

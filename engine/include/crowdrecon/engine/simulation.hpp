@@ -182,6 +182,11 @@ bool CudaAvailable(std::string* why = nullptr);
 
 // Time-step estimate for a world (used by the constructor; exposed for tests).
 TimeStepEstimate EstimateTimeStep(const WorldDef& def);
+// "" if `time_step_s` is within the integrator's stability limit, else why
+// not ("0.02 s is above the stability limit of the velocity_verlet
+// integrator ...; give a smaller step, or 0 ..."): the one message of the
+// engine and of the scenario runner, which prefix it with where the step was given.
+std::string TimeStepAboveLimit(double time_step_s, Integrator integrator, const TimeStepEstimate& estimate);
 
 // The error of the restitution that the integrator gives, at `time_step_s`,
 // to a collision in the stiffest contact mode of `def` (|eps_measured / eps
