@@ -199,7 +199,7 @@ def write_json(path, data):
 def default_json_path(kind, stamp, label):
     safe = re.sub(r"[^A-Za-z0-9._-]+", "-", label).strip("-") if label else ""
     name = f"{stamp.strftime('%Y%m%d-%H%M%S')}-{kind}" + (f"-{safe}" if safe else "") + ".json"
-    return BENCH / "results" / name
+    return ROOT / "results" / "bench" / name
 
 
 def header_lines(command, started, load_before, load_after, extra=()):

@@ -12,7 +12,7 @@ Python loop started before the run and stopped after it. The table gives
 median wall seconds per run, their spread, and the ratios that the hardening
 issue asks for: busy 2 threads / busy 1 thread (must stay <= 1.5), and idle
 2 threads with the governor / without it (must stay ~1). Writes its raw data
-to bench/results/ and a section of bench/RESULTS.md (bench_common)."""
+to results/bench/ and a section of bench/RESULTS.md (bench_common)."""
 
 import argparse
 import json

@@ -12,7 +12,7 @@ and reports per build the median engine time (the engine's stage timers),
 loop time (steps and writing every frame with its contacts) and real-time
 factor, and the ratio of the medians of the first build over the others,
 with the median of the per-repetition ratios (paired, so less sensitive to
-drift). Raw results to bench/results/DATE-compare[-LABEL].json; a section in
+drift). Raw results to results/bench/DATE-compare[-LABEL].json; a section in
 bench/RESULTS.md unless --no-results-md.
 
 Example:

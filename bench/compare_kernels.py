@@ -13,7 +13,7 @@ sensitive to the drift of a shared machine). A developed-crowd benchmark
 walks its crowd for 5 simulated seconds before it measures, in every run:
 the builds compared must give the same results for their timings to measure
 the same work (compare the contacts column). Raw results to
-bench/results/DATE-kernels-compare[-LABEL].json; a section in
+results/bench/DATE-kernels-compare[-LABEL].json; a section in
 bench/RESULTS.md unless --no-results-md.
 
 Example:

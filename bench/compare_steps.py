@@ -15,7 +15,7 @@ count and positions checksum (the same work); the script stops otherwise.
 Reports per build the median wall time per step, its range, and the speed-up
 of the reference build (the first --build) over each other: the ratio of the
 medians, and the median of the per-round ratios (paired). Raw results to
-bench/results/DATE-steps-compare[-LABEL].json; a section in bench/RESULTS.md
+results/bench/DATE-steps-compare[-LABEL].json; a section in bench/RESULTS.md
 unless --no-results-md.
 
 Example (worlds from `crowdrecon_bench_kernels --dump_worlds=build/worlds`):

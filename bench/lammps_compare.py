@@ -126,7 +126,7 @@ def main():
     p.add_argument("--mpirun", default="mpirun", help="MPI launcher (default: %(default)s)")
     p.add_argument("--mpi-args", default="", help="extra launcher arguments, e.g. '--oversubscribe'")
     p.add_argument("--workdir", help="keep the LAMMPS files and logs here (default: a temporary folder)")
-    p.add_argument("--json", help="raw results file (default: bench/results/DATE-lammps[-LABEL].json)")
+    p.add_argument("--json", help="raw results file (default: results/bench/DATE-lammps[-LABEL].json)")
     p.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = p.parse_args()
     if args.repeat < 1 or args.steps < 1:

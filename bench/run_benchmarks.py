@@ -321,7 +321,7 @@ def main():
                    help="kernel benchmark program (default: %(default)s)")
     p.add_argument("--filter", help="--kernels: Google Benchmark filter (regular expression)")
     p.add_argument("--min-time", help="--kernels: --benchmark_min_time (seconds per benchmark)")
-    p.add_argument("--json", help="raw results file (default: bench/results/DATE-KIND[-LABEL].json)")
+    p.add_argument("--json", help="raw results file (default: results/bench/DATE-KIND[-LABEL].json)")
     p.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = p.parse_args()
     if args.repeat < 1:

@@ -42,7 +42,7 @@ void RunCheck(const CheckArgs& args) {
   const geo::Venue v = geo::LoadVenue(args.file);
   geo::NavigationOptions nav;
   nav.grid_spacing_m = args.grid_spacing_m;
-  nav.Validate();
+  if (std::string error; !nav.IsValid(&error)) throw InputError("navigation: " + error);
 
   const double area = geo::WalkableArea_m2(v);
   std::printf("venue: %s  [%s]\n", v.metadata.name.c_str(), args.file.c_str());

@@ -32,9 +32,9 @@ echo "== Rendering the hallway run (every other frame, as PNG and as a real-time
 echo "== Analysis of the hallway run (regime, flows, lanes, loads against 400 N)"
 "$exe" analyze "$out/hallway/run.sqlite" --json "$out/hallway/analysis.json" | tee "$out/hallway/analysis.txt"
 
-echo "== Phase diagrams of the shipped Madrid Arena sweeps (venues/madrid-arena/sweeps/results/)"
+echo "== Phase diagrams of the shipped Madrid Arena sweeps (results/sweeps/madrid-arena/)"
 for sweep in hallway-bodies hallway-gamma hallway-lambda; do
-  "$exe" phase "venues/madrid-arena/sweeps/results/$sweep" -o "$out/phase/$sweep" | tail -n 1
+  "$exe" phase "results/sweeps/madrid-arena/$sweep" -o "$out/phase/$sweep" | tail -n 1
 done
 
 echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), phase/"

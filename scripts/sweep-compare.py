@@ -5,7 +5,7 @@ Compares, run by run, the rows of sweep results (results.sqlite written by
 `crowdrecon sweep`) that share a seed and the values of the diagram axes:
 variant B minus variant A, averaged over the selected points, with the
 standard error over the paired differences. Used for the readings in
-venues/madrid-arena/sweeps/results/README.md.
+results/sweeps/madrid-arena/README.md.
 
 usage: sweep-compare.py A_DIR:VARIANT B_DIR:VARIANT [--metric M]
                         [--min-y Y] [--max-y Y] [--min-x X] [--max-x X]

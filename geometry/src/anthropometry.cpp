@@ -61,30 +61,38 @@ std::int64_t ParseInteger(const std::string& text, const std::string& where, con
 
 std::string ToString(Sex sex) { return sex == Sex::kFemale ? "female" : "male"; }
 
-std::string ThoraxDimensions::Validate() const {
-  const auto bad = [](double v) { return !std::isfinite(v) || v <= 0.0 || v > 2.0; };
-  if (bad(chest_breadth_m)) return "chest breadth (" + FormatNumber(chest_breadth_m) + " m) out of (0, 2]";
-  if (bad(chest_depth_m)) return "chest depth (" + FormatNumber(chest_depth_m) + " m) out of (0, 2]";
-  if (bad(biacromial_breadth_m))
-    return "biacromial breadth (" + FormatNumber(biacromial_breadth_m) + " m) out of (0, 2]";
-  if (bad(bideltoid_breadth_m))
-    return "bideltoid breadth (" + FormatNumber(bideltoid_breadth_m) + " m) out of (0, 2]";
-  if (bideltoid_breadth_m <= chest_breadth_m)
-    return "bideltoid breadth (" + FormatNumber(bideltoid_breadth_m) +
-           " m) is not larger than the chest breadth (" + FormatNumber(chest_breadth_m) +
-           " m); expected the arms to stick out";
-  return "";
+bool ThoraxDimensions::IsValid(std::string* error) const {
+  const std::string problem = [&]() -> std::string {
+    const auto bad = [](double v) { return !std::isfinite(v) || v <= 0.0 || v > 2.0; };
+    if (bad(chest_breadth_m)) return "chest breadth (" + FormatNumber(chest_breadth_m) + " m) out of (0, 2]";
+    if (bad(chest_depth_m)) return "chest depth (" + FormatNumber(chest_depth_m) + " m) out of (0, 2]";
+    if (bad(biacromial_breadth_m))
+      return "biacromial breadth (" + FormatNumber(biacromial_breadth_m) + " m) out of (0, 2]";
+    if (bad(bideltoid_breadth_m))
+      return "bideltoid breadth (" + FormatNumber(bideltoid_breadth_m) + " m) out of (0, 2]";
+    if (bideltoid_breadth_m <= chest_breadth_m)
+      return "bideltoid breadth (" + FormatNumber(bideltoid_breadth_m) +
+             " m) is not larger than the chest breadth (" + FormatNumber(chest_breadth_m) +
+             " m); expected the arms to stick out";
+    return "";
+  }();
+  if (!problem.empty() && error) *error = problem;
+  return problem.empty();
 }
 
-std::string ThoraxModel::Validate() const {
-  if (!(superellipse_exponent >= 1.0 && superellipse_exponent <= 10.0))
-    return "superellipse exponent (" + FormatNumber(superellipse_exponent) + ") out of [1, 10]";
-  if (!(arm_overlap_m > 0.0 && arm_overlap_m < 1.0))
-    return "arm overlap (" + FormatNumber(arm_overlap_m) + " m) out of (0, 1)";
-  if (!(arm_depth_fraction > 0.0 && arm_depth_fraction <= 1.0))
-    return "arm depth fraction (" + FormatNumber(arm_depth_fraction) + ") out of (0, 1]";
-  if (samples_per_shape < 16) return "samples per shape (" + std::to_string(samples_per_shape) + ") < 16";
-  return "";
+bool ThoraxModel::IsValid(std::string* error) const {
+  const std::string problem = [&]() -> std::string {
+    if (!(superellipse_exponent >= 1.0 && superellipse_exponent <= 10.0))
+      return "superellipse exponent (" + FormatNumber(superellipse_exponent) + ") out of [1, 10]";
+    if (!(arm_overlap_m > 0.0 && arm_overlap_m < 1.0))
+      return "arm overlap (" + FormatNumber(arm_overlap_m) + " m) out of (0, 1)";
+    if (!(arm_depth_fraction > 0.0 && arm_depth_fraction <= 1.0))
+      return "arm depth fraction (" + FormatNumber(arm_depth_fraction) + ") out of (0, 1]";
+    if (samples_per_shape < 16) return "samples per shape (" + std::to_string(samples_per_shape) + ") < 16";
+    return "";
+  }();
+  if (!problem.empty() && error) *error = problem;
+  return problem.empty();
 }
 
 std::vector<AnsurRecord> ReadAnsurExtract(const std::filesystem::path& file) {
@@ -129,7 +137,7 @@ std::vector<AnsurRecord> ReadAnsurExtract(const std::filesystem::path& file) {
     r.thorax = {mm(2), mm(3), mm(4), mm(5)};
     r.weight_kg = static_cast<double>(ParseInteger(fields[6], where, "weightkg")) / 10.0;  // 0.1 kg units
     r.stature_m = mm(7);
-    if (const std::string error = r.thorax.Validate(); !error.empty())
+    if (std::string error; !r.thorax.IsValid(&error))
       throw InputError(where + ": subject " + std::to_string(r.subject_id) + ": " + error);
     if (!(r.weight_kg > 0.0)) throw InputError(where + ": weightkg must be positive");
     records.push_back(r);
@@ -170,8 +178,8 @@ ThoraxDimensions MedianThoraxDimensions(const std::vector<AnsurRecord>& records,
 }
 
 std::vector<Vec2> ThoraxOutline(const ThoraxDimensions& d, const ThoraxModel& model) {
-  if (const std::string error = d.Validate(); !error.empty()) throw GeometryError("thorax outline: " + error);
-  if (const std::string error = model.Validate(); !error.empty()) throw GeometryError("thorax model: " + error);
+  if (std::string error; !d.IsValid(&error)) throw GeometryError("thorax outline: " + error);
+  if (std::string error; !model.IsValid(&error)) throw GeometryError("thorax model: " + error);
 
   const Superellipse torso{{0, 0}, d.chest_depth_m / 2, d.chest_breadth_m / 2, model.superellipse_exponent};
   // Arm: from y = B/2 - overlap to y = W/2.

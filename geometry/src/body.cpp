@@ -213,28 +213,32 @@ double ExtentAlongAxis(const std::vector<Vec2>& ring, Vec2 axis) {
   return hi - lo;
 }
 
-std::string BodyOptions::Validate() const {
-  if (vertex_count < 3)
-    return "vertex count (" + std::to_string(vertex_count) + ") is too small; expected at least 3";
-  if (vertex_count > 1000)
-    return "vertex count (" + std::to_string(vertex_count) + ") is too large; expected at most 1000";
-  if (!std::isfinite(radius_m) || radius_m <= 0.0)
-    return "sphero-radius (" + FormatNumber(radius_m) + " m) must be positive; expected e.g. 0.05";
-  if (!std::isfinite(presimplify_tolerance_m) || presimplify_tolerance_m < 0.0)
-    return "pre-simplification tolerance (" + FormatNumber(presimplify_tolerance_m) +
-           " m) must be >= 0";
-  if (!std::isfinite(hausdorff_spacing_m) || hausdorff_spacing_m < 0.0)
-    return "Hausdorff sampling spacing (" + FormatNumber(hausdorff_spacing_m) + " m) must be >= 0";
-  if (scale.kind != ScaleRule::Kind::kNone && !(std::isfinite(scale.value) && scale.value > 0.0))
-    return "scale value (" + FormatNumber(scale.value) + ") must be positive";
-  return "";
+bool BodyOptions::IsValid(std::string* error) const {
+  const std::string problem = [&]() -> std::string {
+    if (vertex_count < 3)
+      return "vertex count (" + std::to_string(vertex_count) + ") is too small; expected at least 3";
+    if (vertex_count > 1000)
+      return "vertex count (" + std::to_string(vertex_count) + ") is too large; expected at most 1000";
+    if (!std::isfinite(radius_m) || radius_m <= 0.0)
+      return "sphero-radius (" + FormatNumber(radius_m) + " m) must be positive; expected e.g. 0.05";
+    if (!std::isfinite(presimplify_tolerance_m) || presimplify_tolerance_m < 0.0)
+      return "pre-simplification tolerance (" + FormatNumber(presimplify_tolerance_m) +
+             " m) must be >= 0";
+    if (!std::isfinite(hausdorff_spacing_m) || hausdorff_spacing_m < 0.0)
+      return "Hausdorff sampling spacing (" + FormatNumber(hausdorff_spacing_m) + " m) must be >= 0";
+    if (scale.kind != ScaleRule::Kind::kNone && !(std::isfinite(scale.value) && scale.value > 0.0))
+      return "scale value (" + FormatNumber(scale.value) + ") must be positive";
+    return "";
+  }();
+  if (!problem.empty() && error) *error = problem;
+  return problem.empty();
 }
 
 // --- the pipeline ------------------------------------------------------------
 
 Body BuildBody(const Outline& outline, const BodyOptions& options) {
   const std::string what = outline.source.empty() ? std::string("outline") : outline.source;
-  if (const std::string error = options.Validate(); !error.empty()) throw InputError(what + ": " + error);
+  if (std::string error; !options.IsValid(&error)) throw InputError(what + ": " + error);
   const std::vector<Vec2> points = ValidateOutlineRing(outline.points, what);
   std::vector<std::string> notes = outline.notes;
 

@@ -13,10 +13,11 @@
 
 namespace crowdrecon::geometry {
 
-void NavigationOptions::Validate() const {
-  if (!(grid_spacing_m >= 0.005 && grid_spacing_m <= 10.0))
-    throw InputError("navigation: grid_spacing_m = " + FormatNumber(grid_spacing_m) +
-                     " is out of range; expected a spacing in [0.005, 10] m");
+bool NavigationOptions::IsValid(std::string* error) const {
+  if (grid_spacing_m >= 0.005 && grid_spacing_m <= 10.0) return true;
+  if (error)
+    *error = "grid_spacing_m = " + FormatNumber(grid_spacing_m) + " is out of range; expected a spacing in [0.005, 10] m";
+  return false;
 }
 
 // ---------------------------------------------------------------------------
@@ -130,7 +131,7 @@ NavigationField NavigationField::ForTarget(const Venue& venue, std::string_view 
 
 NavigationField NavigationField::ToExit(const Venue& venue, std::string_view exit_id,
                                         const NavigationOptions& options) {
-  options.Validate();
+  if (std::string error; !options.IsValid(&error)) throw InputError("navigation: " + error);
   const Exit* exit = venue.FindExit(exit_id);
   if (!exit) throw GeometryError(venue.origin + ": no exit named \"" + std::string(exit_id) + "\"");
   const double h = options.grid_spacing_m;

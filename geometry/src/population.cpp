@@ -35,28 +35,32 @@ PopulationMode PopulationModeFromString(const std::string& text, const std::stri
                    "\"; expected paper, anthropometric or circle");
 }
 
-std::string PopulationOptions::Validate() const {
-  if (count < 1 || count > kMaxPeople)
-    return "count (" + std::to_string(count) + ") out of range; expected 1 to " + std::to_string(kMaxPeople) +
-           " (check the count)";
-  if (!(mass_min_kg > 0.0 && mass_min_kg <= mass_max_kg && std::isfinite(mass_max_kg)))
-    return "mass range [" + FormatNumber(mass_min_kg) + ", " + FormatNumber(mass_max_kg) +
-           "] kg; expected 0 < min <= max";
-  if (!(density_kg_m2 > 0.0 && std::isfinite(density_kg_m2)))
-    return "density (" + FormatNumber(density_kg_m2) + " kg/m^2) must be positive";
-  if (!(female_fraction >= 0.0 && female_fraction <= 1.0))
-    return "female fraction (" + FormatNumber(female_fraction) + ") out of range; expected 0 to 1";
-  if (vertex_count < 3)
-    return "vertex count (" + std::to_string(vertex_count) + ") is too small; expected at least 3";
-  if (!(radius_m > 0.0 && std::isfinite(radius_m)))
-    return "sphero-radius (" + FormatNumber(radius_m) + " m) must be positive";
-  return thorax.Validate();
+bool PopulationOptions::IsValid(std::string* error) const {
+  const std::string problem = [&]() -> std::string {
+    if (count < 1 || count > kMaxPeople)
+      return "count (" + std::to_string(count) + ") out of range; expected 1 to " + std::to_string(kMaxPeople) +
+             " (check the count)";
+    if (!(mass_min_kg > 0.0 && mass_min_kg <= mass_max_kg && std::isfinite(mass_max_kg)))
+      return "mass range [" + FormatNumber(mass_min_kg) + ", " + FormatNumber(mass_max_kg) +
+             "] kg; expected 0 < min <= max";
+    if (!(density_kg_m2 > 0.0 && std::isfinite(density_kg_m2)))
+      return "density (" + FormatNumber(density_kg_m2) + " kg/m^2) must be positive";
+    if (!(female_fraction >= 0.0 && female_fraction <= 1.0))
+      return "female fraction (" + FormatNumber(female_fraction) + ") out of range; expected 0 to 1";
+    if (vertex_count < 3)
+      return "vertex count (" + std::to_string(vertex_count) + ") is too small; expected at least 3";
+    if (!(radius_m > 0.0 && std::isfinite(radius_m)))
+      return "sphero-radius (" + FormatNumber(radius_m) + " m) must be positive";
+    std::string thorax_error;
+    return thorax.IsValid(&thorax_error) ? std::string() : thorax_error;
+  }();
+  if (!problem.empty() && error) *error = problem;
+  return problem.empty();
 }
 
 Population MakePopulation(const PopulationOptions& options, const Spheropolygon& reference,
                           const std::vector<AnsurRecord>& records) {
-  if (const std::string error = options.Validate(); !error.empty())
-    throw InputError("population: " + error);
+  if (std::string error; !options.IsValid(&error)) throw InputError("population: " + error);
   Population population{options, {}, 0, 0};
   population.people.reserve(options.count);
   std::mt19937_64 rng(options.seed);

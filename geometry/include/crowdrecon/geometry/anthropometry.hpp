@@ -26,7 +26,8 @@ struct ThoraxDimensions {
   double bideltoid_breadth_m = 0.0;   // across the deltoid muscles: the widest point
 
   // Empty if usable for ThoraxOutline, else a message naming the bad value.
-  std::string Validate() const;
+  // false (and *error: what is wrong, what was expected) if a value is out of range.
+  bool IsValid(std::string* error) const;
 };
 
 struct AnsurRecord {
@@ -66,7 +67,8 @@ struct ThoraxModel {
   double arm_depth_fraction = 0.6;     // arm depth / chest depth
   std::size_t samples_per_shape = 240; // boundary points per piece (1.5 degree steps)
 
-  std::string Validate() const;
+  // false (and *error: what is wrong, what was expected) if a value is out of range.
+  bool IsValid(std::string* error) const;
 };
 
 // Boundary of the union, counter-clockwise, body frame (front +x, centred on

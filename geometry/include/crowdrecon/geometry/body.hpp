@@ -77,7 +77,8 @@ struct BodyOptions {
   bool shrink_radius_to_keep_one_piece = false;
 
   // Empty if valid, else a message naming the bad field and value.
-  std::string Validate() const;
+  // false (and *error: what is wrong, what was expected) if a value is out of range.
+  bool IsValid(std::string* error) const;
 };
 
 struct Body {

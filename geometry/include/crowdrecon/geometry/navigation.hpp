@@ -34,7 +34,8 @@ struct NavigationOptions {
   double grid_spacing_m = 0.1;
 
   // Throws InputError naming the option if a value is out of range.
-  void Validate() const;
+  // false (and *error: what is wrong, what was expected) if a value is out of range.
+  bool IsValid(std::string* error) const;
 };
 
 class NavigationField {

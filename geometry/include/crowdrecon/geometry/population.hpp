@@ -61,7 +61,8 @@ struct PopulationOptions {
   ThoraxModel thorax;
 
   // Empty if valid, else a message naming the bad field and value.
-  std::string Validate() const;
+  // false (and *error: what is wrong, what was expected) if a value is out of range.
+  bool IsValid(std::string* error) const;
 };
 
 struct Person {
