@@ -6,17 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include "scratch.hpp"
+
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/body.hpp"
 
 namespace crowdrecon::geometry {
 namespace {
 
-std::filesystem::path Scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "crowdrecon_test_body_json";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
 
 Body SquareBody() {
   Outline outline;

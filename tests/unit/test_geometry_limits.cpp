@@ -9,6 +9,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "scratch.hpp"
 #include <opencv2/imgcodecs.hpp>
 
 #include "test_util.hpp"
@@ -26,11 +28,7 @@ using testing_util::ErrorOf;
 
 bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-std::filesystem::path Scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "crowdrecon_test_geometry_limits";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
 
 double BruteForceHausdorff(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
   const auto directed = [](const std::vector<Vec2>& from, const std::vector<Vec2>& to) {

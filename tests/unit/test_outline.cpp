@@ -6,6 +6,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "scratch.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -23,11 +25,7 @@ const std::string kData = std::string(CROWDRECON_SOURCE_DIR) + "/tests/data/bodi
 constexpr double kA = 0.25, kB = 0.15;  // semi-axes, m: across the shoulders, front-back
 const double kEllipseArea = std::numbers::pi * kA * kB;
 
-std::filesystem::path Scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "crowdrecon_test_outline";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
 
 // The ellipse drawn dark on white at 1000 px/m, front (+y, semi-axis kB) up,
 // with 1/16 px precision. Not anti-aliased: OpenCV draws a filled LINE_AA

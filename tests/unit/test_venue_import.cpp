@@ -2,6 +2,8 @@
 // the same walkable area; curves, units, layers and bad inputs.
 #include <gtest/gtest.h>
 
+#include "scratch.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -26,11 +28,7 @@ using testing_util::ErrorOf;
 
 const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
 
-std::filesystem::path TempFile(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "crowdrecon_test_venue_import";
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
+std::filesystem::path TempFile(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
 
 // --- DXF text ------------------------------------------------------------
 
