@@ -57,8 +57,8 @@ ParameterInfo Choice(const char* name, const char* const (&choices)[N], const ch
   return info;
 }
 
-std::array<ParameterInfo, 18> MakeTable() {
-  std::array<ParameterInfo, 18> t{
+auto MakeTable() {
+  return std::array{
       // --- Contact forces (eqs. 7-14, 19) ---
       Number("normal_stiffness_n_per_m", &P::normal_stiffness_n_per_m, "N/m", 1.0, 1e9, "Table 1",
              "k_n, normal stiffness of contacts (thorax deformation data)"),
@@ -102,13 +102,12 @@ std::array<ParameterInfo, 18> MakeTable() {
       Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
              "the engine's step as a fraction of the integrator's stability limit"),
   };
-  return t;
 }
 
 }  // namespace
 
 std::span<const ParameterInfo> ModelParameterTable() {
-  static const std::array<ParameterInfo, 18> table = MakeTable();
+  static const auto table = MakeTable();
   return table;
 }
 

@@ -55,6 +55,7 @@ class PairCollider {
         chunks_(person_chunks_ + (in.wall_pairs.size() + kChunk - 1) / kChunk) {}
 
   std::size_t person_chunks() const { return person_chunks_; }
+  const ContactLaw& law() const { return law_; }
   std::size_t chunks() const { return chunks_; }
 
   // One chunk: its contacts appended to `out`, in pair order. Returns true if
@@ -208,7 +209,7 @@ void Simulation::Collide() {
   ContactLaw wall_law = law;
   wall_law.damping_factor = in.wall_restitution_factor;
   const PairCollider collider(bodies_, in, def_.periodic, law, wall_law);
-  if (in.cuda && CollideOnDevice(collider, law)) return;
+  if (in.cuda && CollideOnDevice(collider)) return;
   if (def_.threads == 1 || collider.chunks() < 4) {
     // On one thread the chunks come in order: straight into the contact list,
     // which is then what the concatenation of CollideOnThreads would make.
@@ -229,7 +230,7 @@ void Simulation::Collide() {
 // the processor (they follow the person pairs in the contact list). False if
 // the device failed: it is then dropped, and the processor computes this
 // evaluation and the following ones, with the same results.
-bool Simulation::CollideOnDevice(const PairCollider& collider, const ContactLaw& law) {
+bool Simulation::CollideOnDevice(const PairCollider& collider) {
   Internals& in = *in_;
   cuda::CollideInput input;
   input.n = bodies_.size();
@@ -246,7 +247,7 @@ bool Simulation::CollideOnDevice(const PairCollider& collider, const ContactLaw&
   input.pair_generation = profile_.pair_rebuilds;
   input.previous = &in.previous_contacts;
   input.previous_is_last_output = in.cuda_has_history;
-  input.law = law;
+  input.law = collider.law();
   contacts_.clear();
   bool overlap_beyond = false;
   try {

@@ -271,14 +271,13 @@ Relaxation GrowAndRelax(const engine::WorldDef& def, Placement& placement, doubl
                         const std::string& origin, const std::function<void(const std::string&)>& say) {
   // Grow to full size in stages with a passive, quenched relaxation after each.
   const int stages = initial_scale < 1.0 ? 8 : 1;
-  const double s0 = initial_scale;
   Relaxation result;
   double& residual = result.residual;
   std::vector<Vec2>& position = placement.position;
   std::vector<double>& angle = placement.angle;
   const std::size_t count = def.people.size();
   for (int stage = 1; stage <= stages; ++stage) {
-    const double scale = stages == 1 ? 1.0 : s0 + (1.0 - s0) * stage / stages;
+    const double scale = stages == 1 ? 1.0 : initial_scale + (1.0 - initial_scale) * stage / stages;
     engine::WorldDef relax = def;
     relax.parameters.ground_reaction = false;
     relax.parameters.restitution = relax.parameters.wall_restitution = 0.05;

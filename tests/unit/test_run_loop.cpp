@@ -18,6 +18,7 @@ class Recorder : public RunSystem {
  public:
   Recorder(std::string name, std::vector<std::string>& log) : name_(std::move(name)), log_(log) {}
   std::string_view name() const override { return name_; }
+  bool acts_every_step() const override { return true; }
   void BeforeStep(engine::Simulation& sim) override { log_.push_back(name_ + ":before@" + std::to_string(sim.step_count())); }
   void AfterStep(engine::Simulation& sim) override { log_.push_back(name_ + ":after@" + std::to_string(sim.step_count())); }
   void AtFrame(FrameContext& c) override {

@@ -74,7 +74,6 @@ class SimulationError : public std::runtime_error {
 
 namespace detail {
 class PairCollider;  // engine/src/stage_collide.cpp
-struct ContactLaw;   // engine/src/contact_law.hpp
 }  // namespace detail
 
 class Simulation {
@@ -151,7 +150,7 @@ class Simulation {
   void Collide();
   // The collide stage's other two ways: person pairs on the CUDA device, and
   // several threads with work stealing (stage_collide.cpp).
-  bool CollideOnDevice(const detail::PairCollider& collider, const detail::ContactLaw& law);
+  bool CollideOnDevice(const detail::PairCollider& collider);
   void CollideOnThreads(const detail::PairCollider& collider);
   friend class detail::PairCollider;
   void Gather();

@@ -12,9 +12,7 @@ namespace crowdrecon::geometry {
 
 // UK guidance after Hillsborough: the maximum for standing terraces.
 inline constexpr double kGuidanceDensity_per_m2 = 4.7;
-// Fruin: dangerous crowd forces from 5.6 /m^2 in a moving crowd; the capacity
-// line quotes 6, just beyond it.
-inline constexpr double kFruinDangerousDensity_per_m2 = 5.6;
+// Just beyond Fruin's 5.6 /m^2, where a moving crowd's forces become dangerous.
 inline constexpr double kDangerDensity_per_m2 = 6.0;
 
 struct Capacity {

@@ -43,6 +43,9 @@ class RunSystem {
  public:
   virtual ~RunSystem() = default;
   virtual std::string_view name() const = 0;
+  // True if BeforeStep or AfterStep act: only such systems are called around
+  // the engine steps (the per-frame ones cost the step loop nothing).
+  virtual bool acts_every_step() const { return false; }
   // Around every engine step.
   virtual void BeforeStep(engine::Simulation&) {}
   virtual void AfterStep(engine::Simulation&) {}
@@ -86,6 +89,7 @@ class RunLoop {
   engine::Simulation& sim_;
   Options options_;
   std::vector<std::unique_ptr<RunSystem>> systems_;
+  std::vector<std::size_t> step_systems_;  // indices of those that act every step
   Summary summary_;
 };
 
