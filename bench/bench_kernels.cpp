@@ -32,7 +32,7 @@
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
 #include "crowdrecon/geometry/body.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 
 namespace crowdrecon::bench {
 
@@ -244,15 +244,15 @@ void FrameWrite(benchmark::State& state, const std::string& world) {
   sim.LoadState(WarmState(world));
   const std::filesystem::path file =
       std::filesystem::temp_directory_path() / ("crowdrecon-bench-frames-" + world + ".sqlite");
-  scenario::RunHeader header;
+  runfile::RunHeader header;
   header.scenario_json = "{}";
   header.walkable_wkt = CachedWorld(world).walkable_wkt;
   header.time_step_s = sim.time_step_s();
   std::int64_t frame = 0;
   {
-    scenario::RunFileWriter writer = scenario::RunFileWriter::Create(file, header, sim);
-    scenario::FrameSnapshot snapshot;
-    snapshot.Take(0, sim, {}, true);
+    runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
+    runfile::FrameSnapshot snapshot;
+    scenario::TakeSnapshot(sim, 0, {}, true, &snapshot);
     for (auto _ : state) {
       snapshot.frame = frame++;
       writer.WriteFrame(snapshot);

@@ -11,7 +11,7 @@
 #include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 
 namespace crowdrecon::cli {
@@ -32,7 +32,7 @@ struct SimulateArgs {
 
 int RunSimulate(const SimulateArgs& args) {
   const scenario::Scenario sc = scenario::LoadScenario(args.scenario);
-  CheckOutputs({{"-o", args.output, scenario::RunFileOutput()}},
+  CheckOutputs({{"-o", args.output, runfile::RunFileOutput()}},
                {{"the scenario", sc.file},
                 {"the venue", sc.venue_file},
                 {"the reference body", sc.population.reference_body},

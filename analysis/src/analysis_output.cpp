@@ -6,7 +6,7 @@
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/scenario/sqlite.hpp"
+#include "crowdrecon/runfile/sqlite.hpp"
 
 namespace crowdrecon::analysis {
 

@@ -3,43 +3,11 @@
 #include <cmath>
 #include <limits>
 
-#include <nlohmann/json.hpp>
-
 #include "crowdrecon/common/error.hpp"
 
 namespace crowdrecon::analysis {
 
-Vec2 Periodicity::MinimumImage(Vec2 d_m) const {
-  if (x) {
-    const double l = max_m.x - min_m.x;
-    d_m.x -= l * std::round(d_m.x / l);
-  }
-  if (y) {
-    const double l = max_m.y - min_m.y;
-    d_m.y -= l * std::round(d_m.y / l);
-  }
-  return d_m;
-}
-
-Periodicity ParsePeriodicity(const std::string& text, const std::string& origin) {
-  Periodicity box;
-  if (text.empty()) return box;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    box.x = j.value("x", false);
-    box.y = j.value("y", false);
-    box.min_m = {j.at("min_m").at(0).get<double>(), j.at("min_m").at(1).get<double>()};
-    box.max_m = {j.at("max_m").at(0).get<double>(), j.at("max_m").at(1).get<double>()};
-  } catch (const std::exception& e) {
-    throw InputError(origin + ": run value periodic_box is malformed (" + e.what() + "): " + text);
-  }
-  // Only the periodic axes need an extent (the engine leaves the others 0).
-  if ((box.x && !(box.max_m.x > box.min_m.x)) || (box.y && !(box.max_m.y > box.min_m.y)))
-    throw InputError(origin + ": run value periodic_box has max <= min along a periodic axis: " + text);
-  return box;
-}
-
-int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m, const Periodicity& box) {
+int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m, const PeriodicBox& box) {
   const Vec2 along = line.b_m - line.a_m;
   const double along2 = LengthSquared(along);
   if (!(along2 > 0.0)) return 0;
@@ -82,7 +50,7 @@ bool LaneOrderOptions::IsValid(std::string* error) const {
 }
 
 LaneOrderResult LaneOrder(const std::vector<Vec2>& position_m, const std::vector<std::uint32_t>& group,
-                          Vec2 flow_axis, const LaneOrderOptions& options, const Periodicity& box,
+                          Vec2 flow_axis, const LaneOrderOptions& options, const PeriodicBox& box,
                           std::vector<double>* per_person) {
   const std::size_t n = position_m.size();
   if (group.size() != n) throw InputError("LaneOrder: positions and groups differ in number");

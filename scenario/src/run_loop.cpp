@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 
 namespace crowdrecon::scenario {
 

@@ -22,7 +22,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/vec2.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 
 namespace crowdrecon::scenario::detail {
@@ -44,12 +44,14 @@ class WallCheckSystem : public RunSystem {
 
 class FrameOutputSystem : public RunSystem {
  public:
-  FrameOutputSystem(FrameWriterThread& frames, bool with_contacts) : frames_(frames), with_contacts_(with_contacts) {}
+  FrameOutputSystem(runfile::FrameWriterThread& frames, bool with_contacts) : frames_(frames), with_contacts_(with_contacts) {}
   std::string_view name() const override { return "frames"; }
-  void AtFrame(FrameContext& c) override { frames_.Write(c.frame, c.sim, {}, with_contacts_); }
+  void AtFrame(FrameContext& c) override {
+    frames_.Write([&](runfile::FrameSnapshot& f) { TakeSnapshot(c.sim, c.frame, {}, with_contacts_, &f); });
+  }
 
  private:
-  FrameWriterThread& frames_;
+  runfile::FrameWriterThread& frames_;
   bool with_contacts_;
 };
 

@@ -16,7 +16,8 @@
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/thread_governor.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
 #include "run_systems.hpp"
@@ -153,9 +154,9 @@ std::string NothingToResume(const std::filesystem::path& run_file, const Scenari
   std::error_code ec;
   if (!std::filesystem::exists(run_file, ec))
     return file + ": nothing to resume: the run file does not exist; start the run without --resume";
-  if (!IsRunFile(run_file))
+  if (!runfile::IsRunFile(run_file))
     return file + ": nothing to resume: it is " + DescribeExisting(run_file) + ", not a crowdrecon run file";
-  const RunFileReader reader(run_file);
+  const runfile::RunFileReader reader(run_file);
   if (reader.RunValue("scenario") != scenario.json_text)
     return file + ": nothing to resume: the run file was written for a different scenario (" +
            reader.RunValue("scenario_file") + ", or the scenario file changed); start the run without --resume";
@@ -205,10 +206,11 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   built.world.device = options.device;
   engine::Simulation sim(built.world);
 
-  RunHeader header;
+  runfile::RunHeader header;
   header.scenario_json = scenario.json_text;
   header.scenario_origin = scenario.file.string();
   header.walkable_wkt = built.walkable_wkt;
+  header.venue_json = geometry::VenueToJson(scenario.venue);
   header.output_fps = scenario.run.output_fps;
   header.time_step_s = sim.time_step_s();
   header.seed = scenario.population.seed;
@@ -218,7 +220,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
   std::int64_t last_frame = -1;
   std::vector<std::pair<std::string, std::string>> resumed_systems;
-  RunFileWriter writer = [&] {
+  runfile::RunFileWriter writer = [&] {
     std::error_code ec;
     if (options.resume && !std::filesystem::exists(checkpoint, ec)) {
       const std::string why = NothingToResume(options.output, scenario);
@@ -231,10 +233,10 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
       last_frame = c.last_frame;
       resumed_systems = c.systems;
       say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
-      return RunFileWriter::Resume(options.output, last_frame);
+      return runfile::RunFileWriter::Resume(options.output, last_frame);
     }
     std::filesystem::remove(checkpoint, ec);
-    return RunFileWriter::Create(options.output, header, sim);
+    return CreateRunFile(options.output, header, sim);
   }();
   writer.SetRunValue("people", std::to_string(sim.bodies().size()));
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));
@@ -259,9 +261,9 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   // everything that must follow the frames in the file (a checkpoint naming
   // the last frame, an event, the status) waits for them with Flush.
   const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
-  FrameWriterThread frames(writer, core_free);
+  runfile::FrameWriterThread frames(writer, core_free);
   if (last_frame < 0) {
-    frames.Write(0, sim, {}, scenario.run.write_contacts);
+    frames.Write([&](runfile::FrameSnapshot& f) { TakeSnapshot(sim, 0, {}, scenario.run.write_contacts, &f); });
     last_frame = 0;
   }
 

@@ -9,7 +9,7 @@
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/scenario/sqlite.hpp"
+#include "crowdrecon/runfile/sqlite.hpp"
 
 #include "crowdrecon/sweep/version.hpp"  // generated at build time: CROWDRECON_GIT_VERSION
 

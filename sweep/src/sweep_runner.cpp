@@ -300,6 +300,241 @@ std::string SweepSummary::BriefReport() const {
   return r;
 }
 
+namespace {
+
+using Work = std::function<Outcome(std::size_t)>;
+
+// What every rank sets up before any run: the sweep, its runs, every run's
+// scenario checked (so that a bad override stops the sweep before any run),
+// the runs folder; rank 0 also opens the results.
+struct SweepSetup {
+  SweepSpec spec;
+  std::vector<RunPlan> runs;
+  std::unique_ptr<ResultsStore> store;  // rank 0 only
+  fs::path runs_dir;
+  std::exception_ptr error;
+};
+
+// 1. Set-up (its error kept, so that MPI ranks can agree on it first).
+SweepSetup SetUpSweep(const SweepOptions& options, int rank) {
+  SweepSetup setup;
+  setup.runs_dir = options.output_dir / "runs";
+  try {
+    setup.spec = LoadSweep(options.sweep_file);
+    setup.runs = ExpandRuns(setup.spec);
+    ValidateRuns(setup.spec, setup.runs);
+    std::error_code ec;
+    fs::create_directories(setup.runs_dir, ec);
+    if (!fs::is_directory(setup.runs_dir))
+      throw InputError(setup.runs_dir.string() + ": cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+    if (rank == 0)
+      setup.store = std::make_unique<ResultsStore>(options.output_dir, setup.spec, setup.runs, analysis::OptionsToJson({}));
+  } catch (...) {
+    setup.error = std::current_exception();
+  }
+  return setup;
+}
+
+// 2. Under MPI, every rank learns whether all could set up. Every rank reads
+//    the same files, so they usually fail alike: rank 0 reports, the others
+//    stay quiet unless only they failed. False: this rank stops with `s`.
+bool AgreeOnSetUp(MpiTransport& transport, int rank, const std::exception_ptr& error, SweepSummary* s) {
+  if (transport.AllOk(!error)) return true;
+  const bool root_ok = transport.RootOk(!error);
+  if (error && rank == 0) std::rethrow_exception(error);
+  if (error && root_ok) {
+    try {
+      std::rethrow_exception(error);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "crowdrecon: MPI rank %d: %s\n", rank, e.what());
+    }
+  }
+  if (rank == 0) throw InputError("another MPI rank could not start the sweep (its message is above)");
+  s->exit_code = 2;
+  return false;
+}
+
+// SIGINT and SIGTERM stop the sweep after the runs in progress checkpoint;
+// the previous handlers come back when the sweep ends.
+class SweepSignals {
+ public:
+  SweepSignals() : int_(std::signal(SIGINT, OnSweepSignal)), term_(std::signal(SIGTERM, OnSweepSignal)) {}
+  ~SweepSignals() {
+    std::signal(SIGINT, int_);
+    std::signal(SIGTERM, term_);
+  }
+  SweepSignals(const SweepSignals&) = delete;
+  SweepSignals& operator=(const SweepSignals&) = delete;
+
+ private:
+  void (*int_)(int);
+  void (*term_)(int);
+};
+
+// 3a. A worker rank: asks for a run per slot, runs what comes, sends the rows.
+void RunWorkerRank(MpiTransport& transport, int rank, int jobs, const Work& work) {
+  WorkerPool pool(jobs, work);
+  StopRunsOnError stop_on_error;
+  for (int slot = 0; slot < jobs; ++slot) transport.SendToRoot(EncodeWorkerMessage(false, false, std::nullopt));
+  int active_slots = jobs;
+  while (active_slots > 0) {
+    bool acted = false;
+    std::int64_t code = 0;
+    while (transport.PollControl(&code)) {
+      acted = true;
+      if (code == kInterrupt) g_stop.store(true);
+      else if (code == kStopSlot) --active_slots;
+      else if (g_stop.load()) transport.SendToRoot(EncodeWorkerMessage(true, true, std::nullopt));  // declined
+      else pool.Submit(static_cast<std::size_t>(code));
+    }
+    Outcome o;
+    while (pool.TryPop(&o)) {
+      if (o.fatal) {
+        try {
+          std::rethrow_exception(o.fatal);
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "crowdrecon: error on MPI rank %d, run %zu: %s\n", rank, o.index, e.what());
+        }
+        transport.Abort(3);
+      }
+      acted = true;
+      transport.SendToRoot(EncodeWorkerMessage(true, g_stop.load(), o.row));
+    }
+    if (!acted) pool.WaitFor(std::chrono::milliseconds(2));
+  }
+}
+
+// 3b. Rank 0, or the only process: hands out the runs not yet done (to its
+//     own worker threads and to the worker ranks' slots), commits each row as
+//     it comes, keeps the CSV and the progress line up to date, and stops
+//     everyone on a signal, on --stop-after or on an error.
+class Coordinator {
+ public:
+  Coordinator(const SweepOptions& options, const SweepSetup& setup, MpiTransport* transport, int ranks, int jobs,
+              Clock::time_point start, SweepSummary* s)
+      : options_(options), store_(*setup.store), transport_(transport), ranks_(ranks), jobs_(jobs), start_(start),
+        s_(*s), progress_(options.show_progress) {
+    s_.already_done = store_.done().size();
+    s_.results_sqlite = store_.sqlite_file();
+    s_.results_csv = store_.csv_file();
+    s_.runs_per_rank.assign(static_cast<std::size_t>(ranks), 0);
+    for (const RunPlan& r : setup.runs)
+      if (!store_.done().contains(r.index)) pending_.push_back(r.index);
+  }
+
+  void Run(const Work& work) {
+    {
+      WorkerPool pool(jobs_, work);
+      StopRunsOnError stop_on_error;
+      if (options_.stop_after_runs == 0) stopping_ = true;
+      const int remote_slots = (ranks_ - 1) * jobs_;
+      for (;;) {
+        bool acted = false;  // something happened: look again before waiting
+        StopIfAsked();
+        while (!stopping_ && !pending_.empty() && pool.outstanding() < static_cast<std::size_t>(jobs_)) {
+          pool.Submit(pending_.front());
+          pending_.pop_front();
+          acted = true;
+        }
+        if (transport_) acted |= ServeWorkerRanks();
+        Outcome o;
+        while (pool.TryPop(&o)) {
+          acted = true;
+          if (o.fatal) {
+            if (!fatal_) fatal_ = o.fatal;
+            stopping_ = true;
+            g_stop.store(true);
+          } else if (o.row) {
+            Commit(*o.row, 0);
+          }
+        }
+        progress_.Show(store_.done().size(), s_.total, s_.completed, s_.failed, pool.outstanding() + remote_in_flight_,
+                       Elapsed(), false);
+        if (pool.outstanding() == 0 && (pending_.empty() || stopping_) && remote_stopped_ == remote_slots) break;
+        if (!acted) pool.WaitFor(std::chrono::milliseconds(transport_ ? 2 : 200));
+      }
+    }
+    const double elapsed = Elapsed();
+    progress_.Show(store_.done().size(), s_.total, s_.completed, s_.failed, 0, elapsed, true);
+    progress_.End();
+    store_.WriteCsv();
+    if (fatal_) std::rethrow_exception(fatal_);
+    s_.remaining = s_.total - store_.done().size();
+    s_.interrupted = s_.remaining > 0;
+    s_.wall_s = elapsed;
+  }
+
+ private:
+  double Elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+  // A signal or a stop anywhere stops everyone (the worker ranks once).
+  void StopIfAsked() {
+    if (g_stop.load()) stopping_ = true;
+    if (stopping_) g_stop.store(true);
+    if (stopping_ && transport_ && !interrupt_sent_) {
+      for (int r = 1; r < ranks_; ++r) transport_->SendControl(r, kInterrupt);
+      interrupt_sent_ = true;
+    }
+  }
+
+  // The worker ranks' messages: rows to commit, and a free slot each, which
+  // gets the next run or is told to stop.
+  bool ServeWorkerRanks() {
+    bool acted = false;
+    int source = 0;
+    std::string bytes;
+    while (transport_->PollFromWorkers(&source, &bytes)) {
+      acted = true;
+      const WorkerMessage m = DecodeWorkerMessage(bytes);
+      if (m.had_run) --remote_in_flight_;
+      if (m.row) Commit(*m.row, source);
+      if (m.stopping) stopping_ = true;
+      if (!stopping_ && !pending_.empty()) {
+        transport_->SendControl(source, static_cast<std::int64_t>(pending_.front()));
+        pending_.pop_front();
+        ++remote_in_flight_;
+      } else {
+        transport_->SendControl(source, kStopSlot);
+        ++remote_stopped_;
+      }
+    }
+    return acted;
+  }
+
+  void Commit(const ResultRow& row, int from_rank) {
+    store_.Commit(row);
+    ++s_.runs_per_rank[static_cast<std::size_t>(from_rank)];
+    ++s_.completed;
+    if (row.status != "complete") ++s_.failed;
+    if (options_.stop_after_runs >= 0 && static_cast<long long>(s_.completed) >= options_.stop_after_runs) {
+      stopping_ = true;
+      g_stop.store(true);
+    }
+    // The CSV follows the table every few seconds, and at the end.
+    if (Clock::now() - last_csv_ > std::chrono::seconds(10)) {
+      store_.WriteCsv();
+      last_csv_ = Clock::now();
+    }
+  }
+
+  const SweepOptions& options_;
+  ResultsStore& store_;
+  MpiTransport* transport_;  // null without MPI
+  int ranks_, jobs_;
+  Clock::time_point start_;
+  SweepSummary& s_;
+  ProgressLine progress_;
+  std::deque<std::size_t> pending_;
+  int remote_stopped_ = 0;
+  std::size_t remote_in_flight_ = 0;
+  bool stopping_ = false;
+  bool interrupt_sent_ = false;
+  std::exception_ptr fatal_;
+  Clock::time_point last_csv_ = Clock::now();
+};
+
+}  // namespace
+
 SweepSummary RunSweep(const SweepOptions& options) {
   const auto start = Clock::now();
   g_stop.store(false);
@@ -311,51 +546,18 @@ SweepSummary RunSweep(const SweepOptions& options) {
   const int jobs = options.jobs > 0 ? options.jobs
                                     : (mpi ? 1 : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 
-  // Set-up, on every rank: the sweep, its runs, every run's scenario (so that
-  // a bad override stops the sweep before any run); rank 0 opens the results.
-  SweepSpec spec;
-  std::vector<RunPlan> runs;
-  std::unique_ptr<ResultsStore> store;
-  std::exception_ptr setup_error;
-  const fs::path runs_dir = options.output_dir / "runs";
-  try {
-    spec = LoadSweep(options.sweep_file);
-    runs = ExpandRuns(spec);
-    ValidateRuns(spec, runs);
-    std::error_code ec;
-    fs::create_directories(runs_dir, ec);
-    if (!fs::is_directory(runs_dir))
-      throw InputError(runs_dir.string() + ": cannot create the output folder" + (ec ? ": " + ec.message() : ""));
-    if (rank == 0) store = std::make_unique<ResultsStore>(options.output_dir, spec, runs, analysis::OptionsToJson({}));
-  } catch (...) {
-    setup_error = std::current_exception();
-  }
+  SweepSetup setup = SetUpSweep(options, rank);
   SweepSummary s;
-  s.name = spec.name;
+  s.name = setup.spec.name;
   s.ranks = ranks;
   s.jobs = jobs;
   s.coordinator = rank == 0;
-  s.total = runs.size();
-  if (mpi && !transport->AllOk(!setup_error)) {
-    // Every rank reads the same files, so they usually fail alike: rank 0
-    // reports, the others stay quiet unless only they failed.
-    const bool root_ok = transport->RootOk(!setup_error);
-    if (setup_error && rank == 0) std::rethrow_exception(setup_error);
-    if (setup_error && root_ok) {
-      try {
-        std::rethrow_exception(setup_error);
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "crowdrecon: MPI rank %d: %s\n", rank, e.what());
-      }
-    }
-    if (rank == 0) throw InputError("another MPI rank could not start the sweep (its message is above)");
-    s.exit_code = 2;
-    return s;
-  }
-  if (setup_error) std::rethrow_exception(setup_error);
+  s.total = setup.runs.size();
+  if (mpi && !AgreeOnSetUp(*transport, rank, setup.error, &s)) return s;
+  if (setup.error) std::rethrow_exception(setup.error);
 
-  const Context ctx{spec, runs, options.output_dir, runs_dir, {}};
-  const auto work = [&ctx](std::size_t index) {
+  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}};
+  const Work work = [&ctx](std::size_t index) {
     Outcome o;
     o.index = index;
     try {
@@ -365,146 +567,13 @@ SweepSummary RunSweep(const SweepOptions& options) {
     }
     return o;
   };
-  const auto previous_int = std::signal(SIGINT, OnSweepSignal);
-  const auto previous_term = std::signal(SIGTERM, OnSweepSignal);
-  struct RestoreSignals {
-    decltype(previous_int) int_handler, term_handler;
-    ~RestoreSignals() {
-      std::signal(SIGINT, int_handler);
-      std::signal(SIGTERM, term_handler);
-    }
-  } restore{previous_int, previous_term};
-
+  const SweepSignals signals;
   if (rank != 0) {
-    // A worker rank: ask for a run per slot, run what comes, send the rows.
-    WorkerPool pool(jobs, work);
-    StopRunsOnError stop_on_error;
-    for (int slot = 0; slot < jobs; ++slot) transport->SendToRoot(EncodeWorkerMessage(false, false, std::nullopt));
-    int active_slots = jobs;
-    while (active_slots > 0) {
-      bool acted = false;
-      std::int64_t code = 0;
-      while (transport->PollControl(&code)) {
-        acted = true;
-        if (code == kInterrupt) g_stop.store(true);
-        else if (code == kStopSlot) --active_slots;
-        else if (g_stop.load()) transport->SendToRoot(EncodeWorkerMessage(true, true, std::nullopt));  // declined
-        else pool.Submit(static_cast<std::size_t>(code));
-      }
-      Outcome o;
-      while (pool.TryPop(&o)) {
-        if (o.fatal) {
-          try {
-            std::rethrow_exception(o.fatal);
-          } catch (const std::exception& e) {
-            std::fprintf(stderr, "crowdrecon: error on MPI rank %d, run %zu: %s\n", rank, o.index, e.what());
-          }
-          transport->Abort(3);
-        }
-        acted = true;
-        transport->SendToRoot(EncodeWorkerMessage(true, g_stop.load(), o.row));
-      }
-      if (!acted) pool.WaitFor(std::chrono::milliseconds(2));
-    }
+    RunWorkerRank(*transport, rank, jobs, work);
     s.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
     return s;
   }
-
-  // Rank 0 (or the only process): hand out runs, write rows.
-  s.already_done = store->done().size();
-  s.results_sqlite = store->sqlite_file();
-  s.results_csv = store->csv_file();
-  std::deque<std::size_t> pending;
-  for (const RunPlan& r : runs)
-    if (!store->done().contains(r.index)) pending.push_back(r.index);
-  const int remote_slots = (ranks - 1) * jobs;
-  int remote_stopped = 0;
-  std::size_t remote_in_flight = 0;
-  bool stopping = false;
-  bool interrupt_sent = false;
-  std::exception_ptr fatal;
-  auto last_csv = Clock::now();
-  ProgressLine progress(options.show_progress);
-
-  s.runs_per_rank.assign(static_cast<std::size_t>(ranks), 0);
-  const auto commit = [&](const ResultRow& row, int from_rank) {
-    store->Commit(row);
-    ++s.runs_per_rank[static_cast<std::size_t>(from_rank)];
-    ++s.completed;
-    if (row.status != "complete") ++s.failed;
-    if (options.stop_after_runs >= 0 && static_cast<long long>(s.completed) >= options.stop_after_runs) {
-      stopping = true;
-      g_stop.store(true);
-    }
-    // The CSV follows the table every few seconds, and at the end.
-    if (Clock::now() - last_csv > std::chrono::seconds(10)) {
-      store->WriteCsv();
-      last_csv = Clock::now();
-    }
-  };
-
-  {
-    WorkerPool pool(jobs, work);
-    StopRunsOnError stop_on_error;
-    if (options.stop_after_runs == 0) stopping = true;
-    while (true) {
-      bool acted = false;  // something happened: look again before waiting
-      if (g_stop.load()) stopping = true;
-      if (stopping) g_stop.store(true);
-      if (stopping && mpi && !interrupt_sent) {
-        for (int r = 1; r < ranks; ++r) transport->SendControl(r, kInterrupt);
-        interrupt_sent = true;
-      }
-      while (!stopping && !pending.empty() && pool.outstanding() < static_cast<std::size_t>(jobs)) {
-        pool.Submit(pending.front());
-        pending.pop_front();
-        acted = true;
-      }
-      if (mpi) {
-        int source = 0;
-        std::string bytes;
-        while (transport->PollFromWorkers(&source, &bytes)) {
-          acted = true;
-          const WorkerMessage m = DecodeWorkerMessage(bytes);
-          if (m.had_run) --remote_in_flight;
-          if (m.row) commit(*m.row, source);
-          if (m.stopping) stopping = true;
-          if (!stopping && !pending.empty()) {
-            transport->SendControl(source, static_cast<std::int64_t>(pending.front()));
-            pending.pop_front();
-            ++remote_in_flight;
-          } else {
-            transport->SendControl(source, kStopSlot);
-            ++remote_stopped;
-          }
-        }
-      }
-      Outcome o;
-      while (pool.TryPop(&o)) {
-        acted = true;
-        if (o.fatal) {
-          if (!fatal) fatal = o.fatal;
-          stopping = true;
-          g_stop.store(true);
-        } else if (o.row) {
-          commit(*o.row, 0);
-        }
-      }
-      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-      progress.Show(store->done().size(), s.total, s.completed, s.failed, pool.outstanding() + remote_in_flight, elapsed,
-                    false);
-      if (pool.outstanding() == 0 && (pending.empty() || stopping) && remote_stopped == remote_slots) break;
-      if (!acted) pool.WaitFor(std::chrono::milliseconds(mpi ? 2 : 200));
-    }
-  }
-  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  progress.Show(store->done().size(), s.total, s.completed, s.failed, 0, elapsed, true);
-  progress.End();
-  store->WriteCsv();
-  if (fatal) std::rethrow_exception(fatal);
-  s.remaining = s.total - store->done().size();
-  s.interrupted = s.remaining > 0;
-  s.wall_s = elapsed;
+  Coordinator(options, setup, transport.get(), ranks, jobs, start, &s).Run(work);
   return s;
 }
 

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 #include "engine_scenes.hpp"
 
 namespace crowdrecon::engine::testing {
@@ -57,20 +57,20 @@ inline std::string RectangleWkt(double length_m, double width_m) {
 // a run file that does not record it.
 inline void WriteCorridorRun(const std::filesystem::path& file, Simulation& sim, const CorridorScene& c,
                              int frames, double fps, bool record_periodic_box) {
-  scenario::RunHeader header;
+  runfile::RunHeader header;
   header.scenario_json = "{\"test\": \"counter-flow corridor\"}";
   header.scenario_origin = "tests/unit/render_scene.hpp";
   header.walkable_wkt = RectangleWkt(c.length_m, c.width_m);
   header.output_fps = fps;
   header.time_step_s = sim.time_step_s();
   header.target_names = {"to_exit", "to_court"};
-  scenario::RunFileWriter writer = scenario::RunFileWriter::Create(file, header, sim);
+  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
   // RunFileWriter records the periodic box itself; an empty value stands for
   // run files that do not (the renderer must cope with both).
   if (!record_periodic_box) writer.SetRunValue("periodic_box", "");
   for (int k = 0; k < frames; ++k) {
     if (k > 0) sim.AdvanceTo(k / fps);
-    writer.WriteFrame(k, sim, {}, /*with_contacts=*/true);
+    scenario::WriteFrame(writer, sim, k, {}, /*with_contacts=*/true);
   }
   writer.SetStatus("complete");
 }

@@ -17,7 +17,7 @@
 #include "crowdrecon/analysis/metrics.hpp"
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/analysis/run_analysis.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 #include "engine_scenes.hpp"
 #include "render_scene.hpp"
 #include "test_util.hpp"
@@ -200,8 +200,8 @@ TEST(Regime, NamesAndOptions) {
 
 // --- lane order ------------------------------------------------------------------
 
-Periodicity Hallway() {
-  Periodicity box;
+PeriodicBox Hallway() {
+  PeriodicBox box;
   box.x = true;
   box.min_m = {0.0, 0.0};
   box.max_m = {12.0, 3.0};
@@ -230,7 +230,7 @@ TEST(LaneOrder, AlternatingAlongTheLaneGivesZero) {
   // each group on either side, so n_same = n_other and phi_j = 0.
   std::vector<Vec2> position;
   std::vector<std::uint32_t> group;
-  Periodicity box = Hallway();
+  PeriodicBox box = Hallway();
   box.max_m.x = 0.45 * 26;  // a whole number of pairs around the seam
   for (int k = 0; k < 26; ++k) {
     position.push_back({0.45 * k, 1.5});
@@ -274,7 +274,7 @@ TEST(LaneOrder, NobodyInTheBandIsNaN) {
 // --- crossings ----------------------------------------------------------------------
 
 TEST(Crossing, DirectionAndPeriodicSeam) {
-  const Periodicity box = Hallway();
+  const PeriodicBox box = Hallway();
   const MeasurementLine middle{{6.0, 0.0}, {6.0, 3.0}};
   const Vec2 forward{1.0, 0.0};
   EXPECT_EQ(CrossingDirection(middle, forward, {5.9, 1.0}, {6.1, 1.0}, box), 1);
@@ -297,16 +297,6 @@ TEST(Crossing, DirectionAndPeriodicSeam) {
   // The forward side follows `forward`, whichever way the segment is drawn.
   const MeasurementLine reversed{{6.0, 3.0}, {6.0, 0.0}};
   EXPECT_EQ(CrossingDirection(reversed, forward, {5.9, 1.0}, {6.1, 1.0}, box), 1);
-}
-
-TEST(Crossing, PeriodicBoxFromRunValue) {
-  const Periodicity box = ParsePeriodicity(R"({"max_m":[12.0,0.0],"min_m":[0.0,0.0],"x":true,"y":false})", "run");
-  EXPECT_TRUE(box.x);
-  EXPECT_FALSE(box.y);
-  EXPECT_NEAR(box.MinimumImage({11.8, 0.5}).x, -0.2, 1e-12);
-  EXPECT_FALSE(ParsePeriodicity("", "run").any());
-  EXPECT_NE(ErrorOf([] { ParsePeriodicity("{\"x\": true}", "r.sqlite"); }).find("r.sqlite: run value periodic_box is malformed"),
-            std::string::npos);
 }
 
 // --- a run file written from an engine world ------------------------------------------
@@ -341,17 +331,17 @@ std::filesystem::path WriteWalkersRun(const std::string& name) {
   def.periodic.max_m = {12.0, 3.0};
   engine::Simulation sim(def);
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / name;
-  scenario::RunHeader header;
+  runfile::RunHeader header;
   header.scenario_json = "{\"test\": \"three walkers\"}";
   header.scenario_origin = "tests/unit/test_analysis.cpp";
   header.walkable_wkt = engine::testing::RectangleWkt(12.0, 3.0);
   header.output_fps = 10.0;
   header.time_step_s = sim.time_step_s();
   header.target_names = {"to_exit", "to_court"};
-  scenario::RunFileWriter writer = scenario::RunFileWriter::Create(file, header, sim);
+  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
   for (int k = 0; k <= 100; ++k) {
     if (k > 0) sim.AdvanceTo(k / 10.0);
-    writer.WriteFrame(k, sim, {}, /*with_contacts=*/false);
+    scenario::WriteFrame(writer, sim, k, {}, /*with_contacts=*/false);
   }
   writer.SetStatus("complete");
   return file;
@@ -406,7 +396,7 @@ TEST(AnalyzeRun, WritesTablesIntoTheRunFile) {
   const RunAnalysis a = AnalyzeRun(file, options);
   WriteAnalysis(file, a, options);
   WriteAnalysis(file, a, options);  // a second analysis replaces the first
-  const scenario::RunFileReader run(file);
+  const runfile::RunFileReader run(file);
   EXPECT_EQ(run.RunValue("regime"), "unclassified");
   EXPECT_NE(run.RunValue("regime_reason").find("run too short"), std::string::npos);
   EXPECT_NE(run.RunValue("analysis_options").find("\"frozen_window_s\":10.0"), std::string::npos);
@@ -448,11 +438,11 @@ TEST(AnalyzeRun, StopAndGoRunFile) {
     def.periodic.x = true;
     def.periodic.max_m = {12.0, 3.0};
     engine::Simulation sim(def);
-    scenario::RunHeader header;
+    runfile::RunHeader header;
     header.scenario_json = "{}";
     header.walkable_wkt = engine::testing::RectangleWkt(12.0, 3.0);
     header.target_names = {"to_exit", "to_court"};
-    scenario::RunFileWriter writer = scenario::RunFileWriter::Create(file, header, sim);
+    runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
     writer.SetStatus("complete");
   }
   sqlite3* db = nullptr;

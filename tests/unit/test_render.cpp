@@ -145,8 +145,8 @@ TEST(RenderRun, DrawsBodiesWallsAndForcesIntoPngFramesAndAVideo) {
   // Frame 0 has no contacts yet (people stand on a lattice): a point inside
   // each body, between centroid and back, shows its group's colour -- blue
   // (group 0) or orange (group 1) -- and not the floor or the background.
-  scenario::RunFileReader reader(run);
-  const scenario::RunFrame frame0 = reader.Frame(0);
+  runfile::RunFileReader reader(run);
+  const runfile::RunFrame frame0 = reader.Frame(0);
   ASSERT_TRUE(frame0.contacts.empty());
   const std::vector<std::uint32_t> groups = reader.PersonGroups();
   const cv::Mat image = cv::imread(FramePicturePath(options.output_dir, 0, ".png").string(), cv::IMREAD_COLOR);

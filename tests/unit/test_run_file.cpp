@@ -9,11 +9,17 @@
 #include <filesystem>
 #include <string>
 
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/scenario/run_record.hpp"
 #include "engine_scenes.hpp"
 
 namespace crowdrecon::scenario {
 namespace {
+
+using runfile::FrameSnapshot;
+using runfile::FrameWriterThread;
+using runfile::RunFileWriter;
+using runfile::RunHeader;
 
 // Every row of the frame tables, in a fixed order, as text.
 std::string DumpFrames(const std::filesystem::path& file) {
@@ -54,18 +60,18 @@ enum class Writing { kDirect, kOnThread, kInTurn };
 std::filesystem::path WriteGas(const std::string& name, Writing how) {
   engine::Simulation sim(engine::testing::RandomGas(8, 0.5, 7, true));
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / name;
-  RunFileWriter writer = RunFileWriter::Create(file, Header(sim), sim);
+  RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
   if (how != Writing::kDirect) {
     FrameWriterThread frames(writer, /*background=*/how == Writing::kOnThread, 2);
     for (int k = 0; k <= 20; ++k) {
       if (k > 0) sim.AdvanceTo(k / 10.0);
-      frames.Write(k, sim, {}, /*with_contacts=*/true);
+      frames.Write([&](FrameSnapshot& f) { TakeSnapshot(sim, k, {}, /*with_contacts=*/true, &f); });
     }
     frames.Flush();
   } else {
     for (int k = 0; k <= 20; ++k) {
       if (k > 0) sim.AdvanceTo(k / 10.0);
-      writer.WriteFrame(k, sim, {}, /*with_contacts=*/true);
+      WriteFrame(writer, sim, k, {}, /*with_contacts=*/true);
     }
   }
   writer.SetStatus("complete");
@@ -85,9 +91,12 @@ TEST(FrameWriterThread, WritesExactlyWhatDirectWritesDo) {
 TEST(FrameWriterThread, AFailureOfTheWritingThreadReachesTheCaller) {
   engine::Simulation sim(engine::testing::RandomGas(4, 0.5, 3, true));
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "gas-fail.sqlite";
-  RunFileWriter writer = RunFileWriter::Create(file, Header(sim), sim);
+  RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
   FrameWriterThread frames(writer, /*background=*/true, 2);
-  frames.Write(0, sim, {}, true);
+  const auto frame_of = [&](std::int64_t k) {
+    return [&sim, k](FrameSnapshot& f) { TakeSnapshot(sim, k, {}, true, &f); };
+  };
+  frames.Write(frame_of(0));
   frames.Flush();
   {
     // Another connection drops a table the frames go to.
@@ -98,7 +107,7 @@ TEST(FrameWriterThread, AFailureOfTheWritingThreadReachesTheCaller) {
   }
   std::string message;
   try {
-    for (int k = 1; k <= 5; ++k) frames.Write(k, sim, {}, true);
+    for (int k = 1; k <= 5; ++k) frames.Write(frame_of(k));
     frames.Flush();
   } catch (const std::exception& e) {
     message = e.what();
@@ -125,10 +134,10 @@ TEST(RunFileWriter, FramesAreReadableWhileWrittenAndTheFileIsPlainWhenClosed) {
     return value;
   };
   {
-    RunFileWriter writer = RunFileWriter::Create(file, Header(sim), sim);
+    RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
     for (int k = 0; k <= 3; ++k) {
       if (k > 0) sim.AdvanceTo(k / 10.0);
-      writer.WriteFrame(k, sim, {}, true);
+      WriteFrame(writer, sim, k, {}, true);
     }
     EXPECT_EQ(query("PRAGMA journal_mode"), "wal");
     EXPECT_EQ(query("SELECT COUNT(*) FROM frame_time"), "4");
@@ -139,6 +148,111 @@ TEST(RunFileWriter, FramesAreReadableWhileWrittenAndTheFileIsPlainWhenClosed) {
   EXPECT_EQ(query("SELECT COUNT(*) FROM trajectory_data"), std::to_string(4 * 16));
   EXPECT_FALSE(std::filesystem::exists(file.string() + "-wal"));
   EXPECT_FALSE(std::filesystem::exists(file.string() + "-shm"));
+}
+
+// The reader gives back what the writer stored: people, frames with every
+// person's state, events, the venue; and it needs no engine (the records here
+// are written without a simulation).
+TEST(RunFileReader, GivesBackEveryTableTheWriterFilled) {
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "records.sqlite";
+  RunHeader header;
+  header.scenario_json = "{}";
+  header.venue_json = "{\"version\": 1}";
+  header.walkable_wkt = "POLYGON ((0 0, 4 0, 4 4, 0 4, 0 0))";
+  header.periodic_box = {true, false, {0.0, 0.0}, {4.0, 0.0}};
+  header.target_names = {"east", "west"};
+  runfile::RunSetup setup;
+  setup.shapes = {{0.05, {{0.1, 0.0}, {-0.1, 0.0}}}};
+  setup.people = {{0, 80.0, 2.5, 1.3, 0, 0}, {0, 70.0, 2.0, 1.1, 1, 1}};
+  {
+    RunFileWriter writer = RunFileWriter::Create(file, header, setup);
+    for (std::int64_t k = 0; k < 3; ++k) {
+      FrameSnapshot f;
+      f.frame = k;
+      f.time_s = 0.1 * static_cast<double>(k);
+      f.person = {0, 1};
+      f.position_m = {{1.0 + 0.1 * static_cast<double>(k), 1.0}, {3.0, 2.0}};
+      f.velocity_m_per_s = {{1.0, 0.0}, {-0.5, 0.25}};
+      f.angle_rad = {0.0, 3.0};
+      f.angular_velocity_rad_per_s = {0.0, -0.5};
+      f.state = {runfile::PersonStatus::kWalking, k == 2 ? runfile::PersonStatus::kFallen : runfile::PersonStatus::kWalking};
+      f.load_n = {12.5, 410.0};
+      if (k == 2) f.events.push_back({0.2, "fall", 1, -1, "pushed"});
+      if (k == 1) {  // the first person leaves
+        f.person = {1};
+        f.position_m = {{3.0, 2.0}};
+        f.velocity_m_per_s = {{-0.5, 0.25}};
+        f.angle_rad = {3.0};
+        f.angular_velocity_rad_per_s = {-0.5};
+        f.state = {runfile::PersonStatus::kWalking};
+        f.load_n = {410.0};
+      }
+      writer.WriteFrame(f);
+    }
+    writer.SetStatus("complete");
+  }
+  const runfile::RunFileReader run(file);
+  EXPECT_EQ(run.venue_json(), "{\"version\": 1}");
+  const PeriodicBox box = run.periodic_box();
+  EXPECT_TRUE(box.x);
+  EXPECT_FALSE(box.y);
+  EXPECT_NEAR(box.MinimumImage({3.8, 0.5}).x, -0.2, 1e-12);
+  const std::vector<runfile::PersonInfo> people = run.People();
+  ASSERT_EQ(people.size(), 2u);
+  EXPECT_EQ(people[1].group, 1u);
+  EXPECT_EQ(people[1].target, "west");
+  EXPECT_DOUBLE_EQ(people[0].mass_kg, 80.0);
+  EXPECT_DOUBLE_EQ(people[1].desired_speed_m_per_s, 1.1);
+  const std::vector<runfile::FrameTime> times = run.FrameTimes();
+  ASSERT_EQ(times.size(), 3u);
+  EXPECT_DOUBLE_EQ(times[2].time_s, 0.2);
+  runfile::PersonFrameStream stream = run.PersonFrames(1);  // frames 0 and 1 only
+  runfile::PersonFrame rows;
+  ASSERT_TRUE(stream.Next(&rows));
+  EXPECT_EQ(rows.frame, 0);
+  EXPECT_EQ(rows.person, (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_DOUBLE_EQ(rows.load_n[1], 410.0);
+  EXPECT_DOUBLE_EQ(rows.velocity_m_per_s[1].y, 0.25);
+  ASSERT_TRUE(stream.Next(&rows));
+  EXPECT_EQ(rows.frame, 1);
+  EXPECT_EQ(rows.person, (std::vector<std::uint32_t>{1}));
+  EXPECT_FALSE(stream.Next(&rows));
+  runfile::PersonFrameStream all = run.PersonFrames(2);
+  while (all.Next(&rows)) {
+  }
+  EXPECT_EQ(rows.state[1], runfile::PersonStatus::kFallen);
+  const std::vector<runfile::Event> events = run.Events();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, "fall");
+  EXPECT_EQ(events[0].person, 1);
+  EXPECT_EQ(events[0].other, -1);
+  const std::vector<Vec2> sums = run.GroupVelocitySums();
+  ASSERT_EQ(sums.size(), 2u);
+  EXPECT_DOUBLE_EQ(sums[0].x, 2.0);  // person 0 in frames 0 and 2
+  EXPECT_DOUBLE_EQ(sums[1].x, -1.5);
+}
+
+// A damaged periodic box names the file, the table, the row and what was expected.
+TEST(RunFileReader, ADamagedPeriodicBoxIsReported) {
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "box.sqlite";
+  const auto error_of = [&](const std::string& value) {
+    {
+      RunHeader header;
+      RunFileWriter writer = RunFileWriter::Create(file, header, {});
+      writer.SetRunValue("periodic_box", value);
+    }
+    try {
+      (void)runfile::RunFileReader(file).periodic_box();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("{\"x\": true}").find("box.sqlite: table run, row key periodic_box, column value: malformed"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"x": true, "y": false, "min_m": [5, 0], "max_m": [4, 0]})").find("expected max_m > min_m"),
+            std::string::npos);
+  EXPECT_EQ(error_of(""), "no error");
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "engine_scenes.hpp"
 

@@ -8,16 +8,14 @@
 #include <regex>
 #include <system_error>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "crowdrecon/common/error.hpp"
-#include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/geometry/venue.hpp"
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/canvas.hpp"
 
 namespace crowdrecon::viz {
@@ -86,7 +84,7 @@ struct Scene {
   std::vector<ShapeInfo> shapes;
   std::vector<std::uint32_t> person_shape;  // by engine index (id - 1)
   std::vector<std::uint32_t> person_group;
-  std::optional<engine::PeriodicBox> periodic;
+  std::optional<PeriodicBox> periodic;
   std::string floor_note;  // why the walkable area is not drawn, if it is not
 
   const ShapeInfo& ShapeOf(std::size_t person) const {
@@ -97,46 +95,12 @@ struct Scene {
     return person < person_group.size() ? person_group[person] : 0;
   }
   // Minimum-image form of a difference under the periodic box (identity without one).
-  Vec2 MinimumImage(Vec2 d) const {
-    if (!periodic) return d;
-    if (periodic->x) {
-      const double l = periodic->max_m.x - periodic->min_m.x;
-      d.x -= l * std::round(d.x / l);
-    }
-    if (periodic->y) {
-      const double l = periodic->max_m.y - periodic->min_m.y;
-      d.y -= l * std::round(d.y / l);
-    }
-    return d;
-  }
+  Vec2 MinimumImage(Vec2 d) const { return periodic ? periodic->MinimumImage(d) : d; }
 };
-
-// The run's periodic box, if its run table records one as
-//   run.periodic_box = {"x": true, "y": false, "min_m": [x, y], "max_m": [x, y]}.
-// Run files do not have to: without it, seams are handled by leaving out
-// contact lines that would span the box (see DrawForceNetwork).
-std::optional<engine::PeriodicBox> ReadPeriodicBox(const scenario::RunFileReader& run, const std::string& file) {
-  const std::string text = run.RunValue("periodic_box");
-  if (text.empty()) return std::nullopt;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    engine::PeriodicBox box;
-    box.x = j.value("x", false);
-    box.y = j.value("y", false);
-    box.min_m = {j.at("min_m").at(0).get<double>(), j.at("min_m").at(1).get<double>()};
-    box.max_m = {j.at("max_m").at(0).get<double>(), j.at("max_m").at(1).get<double>()};
-    if ((box.x && !(box.max_m.x > box.min_m.x)) || (box.y && !(box.max_m.y > box.min_m.y)))
-      throw std::runtime_error("max must exceed min along periodic axes");
-    if (!box.x && !box.y) return std::nullopt;
-    return box;
-  } catch (const std::exception& e) {
-    throw InputError(file + ": run value periodic_box is malformed (" + e.what() + "): " + text);
-  }
-}
 
 // Clips the segment [a, b] to the periodic box widened by `margin_m` along its
 // periodic axes (Liang-Barsky); false if nothing is left.
-bool ClipToPeriodicBox(const engine::PeriodicBox& box, double margin_m, Vec2* a, Vec2* b) {
+bool ClipToPeriodicBox(const PeriodicBox& box, double margin_m, Vec2* a, Vec2* b) {
   double t0 = 0.0, t1 = 1.0;
   const Vec2 d = *b - *a;
   const auto clip = [&](double p, double q) {  // keeps the part where p t <= q
@@ -155,9 +119,9 @@ bool ClipToPeriodicBox(const engine::PeriodicBox& box, double margin_m, Vec2* a,
   return true;
 }
 
-Scene LoadScene(const scenario::RunFileReader& run, const std::string& file) {
+Scene LoadScene(const runfile::RunFileReader& run, const std::string& file) {
   Scene scene;
-  for (const engine::BodyShape& s : run.Shapes()) {
+  for (const runfile::Shape& s : run.Shapes()) {
     ShapeInfo info;
     info.vertices = s.vertices;
     info.radius_m = s.radius_m;
@@ -172,13 +136,15 @@ Scene LoadScene(const scenario::RunFileReader& run, const std::string& file) {
   if (scene.shapes.empty()) throw InputError(file + ": run file has no body shapes (table shape is empty)");
   scene.person_shape = run.PersonShapes();
   scene.person_group = run.PersonGroups();
-  scene.periodic = ReadPeriodicBox(run, file);
+  // Run files need not record a periodic box: without one, seams are handled
+  // by leaving out contact lines that would span the box (see DrawForceNetwork).
+  if (const PeriodicBox box = run.periodic_box(); box.any()) scene.periodic = box;
   // The engine extends walls that cross a periodic seam beyond it (so that a
   // body straddling the seam meets a straight wall) and the run stores them so;
   // drawn, they are cut back to the box and the bodies' images across the seam.
   double max_reach_m = 0.0;
   for (const ShapeInfo& shape : scene.shapes) max_reach_m = std::max(max_reach_m, shape.reach_m);
-  for (const engine::Wall& w : run.Walls()) {
+  for (const runfile::Wall& w : run.Walls()) {
     const std::size_t n = w.points.size();
     for (std::size_t k = 0; k + 1 < n + (w.closed ? 1 : 0); ++k) {
       WallPiece piece{w.points[k], w.points[(k + 1) % n], w.radius_m};
@@ -257,7 +223,7 @@ const Color kSubtleText = Color::Hex(0x505050);
 std::vector<Vec2> ImageOffsets(const Scene& scene, Vec2 p, double reach_m) {
   std::vector<Vec2> offsets{{0.0, 0.0}};
   if (!scene.periodic) return offsets;
-  const engine::PeriodicBox& box = *scene.periodic;
+  const PeriodicBox& box = *scene.periodic;
   std::vector<double> dx{0.0}, dy{0.0};
   if (box.x) {
     const double l = box.max_m.x - box.min_m.x;
@@ -326,7 +292,7 @@ struct FrameStats {
 // far from b's stored (wrapped) position: with a known periodic box the branch
 // is unwrapped to the nearest image and drawn at both sides of the seam;
 // without one, a branch longer than the body could reach is left out.
-void DrawForceNetwork(Canvas& canvas, const Layout& layout, const Scene& scene, const scenario::RunFrame& frame,
+void DrawForceNetwork(Canvas& canvas, const Layout& layout, const Scene& scene, const runfile::RunFrame& frame,
                       const std::vector<std::int64_t>& slot_of_person, double force_n_per_px,
                       FrameStats* stats) {
   const auto branch = [&](std::size_t person, Vec2 point, double width_px) {
@@ -351,7 +317,7 @@ void DrawForceNetwork(Canvas& canvas, const Layout& layout, const Scene& scene, 
       offsets.push_back(to_point_image);
     for (Vec2 o : offsets) ForceLine(canvas, layout, centre + o, centre + o + d, width_px);
   };
-  for (const engine::Contact& c : frame.contacts) {
+  for (const runfile::Contact& c : frame.contacts) {
     const double force_n = Length(c.Force());
     stats->max_force_n = std::max(stats->max_force_n, force_n);
     ++stats->contacts;
@@ -637,31 +603,13 @@ std::string RenderSummary::BriefReport() const {
   return s;
 }
 
-RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw InputError(error);
-  const std::string file = run_file.string();
+namespace {
 
-  // 1. Open the run (RunFileReader names missing, foreign and non-run files).
-  std::optional<scenario::RunFileReader> reader;
-  reader.emplace(run_file);
-  const scenario::RunFileReader& run = *reader;
-  const std::vector<std::int64_t> all_frames = run.Frames();
-  if (all_frames.empty()) {
-    const std::string status = run.RunValue("status");
-    throw InputError(file + ": the run has no frames to draw" + (status.empty() ? "" : " (status: " + status + ")"));
-  }
-  // Frame times exceed their nominal times by less than one time step.
-  const double time_step_s = run.RunNumber("time_step_s", 0.0, 0.0, 1.0);  // absent: exact times assumed
-  const std::vector<std::int64_t> frames =
-      SelectFrames(options.frames, all_frames, [&](std::int64_t f) { return run.Frame(f).time_s; },
-                   std::max(1e-6, std::isfinite(time_step_s) ? time_step_s : 0.0));
-  const Scene scene = LoadScene(run, file);
-
-  // 2. First pass over the selected frames: the region people occupy and the
-  //    largest force, so that every frame shares one layout and one force scale.
-  RenderSummary summary;
-  if (!scene.floor_note.empty()) summary.notes.push_back(scene.floor_note);
+// 2. The layout every frame shares: a first pass over the selected frames finds
+//    the region people occupy and the largest force (one force scale).
+Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::int64_t>& frames, const Scene& scene,
+                    const RenderOptions& options, RenderSummary* summary) {
+  const std::string& file = run.file();
   Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   Vec2 hi = -lo;
   const auto include = [&](Vec2 p, double pad) {
@@ -679,7 +627,7 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
     include(scene.periodic->max_m, 0.0);
   }
   for (std::int64_t f : frames) {
-    const scenario::RunFrame frame = run.Frame(f);
+    const runfile::RunFrame frame = run.Frame(f);
     // Ids are 1-based (PedPy's convention); anything else would index out of range below.
     for (std::int64_t id : frame.ids)
       if (id < 1 || id > (std::int64_t{1} << 31))
@@ -687,8 +635,8 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
                          "; expected ids from 1 (trajectory_data.id)");
     for (std::size_t i = 0; i < frame.position_m.size(); ++i)
       include(frame.position_m[i], scene.ShapeOf(static_cast<std::size_t>(frame.ids[i] - 1)).reach_m);
-    for (const engine::Contact& c : frame.contacts)
-      summary.max_contact_force_n = std::max(summary.max_contact_force_n, Length(c.Force()));
+    for (const runfile::Contact& c : frame.contacts)
+      summary->max_contact_force_n = std::max(summary->max_contact_force_n, Length(c.Force()));
   }
   if (!(lo.x < hi.x && lo.y < hi.y)) {  // a lone person and no venue: a square around them
     lo -= Vec2{1.0, 1.0};
@@ -708,98 +656,143 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
     throw InputError(file + ": the drawn region is " + Fixed(hi.x - lo.x, 1) + " m x " + Fixed(hi.y - lo.y, 1) +
                      " m; at --width " + std::to_string(options.width_px) + " the pictures would be " +
                      std::to_string(layout.height_px) + " px tall (at most 20000): give a larger --width");
-  summary.world_min_m = layout.lo;
-  summary.world_max_m = layout.hi;
-  summary.pixels_per_metre = layout.ppm;
-  summary.margin_px = kMargin_px;
-  summary.force_n_per_px =
+  summary->world_min_m = layout.lo;
+  summary->world_max_m = layout.hi;
+  summary->pixels_per_metre = layout.ppm;
+  summary->margin_px = kMargin_px;
+  summary->force_n_per_px =
       options.force_n_per_px > 0.0 ? options.force_n_per_px
-      : summary.max_contact_force_n > 0.0
-          ? summary.max_contact_force_n / std::max(4.0, kAutoMaxLineWidth_m * layout.ppm)
+      : summary->max_contact_force_n > 0.0
+          ? summary->max_contact_force_n / std::max(4.0, kAutoMaxLineWidth_m * layout.ppm)
           : 100.0;  // no contact anywhere: any scale will do; 100 N/px puts the paper's 400 N at 4 px
+  return layout;
+}
 
-  // 3. The output folder, made only once every selected frame has been read
-  //    and checked (step 2), so that a damaged run file leaves nothing behind.
+// 3. The output folder, made only once every selected frame has been read and
+//    checked (ChooseLayout), so that a damaged run file leaves nothing behind.
+void MakeOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
-  std::filesystem::create_directories(options.output_dir, ec);
-  if (ec || !std::filesystem::is_directory(options.output_dir))
-    throw InputError(options.output_dir.string() + ": cannot create the output folder" +
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw InputError(dir.string() + ": cannot create the output folder" +
                      (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
+}
 
-  // 4. The video, opened before any drawing so that a bad path fails early.
+// 4. The video, opened before any drawing so that a bad path fails early; its
+//    rate is the run's frame rate over the stride, unless given.
+std::optional<VideoOut> OpenVideo(const runfile::RunFileReader& run, const RenderOptions& options, const Layout& layout,
+                                  RenderSummary* summary) {
   std::optional<VideoOut> video;
-  if (!options.video.empty()) {
-    double fps = options.video_fps;
-    if (fps <= 0.0) {
-      double run_fps = 10.0;
-      try {
-        run_fps = run.fps();
-      } catch (const InputError&) {
-        // A run without metadata.fps: 10 frames per second, JuPedSim's default.
-      }
-      const double stride = options.frames.kind == FrameSelection::Kind::kEvery
-                                ? static_cast<double>(options.frames.stride) : 1.0;
-      fps = std::max(run_fps / stride, 1.0);
+  if (options.video.empty()) return video;
+  double fps = options.video_fps;
+  if (fps <= 0.0) {
+    double run_fps = 10.0;
+    try {
+      run_fps = run.fps();
+    } catch (const InputError&) {
+      // A run without metadata.fps: 10 frames per second, JuPedSim's default.
     }
-    video.emplace(options.video, fps, layout.width_px, layout.height_px, &summary);
+    const double stride =
+        options.frames.kind == FrameSelection::Kind::kEvery ? static_cast<double>(options.frames.stride) : 1.0;
+    fps = std::max(run_fps / stride, 1.0);
   }
+  video.emplace(options.video, fps, layout.width_px, layout.height_px, summary);
+  return video;
+}
 
-  // 5. Draw each frame: floor, walls, bodies (and their images across seams),
-  //    force network on top, legend in the margins.
+// The legend's counts of a frame, and each person's slot in it (-1: absent).
+FrameLegend LegendOf(const runfile::RunFrame& frame, const Scene& scene, std::vector<std::int64_t>* slot_of_person) {
+  slot_of_person->assign(scene.person_shape.size(), -1);
+  FrameLegend legend;
+  legend.frame = frame.frame;
+  legend.time_s = frame.time_s;
+  legend.people = frame.ids.size();
+  for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
+    if (person >= slot_of_person->size()) slot_of_person->resize(person + 1, -1);
+    (*slot_of_person)[person] = static_cast<std::int64_t>(i);
+    const std::uint32_t g = scene.GroupOf(person);
+    if (std::find(legend.groups_present.begin(), legend.groups_present.end(), g) == legend.groups_present.end())
+      legend.groups_present.push_back(g);
+  }
+  std::sort(legend.groups_present.begin(), legend.groups_present.end());
+  return legend;
+}
+
+// 5. One frame into one picture: floor, walls, periodic seams, bodies (and
+//    their images across seams), force network on top, legend in the margins.
+//    Returns the picture's size in pixels.
+std::pair<double, double> DrawFrame(const std::filesystem::path& path, const runfile::RunFrame& frame,
+                                    const Scene& scene, const Layout& layout, const FrameLegend& legend,
+                                    const std::vector<std::int64_t>& slot_of_person, const RenderSummary& summary,
+                                    FrameStats* stats) {
+  Canvas canvas(path, layout.lo, layout.hi, layout.ppm, kMargin_px);
+  if (!scene.floor_rings.empty()) canvas.FillRings(scene.floor_rings, kFloor);
+  for (const WallPiece& w : scene.walls) canvas.Line(w.a, w.b, kWall, std::max(3.0, 2.0 * w.radius_m * layout.ppm));
+  if (scene.periodic) {  // dashed grey lines across the box where it wraps
+    const PeriodicBox& box = *scene.periodic;
+    const Color seam = Color::Hex(0x777777);
+    if (box.x)
+      for (double x : {box.min_m.x, box.max_m.x})
+        canvas.StrokePolyline({{x, layout.lo.y}, {x, layout.hi.y}}, seam, 1.5, /*dashed=*/true);
+    if (box.y)
+      for (double y : {box.min_m.y, box.max_m.y})
+        canvas.StrokePolyline({{layout.lo.x, y}, {layout.hi.x, y}}, seam, 1.5, /*dashed=*/true);
+  }
+  for (std::size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
+    const ShapeInfo& shape = scene.ShapeOf(person);
+    for (Vec2 offset : ImageOffsets(scene, frame.position_m[i], shape.reach_m))
+      DrawBody(canvas, layout, shape, frame.position_m[i] + offset, frame.orientation[i],
+               GroupColor(scene.GroupOf(person)));
+  }
+  *stats = FrameStats{};
+  DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, stats);
+  for (Vec2 p : frame.position_m) canvas.Dot(p, std::clamp(0.02 * layout.ppm, 1.0, 2.5), kForce);
+  DrawLegend(canvas, layout, legend, *stats, summary.force_n_per_px, summary.max_contact_force_n);
+  canvas.Finish();
+  return {canvas.width_px(), canvas.height_px()};
+}
+
+}  // namespace
+
+RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  const std::string file = run_file.string();
+
+  // 1. Open the run (RunFileReader names missing, foreign and non-run files)
+  //    and select its frames.
+  const runfile::RunFileReader run(run_file);
+  const std::vector<std::int64_t> all_frames = run.Frames();
+  if (all_frames.empty()) {
+    const std::string status = run.RunValue("status");
+    throw InputError(file + ": the run has no frames to draw" + (status.empty() ? "" : " (status: " + status + ")"));
+  }
+  // Frame times exceed their nominal times by less than one time step.
+  const double time_step_s = run.RunNumber("time_step_s", 0.0, 0.0, 1.0);  // absent: exact times assumed
+  const std::vector<std::int64_t> frames =
+      SelectFrames(options.frames, all_frames, [&](std::int64_t f) { return run.Frame(f).time_s; },
+                   std::max(1e-6, std::isfinite(time_step_s) ? time_step_s : 0.0));
+  const Scene scene = LoadScene(run, file);
+  RenderSummary summary;
+  if (!scene.floor_note.empty()) summary.notes.push_back(scene.floor_note);
+
+  const Layout layout = ChooseLayout(run, frames, scene, options, &summary);
+  MakeOutputFolder(options.output_dir);
+  std::optional<VideoOut> video = OpenVideo(run, options, layout, &summary);
+
   std::vector<std::int64_t> slot_of_person;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const scenario::RunFrame frame = run.Frame(frames[k]);
-    slot_of_person.assign(scene.person_shape.size(), -1);
-    FrameLegend legend;
-    legend.frame = frame.frame;
-    legend.time_s = frame.time_s;
-    legend.people = frame.ids.size();
-    for (std::size_t i = 0; i < frame.ids.size(); ++i) {
-      const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
-      if (person >= slot_of_person.size()) slot_of_person.resize(person + 1, -1);
-      slot_of_person[person] = static_cast<std::int64_t>(i);
-      const std::uint32_t g = scene.GroupOf(person);
-      if (std::find(legend.groups_present.begin(), legend.groups_present.end(), g) == legend.groups_present.end())
-        legend.groups_present.push_back(g);
-    }
-    std::sort(legend.groups_present.begin(), legend.groups_present.end());
-
+    const runfile::RunFrame frame = run.Frame(frames[k]);
+    const FrameLegend legend = LegendOf(frame, scene, &slot_of_person);
     FrameStats stats;
-    const auto draw = [&](const std::filesystem::path& path) {
-      Canvas canvas(path, layout.lo, layout.hi, layout.ppm, kMargin_px);
-      if (!scene.floor_rings.empty()) canvas.FillRings(scene.floor_rings, kFloor);
-      for (const WallPiece& w : scene.walls)
-        canvas.Line(w.a, w.b, kWall, std::max(3.0, 2.0 * w.radius_m * layout.ppm));
-      // Periodic seams: dashed grey lines across the box where it wraps.
-      if (scene.periodic) {
-        const engine::PeriodicBox& box = *scene.periodic;
-        const Color seam = Color::Hex(0x777777);
-        if (box.x)
-          for (double x : {box.min_m.x, box.max_m.x})
-            canvas.StrokePolyline({{x, layout.lo.y}, {x, layout.hi.y}}, seam, 1.5, /*dashed=*/true);
-        if (box.y)
-          for (double y : {box.min_m.y, box.max_m.y})
-            canvas.StrokePolyline({{layout.lo.x, y}, {layout.hi.x, y}}, seam, 1.5, /*dashed=*/true);
-      }
-      for (std::size_t i = 0; i < frame.ids.size(); ++i) {
-        const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
-        const ShapeInfo& shape = scene.ShapeOf(person);
-        for (Vec2 offset : ImageOffsets(scene, frame.position_m[i], shape.reach_m))
-          DrawBody(canvas, layout, shape, frame.position_m[i] + offset, frame.orientation[i],
-                   GroupColor(scene.GroupOf(person)));
-      }
-      stats = FrameStats{};
-      DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, &stats);
-      for (Vec2 p : frame.position_m) canvas.Dot(p, std::clamp(0.02 * layout.ppm, 1.0, 2.5), kForce);
-      DrawLegend(canvas, layout, legend, stats, summary.force_n_per_px, summary.max_contact_force_n);
-      canvas.Finish();
-      return std::pair<double, double>{canvas.width_px(), canvas.height_px()};
-    };
     const std::filesystem::path png = FramePicturePath(options.output_dir, frame.frame, ".png");
-    const auto [w, h] = draw(png);
-    if (options.svg) draw(FramePicturePath(options.output_dir, frame.frame, ".svg"));
+    const auto [w, h] = DrawFrame(png, frame, scene, layout, legend, slot_of_person, summary, &stats);
+    if (options.svg)
+      DrawFrame(FramePicturePath(options.output_dir, frame.frame, ".svg"), frame, scene, layout, legend, slot_of_person,
+                summary, &stats);
     if (video) video->Append(png);
-
     if (k == 0) {
       summary.first_picture = png;
       summary.first_frame = frame.frame;

@@ -1,5 +1,5 @@
 // Per-frame measurements of a crowd, as plain functions of positions, groups
-// and a periodic box: crossings of a measurement line and the lane order
+// and a periodic box (common/periodic_box.hpp): crossings of a measurement line and the lane order
 // parameter. Used by AnalyzeRun (run_analysis.hpp) on every frame of a run and
 // by the tests on hand-made configurations. Definitions: docs/analysis.md.
 #pragma once
@@ -8,26 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/periodic_box.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::analysis {
-
-// A periodic box as run files record it (run value `periodic_box`, written by
-// RunFileWriter from engine::PeriodicBox): positions are wrapped into
-// [min_m, max_m) along the periodic axes.
-struct Periodicity {
-  bool x = false, y = false;
-  Vec2 min_m, max_m;
-
-  bool any() const { return x || y; }
-  // The minimum-image representative of a difference of two positions.
-  Vec2 MinimumImage(Vec2 d_m) const;
-};
-
-// Reads run value `periodic_box` ({"x": true, "y": false, "min_m": [x, y],
-// "max_m": [x, y]}); an empty text means no periodic axis. Throws InputError
-// naming `origin` if the text is malformed.
-Periodicity ParsePeriodicity(const std::string& text, const std::string& origin);
 
 // A measurement line (as in PedPy): the segment from a to b.
 struct MeasurementLine {
@@ -47,7 +31,7 @@ struct MeasurementLine {
 // ends exactly on the line counts; one that starts on it does not, so a person
 // standing on the line is counted once, when they leave its back side.
 int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m,
-                      const Periodicity& box);
+                      const PeriodicBox& box);
 
 // Lane order parameter after Rex and Löwen, Phys. Rev. E 75, 051402 (2007):
 // for each person j, n_same and n_other count the people of j's own group and
@@ -82,7 +66,7 @@ struct LaneOrderResult {
 // `per_person` (optional) receives phi_j, NaN for people with an empty band.
 // O(N^2) in the number of people, which is a few hundred in a hallway.
 LaneOrderResult LaneOrder(const std::vector<Vec2>& position_m, const std::vector<std::uint32_t>& group,
-                          Vec2 flow_axis, const LaneOrderOptions& options, const Periodicity& box,
+                          Vec2 flow_axis, const LaneOrderOptions& options, const PeriodicBox& box,
                           std::vector<double>* per_person = nullptr);
 
 }  // namespace crowdrecon::analysis

@@ -10,9 +10,9 @@
 // load distribution, the regime with its reason.
 //
 // Where the definitions come from:
-//   desired directions  the run's venue targets when the scenario's venue file
-//                       can be found and the person's target is a fixed
-//                       direction (the periodic hallway); otherwise the
+//   desired directions  the targets of the venue stored in the run file when
+//                       every person's target is a fixed direction (the
+//                       periodic hallway); otherwise the
 //                       direction of the group's mean velocity over the run;
 //   measurement line    AnalysisOptions::line, else the venue's first
 //                       measurement line, else a line through the middle of
@@ -119,7 +119,7 @@ struct RunAnalysis {
   MeasurementLine line;
   Vec2 forward;  // unit normal of the line on group 0's side
   std::string line_source;
-  Periodicity box;
+  PeriodicBox box;
 
   MetricSeries series;
 

@@ -15,7 +15,7 @@
 //   - two outputs of one command never name the same path.
 //
 // A module that owns a file format describes its previous outputs with an
-// OutputKind (scenario::RunFileOutput(), geometry::BodyJsonOutput(), ...), so
+// OutputKind (runfile::RunFileOutput(), geometry::BodyJsonOutput(), ...), so
 // a new command gets the rule by listing its outputs and inputs.
 #pragma once
 

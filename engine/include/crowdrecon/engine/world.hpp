@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/periodic_box.hpp"
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/engine/parameters.hpp"
 #include "crowdrecon/geometry/navigation.hpp"
@@ -54,10 +55,9 @@ struct PersonDef {
   PersonState state = PersonState::kWalking;
 };
 
-struct PeriodicBox {
-  bool x = false, y = false;
-  Vec2 min_m, max_m;  // the box; positions are wrapped into it along periodic axes
-};
+// The box of a periodic run (common/periodic_box.hpp): positions are wrapped
+// into it along periodic axes.
+using crowdrecon::PeriodicBox;
 
 struct FloorSlope {
   Vec2 downhill;          // unit vector (0, 0 = flat)

@@ -24,9 +24,13 @@
 
 #include "crowdrecon/engine/simulation.hpp"
 
+namespace crowdrecon::runfile {
+struct Event;
+}  // namespace crowdrecon::runfile
+
 namespace crowdrecon::scenario {
 
-struct Event;
+using runfile::Event;
 
 // What a system sees at a frame.
 struct FrameContext {

@@ -1,5 +1,5 @@
 // Pictures and videos of a run: every selected frame of a run file
-// (scenario/run_file.hpp) drawn as the paper's Figure 6 -- the walkable area,
+// (runfile/run_file.hpp) drawn as the paper's Figure 6 -- the walkable area,
 // the walls, each person's spheropolygon body coloured by group with a mark on
 // the chest, and the contact force network: "a line from the center of mass
 // of the pedestrian to the contact point, ... the magnitude of the force [as]

@@ -1,4 +1,4 @@
-#include "crowdrecon/scenario/run_file.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,9 +15,9 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fnv.hpp"
-#include "crowdrecon/scenario/sqlite.hpp"
+#include "crowdrecon/runfile/sqlite.hpp"
 
-namespace crowdrecon::scenario {
+namespace crowdrecon::runfile {
 
 namespace {
 
@@ -141,7 +141,7 @@ RunFileWriter::~RunFileWriter() {
 }
 
 RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
-                                    const engine::Simulation& sim) {
+                                    const RunSetup& setup) {
   // The caller checked the path (CheckOutputs: a previous run file, or a
   // file --force lets us replace); a folder is never removed here.
   std::error_code ec;
@@ -167,44 +167,43 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
     Statement run(db, "INSERT INTO run VALUES(?, ?)");
     const auto put = [&](const std::string& k, const std::string& v) { run.Bind(1, k).Bind(2, v).Run(); };
     put("format", "crowdrecon-run");
-    put("format_version", "1");
+    put("format_version", "2");  // 2: the venue is stored (key venue)
     put("scenario", header.scenario_json);
     put("scenario_file", header.scenario_origin);
     put("seed", std::to_string(header.seed));
     put("time_step_s", NumberText(header.time_step_s));
     put("output_fps", NumberText(header.output_fps));
     put("status", "running");
-    const engine::PeriodicBox& box = sim.definition().periodic;
-    if (box.x || box.y) {
-      nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
-                          {"max_m", {box.max_m.x, box.max_m.y}}};
+    if (!header.venue_json.empty()) put("venue", header.venue_json);
+    const PeriodicBox& box = header.periodic_box;
+    if (box.any()) {
+      const nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
+                                {"max_m", {box.max_m.x, box.max_m.y}}};
       put("periodic_box", j.dump());
     }
   }
-  const engine::WorldDef& def = sim.definition();
   {
     Statement shape(db, "INSERT INTO shape VALUES(?, ?, ?)");
-    for (std::size_t s = 0; s < def.shapes.size(); ++s)
-      shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, def.shapes[s].radius_m).Bind(3, PointsJson(def.shapes[s].vertices)).Run();
+    for (std::size_t s = 0; s < setup.shapes.size(); ++s)
+      shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, setup.shapes[s].radius_m).Bind(3, PointsJson(setup.shapes[s].vertices)).Run();
     Statement person(db, "INSERT INTO person VALUES(?, ?, ?, ?, ?, ?, ?)");
-    const engine::BodyState& b = sim.bodies();
-    for (std::size_t i = 0; i < b.size(); ++i) {
-      const std::uint32_t t = b.target[i];
+    for (std::size_t i = 0; i < setup.people.size(); ++i) {
+      const Person& p = setup.people[i];
       person.Bind(1, static_cast<std::int64_t>(i + 1))
-          .Bind(2, static_cast<std::int64_t>(b.shape[i]))
-          .Bind(3, b.mass_kg[i])
-          .Bind(4, b.inertia_kg_m2[i])
-          .Bind(5, b.desired_speed_m_per_s[i])
-          .Bind(6, static_cast<std::int64_t>(b.group[i]))
-          .Bind(7, t < header.target_names.size() ? header.target_names[t] : std::to_string(t))
+          .Bind(2, static_cast<std::int64_t>(p.shape))
+          .Bind(3, p.mass_kg)
+          .Bind(4, p.inertia_kg_m2)
+          .Bind(5, p.desired_speed_m_per_s)
+          .Bind(6, static_cast<std::int64_t>(p.group))
+          .Bind(7, p.target < header.target_names.size() ? header.target_names[p.target] : std::to_string(p.target))
           .Run();
     }
     Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
-    for (std::size_t k = 0; k < def.walls.size(); ++k)
+    for (std::size_t k = 0; k < setup.walls.size(); ++k)
       wall.Bind(1, static_cast<std::int64_t>(k))
-          .Bind(2, static_cast<std::int64_t>(def.walls[k].closed))
-          .Bind(3, def.walls[k].radius_m)
-          .Bind(4, PointsJson(def.walls[k].points))
+          .Bind(2, static_cast<std::int64_t>(setup.walls[k].closed))
+          .Bind(3, setup.walls[k].radius_m)
+          .Bind(4, PointsJson(setup.walls[k].points))
           .Run();
   }
   db.Exec("COMMIT");
@@ -239,55 +238,6 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   return w;
 }
 
-void FrameSnapshot::Take(std::int64_t frame_index, const engine::Simulation& sim, const std::vector<Event>& frame_events,
-                         bool contacts_too) {
-  const engine::BodyState& b = sim.bodies();
-  frame = frame_index;
-  time_s = sim.time_s();
-  person.clear();
-  position_m.clear();
-  velocity_m_per_s.clear();
-  angle_rad.clear();
-  angular_velocity_rad_per_s.clear();
-  state.clear();
-  load_n.clear();
-  // Per-person load: the sum of the magnitudes of the contact forces on the
-  // person (the quantity compared with the 400 N threshold).
-  std::vector<double>& load = load_n;
-  load.assign(b.size(), 0.0);
-  for (const engine::Contact& c : sim.contacts()) {
-    const double f = Length(c.Force());
-    load[c.a] += f;
-    if (!c.wall) load[c.b] += f;
-  }
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    if (b.state[i] == engine::PersonState::kRemoved) continue;
-    person.push_back(static_cast<std::uint32_t>(i));
-    position_m.push_back(b.position_m[i]);
-    velocity_m_per_s.push_back(b.velocity_m_per_s[i]);
-    angle_rad.push_back(b.angle_rad[i]);
-    angular_velocity_rad_per_s.push_back(b.angular_velocity_rad_per_s[i]);
-    state.push_back(b.state[i]);
-    load[kept++] = load[i];  // kept <= i: compacts in place
-  }
-  load.resize(kept);
-  with_contacts = contacts_too;
-  if (with_contacts) {
-    contacts.assign(sim.contacts().begin(), sim.contacts().end());
-  } else {
-    contacts.clear();
-  }
-  events = frame_events;
-}
-
-void RunFileWriter::WriteFrame(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
-                               bool with_contacts) {
-  FrameSnapshot snapshot;
-  snapshot.Take(frame, sim, events, with_contacts);
-  WriteFrame(snapshot);
-}
-
 void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
   Database& db = *impl_->db;
   const std::int64_t frame = f.frame;
@@ -319,7 +269,7 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
     state.Finish();
     if (f.with_contacts) {
       sqlite::BatchInsert& contact = *impl_->contact;
-      for (const engine::Contact& c : f.contacts)
+      for (const Contact& c : f.contacts)
         contact.Add(frame).Add(static_cast<std::int64_t>(c.a + 1))
             .Add(static_cast<std::int64_t>(c.wall ? c.b : c.b + 1))
             .Add(static_cast<std::int64_t>(c.wall))
@@ -414,10 +364,9 @@ FrameWriterThread::~FrameWriterThread() {
   impl_->thread.join();
 }
 
-void FrameWriterThread::Write(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
-                              bool with_contacts) {
+void FrameWriterThread::Write(const std::function<void(FrameSnapshot&)>& fill) {
   if (!impl_->background) {
-    impl_->direct.Take(frame, sim, events, with_contacts);
+    fill(impl_->direct);
     impl_->writer.WriteFrame(impl_->direct);
     return;
   }
@@ -432,7 +381,7 @@ void FrameWriterThread::Write(std::int64_t frame, const engine::Simulation& sim,
     }
   }
   if (!snapshot) snapshot = std::make_unique<FrameSnapshot>();
-  snapshot->Take(frame, sim, events, with_contacts);  // outside the lock: the thread may be writing
+  fill(*snapshot);  // outside the lock: the thread may be writing
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     impl_->queued.push_back(std::move(snapshot));
@@ -556,7 +505,7 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
               "tangential_force_n FROM contact WHERE frame = ? ORDER BY rowid");
   c.Bind(1, frame).Describe("contact", {0, 1});
   while (c.Next()) {
-    engine::Contact k;
+    Contact k;
     k.a = static_cast<std::uint32_t>(c.Integer(2, 1, kPersonId) - 1);
     k.wall = c.Integer(4, 0, 1) != 0;
     k.b = static_cast<std::uint32_t>(k.wall ? c.Integer(3, 0, kPersonId) : c.Integer(3, 1, kPersonId) - 1);
@@ -570,12 +519,12 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
   return f;
 }
 
-std::vector<engine::BodyShape> RunFileReader::Shapes() const {
-  std::vector<engine::BodyShape> shapes;
+std::vector<Shape> RunFileReader::Shapes() const {
+  std::vector<Shape> shapes;
   Statement s(*impl_->db, "SELECT id, radius_m, vertices FROM shape ORDER BY id");
   s.Describe("shape", {0});
   while (s.Next()) {
-    engine::BodyShape shape;
+    Shape shape;
     shape.radius_m = s.Real(1, 0.0, run_limits::kRadius_m);
     shape.vertices = PointsFromJson(s.Text(2), impl_->file, "shape", "id " + s.Text(0), "vertices");
     shapes.push_back(std::move(shape));
@@ -599,12 +548,12 @@ std::vector<std::uint32_t> RunFileReader::PersonGroups() const {
   return out;
 }
 
-std::vector<engine::Wall> RunFileReader::Walls() const {
-  std::vector<engine::Wall> walls;
+std::vector<Wall> RunFileReader::Walls() const {
+  std::vector<Wall> walls;
   Statement s(*impl_->db, "SELECT id, closed, radius_m, points FROM wall ORDER BY id");
   s.Describe("wall", {0});
   while (s.Next()) {
-    engine::Wall w;
+    Wall w;
     w.closed = s.Integer(1, 0, 1) != 0;
     w.radius_m = s.Real(2, 0.0, run_limits::kRadius_m);
     w.points = PointsFromJson(s.Text(3), impl_->file, "wall", "id " + s.Text(0), "points");
@@ -613,4 +562,145 @@ std::vector<engine::Wall> RunFileReader::Walls() const {
   return walls;
 }
 
-}  // namespace crowdrecon::scenario
+const std::string& RunFileReader::file() const { return impl_->file; }
+
+std::string RunFileReader::venue_json() const { return RunValue("venue"); }
+
+PeriodicBox RunFileReader::periodic_box() const {
+  PeriodicBox box;
+  const std::string text = RunValue("periodic_box");
+  if (text.empty()) return box;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    box.x = j.value("x", false);
+    box.y = j.value("y", false);
+    box.min_m = {j.at("min_m").at(0).get<double>(), j.at("min_m").at(1).get<double>()};
+    box.max_m = {j.at("max_m").at(0).get<double>(), j.at("max_m").at(1).get<double>()};
+  } catch (const std::exception& e) {
+    throw InputError(impl_->file + ": table run, row key periodic_box, column value: malformed (" +
+                     ShortText(e.what(), 120) + "): " + ShortText(text) +
+                     "; expected {\"x\": true|false, \"y\": true|false, \"min_m\": [x, y], \"max_m\": [x, y]}");
+  }
+  // Only the periodic axes need an extent (the engine leaves the others 0).
+  for (int axis = 0; axis < 2; ++axis) {
+    const bool periodic = axis == 0 ? box.x : box.y;
+    const double lo = axis == 0 ? box.min_m.x : box.min_m.y, hi = axis == 0 ? box.max_m.x : box.max_m.y;
+    if (periodic && !(hi > lo && lo >= -run_limits::kCoordinate_m && hi <= run_limits::kCoordinate_m))
+      throw InputError(impl_->file + ": table run, row key periodic_box, column value: " + ShortText(text) +
+                       "; expected max_m > min_m within +-" + FormatNumber(run_limits::kCoordinate_m) +
+                       " m along the periodic axis " + (axis == 0 ? "x" : "y"));
+  }
+  return box;
+}
+
+std::vector<FrameTime> RunFileReader::FrameTimes() const {
+  std::vector<FrameTime> times;
+  Statement s(*impl_->db, "SELECT frame, time_s FROM frame_time ORDER BY frame");
+  s.Describe("frame_time", {0});
+  while (s.Next()) times.push_back({s.Integer(0, 0, run_limits::kFrame), s.Real(1, 0.0, run_limits::kTime_s)});
+  return times;
+}
+
+struct PersonFrameStream::Impl {
+  std::unique_ptr<Statement> query;
+  bool have_row = false;
+};
+
+PersonFrameStream::PersonFrameStream() : impl_(std::make_unique<Impl>()) {}
+PersonFrameStream::PersonFrameStream(PersonFrameStream&&) noexcept = default;
+PersonFrameStream::~PersonFrameStream() = default;
+
+bool PersonFrameStream::Next(PersonFrame* out) {
+  using namespace run_limits;
+  if (!impl_->have_row) return false;
+  Statement& q = *impl_->query;
+  out->frame = q.Int(0);
+  out->person.clear();
+  out->position_m.clear();
+  out->velocity_m_per_s.clear();
+  out->angle_rad.clear();
+  out->angular_velocity_rad_per_s.clear();
+  out->state.clear();
+  out->load_n.clear();
+  while (impl_->have_row && q.Int(0) == out->frame) {
+    out->person.push_back(static_cast<std::uint32_t>(q.Integer(1, 1, kPersonId) - 1));
+    out->position_m.push_back({q.Real(2, -kCoordinate_m, kCoordinate_m), q.Real(3, -kCoordinate_m, kCoordinate_m)});
+    out->velocity_m_per_s.push_back({q.Real(4, -kSpeed_m_per_s, kSpeed_m_per_s), q.Real(5, -kSpeed_m_per_s, kSpeed_m_per_s)});
+    out->angle_rad.push_back(q.Real(6, -1e6, 1e6));
+    out->angular_velocity_rad_per_s.push_back(q.Real(7, -kSpeed_m_per_s, kSpeed_m_per_s));
+    out->state.push_back(static_cast<PersonStatus>(q.Integer(8, 0, 2)));
+    out->load_n.push_back(q.Real(9, 0.0, kForce_n));
+    impl_->have_row = q.Next();
+  }
+  return true;
+}
+
+PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
+  PersonFrameStream stream;
+  // Column aliases name person_state's columns, so that a damaged value is
+  // reported in the table it was read from.
+  stream.impl_->query = std::make_unique<Statement>(
+      *impl_->db,
+      "SELECT t.frame AS frame, t.id AS id, t.pos_x AS pos_x, t.pos_y AS pos_y, "
+      "s.vel_x AS \"person_state.vel_x\", s.vel_y AS \"person_state.vel_y\", "
+      "s.angle_rad AS \"person_state.angle_rad\", s.omega_rad_per_s AS \"person_state.omega_rad_per_s\", "
+      "s.state AS \"person_state.state\", s.load_n AS \"person_state.load_n\" FROM trajectory_data t "
+      "JOIN person_state s ON s.frame = t.frame AND s.id = t.id WHERE t.frame <= ?1 "
+      "ORDER BY t.frame, t.id");
+  stream.impl_->query->Bind(1, last_frame).Describe("trajectory_data", {0, 1});
+  stream.impl_->have_row = stream.impl_->query->Next();
+  return stream;
+}
+
+std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
+  std::vector<Vec2> sums;
+  Statement q(*impl_->db,
+              "SELECT p.grp, SUM(s.vel_x), SUM(s.vel_y) FROM person_state s JOIN person p ON p.id = s.id "
+              "GROUP BY p.grp ORDER BY p.grp");
+  while (q.Next()) {
+    const std::int64_t g = q.Int(0);
+    if (g < 0 || g > run_limits::kGroup) continue;  // PersonGroups() reports such a row
+    if (static_cast<std::size_t>(g) >= sums.size()) sums.resize(static_cast<std::size_t>(g) + 1);
+    sums[static_cast<std::size_t>(g)] = {q.Double(1), q.Double(2)};
+  }
+  return sums;
+}
+
+std::vector<Event> RunFileReader::Events() const {
+  std::vector<Event> events;
+  Statement s(*impl_->db, "SELECT frame, rowid, time_s, kind, person, other, detail FROM event ORDER BY frame, rowid");
+  s.Describe("event", {0, 1});
+  while (s.Next()) {
+    Event e;
+    e.time_s = s.Real(2, 0.0, run_limits::kTime_s);
+    e.kind = s.Text(3);
+    e.person = s.Integer(4, 0, run_limits::kPersonId) - 1;
+    e.other = s.Integer(5, 0, run_limits::kPersonId) - 1;
+    e.detail = s.Text(6);
+    events.push_back(std::move(e));
+  }
+  return events;
+}
+
+std::vector<PersonInfo> RunFileReader::People() const {
+  std::vector<PersonInfo> people;
+  using namespace run_limits;
+  Statement s(*impl_->db,
+              "SELECT id, shape, mass_kg, inertia_kg_m2, desired_speed_m_per_s, grp, target, "
+              "(SELECT COUNT(*) FROM shape) FROM person ORDER BY id");
+  s.Describe("person", {0});
+  while (s.Next()) {
+    const std::int64_t id = s.Integer(0, 1, kPersonId);
+    if (static_cast<std::size_t>(id) > people.size()) people.resize(static_cast<std::size_t>(id));
+    PersonInfo& p = people[static_cast<std::size_t>(id - 1)];
+    p.shape = static_cast<std::uint32_t>(s.Integer(1, 0, std::max<std::int64_t>(0, s.Int(7) - 1)));
+    p.mass_kg = s.Real(2, 0.0, kMass_kg);
+    p.inertia_kg_m2 = s.Real(3, 0.0, kMass_kg * kRadius_m * kRadius_m);
+    p.desired_speed_m_per_s = s.Real(4, 0.0, kSpeed_m_per_s);
+    p.group = static_cast<std::uint32_t>(s.Integer(5, 0, kGroup));
+    p.target = s.Text(6);
+  }
+  return people;
+}
+
+}  // namespace crowdrecon::runfile

@@ -1,4 +1,6 @@
-// RunFile: one SQLite file per run, readable by the field's tools.
+// Run files: one SQLite file per run, readable by the field's tools, and by
+// crowdrecon's analysis, renderer, reports and calibration without the engine
+// (this library depends on common and SQLite only).
 //
 // JuPedSim trajectory format, version 2 (what PedPy's
 // load_trajectory_from_jupedsim_sqlite and load_walkable_area_from_jupedsim_sqlite read):
@@ -7,7 +9,7 @@
 //   geometry(hash INTEGER, wkt TEXT)             the walkable area as WKT
 //   frame_data(frame INTEGER, geometry_hash INTEGER)
 // plus crowdrecon's own tables in the same file:
-//   run(key TEXT PRIMARY KEY, value TEXT)        scenario JSON, seed, time step, status, ...
+//   run(key TEXT PRIMARY KEY, value TEXT)        scenario JSON, venue JSON, seed, time step, status, ...
 //   shape(id INTEGER PRIMARY KEY, radius_m REAL, vertices TEXT)   body frame, JSON [[x,y],...]
 //   person(id INTEGER PRIMARY KEY, shape INTEGER, mass_kg REAL, inertia_kg_m2 REAL,
 //          desired_speed_m_per_s REAL, grp INTEGER, target TEXT)
@@ -20,7 +22,14 @@
 //   event(frame, time_s, kind TEXT, person INTEGER, other INTEGER, detail TEXT)
 //   wall(id INTEGER PRIMARY KEY, closed INTEGER, radius_m REAL, points TEXT)
 // Person ids in every table are 1-based in trajectory_data/person (as PedPy
-// expects ids), i.e. engine index + 1; contact.a/b use the same ids.
+// expects ids), i.e. person index + 1; contact.a/b use the same ids. In this
+// library's records (Contact, PersonFrame.person, Event) people are 0-based
+// indices, as in the engine.
+//
+// The run table's key `venue` holds the venue the run was simulated in, as
+// venue JSON (docs/venues.md), so that a run file is self-contained: its
+// analysis needs no other file and does not depend on where it is opened.
+// Run files written before this key existed have no venue (format_version 1).
 //
 // Each frame is one transaction: a run killed at any moment leaves a valid
 // file holding every frame committed so far (in write-ahead-log mode while
@@ -30,59 +39,113 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "crowdrecon/common/output_path.hpp"
-#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/common/periodic_box.hpp"
+#include "crowdrecon/common/vec2.hpp"
 
-namespace crowdrecon::scenario {
+namespace crowdrecon::runfile {
+
+// The codes of person_state.state (the engine's PersonState has the same
+// values; scenario/src/frame_snapshot.cpp checks that at compile time).
+enum class PersonStatus : std::uint8_t {
+  kWalking = 0,
+  kFallen = 1,   // lies on the floor, an obstacle to others
+  kRemoved = 2,  // left the venue; not in the frame tables after it left
+};
 
 // Identity of a run, written once.
 struct RunHeader {
   std::string scenario_json;    // the scenario as given
   std::string scenario_origin;  // its file
+  std::string venue_json;       // the venue as venue JSON ("" when the scenario has none)
   std::string walkable_wkt;     // POLYGON/MULTIPOLYGON of the walkable area
+  PeriodicBox periodic_box;     // of a periodic run (run value periodic_box, written when any())
   double output_fps = 10.0;
   double time_step_s = 0.0;
   std::uint64_t seed = 0;
   std::vector<std::string> target_names;  // by target index
 };
 
+// A body shape in its own frame: a convex polygon swept by a disc of radius_m.
+struct Shape {
+  double radius_m = 0.0;
+  std::vector<Vec2> vertices;
+};
+
+// A wall polyline (closed: a polygon) swept by a disc of radius_m.
+struct Wall {
+  bool closed = false;
+  double radius_m = 0.0;
+  std::vector<Vec2> points;
+};
+
+// A person as placed at the start of the run.
+struct Person {
+  std::uint32_t shape = 0;
+  double mass_kg = 0.0;
+  double inertia_kg_m2 = 0.0;
+  double desired_speed_m_per_s = 0.0;
+  std::uint32_t group = 0;
+  std::uint32_t target = 0;  // index into RunHeader::target_names
+};
+
+// Everything the file stores of a run before its first frame.
+struct RunSetup {
+  std::vector<Shape> shapes;
+  std::vector<Person> people;  // index = person index (id - 1)
+  std::vector<Wall> walls;
+};
+
+// One contact of a frame: a and b are person indices (b a wall index when
+// wall); the forces act on a.
+struct Contact {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  bool wall = false;
+  Vec2 point_m;
+  Vec2 normal;  // unit, from b to a
+  double overlap_m = 0.0;
+  double normal_force_n = 0.0;      // along normal
+  double tangential_force_n = 0.0;  // along Perp(normal)
+  constexpr Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
+};
+
 struct Event {
   double time_s = 0.0;
   std::string kind;          // e.g. "fall", "avalanche_start", "numerical_failure"
-  std::int64_t person = -1;  // engine index, -1 if none
+  std::int64_t person = -1;  // person index, -1 if none
   std::int64_t other = -1;
   std::string detail;
 };
 
 // Everything one frame of the run file holds, copied out of the simulation
-// (cheap next to writing it), so that the frame can be written while the
-// simulation goes on (FrameWriterThread). Take() reuses the vectors' storage.
+// (cheap next to writing it: scenario::TakeSnapshot), so that the frame can
+// be written while the simulation goes on (FrameWriterThread). Whoever fills
+// it reuses the vectors' storage.
 struct FrameSnapshot {
   std::int64_t frame = 0;
   double time_s = 0.0;
-  std::vector<std::uint32_t> person;  // engine index of each entry below (removed people left out)
+  std::vector<std::uint32_t> person;  // person index of each entry below (removed people left out)
   std::vector<Vec2> position_m;
   std::vector<Vec2> velocity_m_per_s;
   std::vector<double> angle_rad;
   std::vector<double> angular_velocity_rad_per_s;
-  std::vector<engine::PersonState> state;
+  std::vector<PersonStatus> state;
   std::vector<double> load_n;  // sum of the magnitudes of the contact forces on the person
   bool with_contacts = false;
-  std::vector<engine::Contact> contacts;  // every contact when with_contacts, else empty
+  std::vector<Contact> contacts;  // every contact when with_contacts, else empty
   std::vector<Event> events;
-
-  void Take(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events, bool with_contacts);
 };
 
 class RunFileWriter {
  public:
-  // Creates (truncating) the file and writes the header, shapes, persons and walls.
-  static RunFileWriter Create(const std::filesystem::path& file, const RunHeader& header,
-                              const engine::Simulation& sim);
+  // Creates (truncating) the file and writes the header, shapes, people and walls.
+  static RunFileWriter Create(const std::filesystem::path& file, const RunHeader& header, const RunSetup& setup);
   // Reopens an existing run to continue after a checkpoint: frames after
   // `last_frame` are deleted (they will be written again identically).
   static RunFileWriter Resume(const std::filesystem::path& file, std::int64_t last_frame);
@@ -90,9 +153,7 @@ class RunFileWriter {
   RunFileWriter& operator=(RunFileWriter&&) noexcept;
   ~RunFileWriter();
 
-  // Writes frame `frame` (trajectories, states, contacts if enabled, events) in one transaction.
-  void WriteFrame(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events,
-                  bool with_contacts);
+  // Writes one frame (trajectories, states, contacts if taken, events) in one transaction.
   void WriteFrame(const FrameSnapshot& snapshot);
   // Records an event outside a frame (e.g. a failure), committed at once.
   void WriteEvent(std::int64_t frame, const Event& event);
@@ -127,8 +188,9 @@ class FrameWriterThread {
   FrameWriterThread(const FrameWriterThread&) = delete;
   FrameWriterThread& operator=(const FrameWriterThread&) = delete;
 
-  // Copies the frame out of `sim` and queues it.
-  void Write(std::int64_t frame, const engine::Simulation& sim, const std::vector<Event>& events, bool with_contacts);
+  // Has `fill` copy the frame into a snapshot (one whose storage is reused)
+  // in the caller's thread, then queues it.
+  void Write(const std::function<void(FrameSnapshot&)>& fill);
   // Returns once every queued frame is committed.
   void Flush();
 
@@ -148,19 +210,67 @@ inline constexpr double kSpeed_m_per_s = 1e5;
 inline constexpr double kForce_n = 1e12;         // contact forces, loads
 inline constexpr double kTime_s = 1e9;
 inline constexpr double kRadius_m = 10.0;        // sphero-radii of bodies and walls
+inline constexpr double kMass_kg = 1e4;          // masses; inertias up to kMass_kg * kRadius_m^2
 inline constexpr std::int64_t kFrame = std::int64_t{1} << 53;
 inline constexpr std::int64_t kPersonId = 10'000'000;
 inline constexpr std::int64_t kGroup = 1023;
 }  // namespace run_limits
 
-// Reading a run back (render, reports, tests).
+// Reading a run back: the trajectory of one frame, as PedPy sees it.
 struct RunFrame {
   std::int64_t frame = 0;
   double time_s = 0.0;
   std::vector<std::int64_t> ids;  // 1-based
   std::vector<Vec2> position_m;
   std::vector<Vec2> orientation;  // unit vector the chest faces
-  std::vector<engine::Contact> contacts;  // a, b as engine indices (id - 1) / wall index
+  std::vector<Contact> contacts;
+};
+
+struct FrameTime {
+  std::int64_t frame = 0;
+  double time_s = 0.0;
+};
+
+// A person as the reader gives it back: the placement record, with the
+// target's name.
+struct PersonInfo {
+  std::uint32_t shape = 0;
+  double mass_kg = 0.0;
+  double inertia_kg_m2 = 0.0;
+  double desired_speed_m_per_s = 0.0;
+  std::uint32_t group = 0;
+  std::string target;
+};
+
+// The state of every person present in one frame (trajectory_data joined with
+// person_state), for analysis, reports and calibration.
+struct PersonFrame {
+  std::int64_t frame = 0;
+  std::vector<std::uint32_t> person;  // person index (id - 1), ascending
+  std::vector<Vec2> position_m;
+  std::vector<Vec2> velocity_m_per_s;
+  std::vector<double> angle_rad;
+  std::vector<double> angular_velocity_rad_per_s;
+  std::vector<PersonStatus> state;
+  std::vector<double> load_n;
+};
+
+class RunFileReader;
+
+// The frames of a run in order, one PersonFrame at a time (one query, so that
+// a long run is read in one pass without holding it in memory).
+class PersonFrameStream {
+ public:
+  PersonFrameStream(PersonFrameStream&&) noexcept;
+  ~PersonFrameStream();
+  // Fills `out` with the next frame; false after the last.
+  bool Next(PersonFrame* out);
+
+ private:
+  friend class RunFileReader;
+  PersonFrameStream();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 class RunFileReader {
@@ -169,18 +279,31 @@ class RunFileReader {
   RunFileReader(RunFileReader&&) noexcept;
   ~RunFileReader();
 
+  const std::string& file() const;
   std::string RunValue(const std::string& key) const;  // "" if absent
   // A run value that must be a number in [min, max]; absent: `fallback`.
   double RunNumber(const std::string& key, double fallback, double min, double max) const;
   double fps() const;
   std::string walkable_wkt() const;
+  // The venue JSON stored with the run ("" in run files written before it was).
+  std::string venue_json() const;
+  // The periodic box (run value periodic_box = {"x": true, "y": false,
+  // "min_m": [x, y], "max_m": [x, y]}); none recorded: no periodic axis.
+  PeriodicBox periodic_box() const;
   std::vector<std::int64_t> Frames() const;
+  std::vector<FrameTime> FrameTimes() const;
   RunFrame Frame(std::int64_t frame) const;
+  // Every frame up to `last_frame` inclusive, in order.
+  PersonFrameStream PersonFrames(std::int64_t last_frame) const;
+  // The sum of every recorded velocity of each group's people (index = group).
+  std::vector<Vec2> GroupVelocitySums() const;
+  std::vector<Event> Events() const;
   // Shapes (body frame) and each person's shape index.
-  std::vector<engine::BodyShape> Shapes() const;
+  std::vector<Shape> Shapes() const;
+  std::vector<PersonInfo> People() const;  // index = person index (ids 1..N must be contiguous)
   std::vector<std::uint32_t> PersonShapes() const;
   std::vector<std::uint32_t> PersonGroups() const;
-  std::vector<engine::Wall> Walls() const;
+  std::vector<Wall> Walls() const;
 
  private:
   struct Impl;
@@ -193,4 +316,4 @@ OutputKind RunFileOutput();
 // True if `file` is a crowdrecon run file (false for anything else, no error).
 bool IsRunFile(const std::filesystem::path& file);
 
-}  // namespace crowdrecon::scenario
+}  // namespace crowdrecon::runfile

@@ -1,0 +1,33 @@
+// What a run file records of a simulation. The run-file library
+// (runfile/run_file.hpp) knows no engine; these functions copy the engine's
+// world and frames into its records.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+
+namespace crowdrecon::scenario {
+
+// Shapes, people (as placed) and walls of the simulation.
+runfile::RunSetup RunSetupOf(const engine::Simulation& sim);
+// Creates the run file of `sim`: the header (its periodic box taken from the
+// simulation) and RunSetupOf(sim).
+runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
+                                     const engine::Simulation& sim);
+
+// Copies frame `frame` of the simulation into `out`, reusing its storage:
+// every person still in the venue, their loads (the sum of the magnitudes of
+// the contact forces on each, the quantity compared with the 400 N
+// threshold), every contact when `with_contacts`, and the frame's events.
+void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::vector<runfile::Event>& events,
+                  bool with_contacts, runfile::FrameSnapshot* out);
+// TakeSnapshot then RunFileWriter::WriteFrame, in the caller's thread.
+void WriteFrame(runfile::RunFileWriter& writer, const engine::Simulation& sim, std::int64_t frame,
+                const std::vector<runfile::Event>& events, bool with_contacts);
+
+}  // namespace crowdrecon::scenario
