@@ -250,7 +250,7 @@ void FrameWrite(benchmark::State& state, const std::string& world) {
   header.time_step_s = sim.time_step_s();
   std::int64_t frame = 0;
   {
-    runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
+    runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim, {});
     runfile::FrameSnapshot snapshot;
     scenario::TakeSnapshot(sim, 0, {}, true, &snapshot);
     for (auto _ : state) {

@@ -18,6 +18,7 @@
 #include "crowdrecon/geometry/body.hpp"
 #include "crowdrecon/geometry/outline.hpp"
 #include "crowdrecon/geometry/population.hpp"
+#include "crowdrecon/geometry/population_table.hpp"
 #include "crowdrecon/viz/canvas.hpp"
 
 namespace crowdrecon::cli {
@@ -320,14 +321,18 @@ void RegisterShapeCommands(CLI::App& app) {
     auto args = std::make_shared<PopulationArgs>();
     CLI::App* cmd = app.add_subcommand("population", "Draw a population of bodies with masses");
     cmd->add_option("--mode", args->mode, "paper | anthropometric | circle")->capture_default_str();
-    cmd->add_option("--count", args->count, "Number of people")
-        ->capture_default_str()
-        ->check(IntegerIn(1, static_cast<long long>(geometry::kMaxPeople)));
-    cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str()->check(IntegerIn(0, 1LL << 62));
+    // Ranges from the population table (geometry/population_table.hpp), as in scenarios.
+    const auto in_table = [](std::string_view path) {
+      const geometry::PopulationKeyInfo& k = geometry::PopulationKey(path);
+      return k.integer ? IntegerIn(static_cast<long long>(k.min), static_cast<long long>(k.max))
+                       : NumberIn(k.min, k.max, k.unit);
+    };
+    cmd->add_option("--count", args->count, "Number of people")->capture_default_str()->check(in_table("count"));
+    cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str()->check(in_table("seed"));
     cmd->add_option("--female-fraction", args->female_fraction,
                     "Anthropometric mode: fraction of women")
         ->capture_default_str()
-        ->check(NumberIn(0.0, 1.0));
+        ->check(in_table("body.female_fraction"));
     cmd->add_option("--body", args->body, "Reference body (paper, circle modes)")->capture_default_str();
     cmd->add_option("--anthropometry", args->anthropometry, "ANSUR II extract (anthropometric mode)")
         ->capture_default_str();

@@ -155,7 +155,7 @@ namespace {
 
 // The people and frames of a run (step 1).
 struct RunContents {
-  std::vector<runfile::PersonInfo> people;  // index = person index
+  std::vector<runfile::Person> people;  // index = person index
   std::vector<std::int64_t> frame;
   std::vector<double> time_s;
   std::uint32_t first_group = 0;  // the lowest group with people
@@ -185,7 +185,7 @@ RunContents OpenRun(const runfile::RunFileReader& run, RunAnalysis* out) {
   out->duration_s = c.time_s.back() - c.time_s.front();
   std::uint32_t max_group = 0;
   c.first_group = std::numeric_limits<std::uint32_t>::max();
-  for (const runfile::PersonInfo& p : c.people) {
+  for (const runfile::Person& p : c.people) {
     max_group = std::max(max_group, p.group);
     c.first_group = std::min(c.first_group, p.group);
   }
@@ -204,7 +204,7 @@ void DesiredDirections(const runfile::RunFileReader& run, const RunContents& c, 
   if (venue.venue) {
     std::vector<std::optional<Vec2>> direction(out->groups);
     from_venue = true;
-    for (const runfile::PersonInfo& p : c.people) {
+    for (const runfile::Person& p : c.people) {
       const std::optional<geometry::Target> target = venue.venue->FindTarget(p.target);
       if (!target || target->kind != geometry::Target::Kind::kDirection) {
         venue_problem = "target \"" + p.target + "\" is not a fixed direction of the run's venue";

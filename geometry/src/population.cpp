@@ -15,6 +15,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/geometry/population_table.hpp"
 
 namespace crowdrecon::geometry {
 
@@ -37,18 +38,18 @@ PopulationMode PopulationModeFromString(const std::string& text, const std::stri
 
 bool PopulationOptions::IsValid(std::string* error) const {
   const std::string problem = [&]() -> std::string {
-    if (count < 1 || count > kMaxPeople)
-      return "count (" + std::to_string(count) + ") out of range; expected 1 to " + std::to_string(kMaxPeople) +
-             " (check the count)";
+    // The options a scenario gives, against the population table.
+    if (const PopulationKeyInfo& k = PopulationKey("count"); !k.Contains(static_cast<double>(count)))
+      return "count (" + std::to_string(count) + ") out of range; expected " + k.Expected() + " (check the count)";
     if (!(mass_min_kg > 0.0 && mass_min_kg <= mass_max_kg && std::isfinite(mass_max_kg)))
       return "mass range [" + FormatNumber(mass_min_kg) + ", " + FormatNumber(mass_max_kg) +
              "] kg; expected 0 < min <= max";
     if (!(density_kg_m2 > 0.0 && std::isfinite(density_kg_m2)))
       return "density (" + FormatNumber(density_kg_m2) + " kg/m^2) must be positive";
-    if (!(female_fraction >= 0.0 && female_fraction <= 1.0))
-      return "female fraction (" + FormatNumber(female_fraction) + ") out of range; expected 0 to 1";
-    if (vertex_count < 3)
-      return "vertex count (" + std::to_string(vertex_count) + ") is too small; expected at least 3";
+    if (const PopulationKeyInfo& k = PopulationKey("body.female_fraction"); !k.Contains(female_fraction))
+      return "female fraction (" + FormatNumber(female_fraction) + ") out of range; expected " + k.Expected();
+    if (const PopulationKeyInfo& k = PopulationKey("body.vertices"); !k.Contains(static_cast<double>(vertex_count)))
+      return "vertex count (" + std::to_string(vertex_count) + ") out of range; expected " + k.Expected();
     if (!(radius_m > 0.0 && std::isfinite(radius_m)))
       return "sphero-radius (" + FormatNumber(radius_m) + " m) must be positive";
     std::string thorax_error;

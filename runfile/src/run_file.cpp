@@ -195,7 +195,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
           .Bind(4, p.inertia_kg_m2)
           .Bind(5, p.desired_speed_m_per_s)
           .Bind(6, static_cast<std::int64_t>(p.group))
-          .Bind(7, p.target < header.target_names.size() ? header.target_names[p.target] : std::to_string(p.target))
+          .Bind(7, p.target)
           .Run();
     }
     Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
@@ -682,8 +682,8 @@ std::vector<Event> RunFileReader::Events() const {
   return events;
 }
 
-std::vector<PersonInfo> RunFileReader::People() const {
-  std::vector<PersonInfo> people;
+std::vector<Person> RunFileReader::People() const {
+  std::vector<Person> people;
   using namespace run_limits;
   Statement s(*impl_->db,
               "SELECT id, shape, mass_kg, inertia_kg_m2, desired_speed_m_per_s, grp, target, "
@@ -692,7 +692,7 @@ std::vector<PersonInfo> RunFileReader::People() const {
   while (s.Next()) {
     const std::int64_t id = s.Integer(0, 1, kPersonId);
     if (static_cast<std::size_t>(id) > people.size()) people.resize(static_cast<std::size_t>(id));
-    PersonInfo& p = people[static_cast<std::size_t>(id - 1)];
+    Person& p = people[static_cast<std::size_t>(id - 1)];
     p.shape = static_cast<std::uint32_t>(s.Integer(1, 0, std::max<std::int64_t>(0, s.Int(7) - 1)));
     p.mass_kg = s.Real(2, 0.0, kMass_kg);
     p.inertia_kg_m2 = s.Real(3, 0.0, kMass_kg * kRadius_m * kRadius_m);

@@ -7,23 +7,25 @@ static_assert(static_cast<int>(engine::PersonState::kWalking) == static_cast<int
                   static_cast<int>(engine::PersonState::kRemoved) == static_cast<int>(runfile::PersonStatus::kRemoved),
               "the run file's person_state.state codes are the engine's PersonState values");
 
-runfile::RunSetup RunSetupOf(const engine::Simulation& sim) {
+runfile::RunSetup RunSetupOf(const engine::Simulation& sim, const std::vector<std::string>& target_names) {
   runfile::RunSetup setup;
   const engine::WorldDef& def = sim.definition();
   for (const engine::BodyShape& s : def.shapes) setup.shapes.push_back({s.radius_m, s.vertices});
   const engine::BodyState& b = sim.bodies();
   setup.people.reserve(b.size());
-  for (std::size_t i = 0; i < b.size(); ++i)
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const std::uint32_t t = b.target[i];
     setup.people.push_back({b.shape[i], b.mass_kg[i], b.inertia_kg_m2[i], b.desired_speed_m_per_s[i], b.group[i],
-                            b.target[i]});
+                            t < target_names.size() ? target_names[t] : std::to_string(t)});
+  }
   for (const engine::Wall& w : def.walls) setup.walls.push_back({w.closed, w.radius_m, w.points});
   return setup;
 }
 
 runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
-                                     const engine::Simulation& sim) {
+                                     const engine::Simulation& sim, const std::vector<std::string>& target_names) {
   header.periodic_box = sim.definition().periodic;
-  return runfile::RunFileWriter::Create(file, header, RunSetupOf(sim));
+  return runfile::RunFileWriter::Create(file, header, RunSetupOf(sim, target_names));
 }
 
 void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::vector<runfile::Event>& events,

@@ -214,7 +214,6 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   header.output_fps = scenario.run.output_fps;
   header.time_step_s = sim.time_step_s();
   header.seed = scenario.population.seed;
-  header.target_names = built.target_names;
 
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
@@ -236,7 +235,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
       return runfile::RunFileWriter::Resume(options.output, last_frame);
     }
     std::filesystem::remove(checkpoint, ec);
-    return CreateRunFile(options.output, header, sim);
+    return CreateRunFile(options.output, header, sim, built.target_names);
   }();
   writer.SetRunValue("people", std::to_string(sim.bodies().size()));
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));

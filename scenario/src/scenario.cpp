@@ -9,6 +9,7 @@
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
+#include "crowdrecon/geometry/population_table.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -77,11 +78,18 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
   {
     const JsonReader pop = root.At("population");
     PopulationSpec& p = s.population;
+    // Every number with its range from the population table (geometry/population_table.hpp).
+    const auto number = [](const JsonReader& section, std::string_view path, double fallback) {
+      const geometry::PopulationKeyInfo& k = geometry::PopulationKey(path);
+      return k.integer ? static_cast<double>(section.Integer(k.key, static_cast<long long>(fallback),
+                                                             static_cast<long long>(k.min), static_cast<long long>(k.max)))
+                       : section.Number(k.key, fallback, k.min, k.max);
+    };
     if (pop.Has("count") == pop.Has("density_per_m2"))
       pop.Fail("give exactly one of \"count\" and \"density_per_m2\"");
-    if (pop.Has("count")) p.count = static_cast<std::size_t>(pop.Integer("count", 1, static_cast<long long>(geometry::kMaxPeople)));
-    if (pop.Has("density_per_m2")) p.density_per_m2 = pop.Number("density_per_m2", 0.01, 12.0);
-    p.counter_flow_fraction = pop.Number("counter_flow_fraction", 0.0, 0.0, 1.0);
+    if (pop.Has("count")) p.count = static_cast<std::size_t>(number(pop, "count", 0.0));
+    if (pop.Has("density_per_m2")) p.density_per_m2 = number(pop, "density_per_m2", 0.0);
+    p.counter_flow_fraction = number(pop, "counter_flow_fraction", p.counter_flow_fraction);
     p.target = pop.String("target");
     if (!s.venue.FindTarget(p.target))
       pop.At("target").Fail("the venue " + s.venue_file.string() + " has no target or exit \"" + p.target + "\"");
@@ -105,25 +113,27 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
       if (auto ref = body->Find("reference")) p.reference_body = readable(*ref, "a body file (crowdrecon body JSON)");
       if (auto ansur = body->Find("anthropometry"))
         p.anthropometry = readable(*ansur, "an ANSUR II extract (CSV, docs/bodies.md)");
-      p.female_fraction = body->Number("female_fraction", p.female_fraction, 0.0, 1.0);
-      p.vertex_count = static_cast<std::size_t>(body->Integer("vertices", 18, 3, 200));
+      p.female_fraction = number(*body, "body.female_fraction", p.female_fraction);
+      p.vertex_count = static_cast<std::size_t>(number(*body, "body.vertices", static_cast<double>(p.vertex_count)));
       body->Finish();
     }
     if (p.reference_body.empty()) p.reference_body = DataDirectory() / "venues/bodies/thorax-18.json";
     if (p.anthropometry.empty()) p.anthropometry = DataDirectory() / "venues/bodies/ansur2-thorax.csv";
     if (auto speed = pop.Find("desired_speed_m_per_s")) {
-      if (speed->Size() != 2) speed->Fail("expected [min, max] in m/s");
-      p.desired_speed_min_m_per_s = speed->Element(0).AsNumber(0.0, 10.0);
-      p.desired_speed_max_m_per_s = speed->Element(1).AsNumber(p.desired_speed_min_m_per_s, 10.0);
+      const geometry::PopulationKeyInfo& k = geometry::PopulationKey("desired_speed_m_per_s");
+      if (speed->Size() != 2) speed->Fail(std::string("expected ") + k.Expected() + " " + k.unit);
+      p.desired_speed_min_m_per_s = speed->Element(0).AsNumber(k.min, k.max);
+      p.desired_speed_max_m_per_s = speed->Element(1).AsNumber(p.desired_speed_min_m_per_s, k.max);
     }
     if (auto placement = pop.Find("placement")) {
       p.placement_region = placement->Choice("region", "walkable", {"walkable", "entries"});
-      p.max_initial_overlap_m = placement->Number("max_overlap_m", p.max_initial_overlap_m, 1e-5, 0.05);
+      p.max_initial_overlap_m = number(*placement, "placement.max_overlap_m", p.max_initial_overlap_m);
       placement->Finish();
     }
     if (p.placement_region == "entries" && s.venue.entries.empty())
       pop.At("placement").Fail("region \"entries\" but the venue has no entry zones");
-    p.seed = static_cast<std::uint64_t>(pop.Integer("seed", 1, 0, std::int64_t{1} << 62));
+    p.seed = static_cast<std::uint64_t>(pop.Integer("seed", static_cast<long long>(p.seed), 0,
+                                                    static_cast<long long>(geometry::PopulationKey("seed").max)));
     pop.Finish();
   }
 

@@ -63,8 +63,7 @@ inline void WriteCorridorRun(const std::filesystem::path& file, Simulation& sim,
   header.walkable_wkt = RectangleWkt(c.length_m, c.width_m);
   header.output_fps = fps;
   header.time_step_s = sim.time_step_s();
-  header.target_names = {"to_exit", "to_court"};
-  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
+  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim, {"to_exit", "to_court"});
   // RunFileWriter records the periodic box itself; an empty value stands for
   // run files that do not (the renderer must cope with both).
   if (!record_periodic_box) writer.SetRunValue("periodic_box", "");

@@ -337,8 +337,7 @@ std::filesystem::path WriteWalkersRun(const std::string& name) {
   header.walkable_wkt = engine::testing::RectangleWkt(12.0, 3.0);
   header.output_fps = 10.0;
   header.time_step_s = sim.time_step_s();
-  header.target_names = {"to_exit", "to_court"};
-  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
+  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim, {"to_exit", "to_court"});
   for (int k = 0; k <= 100; ++k) {
     if (k > 0) sim.AdvanceTo(k / 10.0);
     scenario::WriteFrame(writer, sim, k, {}, /*with_contacts=*/false);
@@ -441,8 +440,7 @@ TEST(AnalyzeRun, StopAndGoRunFile) {
     runfile::RunHeader header;
     header.scenario_json = "{}";
     header.walkable_wkt = engine::testing::RectangleWkt(12.0, 3.0);
-    header.target_names = {"to_exit", "to_court"};
-    runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim);
+      runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim, {"to_exit", "to_court"});
     writer.SetStatus("complete");
   }
   sqlite3* db = nullptr;

@@ -14,7 +14,7 @@
 namespace crowdrecon::geometry {
 namespace {
 
-std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
+using crowdrecon::testing::ScratchFile;
 
 Body SquareBody() {
   Outline outline;
@@ -52,7 +52,7 @@ std::string ErrorReading(const std::filesystem::path& file) {
 
 TEST(BodyJson, RoundTrips) {
   const Body body = SquareBody();
-  const auto file = Scratch("square.json");
+  const auto file = ScratchFile("square.json");
   WriteBodyJson(body, file);
   const Body back = ReadBodyJson(file);
   ASSERT_EQ(back.shape.size(), 4u);
@@ -67,27 +67,27 @@ TEST(BodyJson, RoundTrips) {
 }
 
 TEST(BodyJson, RejectsUnknownKeysAndInconsistentFigures) {
-  const auto file = Scratch("square.json");
+  const auto file = ScratchFile("square.json");
   WriteBodyJson(SquareBody(), file);
   const std::string text = ReadText(file);
 
-  const auto unknown = Scratch("unknown.json");
+  const auto unknown = ScratchFile("unknown.json");
   WriteText(unknown, Replace(text, "\"format\"", "\"colour\": \"red\",\n \"format\""));
   const std::string e1 = ErrorReading(unknown);
   EXPECT_NE(e1.find("unknown.json"), std::string::npos) << e1;
   EXPECT_NE(e1.find("colour"), std::string::npos) << e1;
 
-  const auto area = Scratch("area.json");
+  const auto area = ScratchFile("area.json");
   WriteText(area, Replace(text, "\"area_m2\": 0.", "\"area_m2\": 0.9"));
   const std::string e2 = ErrorReading(area);
   EXPECT_NE(e2.find("area.json: /area_m2: stored value"), std::string::npos) << e2;
   EXPECT_NE(e2.find("does not match the shape"), std::string::npos) << e2;
 
-  const auto front = Scratch("front.json");
+  const auto front = ScratchFile("front.json");
   WriteText(front, Replace(text, "\"front_axis\": \"+x\"", "\"front_axis\": \"+y\""));
   EXPECT_NE(ErrorReading(front).find("/front_axis"), std::string::npos);
 
-  const auto radius = Scratch("radius.json");
+  const auto radius = ScratchFile("radius.json");
   WriteText(radius, Replace(text, "\"radius_m\": 0.05", "\"radius_m\": -0.05"));
   EXPECT_NE(ErrorReading(radius).find("/radius_m"), std::string::npos);
 }

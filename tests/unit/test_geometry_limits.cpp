@@ -28,7 +28,7 @@ using testing_util::ErrorOf;
 
 bool Has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
+using crowdrecon::testing::ScratchFile;
 
 double BruteForceHausdorff(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
   const auto directed = [](const std::vector<Vec2>& from, const std::vector<Vec2>& to) {
@@ -132,7 +132,7 @@ TEST(GeometryLimits, VenueProblemsIncludeHugeCoordinates) {
 }
 
 TEST(GeometryLimits, FoldersAreNamedAsFolders) {
-  const auto dir = Scratch("folder.png");
+  const auto dir = ScratchFile("folder.png");
   std::filesystem::create_directories(dir);
   EXPECT_TRUE(Has(ErrorOf([&] { ReadOutline(dir); }), "folder.png: is a directory; expected a picture file"));
   RasterImportOptions raster;
@@ -140,7 +140,7 @@ TEST(GeometryLimits, FoldersAreNamedAsFolders) {
   EXPECT_TRUE(Has(ErrorOf([&] { ImportRasterPlan(dir, raster); }), "folder.png: is a directory"));
   EXPECT_TRUE(Has(ErrorOf([&] { ImportWkt(dir); }), "folder.png: is a directory; expected a WKT file"));
   EXPECT_TRUE(Has(ErrorOf([&] { ImportDxf(dir); }), "folder.png: is a directory; expected a DXF file"));
-  const auto csv = Scratch("folder.csv");
+  const auto csv = ScratchFile("folder.csv");
   std::filesystem::create_directories(csv);
   EXPECT_TRUE(Has(ErrorOf([&] { ReadOutline(csv); }), "folder.csv: is a directory; expected a point list (CSV)"));
 }
@@ -148,7 +148,7 @@ TEST(GeometryLimits, FoldersAreNamedAsFolders) {
 TEST(GeometryLimits, PictureAbovePixelLimitIsRefusedFromItsHeader) {
   // A real 11000 x 10000 picture (110 megapixels, mostly one colour so small
   // on disk): refused before it is decoded.
-  const auto file = Scratch("large.png");
+  const auto file = ScratchFile("large.png");
   cv::Mat image(10000, 11000, CV_8UC1, cv::Scalar(255));
   ASSERT_TRUE(cv::imwrite(file.string(), image));
   const std::string m = ErrorOf([&] { ReadOutline(file); });

@@ -15,7 +15,7 @@
 namespace crowdrecon::geometry {
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
+const std::filesystem::path kNavigationData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
 
 Venue Parse(const std::string& json) { return ParseVenue(json, "test.json"); }
 
@@ -102,7 +102,7 @@ TEST(Navigation, LShapedCorridorGoesRoundTheCorner) {
 }
 
 TEST(Navigation, WalksAroundTheObstacle) {
-  const Venue v = LoadVenue(kData / "room.json");
+  const Venue v = LoadVenue(kNavigationData / "room.json");
   const NavigationField f = NavigationField::ToExit(v, "door");
   // Just west of the pillar the direction turns to pass it, not into it.
   const Vec2 west_of_pillar = f.Direction({4.2, 2.2});
@@ -128,7 +128,7 @@ TEST(Navigation, ThinWallsBlock) {
 }
 
 TEST(Navigation, UnreachablePartsAndTargets) {
-  const Venue v = ImportWkt(kData / "two-rooms.wkt");
+  const Venue v = ImportWkt(kNavigationData / "two-rooms.wkt");
   Venue with_exit = v;
   with_exit.exits.push_back({"door", {4, 1}, {4, 2}});
   ValidateVenue(with_exit);
@@ -137,7 +137,7 @@ TEST(Navigation, UnreachablePartsAndTargets) {
   EXPECT_TRUE(std::isinf(f.Distance({6.5, 1.5})));  // the other room
   EXPECT_EQ(f.Direction({6.5, 1.5}), Vec2(0, 0));
 
-  const Venue room = LoadVenue(kData / "room.json");
+  const Venue room = LoadVenue(kNavigationData / "room.json");
   const NavigationField east = NavigationField::ForTarget(room, "east");
   EXPECT_TRUE(east.is_constant());
   EXPECT_EQ(east.Direction({3, 3}), Vec2(1, 0));
@@ -159,7 +159,7 @@ TEST(Navigation, UnreachablePartsAndTargets) {
 }
 
 TEST(Triangulation, AreaAndUniformSamples) {
-  const Venue v = LoadVenue(kData / "room.json");
+  const Venue v = LoadVenue(kNavigationData / "room.json");
   const AreaTriangulation tri = AreaTriangulation::OfWalkableArea(v);
   EXPECT_NEAR(tri.area_m2(), WalkableArea_m2(v), 1e-9);
   double sum = 0.0;

@@ -21,17 +21,17 @@ namespace {
 
 using testing_util::ErrorOf;
 
-const std::string kData = std::string(CROWDRECON_SOURCE_DIR) + "/tests/data/bodies/";
+const std::string kBodyData = std::string(CROWDRECON_SOURCE_DIR) + "/tests/data/bodies/";
 constexpr double kA = 0.25, kB = 0.15;  // semi-axes, m: across the shoulders, front-back
 const double kEllipseArea = std::numbers::pi * kA * kB;
 
-std::filesystem::path Scratch(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
+using crowdrecon::testing::ScratchFile;
 
 // The ellipse drawn dark on white at 1000 px/m, front (+y, semi-axis kB) up,
 // with 1/16 px precision. Not anti-aliased: OpenCV draws a filled LINE_AA
 // ellipse with an extra half-pixel fringe (0.6% too much area here).
 std::filesystem::path EllipseImage() {
-  const auto file = Scratch("ellipse.png");
+  const auto file = ScratchFile("ellipse.png");
   cv::Mat image(500, 700, CV_8UC1, cv::Scalar(255));
   cv::ellipse(image, cv::Point(350 * 16, 250 * 16), cv::Size(250 * 16, 150 * 16), 0, 0, 360,
               cv::Scalar(0), cv::FILLED, cv::LINE_8, 4);
@@ -80,7 +80,7 @@ TEST(Outline, PointListGivesTheSameBodyAsTheImage) {
 }
 
 TEST(Outline, CsvAndJsonPointListsAreRead) {
-  const auto csv = Scratch("square.csv");
+  const auto csv = ScratchFile("square.csv");
   {
     std::FILE* f = std::fopen(csv.c_str(), "w");
     std::fputs("x,y\n# a square\n0,0\n0.4,0\n\n0.4,0.4\n0,0.4\n0,0\n", f);
@@ -88,7 +88,7 @@ TEST(Outline, CsvAndJsonPointListsAreRead) {
   }
   const Outline from_csv = ReadOutline(csv);
   EXPECT_EQ(from_csv.points.size(), 4u);  // closing repeat dropped
-  const auto json = Scratch("square.json");
+  const auto json = ScratchFile("square.json");
   {
     std::FILE* f = std::fopen(json.c_str(), "w");
     std::fputs("{\"front\": \"-x\", \"points\": [[0,0],[0,0.4],[0.4,0.4],[0.4,0]]}", f);
@@ -149,16 +149,16 @@ TEST(Outline, FrontAxisBecomesPlusX) {
 }
 
 TEST(Outline, InvalidOutlinesGiveClearErrors) {
-  EXPECT_NE(ErrorOf([] { ReadOutline(kData + "empty.png"); }).find("not a readable image"),
+  EXPECT_NE(ErrorOf([] { ReadOutline(kBodyData + "empty.png"); }).find("not a readable image"),
             std::string::npos);
-  const std::string no_region = ErrorOf([] { ReadOutline(kData + "blank.png"); });
+  const std::string no_region = ErrorOf([] { ReadOutline(kBodyData + "blank.png"); });
   EXPECT_NE(no_region.find("blank.png: no dark region"), std::string::npos) << no_region;
-  EXPECT_NE(ErrorOf([] { ReadOutline(kData + "two-points.csv"); }).find("too few points (2 distinct)"),
+  EXPECT_NE(ErrorOf([] { ReadOutline(kBodyData + "two-points.csv"); }).find("too few points (2 distinct)"),
             std::string::npos);
-  const std::string bowtie = ErrorOf([] { ReadOutline(kData + "bowtie.json"); });
+  const std::string bowtie = ErrorOf([] { ReadOutline(kBodyData + "bowtie.json"); });
   EXPECT_NE(bowtie.find("bowtie.json: the outline intersects itself (edge 0"), std::string::npos) << bowtie;
   const std::string thin =
-      ErrorOf([] { BuildBody(ReadOutline(kData + "thin-strip.json"), BodyOptions{}); });
+      ErrorOf([] { BuildBody(ReadOutline(kBodyData + "thin-strip.json"), BodyOptions{}); });
   EXPECT_NE(thin.find("thin-strip.json: outline too thin for the sphero-radius (0.05 m)"),
             std::string::npos) << thin;
   BodyOptions two_vertices;
@@ -176,9 +176,9 @@ TEST(Outline, InvalidOutlinesGiveClearErrors) {
             std::string::npos);
   EXPECT_NE(ErrorOf([] { ScaleRuleFromString("sternum:-1", "--scale"); }).find("not a positive number"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] { ReadOutline(kData + "missing.json"); }).find("missing.json: cannot open file"),
+  EXPECT_NE(ErrorOf([] { ReadOutline(kBodyData + "missing.json"); }).find("missing.json: cannot open file"),
             std::string::npos);
-  const std::string bad_json = ErrorOf([] { ReadOutline(kData + "bad-syntax.json"); });
+  const std::string bad_json = ErrorOf([] { ReadOutline(kBodyData + "bad-syntax.json"); });
   EXPECT_NE(bad_json.find("bad-syntax.json:2:1: invalid JSON"), std::string::npos) << bad_json;
   BodyOptions no_scale;  // an image in pixels needs a rule
   EXPECT_NE(ErrorOf([&] { BuildBody(ReadOutline(EllipseImage()), no_scale); }).find("needs a scale rule"),

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "crowdrecon/engine/parameter_table.hpp"
+#include "generated_docs.hpp"
 
 namespace crowdrecon::engine {
 namespace {
@@ -68,25 +69,8 @@ TEST(ParameterTable, IsValidUsesTheTableRanges) {
 // With CROWDRECON_UPDATE_DOCS=1 in the environment, the test writes the
 // table into docs/model.md instead of failing (then review the diff).
 TEST(ParameterTable, DocsMatchTheTable) {
-  const std::string file = std::string(CROWDRECON_SOURCE_DIR) + "/docs/model.md";
-  std::ifstream in(file);
-  ASSERT_TRUE(in) << "docs/model.md";
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string doc = buffer.str();
-  const std::string begin = "<!-- parameter-table: generated from engine::ModelParameterTableMarkdown() -->\n";
-  const std::string end = "<!-- /parameter-table -->";
-  const std::size_t a = doc.find(begin), b = doc.find(end);
-  ASSERT_NE(a, std::string::npos);
-  ASSERT_NE(b, std::string::npos);
-  const std::string in_doc = doc.substr(a + begin.size(), b - a - begin.size());
-  if (const char* update = std::getenv("CROWDRECON_UPDATE_DOCS"); update && std::string(update) == "1") {
-    std::ofstream(file, std::ios::binary) << doc.substr(0, a + begin.size()) << ModelParameterTableMarkdown()
-                                          << doc.substr(b);
-    GTEST_SKIP() << "docs/model.md updated";
-  }
-  EXPECT_EQ(in_doc, ModelParameterTableMarkdown())
-      << "docs/model.md's parameter table differs from the engine's; replace it with the text above";
+  crowdrecon::testing::ExpectGeneratedSection("docs/model.md", "parameter-table", "engine::ModelParameterTableMarkdown()",
+                                  ModelParameterTableMarkdown());
 }
 
 }  // namespace

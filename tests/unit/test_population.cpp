@@ -11,6 +11,8 @@
 #include "crowdrecon/geometry/anthropometry.hpp"
 #include "crowdrecon/geometry/body.hpp"
 #include "crowdrecon/geometry/population.hpp"
+#include "crowdrecon/geometry/population_table.hpp"
+#include "generated_docs.hpp"
 
 namespace crowdrecon::geometry {
 namespace {
@@ -154,6 +156,34 @@ TEST(Population, InvalidOptionsAreReported) {
     EXPECT_NE(std::string(e.what()).find("female fraction (1.5) out of range"), std::string::npos);
   }
   EXPECT_THROW(PopulationModeFromString("crowd"), InputError);
+}
+
+// The options a scenario fills are checked against the population table, the
+// same ranges the scenario reader and `crowdrecon population` use.
+TEST(PopulationTable, OptionsAreCheckedAgainstTheTable) {
+  const auto error_of = [](PopulationOptions options) {
+    std::string error;
+    return options.IsValid(&error) ? std::string("valid") : error;
+  };
+  PopulationOptions options;
+  EXPECT_EQ(error_of(options), "valid");
+  options.vertex_count = 201;  // the table allows 3 to 200 (it used to be any count from 3)
+  EXPECT_EQ(error_of(options), "vertex count (201) out of range; expected a whole number in [3, 200]");
+  options.vertex_count = 200;
+  EXPECT_EQ(error_of(options), "valid");
+  options.count = kMaxPeople + 1;
+  EXPECT_NE(error_of(options).find("count (200001) out of range; expected a whole number in [1, 200000]"),
+            std::string::npos);
+  EXPECT_EQ(PopulationKey("population.body.vertices").key, std::string("vertices"));
+  EXPECT_THROW((void)PopulationKey("body.colour"), std::logic_error);
+  const PopulationKeyInfo& speed = PopulationKey("desired_speed_m_per_s");
+  EXPECT_EQ(speed.DefaultText(), "[0.8, 1.2]");
+  EXPECT_EQ(speed.Expected(), "[low, high] with low <= high, each in [0, 10]");
+}
+
+TEST(PopulationTable, DocsMatchTheTable) {
+  crowdrecon::testing::ExpectGeneratedSection("docs/scenarios.md", "population-table",
+                                              "geometry::PopulationKeyTableMarkdown()", PopulationKeyTableMarkdown());
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ enum class Writing { kDirect, kOnThread, kInTurn };
 std::filesystem::path WriteGas(const std::string& name, Writing how) {
   engine::Simulation sim(engine::testing::RandomGas(8, 0.5, 7, true));
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / name;
-  RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
+  RunFileWriter writer = CreateRunFile(file, Header(sim), sim, {});
   if (how != Writing::kDirect) {
     FrameWriterThread frames(writer, /*background=*/how == Writing::kOnThread, 2);
     for (int k = 0; k <= 20; ++k) {
@@ -91,7 +91,7 @@ TEST(FrameWriterThread, WritesExactlyWhatDirectWritesDo) {
 TEST(FrameWriterThread, AFailureOfTheWritingThreadReachesTheCaller) {
   engine::Simulation sim(engine::testing::RandomGas(4, 0.5, 3, true));
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "gas-fail.sqlite";
-  RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
+  RunFileWriter writer = CreateRunFile(file, Header(sim), sim, {});
   FrameWriterThread frames(writer, /*background=*/true, 2);
   const auto frame_of = [&](std::int64_t k) {
     return [&sim, k](FrameSnapshot& f) { TakeSnapshot(sim, k, {}, true, &f); };
@@ -134,7 +134,7 @@ TEST(RunFileWriter, FramesAreReadableWhileWrittenAndTheFileIsPlainWhenClosed) {
     return value;
   };
   {
-    RunFileWriter writer = CreateRunFile(file, Header(sim), sim);
+    RunFileWriter writer = CreateRunFile(file, Header(sim), sim, {});
     for (int k = 0; k <= 3; ++k) {
       if (k > 0) sim.AdvanceTo(k / 10.0);
       WriteFrame(writer, sim, k, {}, true);
@@ -160,10 +160,9 @@ TEST(RunFileReader, GivesBackEveryTableTheWriterFilled) {
   header.venue_json = "{\"version\": 1}";
   header.walkable_wkt = "POLYGON ((0 0, 4 0, 4 4, 0 4, 0 0))";
   header.periodic_box = {true, false, {0.0, 0.0}, {4.0, 0.0}};
-  header.target_names = {"east", "west"};
   runfile::RunSetup setup;
   setup.shapes = {{0.05, {{0.1, 0.0}, {-0.1, 0.0}}}};
-  setup.people = {{0, 80.0, 2.5, 1.3, 0, 0}, {0, 70.0, 2.0, 1.1, 1, 1}};
+  setup.people = {{0, 80.0, 2.5, 1.3, 0, "east"}, {0, 70.0, 2.0, 1.1, 1, "west"}};
   {
     RunFileWriter writer = RunFileWriter::Create(file, header, setup);
     for (std::int64_t k = 0; k < 3; ++k) {
@@ -197,7 +196,7 @@ TEST(RunFileReader, GivesBackEveryTableTheWriterFilled) {
   EXPECT_TRUE(box.x);
   EXPECT_FALSE(box.y);
   EXPECT_NEAR(box.MinimumImage({3.8, 0.5}).x, -0.2, 1e-12);
-  const std::vector<runfile::PersonInfo> people = run.People();
+  const std::vector<runfile::Person> people = run.People();
   ASSERT_EQ(people.size(), 2u);
   EXPECT_EQ(people[1].group, 1u);
   EXPECT_EQ(people[1].target, "west");

@@ -26,7 +26,7 @@ namespace {
 
 using testing_util::ErrorOf;
 
-const std::filesystem::path kData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
+const std::filesystem::path kImportData = std::filesystem::path(CROWDRECON_SOURCE_DIR) / "tests/data/venues";
 
 std::filesystem::path TempFile(const std::string& name) { return crowdrecon::testing::ScratchFile(name); }
 
@@ -87,12 +87,12 @@ Shape ShapeOf(const Venue& v) {
 // --- the same room in four formats -------------------------------------------
 
 TEST(VenueImport, JsonWktDxfAndImageAgree) {
-  const Shape json = ShapeOf(LoadVenue(kData / "room.json"));
-  const Shape wkt = ShapeOf(ImportWkt(kData / "room.wkt"));
-  const Shape dxf = ShapeOf(ImportDxf(kData / "room.dxf"));  // millimetres, $INSUNITS = 4
+  const Shape json = ShapeOf(LoadVenue(kImportData / "room.json"));
+  const Shape wkt = ShapeOf(ImportWkt(kImportData / "room.wkt"));
+  const Shape dxf = ShapeOf(ImportDxf(kImportData / "room.dxf"));  // millimetres, $INSUNITS = 4
   RasterImportOptions raster;
   raster.pixels_per_metre = 50;
-  const Shape image = ShapeOf(ImportRasterPlan(kData / "room-50ppm.png", raster));
+  const Shape image = ShapeOf(ImportRasterPlan(kImportData / "room-50ppm.png", raster));
 
   EXPECT_DOUBLE_EQ(json.area_m2, 39.0);
   EXPECT_DOUBLE_EQ(json.perimeter_m, 32.0);
@@ -108,7 +108,7 @@ TEST(VenueImport, JsonWktDxfAndImageAgree) {
 }
 
 TEST(VenueImport, ImportedVenueRoundTripsThroughJson) {
-  const Venue v = ImportWkt(kData / "room.wkt");
+  const Venue v = ImportWkt(kImportData / "room.wkt");
   const auto path = TempFile("room-from-wkt.json");
   WriteVenueJson(v, path);
   const Venue w = LoadVenue(path);
@@ -121,7 +121,7 @@ TEST(VenueImport, ImportedVenueRoundTripsThroughJson) {
 // --- WKT --------------------------------------------------------------------
 
 TEST(VenueImport, WktMultipolygonAndJuelichStyle) {
-  const Venue two = ImportWkt(kData / "two-rooms.wkt");
+  const Venue two = ImportWkt(kImportData / "two-rooms.wkt");
   EXPECT_EQ(two.walkable_area.size(), 2u);
   EXPECT_EQ(two.obstacles.size(), 1u);
   EXPECT_NEAR(WalkableArea_m2(two), 12.0 + 9.0 - 1.0, 1e-12);
@@ -138,11 +138,11 @@ TEST(VenueImport, WktMultipolygonAndJuelichStyle) {
 }
 
 TEST(VenueImport, WktErrorsGiveLineAndColumn) {
-  std::string m = ErrorOf([] { ImportWkt(kData / "bad-syntax.wkt"); });
+  std::string m = ErrorOf([] { ImportWkt(kImportData / "bad-syntax.wkt"); });
   EXPECT_NE(m.find("bad-syntax.wkt:2:33: invalid WKT: expected a number but found 'x'"), std::string::npos) << m;
-  m = ErrorOf([] { ImportWkt(kData / "bad-unclosed.wkt"); });
+  m = ErrorOf([] { ImportWkt(kImportData / "bad-unclosed.wkt"); });
   EXPECT_NE(m.find("bad-unclosed.wkt:1:10: invalid WKT: ring is not closed"), std::string::npos) << m;
-  m = ErrorOf([] { ImportWkt(kData / "bad-hole-crosses.wkt"); });
+  m = ErrorOf([] { ImportWkt(kImportData / "bad-hole-crosses.wkt"); });
   EXPECT_NE(m.find("/obstacles/0/polygon: obstacle \"obstacle-1\" meets the boundary"), std::string::npos) << m;
   m = ErrorOf([] { ParseWkt("LINESTRING (0 0, 1 1)", "line.wkt"); });
   EXPECT_NE(m.find("line.wkt:1:1: invalid WKT: unsupported geometry type \"LINESTRING\""), std::string::npos) << m;
@@ -150,7 +150,7 @@ TEST(VenueImport, WktErrorsGiveLineAndColumn) {
   EXPECT_NE(m.find("empty.wkt: the WKT geometry is EMPTY"), std::string::npos) << m;
   m = ErrorOf([] { ParseWkt("POLYGON ((0 0, 1 0, 1 1, 0 0)) trailing", "t.wkt"); });
   EXPECT_NE(m.find("t.wkt:1:32: invalid WKT: unexpected text after the end"), std::string::npos) << m;
-  m = ErrorOf([] { ImportWkt(kData / "no-such.wkt"); });
+  m = ErrorOf([] { ImportWkt(kImportData / "no-such.wkt"); });
   EXPECT_NE(m.find("no-such.wkt: cannot open"), std::string::npos) << m;
 }
 
@@ -201,13 +201,13 @@ TEST(VenueImport, DxfLayerAndUnits) {
 }
 
 TEST(VenueImport, DxfWithoutClosedRegionIsAnError) {
-  std::string m = ErrorOf([] { ImportDxf(kData / "bad-open.dxf"); });
+  std::string m = ErrorOf([] { ImportDxf(kImportData / "bad-open.dxf"); });
   EXPECT_NE(m.find("bad-open.dxf: no closed region found (3 open polyline(s)"), std::string::npos) << m;
-  m = ErrorOf([] { ImportDxf(kData / "no-such.dxf"); });
+  m = ErrorOf([] { ImportDxf(kImportData / "no-such.dxf"); });
   EXPECT_NE(m.find("no-such.dxf: cannot open"), std::string::npos) << m;
   ImportOptions options;
   options.dxf_layer = "nothing-here";
-  m = ErrorOf([&] { ImportDxf(kData / "room.dxf", options); });
+  m = ErrorOf([&] { ImportDxf(kImportData / "room.dxf", options); });
   EXPECT_NE(m.find("no closed region found on layer \"nothing-here\""), std::string::npos) << m;
 }
 
@@ -215,7 +215,7 @@ TEST(VenueImport, TruncatedDxfIsAnError) {
   // The room cut short after its outline (its obstacle's lines and the end-of-file
   // group lost): refused, not imported in part. With the last group present
   // (blank lines and CR after it allowed) the same text imports.
-  std::ifstream in(kData / "room.dxf");
+  std::ifstream in(kImportData / "room.dxf");
   std::stringstream whole;
   whole << in.rdbuf();
   const std::string text = whole.str();
@@ -564,7 +564,7 @@ TEST(VenueImport, RasterSeedAndErrors) {
   m = ErrorOf([&] { ImportRasterPlan(open_path, plain); });
   EXPECT_NE(m.find("no enclosed free region"), std::string::npos) << m;
 
-  m = ErrorOf([&] { ImportRasterPlan(kData / "room.wkt", plain); });
+  m = ErrorOf([&] { ImportRasterPlan(kImportData / "room.wkt", plain); });
   EXPECT_NE(m.find("cannot read the file as an image"), std::string::npos) << m;
   plain.pixels_per_metre = 0;
   m = ErrorOf([&] { ImportRasterPlan(path, plain); });

@@ -68,7 +68,6 @@ struct RunHeader {
   double output_fps = 10.0;
   double time_step_s = 0.0;
   std::uint64_t seed = 0;
-  std::vector<std::string> target_names;  // by target index
 };
 
 // A body shape in its own frame: a convex polygon swept by a disc of radius_m.
@@ -84,14 +83,14 @@ struct Wall {
   std::vector<Vec2> points;
 };
 
-// A person as placed at the start of the run.
+// A person as placed at the start of the run (table person).
 struct Person {
-  std::uint32_t shape = 0;
+  std::uint32_t shape = 0;  // index into RunSetup::shapes
   double mass_kg = 0.0;
   double inertia_kg_m2 = 0.0;
   double desired_speed_m_per_s = 0.0;
   std::uint32_t group = 0;
-  std::uint32_t target = 0;  // index into RunHeader::target_names
+  std::string target;  // the venue target's name
 };
 
 // Everything the file stores of a run before its first frame.
@@ -231,17 +230,6 @@ struct FrameTime {
   double time_s = 0.0;
 };
 
-// A person as the reader gives it back: the placement record, with the
-// target's name.
-struct PersonInfo {
-  std::uint32_t shape = 0;
-  double mass_kg = 0.0;
-  double inertia_kg_m2 = 0.0;
-  double desired_speed_m_per_s = 0.0;
-  std::uint32_t group = 0;
-  std::string target;
-};
-
 // The state of every person present in one frame (trajectory_data joined with
 // person_state), for analysis, reports and calibration.
 struct PersonFrame {
@@ -300,7 +288,7 @@ class RunFileReader {
   std::vector<Event> Events() const;
   // Shapes (body frame) and each person's shape index.
   std::vector<Shape> Shapes() const;
-  std::vector<PersonInfo> People() const;  // index = person index (ids 1..N must be contiguous)
+  std::vector<Person> People() const;  // index = person index (id - 1)
   std::vector<std::uint32_t> PersonShapes() const;
   std::vector<std::uint32_t> PersonGroups() const;
   std::vector<Wall> Walls() const;

@@ -13,12 +13,13 @@
 
 namespace crowdrecon::scenario {
 
-// Shapes, people (as placed) and walls of the simulation.
-runfile::RunSetup RunSetupOf(const engine::Simulation& sim);
+// Shapes, people (as placed; their targets named by `target_names`, by
+// engine target index) and walls of the simulation.
+runfile::RunSetup RunSetupOf(const engine::Simulation& sim, const std::vector<std::string>& target_names);
 // Creates the run file of `sim`: the header (its periodic box taken from the
-// simulation) and RunSetupOf(sim).
+// simulation) and RunSetupOf(sim, target_names).
 runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
-                                     const engine::Simulation& sim);
+                                     const engine::Simulation& sim, const std::vector<std::string>& target_names);
 
 // Copies frame `frame` of the simulation into `out`, reusing its storage:
 // every person still in the venue, their loads (the sum of the magnitudes of

@@ -25,9 +25,11 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "crowdrecon/engine/parameters.hpp"
 #include "crowdrecon/geometry/population.hpp"
+#include "crowdrecon/geometry/population_table.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 
 namespace crowdrecon::scenario {
@@ -35,19 +37,22 @@ namespace crowdrecon::scenario {
 struct PopulationSpec {
   std::optional<std::size_t> count;       // exactly one of count and density
   std::optional<double> density_per_m2;   // persons per m^2 of the placement region
-  double counter_flow_fraction = 0.0;     // share of people walking to counter_target
+  // Numbers' defaults (and ranges) from the population table (geometry/population_table.hpp).
+  double counter_flow_fraction = Default("counter_flow_fraction");  // share of people walking to counter_target
   std::string target;                     // venue target of the main flow
   std::string counter_target;             // venue target of the counter-flow
   geometry::PopulationMode body_mode = geometry::PopulationMode::kPaper;
   std::filesystem::path reference_body;   // body JSON (paper and circle modes)
   std::filesystem::path anthropometry;    // ANSUR II extract (anthropometric mode)
-  double female_fraction = 0.5;
-  std::size_t vertex_count = 18;          // anthropometric bodies
-  double desired_speed_min_m_per_s = 0.8;  // v0 ~ U(min, max), paper
-  double desired_speed_max_m_per_s = 1.2;
+  double female_fraction = Default("body.female_fraction");
+  std::size_t vertex_count = static_cast<std::size_t>(Default("body.vertices"));  // anthropometric bodies
+  double desired_speed_min_m_per_s = Default("desired_speed_m_per_s");  // v0 ~ U(min, max), paper
+  double desired_speed_max_m_per_s = geometry::PopulationKey("desired_speed_m_per_s").default_high;
   std::string placement_region = "walkable";  // "walkable" or "entries"
-  double max_initial_overlap_m = 0.003;       // after relaxation of the placement
-  std::uint64_t seed = 1;
+  double max_initial_overlap_m = Default("placement.max_overlap_m");  // after relaxation of the placement
+  std::uint64_t seed = static_cast<std::uint64_t>(Default("seed"));
+
+  static double Default(std::string_view path) { return geometry::PopulationKey(path).default_value; }
 };
 
 struct RunSpec {
