@@ -83,6 +83,21 @@ macro(crowdrecon_glue_code_directory)
   endif()
 endmacro()
 
+# Cold code: parsers, importers and writers that run once per input or per
+# output (venue import and JSON, sweep files and tables, phase diagrams and
+# run pictures, analysis output, output guards). CROWDRECON_COLD_FLAGS (after
+# the build type's) go to these files only; the sanitizer build compiles them
+# at -O0, which halves their compile time (venue_import_raster.cpp: 65 s at
+# -O1, 34 s at -O0) and costs the tests little: the tests spend their time in
+# the engine, the geometry of bodies and the run loop, which stay at -O1.
+set(CROWDRECON_COLD_FLAGS "" CACHE STRING "Compiler flags for cold code (crowdrecon_cold_code), after the build type's")
+function(crowdrecon_cold_code)
+  if(CROWDRECON_COLD_FLAGS)
+    separate_arguments(flags UNIX_COMMAND "${CROWDRECON_COLD_FLAGS}")
+    set_source_files_properties(${ARGN} DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR} PROPERTIES COMPILE_OPTIONS "${flags}")
+  endif()
+endfunction()
+
 # Sources that only call into a third-party library (CGAL templates, no logic
 # of ours) are left uninstrumented in the sanitizer build: instrumenting
 # CGAL's inlined code triples their compile time (135 s against 48 s for

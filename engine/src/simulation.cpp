@@ -25,32 +25,37 @@ void Simulation::SetThreads(int threads) {
   def_.threads = threads;
 }
 
-Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
+namespace {
+
+// The world is usable: parameters in their ranges, every index in range,
+// finite positions, walls of distinct points, a box with extent. Fills each
+// shape's core radius.
+void ValidateWorld(WorldDef& def) {
   std::string error;
-  if (!def_.parameters.IsValid(&error)) throw InputError("model parameters: " + error);
-  if (def_.threads < 1 || def_.threads > 1024)
-    throw InputError("threads = " + std::to_string(def_.threads) + ", expected 1..1024");
-  for (std::size_t s = 0; s < def_.shapes.size(); ++s) {
-    BodyShape& shape = def_.shapes[s];
+  if (!def.parameters.IsValid(&error)) throw InputError("model parameters: " + error);
+  if (def.threads < 1 || def.threads > 1024)
+    throw InputError("threads = " + std::to_string(def.threads) + ", expected 1..1024");
+  for (std::size_t s = 0; s < def.shapes.size(); ++s) {
+    BodyShape& shape = def.shapes[s];
     if (shape.vertices.empty() || shape.vertices.size() >= 32768 || !(shape.radius_m > 0))
       throw InputError("shape " + std::to_string(s) + ": needs 1..32767 vertices and a radius > 0");
     shape.core_radius_m = 0.0;
     for (const Vec2& v : shape.vertices) shape.core_radius_m = std::max(shape.core_radius_m, Length(v));
   }
-  const std::size_t n = def_.people.size();
+  const std::size_t n = def.people.size();
   if (n >= (std::size_t{1} << 31)) throw InputError("too many people");
   for (std::size_t i = 0; i < n; ++i) {
-    const PersonDef& p = def_.people[i];
+    const PersonDef& p = def.people[i];
     const std::string who = PersonText(static_cast<std::uint32_t>(i));
-    if (p.shape >= def_.shapes.size()) throw InputError(who + ": shape index out of range");
-    if (p.target >= def_.targets.size()) throw InputError(who + ": target index out of range");
+    if (p.shape >= def.shapes.size()) throw InputError(who + ": shape index out of range");
+    if (p.target >= def.targets.size()) throw InputError(who + ": target index out of range");
     if (!(p.mass_kg > 0) || !(p.inertia_kg_m2 > 0))
       throw InputError(who + ": mass and moment of inertia must be > 0");
     if (!std::isfinite(p.position_m.x) || !std::isfinite(p.position_m.y) || !std::isfinite(p.angle_rad))
       throw InputError(who + ": position and angle must be finite");
   }
-  for (std::size_t w = 0; w < def_.walls.size(); ++w) {
-    const Wall& wall = def_.walls[w];
+  for (std::size_t w = 0; w < def.walls.size(); ++w) {
+    const Wall& wall = def.walls[w];
     if (wall.points.size() < 2 || (wall.closed && wall.points.size() < 3) || !(wall.radius_m >= 0.0))
       throw InputError("wall " + std::to_string(w) + ": needs at least 2 points (3 if closed) and a radius >= 0");
     for (std::size_t k = 0; k + 1 < wall.points.size(); ++k)
@@ -58,11 +63,38 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
         throw InputError("wall " + std::to_string(w) + ": points " + std::to_string(k) + " and " +
                          std::to_string(k + 1) + " coincide");
   }
-  const PeriodicBox& box = def_.periodic;
+  const PeriodicBox& box = def.periodic;
   if ((box.x && !(box.max_m.x > box.min_m.x)) || (box.y && !(box.max_m.y > box.min_m.y)))
     throw InputError("periodic box: max must exceed min along periodic axes");
+}
 
-  // Bodies.
+}  // namespace
+
+Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
+  ValidateWorld(def_);
+  LoadBodies();
+  BuildShapeFamilies();
+  BuildWalls();
+  // The contact law's constants, the time step, the device, the forces at t = 0.
+  in_->restitution_factor = RestitutionDampingFactor(def_.parameters.restitution);
+  in_->wall_restitution_factor = RestitutionDampingFactor(def_.parameters.wall_restitution);
+
+  dt_estimate_ = EstimateTimeStep(def_);
+  if (const std::string unstable = TimeStepAboveLimit(def_.parameters.time_step_s, def_.parameters.integrator, dt_estimate_);
+      !unstable.empty())
+    throw InputError("time_step_s: " + unstable);
+  dt_s_ = dt_estimate_.chosen_s;
+
+  if (def_.device == ComputeDevice::kCuda)
+    in_->cuda = std::make_unique<cuda::Collider>(in_->family_geometry, in_->shape_family, in_->shape_scale,
+                                                 def_.periodic);
+  ComputeForces();  // forces at t = 0 (no spring increment: contacts start unloaded)
+  in_->previous_contacts = contacts_;
+}
+
+// The bodies' state from the people of the world, wrapped into the periodic box.
+void Simulation::LoadBodies() {
+  const std::size_t n = def_.people.size();
   bodies_.position_m.resize(n);
   bodies_.angle_rad.resize(n);
   bodies_.velocity_m_per_s.resize(n);
@@ -97,6 +129,15 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     in_->bound_m[i] = s.core_radius_m + s.radius_m;
     detail::Wrap(def_.periodic, bodies_.position_m[i]);
   }
+  in_->cos_angle.assign(n, 1.0);
+  in_->sin_angle.assign(n, 0.0);
+  in_->travel_m.assign(n, 0.0);
+  in_->travel_position = bodies_.position_m;
+  in_->travel_angle = bodies_.angle_rad;
+}
+
+void Simulation::BuildShapeFamilies() {
+  const std::size_t n = def_.people.size();
   // Shape families (see Internals), each with a grid of candidate edges for
   // the largest reach it can meet: its member's radius plus the largest
   // radius of any shape or wall, over its smallest member. A shape joins a
@@ -146,11 +187,6 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     for (std::size_t f = 0; f < in_->family_geometry.size(); ++f)
       in_->family_geometry[f].BuildEdgeGrid(1.0 + radius_max / smallest[f]);
   }
-  in_->cos_angle.assign(n, 1.0);
-  in_->sin_angle.assign(n, 0.0);
-  in_->travel_m.assign(n, 0.0);
-  in_->travel_position = bodies_.position_m;
-  in_->travel_angle = bodies_.angle_rad;
   in_->rotation_arm_m.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t shape = bodies_.shape[i];
@@ -159,7 +195,10 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     in_->rotation_arm_m[i] =
         in_->family_geometry[in_->shape_family[shape]].core_radius_m * in_->shape_scale[shape] * (1.0 + 1e-12);
   }
+}
 
+void Simulation::BuildWalls() {
+  const PeriodicBox& box = def_.periodic;
   // Walls crossing a periodic boundary are extended beyond it, so that a body
   // straddling the seam meets a straight wall and never a wall's end cap.
   double bound_max = 0.0;
@@ -187,21 +226,6 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
     const Wall& wall = def_.walls[w];
     in_->wall_geometry.push_back(ShapeGeometry::FromWorld(wall.points, wall.closed, wall.radius_m, in_->wall_origin[w]));
   }
-
-  in_->restitution_factor = RestitutionDampingFactor(def_.parameters.restitution);
-  in_->wall_restitution_factor = RestitutionDampingFactor(def_.parameters.wall_restitution);
-
-  dt_estimate_ = EstimateTimeStep(def_);
-  if (const std::string unstable = TimeStepAboveLimit(def_.parameters.time_step_s, def_.parameters.integrator, dt_estimate_);
-      !unstable.empty())
-    throw InputError("time_step_s: " + unstable);
-  dt_s_ = dt_estimate_.chosen_s;
-
-  if (def_.device == ComputeDevice::kCuda)
-    in_->cuda = std::make_unique<cuda::Collider>(in_->family_geometry, in_->shape_family, in_->shape_scale,
-                                                 def_.periodic);
-  ComputeForces();  // forces at t = 0 (no spring increment: contacts start unloaded)
-  in_->previous_contacts = contacts_;
 }
 
 Simulation::~Simulation() = default;

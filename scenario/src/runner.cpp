@@ -179,64 +179,85 @@ void InstallInterruptHandlers() {
   std::signal(SIGTERM, OnInterrupt);
 }
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// 2. The time step: the scenario's, or the engine's choice, shortened so that
+//    a whole number of steps fits one output frame (frames exactly 1/fps
+//    apart, the rate JuPedSim's format declares), never lengthened. A step
+//    above the stability limit is refused; one above the accurate step is
+//    allowed with a warning (returned). Sets the world's step.
+std::string ChooseTimeStep(const Scenario& scenario, BuiltWorld& built, std::int64_t* steps_per_frame) {
+  const double frame_dt = 1.0 / scenario.run.output_fps;
+  const engine::TimeStepEstimate estimate = engine::EstimateTimeStep(built.world);
+  if (const std::string unstable =
+          engine::TimeStepAboveLimit(scenario.model.time_step_s, scenario.model.integrator, estimate);
+      !unstable.empty())
+    throw InputError(scenario.file.string() + ": /model/time_step_s: " + unstable);
+  const double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
+  built.world.parameters.time_step_s = frame_dt / steps;
+  *steps_per_frame = static_cast<std::int64_t>(std::llround(frame_dt / built.world.parameters.time_step_s));
+  return TimeStepWarning(scenario, built.world, estimate);
+}
+
+// 3. The run file: created with the run's header and records, or, with
+//    --resume, reopened at the checkpoint's frame (whose state `sim` takes,
+//    with the systems' saved states and the last frame written). A run
+//    without a checkpoint yet starts again from the beginning if that gives
+//    the same result (NothingToResume).
+struct OpenedRun {
+  runfile::RunFileWriter writer;
+  std::int64_t last_frame = -1;  // -1: nothing written yet
+  std::vector<std::pair<std::string, std::string>> systems;
+};
+
+OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const BuiltWorld& built,
+                      engine::Simulation& sim, std::uint64_t fingerprint, const std::function<void(const std::string&)>& say) {
+  const std::filesystem::path checkpoint = CheckpointPath(options.output);
+  std::error_code ec;
+  if (options.resume && !std::filesystem::exists(checkpoint, ec)) {
+    const std::string why = NothingToResume(options.output, scenario);
+    if (!why.empty()) throw InputError(why);
+    std::fprintf(stderr, "crowdrecon: note: %s has no checkpoint yet (the run stopped before its first one); "
+                 "starting it again from the beginning\n", options.output.string().c_str());
+  } else if (options.resume) {
+    const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
+    sim.LoadState(c.state);
+    say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(c.last_frame) + ")");
+    return {runfile::RunFileWriter::Resume(options.output, c.last_frame), c.last_frame, c.systems};
+  }
+  std::filesystem::remove(checkpoint, ec);
+  runfile::RunHeader header;
+  header.scenario_json = scenario.json_text;
+  header.scenario_origin = scenario.file.string();
+  header.venue_json = geometry::VenueToJson(scenario.venue);
+  header.walkable_wkt = built.walkable_wkt;
+  header.output_fps = scenario.run.output_fps;
+  header.time_step_s = sim.time_step_s();
+  header.seed = scenario.population.seed;
+  return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
+}
+
+}  // namespace
+
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
-  using Clock = std::chrono::steady_clock;
   const auto say = [&](const std::string& line) {
     if (options.show_progress) std::fprintf(stderr, "%s\n", line.c_str());
   };
   g_stop_requested.store(false);
+  // 1. The world.
   BuiltWorld built = BuildWorld(scenario, options.threads, say);
-
-  // An integer number of steps per output frame, so that frames are exactly
-  // 1/fps apart (the frame rate JuPedSim's format declares): the chosen step
-  // is shortened, never lengthened.
-  const double frame_dt = 1.0 / scenario.run.output_fps;
-  std::string step_warning;
-  {
-    const engine::TimeStepEstimate estimate = engine::EstimateTimeStep(built.world);
-    if (const std::string unstable =
-            engine::TimeStepAboveLimit(scenario.model.time_step_s, scenario.model.integrator, estimate);
-        !unstable.empty())
-      throw InputError(scenario.file.string() + ": /model/time_step_s: " + unstable);
-    const double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
-    built.world.parameters.time_step_s = frame_dt / steps;
-    step_warning = TimeStepWarning(scenario, built.world, estimate);
-  }
-  const auto steps_per_frame = static_cast<std::int64_t>(std::llround(frame_dt / built.world.parameters.time_step_s));
+  std::int64_t steps_per_frame = 1;
+  const std::string step_warning = ChooseTimeStep(scenario, built, &steps_per_frame);
   built.world.device = options.device;
   engine::Simulation sim(built.world);
 
-  runfile::RunHeader header;
-  header.scenario_json = scenario.json_text;
-  header.scenario_origin = scenario.file.string();
-  header.walkable_wkt = built.walkable_wkt;
-  header.venue_json = geometry::VenueToJson(scenario.venue);
-  header.output_fps = scenario.run.output_fps;
-  header.time_step_s = sim.time_step_s();
-  header.seed = scenario.population.seed;
-
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
-  std::int64_t last_frame = -1;
-  std::vector<std::pair<std::string, std::string>> resumed_systems;
-  runfile::RunFileWriter writer = [&] {
-    std::error_code ec;
-    if (options.resume && !std::filesystem::exists(checkpoint, ec)) {
-      const std::string why = NothingToResume(options.output, scenario);
-      if (!why.empty()) throw InputError(why);
-      std::fprintf(stderr, "crowdrecon: note: %s has no checkpoint yet (the run stopped before its first one); "
-                   "starting it again from the beginning\n", options.output.string().c_str());
-    } else if (options.resume) {
-      const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
-      sim.LoadState(c.state);
-      last_frame = c.last_frame;
-      resumed_systems = c.systems;
-      say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(last_frame) + ")");
-      return runfile::RunFileWriter::Resume(options.output, last_frame);
-    }
-    std::filesystem::remove(checkpoint, ec);
-    return CreateRunFile(options.output, header, sim, built.target_names);
-  }();
+  OpenedRun opened = OpenRunFile(scenario, options, built, sim, fingerprint, say);
+  runfile::RunFileWriter& writer = opened.writer;
+  std::int64_t last_frame = opened.last_frame;
   writer.SetRunValue("people", std::to_string(sim.bodies().size()));
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));
   if (!step_warning.empty()) {
@@ -255,10 +276,10 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const auto start = Clock::now();
   const double start_sim = sim.time_s();
 
-  // Frames are written by a thread of their own while the next ones are
-  // simulated, if the engine leaves a core free (see FrameWriterThread);
-  // everything that must follow the frames in the file (a checkpoint naming
-  // the last frame, an event, the status) waits for them with Flush.
+  // 4. Frames are written by a thread of their own while the next ones are
+  //    simulated, if the engine leaves a core free (see FrameWriterThread);
+  //    everything that must follow the frames in the file (a checkpoint
+  //    naming the last frame, an event, the status) waits for them with Flush.
   const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
   runfile::FrameWriterThread frames(writer, core_free);
   if (last_frame < 0) {
@@ -271,7 +292,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   engine::ThreadGovernor governor(thread_options);
   const bool adapt_threads = options.adapt_threads && thread_options.max_threads > 1;
 
-  // The run loop: the engine step and the systems (run_systems.hpp), in order.
+  // 5. The run loop: the engine step and the systems (run_systems.hpp), in order.
   RunLoop::Options loop_options;
   loop_options.steps_per_frame = steps_per_frame;
   loop_options.step = [&](engine::Simulation& s) {
@@ -295,8 +316,9 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   loop.Add(std::make_unique<detail::StopRequestSystem>(g_stop_requested, options.stop_flag, options.stop_after_s));
   if (options.show_progress)
     loop.Add(std::make_unique<detail::ProgressSystem>(scenario.run.duration_s, start_sim));
-  loop.LoadStates(resumed_systems);
+  loop.LoadStates(opened.systems);
 
+  // 6. Run; a run that goes numerically wrong stops with its state saved.
   std::string status = "complete";
   try {
     loop.Run(last_frame, total_frames);
@@ -323,6 +345,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
                      "; frames up to " + std::to_string(last_frame) + " are in the run file and the state is saved in " +
                      failed.string());
   }
+
+  // 7. Status and summary.
   frames.Flush();
   if (options.show_progress) std::fprintf(stderr, "\n");
   writer.SetStatus(status);

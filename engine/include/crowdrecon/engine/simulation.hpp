@@ -145,6 +145,11 @@ class Simulation {
 
  private:
   struct Internals;
+  // The constructor's steps, in order (after validating the world): the
+  // bodies' state, the shape families the narrow phase uses, the walls.
+  void LoadBodies();
+  void BuildShapeFamilies();
+  void BuildWalls();
   void UpdatePairs();
   void PlaceShapes();
   void Collide();
