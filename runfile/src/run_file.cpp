@@ -626,8 +626,8 @@ bool PersonFrameStream::Next(PersonFrame* out) {
     out->person.push_back(static_cast<std::uint32_t>(q.Integer(1, 1, kPersonId) - 1));
     out->position_m.push_back({q.Real(2, -kCoordinate_m, kCoordinate_m), q.Real(3, -kCoordinate_m, kCoordinate_m)});
     out->velocity_m_per_s.push_back({q.Real(4, -kSpeed_m_per_s, kSpeed_m_per_s), q.Real(5, -kSpeed_m_per_s, kSpeed_m_per_s)});
-    out->angle_rad.push_back(q.Real(6, -1e6, 1e6));
-    out->angular_velocity_rad_per_s.push_back(q.Real(7, -kSpeed_m_per_s, kSpeed_m_per_s));
+    out->angle_rad.push_back(q.Real(6, -kAngle_rad, kAngle_rad));
+    out->angular_velocity_rad_per_s.push_back(q.Real(7, -kAngularSpeed_rad_per_s, kAngularSpeed_rad_per_s));
     out->state.push_back(static_cast<PersonStatus>(q.Integer(8, 0, 2)));
     out->load_n.push_back(q.Real(9, 0.0, kForce_n));
     impl_->have_row = q.Next();

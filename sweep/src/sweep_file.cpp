@@ -284,11 +284,17 @@ SweepSpec ParseSweep(const std::string& json_text, const std::string& origin, co
         if (other.path == axis.path) axes->Element(i).At("path").Fail("axis \"" + axis.path + "\" is given twice");
       if (axis.path == "population.seed")
         axes->Element(i).At("path").Fail("the seed is not an axis; give the seeds with \"seeds\"");
-      for (std::string& v : axis.values) {
-        json value = json::parse(v);
-        RebaseFilePaths(axis.path, value, sweep_dir);
-        v = value.dump();
-      }
+      // Only an axis that is, or holds, a file key can name files (the other
+      // values are left as read: an axis may hold 100,000 numbers).
+      const bool may_name_files = std::any_of(kFileKeys.begin(), kFileKeys.end(), [&](const std::string& key) {
+        return key == axis.path || key.rfind(axis.path + ".", 0) == 0;
+      });
+      if (may_name_files)
+        for (std::string& v : axis.values) {
+          json value = json::parse(v);
+          RebaseFilePaths(axis.path, value, sweep_dir);
+          v = value.dump();
+        }
       s.axes.push_back(std::move(axis));
     }
   }

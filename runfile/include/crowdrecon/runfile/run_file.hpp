@@ -206,6 +206,8 @@ namespace run_limits {
 inline constexpr double kCoordinate_m = 2e7;     // positions, contact points, wall points, lengths
 inline constexpr double kUnit = 1.0 + 1e-6;      // components of orientations and normals
 inline constexpr double kSpeed_m_per_s = 1e5;
+inline constexpr double kAngle_rad = 1e9;             // orientations are not wrapped into [-pi, pi)
+inline constexpr double kAngularSpeed_rad_per_s = 1e5;
 inline constexpr double kForce_n = 1e12;         // contact forces, loads
 inline constexpr double kTime_s = 1e9;
 inline constexpr double kRadius_m = 10.0;        // sphero-radii of bodies and walls
