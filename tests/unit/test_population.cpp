@@ -146,6 +146,30 @@ TEST(Population, DeterministicBySeed) {
   EXPECT_DOUBLE_EQ(p.people[0].mass_kg, 40.0 + 30.0 * UniformUnit(rng()));
 }
 
+// A body that fails to build on a worker thread reaches the caller as the
+// GeometryError it is (issue 17: a worker's exception used to end the process
+// in std::terminate). Every other record is unusable, so both threads meet one.
+TEST(Population, AWorkersFailureReachesTheCaller) {
+  std::vector<AnsurRecord> records;
+  for (const AnsurRecord& r : Records()) {
+    if (r.sex != Sex::kMale) continue;
+    records.push_back(r);
+    if (records.size() % 2 == 0) records.back().thorax.chest_depth_m = 0.0;
+    if (records.size() == 64) break;
+  }
+  PopulationOptions options;
+  options.mode = PopulationMode::kAnthropometric;
+  options.count = 400;
+  options.seed = 3;
+  options.female_fraction = 0.0;
+  try {
+    MakePopulation(options, Reference(), records);
+    FAIL() << "no error";
+  } catch (const GeometryError& e) {
+    EXPECT_NE(std::string(e.what()).find("population: thorax outline"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Population, InvalidOptionsAreReported) {
   PopulationOptions options;
   options.female_fraction = 1.5;
