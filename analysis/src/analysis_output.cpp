@@ -1,6 +1,7 @@
 // The analysis as tables, text reports and JSON, and written into the run file.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -73,8 +74,40 @@ std::vector<SummaryValue> RunAnalysis::SummaryTable() const {
       {"people_ever_above_load", static_cast<double>(people_ever_above_load), ""},
       {"longest_above_load_s", longest_above_load_s, "s"},
       {"regime_code", static_cast<double>(static_cast<int>(regime.regime)), ""},
+      {"regime_classifier_version", static_cast<double>(kRegimeClassifierVersion), ""},
+      {"avalanche_mean_rise_time_s", avalanche_mean_rise_time_s, "s"},
   };
   t.insert(t.end(), rest.begin(), rest.end());
+  // Per direction of travel (group): its own verdict and its passages.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::size_t next_direction = 0;
+  for (std::size_t g = 0; g < group_mean_speed_m_per_s.size(); ++g) {
+    const DirectionRegime* d = nullptr;
+    if (g < group_people.size() && group_people[g] > 0 && next_direction < regime.directions.size())
+      d = &regime.directions[next_direction++];
+    const PassageStatistics* p = g < passages.size() ? &passages[g] : nullptr;
+    const std::string k = "_g" + std::to_string(g);
+    const auto of = [&](double value) { return d ? value : nan; };
+    const auto op = [&](double value) { return p ? value : nan; };
+    const std::vector<SummaryValue> direction = {
+        {"regime_code" + k, of(d ? static_cast<double>(static_cast<int>(d->result.regime)) : 0.0), ""},
+        {"stopped_time_fraction" + k, of(d ? d->result.stopped_time_fraction : 0.0), ""},
+        {"frozen_at_end" + k, of(d && d->result.frozen_at_end ? 1.0 : 0.0), ""},
+        {"end_mean_speed" + k + "_m_per_s", of(d ? d->result.end_mean_speed_m_per_s : 0.0), "m/s"},
+        {"avalanche_count" + k, of(d ? d->result.stationary_avalanches : 0.0), ""},
+        {"passages" + k, op(p ? static_cast<double>(p->passages) : 0.0), ""},
+        {"lapse_median" + k + "_s", op(p ? p->median_lapse_s : 0.0), "s"},
+        {"lapse_max" + k + "_s", op(p ? p->max_lapse_s : 0.0), "s"},
+        {"lapse_open" + k + "_s", op(p ? p->open_lapse_s : 0.0), "s"},
+        {"clogs" + k, op(p ? p->clogs : 0.0), ""},
+        {"clogged_fraction" + k, op(p ? p->clogged_fraction : 0.0), ""},
+        {"burst_mean_size" + k, op(p ? p->mean_burst_size : 0.0), ""},
+        {"lapse_tail_lapses" + k, op(p ? static_cast<double>(p->tail_lapses) : 0.0), ""},
+        {"lapse_tail_exponent" + k, op(p ? p->tail_exponent : 0.0), ""},
+        {"lapse_tail_exponent_error" + k, op(p ? p->tail_exponent_error : 0.0), ""},
+    };
+    t.insert(t.end(), direction.begin(), direction.end());
+  }
   return t;
 }
 
@@ -84,6 +117,24 @@ std::string RunAnalysis::BriefReport() const {
        " people in " + std::to_string(groups) + " group(s), " + std::to_string(frames) + " frames, " +
        Printf("%.1f s", duration_s) + "\n";
   r += std::string("regime: ") + ToString(regime.regime) + " (" + regime.reason + ")\n";
+  for (const DirectionRegime& d : regime.directions)
+    r += "  direction " + d.name + " (" + std::to_string(d.people) + " people): " + ToString(d.result.regime) + " (" +
+         d.result.reason + ")\n";
+  for (std::size_t g = 0; g < passages.size() && g < group_name.size(); ++g) {
+    const PassageStatistics& p = passages[g];
+    if (g < group_people.size() && group_people[g] == 0) continue;
+    r += "  passages of " + group_name[g] + ": " + std::to_string(p.passages) +
+         Printf(", median lapse %.2f s", p.median_lapse_s) + Printf(", longest %.2f s", p.max_lapse_s) +
+         Printf(", open at the end %.2f s", p.open_lapse_s) + ", " + std::to_string(p.clogs) + " clog(s)" +
+         Printf(" (%.0f %% of the time)", 100.0 * p.clogged_fraction) + ", " +
+         std::to_string(p.burst_sizes.size()) + " bounded burst(s)" +
+         (p.burst_sizes.empty() ? "" : Printf(" of %.1f passages on average", p.mean_burst_size)) +
+         (std::isfinite(p.tail_exponent)
+              ? Printf("; lapse tail exponent %.2f", p.tail_exponent) + Printf(" +- %.2f", p.tail_exponent_error) +
+                    " (" + std::to_string(p.tail_lapses) + " lapses)"
+              : "; too few long lapses for a tail exponent (" + std::to_string(p.tail_lapses) + ")") +
+         "\n";
+  }
   r += "mean speed along the desired direction: " + Printf("%.3f m/s", mean_speed_m_per_s);
   for (std::size_t g = 0; g < group_mean_speed_m_per_s.size(); ++g)
     r += (g == 0 ? " (group " : ", group ") + std::to_string(g) + " " + Printf("%.3f", group_mean_speed_m_per_s[g]);
@@ -101,7 +152,8 @@ std::string RunAnalysis::BriefReport() const {
   if (regime.stationary_avalanches > 0)
     r += Printf(", mean duration %.1f s", avalanche_mean_duration_s) + Printf(" (max %.1f s)", avalanche_max_duration_s) +
          Printf(", mean distance %.2f m", avalanche_mean_distance_m) +
-         Printf(", %.1f people moved on average", avalanche_mean_people);
+         Printf(", %.1f people moved on average", avalanche_mean_people) +
+         Printf(", rise time %.2f s on average", avalanche_mean_rise_time_s);
   r += "\n";
   r += "load: max " + Printf("%.0f N", max_load_n) + " (person " + std::to_string(max_load_person) +
        Printf(" at %.1f s)", max_load_time_s) + Printf("; mean %.1f N", mean_load_n) +
@@ -133,6 +185,7 @@ std::string RunAnalysis::FullReport() const {
          Printf(" (%.2f s", a.duration_s) + (a.complete ? "" : ", until the end of the run") +
          Printf(") after a stop of %.2f s", a.stopped_before_s) + Printf(", peak %.3f m/s", a.peak_speed_m_per_s) +
          Printf(", distance %.3f m", a.distance_m) + ", " + std::to_string(a.people_moved) + " people moved" +
+         Printf(", rise %.2f s", a.rise_time_s) +
          (a.stationary ? "" : " [transient]") + "\n";
   }
   r += "load histogram (stationary person-frames):";
@@ -179,9 +232,31 @@ std::string RunAnalysis::ToJson() const {
                                {"peak_speed_m_per_s", a.peak_speed_m_per_s},
                                {"distance_m", a.distance_m},
                                {"people_moved", a.people_moved},
+                               {"rise_time_s", a.rise_time_s},
                                {"complete", a.complete},
                                {"stationary", a.stationary}});
   j["load_histogram"] = {{"bin_n", load_histogram_bin_n}, {"counts", load_histogram}};
+  j["regime_classifier_version"] = kRegimeClassifierVersion;
+  j["directions"] = nlohmann::json::array();
+  for (std::size_t g = 0; g < group_name.size(); ++g) {
+    nlohmann::json d = {{"group", g}, {"name", group_name[g]},
+                        {"people", g < group_people.size() ? group_people[g] : 0}};
+    for (const DirectionRegime& r : regime.directions)
+      if (r.name == group_name[g]) {
+        d["regime"] = ToString(r.result.regime);
+        d["regime_reason"] = r.result.reason;
+      }
+    if (g < passages.size()) {
+      const PassageStatistics& p = passages[g];
+      d["passages"] = p.passages;
+      d["lapses_s"] = p.lapses_s;
+      d["open_lapse_s"] = p.open_lapse_s;
+      d["burst_sizes"] = p.burst_sizes;
+      d["lapse_tail_exponent"] = Number(p.tail_exponent);
+      d["lapse_tail_exponent_error"] = Number(p.tail_exponent_error);
+    }
+    j["directions"].push_back(d);
+  }
   nlohmann::json s;
   s["frame"] = series.frame;
   s["time_s"] = series.time_s;
@@ -201,9 +276,14 @@ std::string OptionsToJson(const AnalysisOptions& o) {
         {"frozen_speed_m_per_s", r.frozen_speed_m_per_s},
         {"frozen_window_s", r.frozen_window_s},
         {"transient_s", r.transient_s},
+        {"stationary_window_s", r.stationary_window_s},
         {"min_avalanches", r.min_avalanches},
         {"max_stopped_fraction_for_lanes", r.max_stopped_fraction_for_lanes},
         {"min_lane_order_for_lanes", r.min_lane_order_for_lanes}}},
+      {"passages",
+       {{"clog_lapse_s", o.passages.clog_lapse_s},
+        {"tail_from_s", o.passages.tail_from_s},
+        {"min_tail_lapses", o.passages.min_tail_lapses}}},
       {"lanes", {{"band_half_width_m", o.lanes.band_half_width_m}, {"band_half_length_m", o.lanes.band_half_length_m}}},
       {"stopped_person_speed_m_per_s", o.stopped_person_speed_m_per_s},
       {"flow_window_s", o.flow_window_s},
@@ -236,7 +316,7 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
         "CREATE TABLE metric_avalanche(idx INTEGER PRIMARY KEY, start_frame INTEGER NOT NULL, end_frame INTEGER NOT "
         "NULL, start_time_s REAL NOT NULL, end_time_s REAL NOT NULL, duration_s REAL NOT NULL, stopped_before_s REAL "
         "NOT NULL, peak_speed_m_per_s REAL NOT NULL, distance_m REAL NOT NULL, people_moved INTEGER NOT NULL, "
-        "complete INTEGER NOT NULL, stationary INTEGER NOT NULL)");
+        "complete INTEGER NOT NULL, stationary INTEGER NOT NULL, rise_time_s REAL NOT NULL)");
     db.Exec("CREATE TABLE metric_load_histogram(lower_n REAL NOT NULL, upper_n REAL, count INTEGER NOT NULL)");
     {
       Statement insert(db, "INSERT INTO metric_series VALUES(?, ?, ?)");
@@ -249,7 +329,7 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
       for (const SummaryValue& v : a.SummaryTable()) insert.Bind(1, v.name).Bind(2, v.value).Bind(3, v.unit).Run();
     }
     {
-      Statement insert(db, "INSERT INTO metric_avalanche VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      Statement insert(db, "INSERT INTO metric_avalanche VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
       for (std::size_t i = 0; i < a.regime.avalanches.size(); ++i) {
         const Avalanche& v = a.regime.avalanches[i];
         insert.Bind(1, static_cast<std::int64_t>(i + 1))
@@ -264,6 +344,7 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
             .Bind(10, static_cast<std::int64_t>(v.people_moved))
             .Bind(11, static_cast<std::int64_t>(v.complete))
             .Bind(12, static_cast<std::int64_t>(v.stationary))
+            .Bind(13, v.rise_time_s)
             .Run();
       }
     }
@@ -281,6 +362,7 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
       Statement put(db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
       put.Bind(1, std::string("regime")).Bind(2, std::string(ToString(a.regime.regime))).Run();
       put.Bind(1, std::string("regime_reason")).Bind(2, a.regime.reason).Run();
+      put.Bind(1, std::string("regime_classifier")).Bind(2, std::to_string(kRegimeClassifierVersion)).Run();
       put.Bind(1, std::string("analysis_options")).Bind(2, OptionsToJson(options)).Run();
     }
     db.Exec("COMMIT");

@@ -7,7 +7,8 @@
 
 namespace crowdrecon::analysis {
 
-int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m, const PeriodicBox& box) {
+int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m, const PeriodicBox& box,
+                      double* fraction) {
   const Vec2 along = line.b_m - line.a_m;
   const double along2 = LengthSquared(along);
   if (!(along2 > 0.0)) return 0;
@@ -33,6 +34,7 @@ int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Ve
       const double u = Dot(hit - a, along) / along2;
       if (u < 0.0 || u > 1.0) continue;
       net += direction;
+      if (fraction) *fraction = t;
     }
   return net;
 }

@@ -1,7 +1,9 @@
 #include "crowdrecon/analysis/regime.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <limits>
 
 #include "crowdrecon/common/error.hpp"
@@ -26,6 +28,15 @@ bool CheckRange(double value, double lo, double hi, const char* name, const char
   *error = std::string("regime ") + name + " = " + FormatNumber(value) + (*unit ? " " : "") + unit +
            ", expected [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
   return false;
+}
+
+// Time at which the series rose through `level` on its way to sample i
+// (speed[i] >= level): linear between samples i - 1 and i if the earlier one
+// is below the level, else the time of sample i.
+double UpwardCrossing(const std::vector<double>& time_s, const std::vector<double>& speed, std::size_t i,
+                      double level) {
+  if (i == 0 || !(speed[i - 1] < level) || !(speed[i] > speed[i - 1])) return time_s[i];
+  return time_s[i - 1] + (level - speed[i - 1]) / (speed[i] - speed[i - 1]) * (time_s[i] - time_s[i - 1]);
 }
 
 }  // namespace
@@ -61,6 +72,12 @@ bool RegimeOptions::IsValid(std::string* error) const {
   if (!CheckRange(frozen_speed_m_per_s, 0.0, 2.0, "frozen_speed_m_per_s", "m/s", error)) return false;
   if (!CheckRange(frozen_window_s, 0.1, 3600.0, "frozen_window_s", "s", error)) return false;
   if (!CheckRange(transient_s, 0.0, 3600.0, "transient_s", "s", error)) return false;
+  if (!CheckRange(stationary_window_s, 1.0, 1e6, "stationary_window_s", "s", error)) return false;
+  if (stationary_window_s < frozen_window_s) {
+    *error = "regime stationary_window_s (" + FormatNumber(stationary_window_s) +
+             " s) must be at least frozen_window_s (" + FormatNumber(frozen_window_s) + " s)";
+    return false;
+  }
   if (min_avalanches < 1) {
     *error = "regime min_avalanches = " + std::to_string(min_avalanches) + ", expected at least 1";
     return false;
@@ -75,6 +92,10 @@ bool RegimeOptions::IsValid(std::string* error) const {
 // the burst speed; every passage stopped -> moving is an avalanche. Sub-burst
 // excursions between the two thresholds neither end a stop nor count as a
 // release: they are creeping, not the "sudden release" of the paper.
+double StationaryStart(double t_first, double t_last, const RegimeOptions& options) {
+  return std::max(t_first + options.transient_s, t_last - options.stationary_window_s);
+}
+
 std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const std::vector<double>& speed_m_per_s,
                                       const RegimeOptions& options) {
   if (time_s.size() != speed_m_per_s.size())
@@ -83,7 +104,7 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
   constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   std::vector<Avalanche> avalanches;
   if (n == 0) return avalanches;
-  const double stationary_start_s = time_s.front() + options.transient_s - kTimeTolerance_s;
+  const double stationary_start_s = StationaryStart(time_s.front(), time_s.back(), options) - kTimeTolerance_s;
   bool armed = false;
   std::size_t below_start = kNone;   // first sample of the current run below the stop speed
   std::size_t armed_stop_start = 0;  // first sample of the stop that armed the trigger
@@ -116,6 +137,8 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
     a.end_time_s = time_s[a.end_index];
     a.duration_s = a.end_time_s - a.start_time_s;
     a.stopped_before_s = a.start_time_s - time_s[armed_stop_start];
+    a.rise_time_s = UpwardCrossing(time_s, speed_m_per_s, i, options.burst_speed_m_per_s) -
+                    UpwardCrossing(time_s, speed_m_per_s, a.start_index, options.stop_speed_m_per_s);
     for (std::size_t k = a.start_index; k <= a.end_index; ++k) {
       a.peak_speed_m_per_s = std::max(a.peak_speed_m_per_s, speed_m_per_s[k]);
       if (k > a.start_index)
@@ -147,8 +170,8 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
   }
   const std::size_t n = time_s.size();
   const double t_first = time_s.front(), t_last = time_s.back();
-  r.stationary_start_s = t_first + options.transient_s;
-  r.long_enough = t_last - r.stationary_start_s >= options.frozen_window_s - kTimeTolerance_s;
+  r.stationary_start_s = StationaryStart(t_first, t_last, options);
+  r.long_enough = t_last - (t_first + options.transient_s) >= options.frozen_window_s - kTimeTolerance_s;
 
   // Stationary stage: fraction of samples stopped, mean lane order. A run
   // that ends before the transient does is averaged whole (and is too short
@@ -219,6 +242,81 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
     r.reason = "intermittent: stopped " + Fixed(100.0 * r.stopped_time_fraction, 1) +
                " % of the stationary stage with " + std::to_string(r.stationary_avalanches) +
                " avalanche(s) (fewer than " + std::to_string(options.min_avalanches) + "), not frozen";
+  }
+  return r;
+}
+
+namespace {
+
+std::string DirectionText(const DirectionRegime& d) {
+  return d.name + " (" + std::to_string(d.people) + " people) " + Fixed(d.result.end_mean_speed_m_per_s, 3) +
+         " m/s";
+}
+
+}  // namespace
+
+RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::vector<double>& crowd_speed_m_per_s,
+                                 const std::vector<DirectionSeries>& directions,
+                                 const std::vector<double>& lane_order, const RegimeOptions& options) {
+  RegimeResult r = ClassifyRegime(time_s, crowd_speed_m_per_s, lane_order, options);
+  for (const DirectionSeries& d : directions) {
+    if (d.speed_m_per_s.size() != time_s.size())
+      throw InputError("ClassifyByDirection: the series of direction " + d.name + " differs in length");
+    std::vector<double> t, v;
+    for (std::size_t i = 0; i < time_s.size(); ++i)
+      if (std::isfinite(d.speed_m_per_s[i])) {
+        t.push_back(time_s[i]);
+        v.push_back(d.speed_m_per_s[i]);
+      }
+    if (t.empty()) continue;
+    r.directions.push_back({d.name, d.people, ClassifyRegime(t, v, {}, options)});
+  }
+  if (!r.long_enough || r.directions.empty()) return r;
+
+  // The combination, worst first.
+  const std::string last_window = "mean speed along the desired direction over the last " +
+                                  FormatNumber(options.frozen_window_s) + " s: ";
+  std::string frozen, moving;
+  for (const DirectionRegime& d : r.directions) {
+    std::string& list = d.result.frozen_at_end ? frozen : moving;
+    list += (list.empty() ? "" : ", ") + DirectionText(d);
+  }
+  if (!frozen.empty()) {
+    const bool all = moving.empty();
+    r.regime = Regime::kClogging;
+    r.reason = std::string(all ? "every direction frozen at the end" : "a direction frozen at the end") + " (" +
+               last_window + frozen + " < " + FormatNumber(options.frozen_speed_m_per_s) + " m/s" +
+               (all ? "" : "; still moving: " + moving) + ")";
+    return r;
+  }
+  int most = r.stationary_avalanches;
+  std::string where = most >= options.min_avalanches ? "the crowd" : "";
+  for (const DirectionRegime& d : r.directions)
+    if (d.result.stationary_avalanches >= options.min_avalanches) {
+      where += (where.empty() ? "" : ", ") + d.name;
+      most = std::max(most, d.result.stationary_avalanches);
+    }
+  if (!where.empty()) {
+    r.regime = Regime::kAvalanches;
+    r.reason = std::to_string(most) + " avalanches (stop >= " + FormatNumber(options.min_stop_duration_s) +
+               " s below " + FormatNumber(options.stop_speed_m_per_s) + " m/s, then a burst above " +
+               FormatNumber(options.burst_speed_m_per_s) + " m/s) in the stationary stage of " + where +
+               ", at least " + std::to_string(options.min_avalanches) + ", no direction frozen (" + last_window +
+               moving + ")";
+    return r;
+  }
+  for (const DirectionRegime& d : r.directions)
+    if (d.result.regime != Regime::kLanes) {
+      r.regime = Regime::kUnclassified;
+      r.reason = "direction " + d.name + " is not free flow: " + d.result.reason;
+      return r;
+    }
+  if (r.regime == Regime::kLanes) {
+    std::string speeds;
+    for (const DirectionRegime& d : r.directions)
+      speeds += (speeds.empty() ? "" : ", ") + d.name + " stopped " +
+                Fixed(100.0 * d.result.stopped_time_fraction, 1) + " %";
+    r.reason += "; every direction free (" + speeds + ")";
   }
   return r;
 }

@@ -115,6 +115,7 @@ double MeanFrom(const std::vector<double>& values, std::size_t first) {
 bool AnalysisOptions::IsValid(std::string* error) const {
   if (!regime.IsValid(error)) return false;
   if (!lanes.IsValid(error)) return false;
+  if (!passages.IsValid(error)) return false;
   if (!InRange(stopped_person_speed_m_per_s, 1e-4, 2.0, "stopped_person_speed_m_per_s", "m/s", error)) return false;
   if (!InRange(flow_window_s, 0.01, 600.0, "flow_window_s", "s", error)) return false;
   if (!InRange(load_threshold_n, 0.0, 1e6, "load_threshold_n", "N", error)) return false;
@@ -190,6 +191,17 @@ RunContents OpenRun(const runfile::RunFileReader& run, RunAnalysis* out) {
     c.first_group = std::min(c.first_group, p.group);
   }
   out->groups = static_cast<std::size_t>(max_group) + 1;
+  // A group is a direction of travel, named after its people's target (or
+  // "group <k>" if they have different ones).
+  out->group_people.assign(out->groups, 0);
+  out->group_name.assign(out->groups, "");
+  for (const runfile::Person& p : c.people) {
+    std::string& name = out->group_name[p.group];
+    if (out->group_people[p.group]++ == 0) name = p.target;
+    else if (name != p.target) name.clear();
+  }
+  for (std::size_t g = 0; g < out->groups; ++g)
+    if (out->group_name[g].empty()) out->group_name[g] = "group " + std::to_string(g);
   return c;
 }
 
@@ -278,10 +290,10 @@ void ChooseMeasurementLine(const AnalysisOptions& options, const VenueLookup& ve
     out->notes.push_back("the measurement line runs along the flow: forward/backward are arbitrary");
 }
 
-// The first frame of the stationary stage (t >= first frame + transient_s);
+// The first frame of the stationary stage (regime.hpp, StationaryStart);
 // 0, with a note, when the run is not longer than the transient.
 std::size_t FirstStationaryFrame(const std::vector<double>& time_s, const AnalysisOptions& options, RunAnalysis* out) {
-  const double start_s = time_s.front() + options.regime.transient_s - kTimeTolerance_s;
+  const double start_s = StationaryStart(time_s.front(), time_s.back(), options.regime) - kTimeTolerance_s;
   std::size_t first = time_s.size();
   for (std::size_t k = 0; k < time_s.size(); ++k)
     if (time_s[k] >= start_s) {
@@ -315,6 +327,10 @@ class FramePass {
     s.group_mean_speed_m_per_s.assign(out_.groups, std::vector<double>(n_frames_, kNaN));
     crossed_forward.assign(n_frames_, 0);
     crossed_backward.assign(n_frames_, 0);
+    passage_times.assign(out_.groups, {});
+    group_sign_.assign(out_.groups, 1);
+    for (std::size_t g = 0; g < out_.groups; ++g)
+      group_sign_[g] = Dot(out_.group_direction[g], out_.forward) < 0.0 ? -1 : 1;
     displacement.assign(n_frames_ * n_people_, 0.0f);
     present_.assign(n_people_, 0);
     was_present_.assign(n_people_, 0);
@@ -361,6 +377,9 @@ class FramePass {
   }
 
   std::vector<std::int64_t> crossed_forward, crossed_backward;  // per frame
+  // Per group: times of crossings of the line along the group's own desired
+  // direction, interpolated within the frame interval.
+  std::vector<std::vector<double>> passage_times;
   std::vector<float> displacement;                               // frame * people + person
   std::vector<double> stationary_loads;                          // every person-frame of the stationary stage
 
@@ -384,9 +403,13 @@ class FramePass {
       const Vec2 e = out_.group_direction[group];
       if (k > 0 && was_present_[i]) {
         cumulative_[i] += Dot(out_.box.MinimumImage(position_[i] - previous_[i]), e);
-        const int crossing = CrossingDirection(out_.line, out_.forward, previous_[i], position_[i], out_.box);
+        double fraction = 1.0;
+        const int crossing =
+            CrossingDirection(out_.line, out_.forward, previous_[i], position_[i], out_.box, &fraction);
         if (crossing > 0) crossed_forward[k] += crossing;
         if (crossing < 0) crossed_backward[k] -= crossing;
+        if (crossing * group_sign_[group] > 0)
+          passage_times[group].push_back(c_.time_s[k - 1] + fraction * (t - c_.time_s[k - 1]));
       }
       const double along = Dot(velocity_[i], e);
       ++count;
@@ -437,6 +460,7 @@ class FramePass {
   std::vector<Vec2> position_, previous_, velocity_, lane_position_;
   std::vector<std::uint32_t> lane_group_;
   std::vector<double> load_, cumulative_, above_since_;
+  std::vector<int> group_sign_;  // +1 if the group walks forward across the line, -1 if backward
 };
 
 // 5. Flows: crossings per second per metre of line in a trailing window of
@@ -495,19 +519,21 @@ void Summarize(const std::vector<double>& speed_for_regime, std::size_t first_st
     if (std::isfinite(f)) out->max_above_load_fraction = std::max(out->max_above_load_fraction, f);
   {
     int count = 0;
-    double duration_sum = 0.0, distance_sum = 0.0, people_sum = 0.0;
+    double duration_sum = 0.0, distance_sum = 0.0, people_sum = 0.0, rise_sum = 0.0;
     for (const Avalanche& a : out->regime.avalanches) {
       if (!a.stationary) continue;
       ++count;
       duration_sum += a.duration_s;
       distance_sum += a.distance_m;
       people_sum += a.people_moved;
+      rise_sum += a.rise_time_s;
       out->avalanche_max_duration_s = std::max(out->avalanche_max_duration_s, a.duration_s);
     }
     if (count > 0) {
       out->avalanche_mean_duration_s = duration_sum / count;
       out->avalanche_mean_distance_m = distance_sum / count;
       out->avalanche_mean_people = people_sum / count;
+      out->avalanche_mean_rise_time_s = rise_sum / count;
     }
   }
   std::sort(stationary_loads.begin(), stationary_loads.end());
@@ -557,8 +583,17 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
   std::vector<double> speed_for_regime = out.series.mean_speed_m_per_s;
   for (double& v : speed_for_regime)
     if (std::isnan(v)) v = 0.0;
-  out.regime = ClassifyRegime(contents.time_s, speed_for_regime, out.series.lane_order, options.regime);
+  std::vector<DirectionSeries> directions;
+  for (std::size_t g = 0; g < out.groups; ++g)
+    if (out.group_people[g] > 0)
+      directions.push_back({out.group_name[g], out.group_people[g], out.series.group_mean_speed_m_per_s[g]});
+  out.regime = ClassifyByDirection(contents.time_s, speed_for_regime, directions, out.series.lane_order,
+                                   options.regime);
   AvalancheSizes(pass, contents.people.size(), options, &out);
+  // 9. Passages per direction over the stationary stage.
+  for (std::size_t g = 0; g < out.groups; ++g)
+    out.passages.push_back(AnalyzePassages(std::move(pass.passage_times[g]), contents.time_s[first_stationary],
+                                           contents.time_s.back(), options.passages));
   Summarize(speed_for_regime, first_stationary, std::move(pass.stationary_loads), options, &out);
   return out;
 }

@@ -57,6 +57,9 @@ std::string Simulation::SaveState() const {
   w.Put(in_->gear_initialised);
   w.PutVector(in_->gear_xy);
   w.PutVector(in_->gear_theta);
+  // Only with BackForceTrigger::kAveragedVelocity (the definition, which the
+  // checkpoint is restored into, says which).
+  if (!in_->averaged_along.empty()) w.PutVector(in_->averaged_along);
   return w.Finish();
 }
 
@@ -91,6 +94,7 @@ void Simulation::LoadState(const std::string& data) {
   in_->gear_initialised = r.Get<bool>();
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
+  if (!in_->averaged_along.empty()) r.GetVector(in_->averaged_along, n);
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
   in_->cuda_has_history = false;  // the device's last contacts are not these
   PlaceShapes();  // orientations of the restored angles (Drive reads them)

@@ -31,6 +31,7 @@ struct ContactLaw {
   double tangential_rate;
   bool tensile;
   bool advance_springs;
+  bool spring_history = true;  // false: TangentialSpring::kNone, no elastic tangential displacement
 
   // Restitution per pair. A pair touching at several points (a flat face) acts
   // as one spring of stiffness k_eff kn along the normal, and the pair's
@@ -72,7 +73,7 @@ struct ContactLaw {
     if (!tensile && fn < 0.0) fn = 0.0;
     // Tangential elastic displacement (eq. 9), accumulated while the contact
     // persists and capped by Coulomb's condition on the elastic parts (eq. 10).
-    double spring = previous_spring + (advance_springs ? vt * dt : 0.0);
+    double spring = spring_history ? previous_spring + (advance_springs ? vt * dt : 0.0) : 0.0;
     const double cap = mu * elastic_n;
     if (kt * std::abs(spring) > cap) spring = std::copysign(cap / kt, spring);
     c.tangential_spring_m = spring;

@@ -16,6 +16,8 @@ using Kind = ParameterInfo::Kind;
 constexpr const char* kTangentialDampingChoices[] = {"from_restitution", "equal_to_normal", "fixed"};
 constexpr const char* kFacingChoices[] = {"velocity", "desired_direction"};
 constexpr const char* kIntegratorChoices[] = {"velocity_verlet", "gear5"};
+constexpr const char* kBackForceTriggerChoices[] = {"velocity", "averaged_velocity"};
+constexpr const char* kTangentialSpringChoices[] = {"history", "none"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -74,6 +76,9 @@ auto MakeTable() {
              "how gamma_t is set: from the restitution with k_t, equal to gamma_n, or fixed"),
       Number("tangential_damping_rate_per_s", &P::tangential_damping_rate_per_s, "1/s", 0.0, 1e6, "ERRATA 2",
              "gamma_t when tangential_damping is fixed"),
+      Choice<&P::tangential_spring>("tangential_spring", kTangentialSpringChoices, "eqs. 9-10; issue 19",
+             "history: the tangential spring accumulates while a contact lasts (static friction); none: only "
+             "the tangential dashpot of eq. 12"),
       Flag("allow_tensile_normal_force", &P::allow_tensile_normal_force, "eq. 19",
            "let the dashpot pull at the end of a contact (false: normal force clamped at zero)"),
       // --- Ground reaction forces (eqs. 3, 15) ---
@@ -83,6 +88,11 @@ auto MakeTable() {
              "tau, relaxation time of the self-driven force (eq. 3)"),
       Number("back_force_gamma", &P::back_force_gamma, "", 0.0, 100.0, "Table 1 (fitted to footage)",
              "Gamma, back force of people pushed from behind (eq. 15)"),
+      Choice<&P::back_force_trigger>("back_force_trigger", kBackForceTriggerChoices, "eq. 15; issue 19",
+             "what Theta of eq. 15 reads: the instantaneous velocity along e (the paper), or that velocity "
+             "averaged over back_force_reaction_time_s"),
+      Number("back_force_reaction_time_s", &P::back_force_reaction_time_s, "s", 0.01, 10.0, "issue 19",
+             "time constant of the averaged velocity of back_force_trigger = averaged_velocity (about one step)"),
       // --- Torques (eqs. 16-17) ---
       Number("torsion_stiffness_lambda", &P::torsion_stiffness_lambda, "", 0.0, 1e4, "Table 1 (fitted to footage)",
              "lambda, torsion stiffness of the motive torque (eq. 16; ERRATA 4)"),

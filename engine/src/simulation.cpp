@@ -130,6 +130,8 @@ void Simulation::LoadBodies() {
     detail::Wrap(def_.periodic, bodies_.position_m[i]);
   }
   in_->cos_angle.assign(n, 1.0);
+  // People are placed at rest: u_i = 0, no back force until pushed back.
+  if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
   in_->sin_angle.assign(n, 0.0);
   in_->travel_m.assign(n, 0.0);
   in_->travel_position = bodies_.position_m;
@@ -262,6 +264,7 @@ void Simulation::Step() {
   }
   time_s_ = static_cast<double>(step_count_ + 1) * dt_s_;
   ++step_count_;
+  AverageBackForceTrigger();
   Check();
 }
 

@@ -259,6 +259,11 @@ struct Simulation::Internals {
   std::vector<std::array<double, 4>> gear_theta;
   bool gear_initialised = false;
 
+  // BackForceTrigger::kAveragedVelocity: per body, the velocity along the
+  // desired direction averaged over back_force_reaction_time_s (updated once
+  // per step, after the integrator; empty otherwise).
+  std::vector<double> averaged_along;
+
   // Parallel Collide: each thread's contacts, in the order of the chunks it
   // took (buffers apart in memory), where each chunk's contacts lie in them,
   // and where each chunk's contacts start in the contact list.

@@ -25,6 +25,7 @@ void Simulation::Drive() {
   const double torsion_factor = mp.torsion_stiffness_lambda * inverse_tau * inverse_tau;             // eq. (16): lambda / tau^2
   const double rotation_damping = 1.0 / mp.rotation_relaxation_time_s;                               // eq. (17)
   const bool face_velocity = mp.facing_target == FacingTarget::kVelocity;
+  const bool averaged_trigger = mp.back_force_trigger == BackForceTrigger::kAveragedVelocity;
   const double slope_force_per_kg =
       def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
                                 : 0.0;
@@ -83,7 +84,9 @@ void Simulation::Drive() {
         force += (e * v0 - v) * (m * inverse_tau);  // eq. (3)
         // Back force, eq. (15): only when pushed backwards (Theta(x) = 1 for x > 0
         // only, ERRATA 9), along e plus e x k, which points to the person's right.
-        if (-Dot(e, v) > 0.0) force += (e + Vec2{e.y, -e.x}) * (back_factor * m * v0);
+        // (With the averaged trigger, Theta reads u_i, see AverageBackForceTrigger.)
+        const double along = averaged_trigger ? in.averaged_along[i] : Dot(e, v);
+        if (-along > 0.0) force += (e + Vec2{e.y, -e.x}) * (back_factor * m * v0);
         // Motive torque, eq. (16) with the restoring sign (ERRATA 4).
         if (turning[k]) torque += torsion_factor * inertia * gain[k] * angle[k];
         // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
@@ -96,5 +99,19 @@ void Simulation::Drive() {
   }
 }
 
+// u_i <- u_i + (1 - exp(-h/T)) (e_i . v_i - u_i): the exact update of
+// du/dt = (e.v - u)/T for e.v constant over the step, once per step after
+// the integrator (not in Drive, which also runs outside steps).
+void Simulation::AverageBackForceTrigger() {
+  const ModelParameters& mp = def_.parameters;
+  if (mp.back_force_trigger != BackForceTrigger::kAveragedVelocity) return;
+  std::vector<double>& u = in_->averaged_along;
+  const double a = -std::expm1(-dt_s_ / mp.back_force_reaction_time_s);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) continue;
+    const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i]);
+    u[i] += a * (Dot(e, bodies_.velocity_m_per_s[i]) - u[i]);
+  }
+}
 
 }  // namespace crowdrecon::engine

@@ -53,6 +53,7 @@ void RunLoop::Add(std::unique_ptr<RunSystem> system) {
 void RunLoop::Run(std::int64_t first_frame, std::int64_t last_frame) {
   summary_.last_frame = first_frame;
   summary_.stopped = false;
+  summary_.finished = false;
   for (std::int64_t frame = first_frame + 1; frame <= last_frame; ++frame) {
     // The frame's engine steps, with the per-step systems around each. The
     // engine's time is the frame's less theirs (two clock readings a frame
@@ -76,13 +77,18 @@ void RunLoop::Run(std::int64_t first_frame, std::int64_t last_frame) {
     summary_.engine_s += Since(steps_start) - step_systems_s;
     // The per-frame systems, in order.
     FrameContext context{sim_, frame, last_frame,
-                         [&](const Event& event) { options_.write_event(event, frame); }, false};
+                         [&](const Event& event) { options_.write_event(event, frame); }, false, false, {}};
     for (std::size_t s = 0; s < systems_.size(); ++s) {
       const auto start = Clock::now();
       systems_[s]->AtFrame(context);
       summary_.system_s[s].second += Since(start);
     }
     summary_.last_frame = frame;
+    if (context.finish && frame < last_frame) {
+      summary_.finished = true;
+      summary_.finish_reason = context.finish_reason;
+      return;
+    }
     if (context.stop && frame < last_frame) {
       summary_.stopped = true;
       return;

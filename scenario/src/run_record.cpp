@@ -28,6 +28,15 @@ runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile:
   return runfile::RunFileWriter::Create(file, header, RunSetupOf(sim, target_names));
 }
 
+void PersonLoads(const engine::Simulation& sim, std::vector<double>* load) {
+  load->assign(sim.bodies().size(), 0.0);
+  for (const engine::Contact& c : sim.contacts()) {
+    const double force = Length(c.Force());
+    (*load)[c.a] += force;
+    if (!c.wall) (*load)[c.b] += force;
+  }
+}
+
 void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::vector<runfile::Event>& events,
                   bool with_contacts, runfile::FrameSnapshot* out) {
   runfile::FrameSnapshot& f = *out;
@@ -41,12 +50,7 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
   f.angular_velocity_rad_per_s.clear();
   f.state.clear();
   std::vector<double>& load = f.load_n;
-  load.assign(b.size(), 0.0);
-  for (const engine::Contact& c : sim.contacts()) {
-    const double force = Length(c.Force());
-    load[c.a] += force;
-    if (!c.wall) load[c.b] += force;
-  }
+  PersonLoads(sim, &load);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (b.state[i] == engine::PersonState::kRemoved) continue;

@@ -4,6 +4,7 @@
 //   wall_check      every person's centre stayed inside the walls (engine::CheckCentresStayInsideWalls)
 //   frames          the frame into the run file (FrameWriterThread: on a core of its own when one is free)
 //   device_fallback a GPU that failed: an event and a note, once
+//   settle          ends a run whose regime has settled (run.stop_when_settled, settle.hpp)
 //   checkpoint      the periodic checkpoint (run.checkpoint_interval_s)
 //   stop_request    Ctrl-C, SIGTERM, a caller's flag, --stop-after: stop here (a checkpoint follows)
 //   progress        the progress line on a terminal
@@ -24,6 +25,7 @@
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
+#include "crowdrecon/scenario/settle.hpp"
 
 namespace crowdrecon::scenario::detail {
 
@@ -75,6 +77,51 @@ class DeviceFallbackSystem : public RunSystem {
  private:
   bool progress_line_;
   bool reported_ = false;
+};
+
+// Ends the run as complete once its regime has settled (settle.hpp): an
+// event `settled` with the reason; the runner stores the reason as run value
+// `settled`.
+class SettleSystem : public RunSystem {
+ public:
+  SettleSystem(const engine::Simulation& sim, const SettleOptions& options, std::vector<std::string> group_names)
+      : detector_(options, sim.bodies().group, std::move(group_names), sim.definition().periodic) {
+    // Frame 0 (written before the loop starts); a resumed run replaces all
+    // of this with the checkpoint's state.
+    Feed(sim);
+  }
+  std::string_view name() const override { return "settle"; }
+  void AtFrame(FrameContext& c) override {
+    const std::string reason = Feed(c.sim);
+    if (reason.empty()) return;
+    Event event;
+    event.time_s = c.sim.time_s();
+    event.kind = "settled";
+    event.detail = reason;
+    c.write_event(event);
+    c.finish = true;
+    c.finish_reason = reason;
+  }
+  std::string SaveState() const override { return detector_.SaveState(); }
+  void LoadState(const std::string& state) override { detector_.LoadState(state); }
+
+ private:
+  std::string Feed(const engine::Simulation& sim) {
+    const engine::BodyState& b = sim.bodies();
+    direction_.resize(b.size());
+    present_.resize(b.size());
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      direction_[i] = sim.definition().targets[b.target[i]].Direction(b.position_m[i]);
+      present_[i] = b.state[i] != engine::PersonState::kRemoved;
+    }
+    PersonLoads(sim, &load_);
+    return detector_.Add({sim.time_s(), &b.position_m, &b.velocity_m_per_s, &direction_, &load_, &present_});
+  }
+
+  SettleDetector detector_;
+  std::vector<Vec2> direction_;
+  std::vector<char> present_;
+  std::vector<double> load_;
 };
 
 class CheckpointSystem : public RunSystem {

@@ -311,6 +311,17 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
   loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts));
   loop.Add(std::make_unique<detail::DeviceFallbackSystem>(options.show_progress));
+  if (scenario.run.settle.enabled) {
+    // Directions of travel by group, named after their target.
+    std::vector<std::string> group_names;
+    const engine::BodyState& b = sim.bodies();
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (b.group[i] >= group_names.size()) group_names.resize(b.group[i] + 1);
+      if (group_names[b.group[i]].empty() && b.target[i] < built.target_names.size())
+        group_names[b.group[i]] = built.target_names[b.target[i]];
+    }
+    loop.Add(std::make_unique<detail::SettleSystem>(sim, scenario.run.settle, group_names));
+  }
   loop.Add(std::make_unique<detail::CheckpointSystem>(
       checkpoint_every, [&](std::int64_t frame) { checkpoint_at(checkpoint, frame); }));
   loop.Add(std::make_unique<detail::StopRequestSystem>(g_stop_requested, options.stop_flag, options.stop_after_s));
@@ -323,7 +334,11 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   try {
     loop.Run(last_frame, total_frames);
     last_frame = loop.summary().last_frame;
-    if (loop.summary().stopped) {
+    if (loop.summary().finished) {
+      frames.Flush();
+      writer.SetRunValue("settled", loop.summary().finish_reason);
+      say(loop.summary().finish_reason);
+    } else if (loop.summary().stopped) {
       checkpoint_at(checkpoint, last_frame);
       status = "interrupted";
     }

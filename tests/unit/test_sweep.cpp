@@ -221,7 +221,11 @@ TEST(SweepResults, ColumnsAndRowRoundTrip) {
   EXPECT_EQ(c.front(), "duration_s");
   EXPECT_NE(std::find(c.begin(), c.end(), "mean_speed_g0_m_per_s"), c.end());
   EXPECT_NE(std::find(c.begin(), c.end(), "mean_speed_g1_m_per_s"), c.end());
-  EXPECT_EQ(c.back(), "regime_code");
+  EXPECT_NE(std::find(c.begin(), c.end(), "regime_code"), c.end());
+  // Per direction (classifier version 2), for both groups.
+  EXPECT_NE(std::find(c.begin(), c.end(), "regime_code_g1"), c.end());
+  EXPECT_NE(std::find(c.begin(), c.end(), "lapse_tail_exponent_g0"), c.end());
+  EXPECT_EQ(c.back(), "lapse_tail_exponent_error_g1");
 
   ResultRow row;
   row.run_index = 42;

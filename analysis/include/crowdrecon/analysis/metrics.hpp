@@ -30,8 +30,11 @@ struct MeasurementLine {
 // shorter than half a period, so no farther image can be reached). A step that
 // ends exactly on the line counts; one that starts on it does not, so a person
 // standing on the line is counted once, when they leave its back side.
+// `fraction` (optional) receives where along the step, in [0, 1], the line
+// was crossed (the last crossing counted, if several): the passage time is
+// then interpolated within the frame interval.
 int CrossingDirection(const MeasurementLine& line, Vec2 forward, Vec2 from_m, Vec2 to_m,
-                      const PeriodicBox& box);
+                      const PeriodicBox& box, double* fraction = nullptr);
 
 // Lane order parameter after Rex and Löwen, Phys. Rev. E 75, 051402 (2007):
 // for each person j, n_same and n_other count the people of j's own group and

@@ -25,6 +25,15 @@
 //                the mean lane order reaches it;
 //   unclassified anything else (e.g. one long stop and one release), or a run
 //                too short to tell (stationary stage < frozen_window_s).
+//
+// Per direction (classifier version 2, ClassifyByDirection): the rules above
+// are applied to each direction of travel's own mean speed (a group walking
+// to one target), and the hallway's verdict combines them, the worst first:
+// clogging if any direction is frozen at the end (a hallway one direction
+// cannot pass is not free flow), else avalanches if any direction (or the
+// crowd) has min_avalanches of them, else lanes if every direction and the
+// crowd pass the lanes rule, else unclassified. Each direction keeps its own
+// verdict and reason.
 #pragma once
 
 #include <cstddef>
@@ -41,6 +50,11 @@ enum class Regime {
 };
 const char* ToString(Regime regime);  // "lanes", "avalanches", "clogging", "unclassified"
 bool FromString(const std::string& text, Regime* regime);
+
+// The classifier's version, stored with every verdict (run value
+// `regime_classifier`, summary `regime_classifier_version`): 1 judged the
+// crowd's mean speed only; 2 judges each direction of travel and combines.
+inline constexpr int kRegimeClassifierVersion = 2;
 
 struct RegimeOptions {
   // Mean speed along the desired direction below which the flow counts as
@@ -67,6 +81,15 @@ struct RegimeOptions {
   // rest in random order; lanes need about the time to walk the 12 m corridor
   // once at ~1 m/s to form.
   double transient_s = 10.0;
+  // Longest stationary stage (s): the regime is that of the stationary
+  // state, which long runs reach at different times (lanes form, or plugs
+  // freeze, between 20 and 150 s in the hallway), so the stage is the last
+  // stationary_window_s of the run after the transient: six final windows,
+  // the 12 m hallway walked five times at ~1 m/s. Once the state is reached a
+  // longer run does not change the verdict. (Runs up to transient_s +
+  // stationary_window_s long, e.g. the 30 s diagrams, are judged exactly as
+  // by classifier version 1.)
+  double stationary_window_s = 60.0;
   // Avalanches needed in the stationary stage for the avalanche regime: the
   // paper's regime is a recurring "temporal clogging followed by a sudden
   // release"; one stop-and-release may be a single rearrangement, two is the
@@ -99,11 +122,22 @@ struct Avalanche {
   // People who advanced at least AnalysisOptions::avalanche_move_m along their
   // desired direction during it; -1 where unknown (series without positions).
   int people_moved = -1;
+  // Abruptness of the release: time from V crossing the stop speed upward to
+  // V reaching the burst speed, both crossings interpolated linearly between
+  // samples (s). A free start (eq. 2 without contacts) takes
+  // tau ln((v0 - v_stop)/(v0 - v_burst)) = 0.17 s for v0 = 1 m/s.
+  double rise_time_s = 0.0;
 };
+
+// Start of the stationary stage of a run from t_first to t_last:
+// max(t_first + transient_s, t_last - stationary_window_s).
+double StationaryStart(double t_first, double t_last, const RegimeOptions& options);
 
 // Avalanches in a mean-speed series (`time_s` increasing, same length).
 std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const std::vector<double>& speed_m_per_s,
                                       const RegimeOptions& options);
+
+struct DirectionRegime;
 
 struct RegimeResult {
   Regime regime = Regime::kUnclassified;
@@ -116,6 +150,21 @@ struct RegimeResult {
   bool frozen_at_end = false;
   double mean_lane_order = 0.0;  // over the stationary stage; NaN if no lane order given
   bool long_enough = false;      // stationary stage at least frozen_window_s long
+  // Per direction of travel (ClassifyByDirection; empty from ClassifyRegime).
+  std::vector<DirectionRegime> directions;
+};
+
+// One direction of travel: the people walking to one target (a group).
+struct DirectionSeries {
+  std::string name;                  // the target's name, or "group <k>"
+  std::size_t people = 0;
+  std::vector<double> speed_m_per_s;  // mean of v_i . e_i per sample; NaN where nobody is present
+};
+
+struct DirectionRegime {
+  std::string name;
+  std::size_t people = 0;
+  RegimeResult result;  // the rules applied to this direction's series alone
 };
 
 // Classifies a run from its mean speed along the desired direction and
@@ -123,5 +172,15 @@ struct RegimeResult {
 // options are invalid or the series differ in length.
 RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector<double>& mean_speed_m_per_s,
                             const std::vector<double>& lane_order, const RegimeOptions& options);
+
+// The hallway's verdict from the crowd's series and each direction's (see the
+// combination rule at the top). The result holds the crowd's measurements
+// (stopped fraction, avalanches, ...) with the combined regime and reason, and
+// `directions` one verdict each. A direction's samples without anyone present
+// are left out of its series (an open venue that empties); a direction with
+// no sample left is skipped. Throws InputError as ClassifyRegime.
+RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::vector<double>& crowd_speed_m_per_s,
+                                 const std::vector<DirectionSeries>& directions,
+                                 const std::vector<double>& lane_order, const RegimeOptions& options);
 
 }  // namespace crowdrecon::analysis

@@ -25,7 +25,7 @@
 //   metric_summary(name TEXT PRIMARY KEY, value REAL, unit TEXT)
 //   metric_avalanche(idx, start_frame, end_frame, start_time_s, end_time_s, duration_s,
 //                    stopped_before_s, peak_speed_m_per_s, distance_m, people_moved,
-//                    complete, stationary)
+//                    complete, stationary, rise_time_s)
 //   metric_load_histogram(lower_n REAL, upper_n REAL, count INTEGER)   upper_n NULL = overflow
 //   run values `regime`, `regime_reason`, `analysis_options` (JSON)
 // replacing the tables of an earlier analysis.
@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "crowdrecon/analysis/metrics.hpp"
+#include "crowdrecon/analysis/passages.hpp"
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
@@ -47,6 +48,7 @@ namespace crowdrecon::analysis {
 struct AnalysisOptions {
   RegimeOptions regime;
   LaneOrderOptions lanes;
+  PassageOptions passages;
   // A person is stopped below this speed (m/s), |v| not only along the
   // desired direction: the same tenth of the desired speed as the crowd's
   // stop threshold (RegimeOptions::stop_speed_m_per_s).
@@ -115,6 +117,8 @@ struct RunAnalysis {
 
   // How the measurements were set up.
   std::vector<Vec2> group_direction;  // desired direction per group (unit)
+  std::vector<std::string> group_name;   // the group's target, or "group <k>"
+  std::vector<std::size_t> group_people;  // people per group
   std::string direction_source;
   MeasurementLine line;
   Vec2 forward;  // unit normal of the line on group 0's side
@@ -153,7 +157,12 @@ struct RunAnalysis {
   double load_histogram_bin_n = 0.0;
   std::vector<std::int64_t> load_histogram;  // last bin: >= load_histogram_max_n
 
-  RegimeResult regime;
+  // Per group (direction of travel): its passages through the measurement
+  // line along its own desired direction, over the stationary stage.
+  std::vector<PassageStatistics> passages;
+  double avalanche_mean_rise_time_s = 0.0;  // over the stationary avalanches of the crowd
+
+  RegimeResult regime;  // regime.directions: one verdict per group with people
   std::vector<std::string> notes;  // fallbacks taken, run not complete, ...
 
   // Every summary number by name, for tables (metric_summary, sweep results).

@@ -25,6 +25,21 @@ enum class TangentialDamping {
 const char* ToString(TangentialDamping t);
 bool FromString(const std::string& s, TangentialDamping* t);
 
+// What switches the back force of eq. (15) on (issue 19: the paper's
+// Theta(-e.v) reads the instantaneous velocity; a person reacts to being
+// pushed back over a reaction time, not within a time step).
+enum class BackForceTrigger {
+  kVelocity,          // Theta(-e_i . v_i), the instantaneous velocity (the paper's eq. 15)
+  kAveragedVelocity,  // Theta(-u_i), u_i the velocity along e_i averaged over back_force_reaction_time_s
+};
+
+// Whether contacts keep a tangential spring (eq. 9) from step to step
+// (issue 19: the springs hold a plug by static friction).
+enum class TangentialSpring {
+  kHistory,  // delta_t accumulates while the contact lasts, capped by Coulomb (eqs. 9-10; default)
+  kNone,     // no elastic tangential displacement: only the tangential dashpot (eq. 12) acts
+};
+
 enum class Integrator {
   kVelocityVerlet,  // second order, symplectic for conservative forces; default
   kGear5,           // fifth-order Gear predictor-corrector, as in the paper's SPOLY code
@@ -43,6 +58,7 @@ struct ModelParameters {
   double wall_restitution = 0.4;  // epsilon for person-wall contacts (same source)
   TangentialDamping tangential_damping = TangentialDamping::kFromRestitution;
   double tangential_damping_rate_per_s = 0.0;  // gamma_t when kFixed (1/s)
+  TangentialSpring tangential_spring = TangentialSpring::kHistory;
   // Allow the linear dashpot to pull at the end of a contact (as in eq. 19's
   // derivation); when false the normal force is clamped at zero.
   bool allow_tensile_normal_force = true;
@@ -55,6 +71,11 @@ struct ModelParameters {
   // (Desired speeds v0 ~ U(0.8, 1.2) m/s are drawn per person: the
   // scenario's population, scenario::PopulationSpec; PersonDef holds each.)
   double back_force_gamma = 1.2;  // Gamma, Table 1 (fitted to footage)
+  BackForceTrigger back_force_trigger = BackForceTrigger::kVelocity;
+  // Time constant of u_i for kAveragedVelocity (s): the duration of a step
+  // (~0.5 s at a cadence of ~2 steps/s): a person pushed back reacts with
+  // the next step, not within milliseconds.
+  double back_force_reaction_time_s = 0.5;
 
   // --- Torques (eqs. 16-17) --------------------------------------------
   double torsion_stiffness_lambda = 27.0;  // lambda, Table 1 (fitted to footage)

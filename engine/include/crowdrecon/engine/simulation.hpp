@@ -160,6 +160,7 @@ class Simulation {
   friend class detail::PairCollider;
   void Gather();
   void Drive();
+  void AverageBackForceTrigger();  // after each step (stage_drive.cpp)
   void ComputeForces();
   void VerletKickDrift();
   void VerletKick();

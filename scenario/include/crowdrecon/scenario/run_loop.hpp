@@ -41,6 +41,10 @@ struct FrameContext {
   std::function<void(const Event&)> write_event;
   // Set by a system to end the run here as interrupted (a checkpoint is then written).
   bool stop = false;
+  // Set by a system to end the run here as complete, before its duration
+  // (a run whose regime has settled, scenario/settle.hpp), with the reason.
+  bool finish = false;
+  std::string finish_reason;
 };
 
 class RunSystem {
@@ -72,6 +76,8 @@ class RunLoop {
   struct Summary {
     std::int64_t last_frame = 0;  // the last frame whose systems all ran
     bool stopped = false;         // a system asked to stop before the run's end
+    bool finished = false;        // a system ended the run early as complete
+    std::string finish_reason;
     std::vector<std::pair<std::string, double>> system_s;  // wall seconds per system, in order
     double engine_s = 0;                                   // wall seconds in engine steps
     std::string BriefReport() const;  // "engine 3.2 s; frames 0.4 s, wall_check 0.01 s, ..."
@@ -80,7 +86,8 @@ class RunLoop {
   RunLoop(engine::Simulation& sim, Options options);
   void Add(std::unique_ptr<RunSystem> system);
   // Frames first_frame + 1 .. last_frame (frame first_frame is already done).
-  // Stops early when a system sets FrameContext::stop. Exceptions of the
+  // Stops early when a system sets FrameContext::stop or finish (finish wins:
+  // the other systems of that frame still run). Exceptions of the
   // engine or of a system propagate, with summary() up to the last frame done.
   void Run(std::int64_t first_frame, std::int64_t last_frame);
   const Summary& summary() const { return summary_; }

@@ -21,6 +21,11 @@ runfile::RunSetup RunSetupOf(const engine::Simulation& sim, const std::vector<st
 runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
                                      const engine::Simulation& sim, const std::vector<std::string>& target_names);
 
+// Each person's load (engine index; 0 for the removed): the sum of the
+// magnitudes of the contact forces on them, the quantity compared with the
+// 400 N threshold.
+void PersonLoads(const engine::Simulation& sim, std::vector<double>* load);
+
 // Copies frame `frame` of the simulation into `out`, reusing its storage:
 // every person still in the venue, their loads (the sum of the magnitudes of
 // the contact forces on each, the quantity compared with the 400 N

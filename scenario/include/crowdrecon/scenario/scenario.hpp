@@ -31,6 +31,7 @@
 #include "crowdrecon/geometry/population.hpp"
 #include "crowdrecon/geometry/population_table.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/scenario/settle.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -60,6 +61,9 @@ struct RunSpec {
   double output_fps = 10.0;
   double checkpoint_interval_s = 10.0;  // 0 = none
   bool write_contacts = true;
+  // Stop once the regime has settled (run.stop_when_settled: an object,
+  // possibly empty, of SettleOptions; absent = run the whole duration).
+  SettleOptions settle;
 };
 
 struct Scenario {
