@@ -47,7 +47,7 @@ analysis::MeasurementLine ParseLine(const std::string& text) {
 }
 
 // Replays the run's frames through the check of run.stop_when_settled
-// (scenario/settle.hpp, default options): when a run with it would have
+// (scenario/settle.hpp; the run's own options, else the defaults): when a run with it would have
 // stopped, and the verdict of the run up to then against the whole run's.
 // Checks the early-stop criteria on runs simulated to their full length.
 void SettleCheck(const std::string& file, const analysis::RunAnalysis& whole,
@@ -57,8 +57,8 @@ void SettleCheck(const std::string& file, const analysis::RunAnalysis& whole,
   const std::size_t n = people.size();
   std::vector<std::uint32_t> group(n);
   for (std::size_t i = 0; i < n; ++i) group[i] = people[i].group;
-  scenario::SettleOptions settle;
-  settle.enabled = true;
+  const scenario::SettleOptions settle =
+      scenario::SettleOptionsOfScenario(run.RunValue("scenario"), file + ": run value scenario");
   scenario::SettleDetector detector(settle, group, whole.group_name, whole.box);
   std::vector<Vec2> position(n), velocity(n), direction(n);
   std::vector<double> load(n, 0.0);

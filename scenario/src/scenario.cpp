@@ -148,19 +148,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     s.run.output_fps = run->Number("output_fps", s.run.output_fps, 0.01, 1000.0);
     s.run.checkpoint_interval_s = run->Number("checkpoint_interval_s", s.run.checkpoint_interval_s, 0.0, 1e6);
     s.run.write_contacts = run->Bool("contacts", s.run.write_contacts);
-    if (auto settle = run->Find("stop_when_settled")) {
-      SettleOptions& o = s.run.settle;
-      if (!settle->IsObject())
-        settle->Fail("expected an object {\"frozen_window_s\": ..., \"lanes_window_s\": ...} (may be empty: "
-                     "the defaults), found " + settle->ValueText());
-      o.enabled = true;
-      o.frozen_window_s = settle->Number("frozen_window_s", o.frozen_window_s, 1.0, 3600.0);
-      o.frozen_displacement_m = settle->Number("frozen_displacement_m", o.frozen_displacement_m, 0.0, 1.0);
-      o.frozen_load_change = settle->Number("frozen_load_change", o.frozen_load_change, 0.0, 1.0);
-      o.lanes_window_s = settle->Number("lanes_window_s", o.lanes_window_s, 1.0, 3600.0);
-      o.sample_interval_s = settle->Number("sample_interval_s", o.sample_interval_s, 0.01, 60.0);
-      settle->Finish();
-    }
+    if (auto settle = run->Find("stop_when_settled")) s.run.settle = ReadSettleOptions(*settle);
     run->Finish();
   }
   root.Finish();

@@ -8,6 +8,7 @@
 
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/json_reader.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -84,6 +85,30 @@ bool SettleOptions::IsValid(std::string* error) const {
          InRange(frozen_load_change, 0.0, 1.0, "frozen_load_change", "", error) &&
          InRange(lanes_window_s, 1.0, 3600.0, "lanes_window_s", "s", error) &&
          InRange(sample_interval_s, 0.01, 60.0, "sample_interval_s", "s", error);
+}
+
+SettleOptions ReadSettleOptions(const JsonReader& settle) {
+  if (!settle.IsObject())
+    settle.Fail("expected an object {\"frozen_window_s\": ..., \"lanes_window_s\": ...} (may be empty: the "
+                "defaults), found " + settle.ValueText());
+  SettleOptions o;
+  o.enabled = true;
+  o.frozen_window_s = settle.Number("frozen_window_s", o.frozen_window_s, 1.0, 3600.0);
+  o.frozen_displacement_m = settle.Number("frozen_displacement_m", o.frozen_displacement_m, 0.0, 1.0);
+  o.frozen_load_change = settle.Number("frozen_load_change", o.frozen_load_change, 0.0, 1.0);
+  o.lanes_window_s = settle.Number("lanes_window_s", o.lanes_window_s, 1.0, 3600.0);
+  o.sample_interval_s = settle.Number("sample_interval_s", o.sample_interval_s, 0.01, 60.0);
+  settle.Finish();
+  return o;
+}
+
+SettleOptions SettleOptionsOfScenario(const std::string& scenario_json, const std::string& origin) {
+  const JsonDocument doc = JsonDocument::Parse(scenario_json, origin);
+  if (auto run = doc.Root().Find("run"))
+    if (auto settle = run->Find("stop_when_settled")) return ReadSettleOptions(*settle);
+  SettleOptions o;
+  o.enabled = true;
+  return o;
 }
 
 SettleDetector::SettleDetector(const SettleOptions& options, std::vector<std::uint32_t> group,

@@ -126,3 +126,14 @@ foreach(case
   crowdrecon_refused_test(run_file.${name} 2 "run.sqlite: ${regex}" --corrupt ${RUN} "${sql}" -- ${EXE} ${cmd})
   set_tests_properties(cli.bad_input.run_file.${name} PROPERTIES FIXTURES_REQUIRED render_data)
 endforeach()
+
+# --- run.stop_when_settled (issue 19) ---------------------------------------------
+crowdrecon_refused_test(json.settle_not_an_object 2
+  "bad-settle-not-object.json: /run/stop_when_settled: expected an object \\{\"frozen_window_s\": \\.\\.\\., \"lanes_window_s\": \\.\\.\\.\\} \\(may be empty: the defaults\\), found true"
+  -- ${EXE} simulate ${S}/bad-settle-not-object.json -o @OUT@/x.sqlite -q)
+crowdrecon_refused_test(json.settle_window_range 2
+  "bad-settle-window.json: /run/stop_when_settled/lanes_window_s: value 0.2 is out of range.*expected a number in \\[1, 3600\\]"
+  -- ${EXE} simulate ${S}/bad-settle-window.json -o @OUT@/x.sqlite -q)
+crowdrecon_refused_test(json.settle_unknown_key 2
+  "bad-settle-unknown.json: /run/stop_when_settled: unknown key\\(s\\) \"lanes_window\""
+  -- ${EXE} simulate ${S}/bad-settle-unknown.json -o @OUT@/x.sqlite -q)

@@ -29,6 +29,10 @@
 #include "crowdrecon/common/periodic_box.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
+namespace crowdrecon {
+class JsonReader;
+}  // namespace crowdrecon
+
 namespace crowdrecon::scenario {
 
 struct SettleOptions {
@@ -52,6 +56,15 @@ struct SettleOptions {
 
   bool IsValid(std::string* error) const;
 };
+
+// A scenario's run.stop_when_settled: an object whose keys (all optional)
+// are the fields above; enabled. Errors name the file, the JSON path and the
+// allowed range.
+SettleOptions ReadSettleOptions(const JsonReader& object);
+// The settle options of a run's scenario (its JSON text, as a run file
+// keeps it): its run.stop_when_settled, or the defaults if it has none;
+// enabled either way (analyze --settle-check).
+SettleOptions SettleOptionsOfScenario(const std::string& scenario_json, const std::string& origin);
 
 // The criteria on a stream of frames, without the engine (tests feed it
 // hand-made frames; SettleSystem feeds it the simulation's).
