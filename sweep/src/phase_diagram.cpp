@@ -153,7 +153,23 @@ struct Panel {
   std::string stem;   // file name stem
   std::map<std::pair<std::size_t, std::size_t>, Point> points;
   std::size_t runs = 0;
+  // What the verdicts rest on: the runs' lengths and the classifiers that
+  // judged them (1 where the table predates the column).
+  double shortest_s = std::numeric_limits<double>::infinity(), longest_s = 0.0;
+  std::set<int> classifiers;
 };
+
+// "120 runs of 30 s, classifier version 1" (or "of 21-240 s" when the runs
+// stopped when settled or failed early).
+std::string RunsText(const Panel& p) {
+  char length[64];
+  if (!(p.longest_s > 0.0)) std::snprintf(length, sizeof length, "of unknown length");
+  else if (p.longest_s - p.shortest_s < 0.5) std::snprintf(length, sizeof length, "of %.0f s", p.longest_s);
+  else std::snprintf(length, sizeof length, "of %.0f-%.0f s", p.shortest_s, p.longest_s);
+  std::string versions;
+  for (int v : p.classifiers) versions += (versions.empty() ? "" : " and ") + std::to_string(v);
+  return std::to_string(p.runs) + " runs " + length + ", classifier version " + versions;
+}
 
 // Page layout in device pixels (y down).
 struct Layout {
@@ -351,7 +367,7 @@ void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_nam
                                             " points disagree",
                             12, 0.0, 0.5, Color::Hex(0x333333));
   page.canvas.TextPxAligned(L.left, L.height - 14,
-                            std::to_string(panel.runs) + " runs; regimes as defined in docs/analysis.md", 12, 0.0, 0.0,
+                            RunsText(panel) + "; regimes as defined in docs/analysis.md", 12, 0.0, 0.0,
                             Color::Hex(0x555555));
   page.canvas.Finish();
 }
@@ -531,6 +547,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
     if (a != x_path && a != y_path) c_other.push_back(t.Column(a));
   const std::size_t c_count = t.Column("avalanche_count"), c_duration = t.Column("duration_s"),
                     c_stationary = t.Column("stationary_start_s");
+  const std::optional<std::size_t> c_classifier = t.FindColumn("regime_classifier_version");
 
   // Panels in variant order, then in order of first appearance of the other
   // axes' values.
@@ -550,10 +567,16 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
       const std::string key = variant + "\n" + slice;
       if (!panel_of.count(key)) {
         panel_of[key] = panels.size();
-        panels.push_back({variant, slice, stem, {}, 0});
+        panels.push_back({variant, slice, stem, {}, 0, std::numeric_limits<double>::infinity(), 0.0, {}});
       }
       Panel& p = panels[panel_of[key]];
       ++p.runs;
+      if (!row[c_duration].null) {
+        p.shortest_s = std::min(p.shortest_s, row[c_duration].number);
+        p.longest_s = std::max(p.longest_s, row[c_duration].number);
+      }
+      if (c_classifier && !row[*c_classifier].null) p.classifiers.insert(static_cast<int>(row[*c_classifier].number));
+      else if (!c_classifier) p.classifiers.insert(1);
       Point& point = p.points[{x.IndexOf(row[c_x]), y.IndexOf(row[c_y])}];
       const Category category = CategoryOf(row[c_status], row[c_regime]);
       if (category == kFailed) ++failed;
@@ -611,7 +634,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
     summary.pictures.push_back(svg);
     ++summary.diagrams;
     html += "<figure><a href=\"" + Html(svg.filename().string()) + "\"><img src=\"" + Html(png.filename().string()) +
-            "\"></a><figcaption>" + Html(PanelTitle(p)) + "</figcaption></figure>\n";
+            "\"></a><figcaption>" + Html(PanelTitle(p) + "; " + RunsText(p)) + "</figcaption></figure>\n";
   }
   html += "</div>\n";
   if (options.heat_maps) {

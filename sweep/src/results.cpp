@@ -286,9 +286,14 @@ void ResultsStore::WriteCsv() const {
   fs::rename(tmp, file);
 }
 
-std::size_t ResultsTable::Column(const std::string& name) const {
+std::optional<std::size_t> ResultsTable::FindColumn(const std::string& name) const {
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i] == name) return i;
+  return std::nullopt;
+}
+
+std::size_t ResultsTable::Column(const std::string& name) const {
+  if (const auto i = FindColumn(name)) return *i;
   throw InputError(file.string() + ": the runs table has no column \"" + name + "\"");
 }
 

@@ -97,6 +97,9 @@ struct ResultsTable {
 
   // Index of a column; throws InputError naming the file if it is missing.
   std::size_t Column(const std::string& name) const;
+  // Index of a column, or nullopt if the table has none (a column added
+  // after the table was written).
+  std::optional<std::size_t> FindColumn(const std::string& name) const;
   std::filesystem::path file;
 };
 
