@@ -22,12 +22,6 @@ namespace {
 
 namespace geo = crowdrecon::geometry;
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 std::string VecText(Vec2 v) { return "(" + FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")"; }
 
 struct CheckArgs {
@@ -47,13 +41,13 @@ void RunCheck(const CheckArgs& args) {
   const double area = geo::WalkableArea_m2(v);
   std::printf("venue: %s  [%s]\n", v.metadata.name.c_str(), args.file.c_str());
   if (!v.metadata.source.empty()) std::printf("  source: %s\n", v.metadata.source.c_str());
-  std::printf("  walkable area: %s m2 in %zu part(s), perimeter %s m\n", Fixed(area, 2).c_str(),
-              v.walkable_area.size(), Fixed(geo::WalkablePerimeter_m(v), 2).c_str());
+  std::printf("  walkable area: %s m2 in %zu part(s), perimeter %s m\n", FormatFixed(area, 2).c_str(),
+              v.walkable_area.size(), FormatFixed(geo::WalkablePerimeter_m(v), 2).c_str());
   double wall_length = 0.0;
   const auto segments = geo::WallSegments(v);
   for (const geo::WallSegment& s : segments) wall_length += Length(s.b - s.a);
   std::printf("  walls: %zu (%zu segments, %s m, exit openings cut out), obstacles: %zu\n", v.walls.size(),
-              segments.size(), Fixed(wall_length, 2).c_str(), v.obstacles.size());
+              segments.size(), FormatFixed(wall_length, 2).c_str(), v.obstacles.size());
   std::printf("  exits: %zu\n", v.exits.size());
   for (const geo::Exit& e : v.exits) {
     // The longest walk to each exit also reveals parts that cannot reach it.
@@ -74,13 +68,13 @@ void RunCheck(const CheckArgs& args) {
         if (clearance > 1.5 * field.spacing_m()) ++unreachable;
       }
     std::printf("    %-16s width %s m, from %s to %s; longest walk to it %s m%s\n", e.id.c_str(),
-                Fixed(e.width_m(), 2).c_str(), VecText(e.a).c_str(), VecText(e.b).c_str(),
-                Fixed(farthest, 1).c_str(),
+                FormatFixed(e.width_m(), 2).c_str(), VecText(e.a).c_str(), VecText(e.b).c_str(),
+                FormatFixed(farthest, 1).c_str(),
                 unreachable > 0 ? (", " + std::to_string(unreachable) + " grid nodes cannot reach it").c_str() : "");
   }
   std::printf("  entries: %zu\n", v.entries.size());
   for (const geo::EntryZone& e : v.entries)
-    std::printf("    %-16s %s m2\n", e.id.c_str(), Fixed(std::abs(geo::RingSignedArea_m2(e.polygon)), 2).c_str());
+    std::printf("    %-16s %s m2\n", e.id.c_str(), FormatFixed(std::abs(geo::RingSignedArea_m2(e.polygon)), 2).c_str());
   std::printf("  measurement areas: %zu, lines: %zu\n", v.measurement_areas.size(), v.measurement_lines.size());
   if (v.periodic.empty()) std::printf("  periodic: none\n");
   for (const geo::PeriodicDirection& p : v.periodic)
@@ -91,7 +85,7 @@ void RunCheck(const CheckArgs& args) {
                                                    : ("direction " + VecText(t.direction)).c_str());
   if (v.slope)
     std::printf("  slope: gradient %s (%s %%) downhill toward %s, %s\n", FormatNumber(v.slope->gradient).c_str(),
-                Fixed(100.0 * v.slope->gradient, 1).c_str(), VecText(v.slope->direction).c_str(),
+                FormatFixed(100.0 * v.slope->gradient, 1).c_str(), VecText(v.slope->direction).c_str(),
                 v.slope->enabled ? "enabled" : "disabled");
   else
     std::printf("  slope: none (level floor)\n");
@@ -179,8 +173,8 @@ void RunImport(const ImportArgs& args) {
   }
   geo::WriteVenueJson(venue, args.output);
   std::printf("imported %s (%s): %s m2 walkable in %zu part(s), %zu obstacle(s), perimeter %s m\n",
-              args.input.c_str(), format.c_str(), Fixed(geo::WalkableArea_m2(venue), 2).c_str(),
-              venue.walkable_area.size(), venue.obstacles.size(), Fixed(geo::WalkablePerimeter_m(venue), 2).c_str());
+              args.input.c_str(), format.c_str(), FormatFixed(geo::WalkableArea_m2(venue), 2).c_str(),
+              venue.walkable_area.size(), venue.obstacles.size(), FormatFixed(geo::WalkablePerimeter_m(venue), 2).c_str());
   std::printf("wrote %s (add exits, entries and targets by hand, then run `crowdrecon venue check`)\n",
               args.output.c_str());
 }

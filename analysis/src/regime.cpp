@@ -17,12 +17,6 @@ namespace {
 // window edges allow for it.
 constexpr double kTimeTolerance_s = 1e-6;
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 bool CheckRange(double value, double lo, double hi, const char* name, const char* unit, std::string* error) {
   if (value >= lo && value <= hi) return true;
   *error = std::string("regime ") + name + " = " + FormatNumber(value) + (*unit ? " " : "") + unit +
@@ -208,10 +202,10 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
   // The decision, in the order of regime.hpp.
   const std::string speed_text = "mean speed along the desired direction over the last " +
                                  FormatNumber(options.frozen_window_s) + " s " +
-                                 Fixed(r.end_mean_speed_m_per_s, 3) + " m/s";
+                                 FormatFixed(r.end_mean_speed_m_per_s, 3) + " m/s";
   if (!r.long_enough) {
     r.regime = Regime::kUnclassified;
-    r.reason = "run too short: " + Fixed(t_last - t_first, 1) + " s, the classifier needs the transient (" +
+    r.reason = "run too short: " + FormatFixed(t_last - t_first, 1) + " s, the classifier needs the transient (" +
                FormatNumber(options.transient_s) + " s) plus a final window of " +
                FormatNumber(options.frozen_window_s) + " s";
   } else if (r.frozen_at_end) {
@@ -228,18 +222,18 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
              (options.min_lane_order_for_lanes <= 0.0 ||
               (std::isfinite(r.mean_lane_order) && r.mean_lane_order >= options.min_lane_order_for_lanes))) {
     r.regime = Regime::kLanes;
-    r.reason = "free flow: stopped " + Fixed(100.0 * r.stopped_time_fraction, 1) +
+    r.reason = "free flow: stopped " + FormatFixed(100.0 * r.stopped_time_fraction, 1) +
                " % of the stationary stage (at most " +
                FormatNumber(100.0 * options.max_stopped_fraction_for_lanes) + " %), " +
                std::to_string(r.stationary_avalanches) + " avalanche(s)";
-    if (std::isfinite(r.mean_lane_order)) r.reason += ", mean lane order " + Fixed(r.mean_lane_order, 2);
+    if (std::isfinite(r.mean_lane_order)) r.reason += ", mean lane order " + FormatFixed(r.mean_lane_order, 2);
   } else if (r.stopped_time_fraction <= options.max_stopped_fraction_for_lanes) {
     r.regime = Regime::kUnclassified;
-    r.reason = "free flow without lanes: mean lane order " + Fixed(r.mean_lane_order, 2) + " below " +
+    r.reason = "free flow without lanes: mean lane order " + FormatFixed(r.mean_lane_order, 2) + " below " +
                FormatNumber(options.min_lane_order_for_lanes);
   } else {
     r.regime = Regime::kUnclassified;
-    r.reason = "intermittent: stopped " + Fixed(100.0 * r.stopped_time_fraction, 1) +
+    r.reason = "intermittent: stopped " + FormatFixed(100.0 * r.stopped_time_fraction, 1) +
                " % of the stationary stage with " + std::to_string(r.stationary_avalanches) +
                " avalanche(s) (fewer than " + std::to_string(options.min_avalanches) + "), not frozen";
   }
@@ -249,7 +243,7 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
 namespace {
 
 std::string DirectionText(const DirectionRegime& d) {
-  return d.name + " (" + std::to_string(d.people) + " people) " + Fixed(d.result.end_mean_speed_m_per_s, 3) +
+  return d.name + " (" + std::to_string(d.people) + " people) " + FormatFixed(d.result.end_mean_speed_m_per_s, 3) +
          " m/s";
 }
 
@@ -315,7 +309,7 @@ RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::v
     std::string speeds;
     for (const DirectionRegime& d : r.directions)
       speeds += (speeds.empty() ? "" : ", ") + d.name + " stopped " +
-                Fixed(100.0 * d.result.stopped_time_fraction, 1) + " %";
+                FormatFixed(100.0 * d.result.stopped_time_fraction, 1) + " %";
     r.reason += "; every direction free (" + speeds + ")";
   }
   return r;

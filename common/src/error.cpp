@@ -11,6 +11,13 @@ std::string FormatNumber(double value) {
   return buffer;
 }
 
+std::string FormatFixed(double value, int decimals) {
+  const int n = std::snprintf(nullptr, 0, "%.*f", decimals, value);
+  std::string text(static_cast<std::size_t>(n > 0 ? n : 0), '\0');
+  std::snprintf(text.data(), text.size() + 1, "%.*f", decimals, value);
+  return text;
+}
+
 std::string ShortText(std::string_view text, std::size_t max_chars) {
   if (text.size() <= max_chars) return std::string(text);
   std::size_t cut = max_chars > 3 ? max_chars - 3 : 0;

@@ -17,12 +17,6 @@ namespace {
 constexpr double kTimeTolerance_s = 1e-6;  // frame times exceed nominal ones by less than a step
 constexpr char kStateMagic[8] = {'S', 'E', 'T', 'T', 'L', 'E', '1', '\0'};
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 bool InRange(double value, double lo, double hi, const char* name, const char* unit, std::string* error) {
   if (value >= lo && value <= hi) return true;
   *error = std::string("run.stop_when_settled.") + name + " = " + FormatNumber(value) + (*unit ? " " : "") + unit +
@@ -39,7 +33,7 @@ class StateWriter {
   }
   void PutDoubles(const std::vector<double>& v) {
     Put<std::uint64_t>(v.size());
-    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
+    if (!v.empty()) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
   }
   std::string out;
 };
@@ -60,7 +54,7 @@ class StateReader {
     if (expected != static_cast<std::size_t>(-1) && n != expected) Fail();
     if (n > (in_.size() - at_) / sizeof(double)) Fail();
     std::vector<double> v(n);
-    std::memcpy(v.data(), in_.data() + at_, n * sizeof(double));
+    if (n > 0) std::memcpy(v.data(), in_.data() + at_, n * sizeof(double));  // (no null pointer to memcpy)
     at_ += n * sizeof(double);
     return v;
   }
@@ -181,10 +175,10 @@ std::string SettleDetector::Evaluate() const {
       change = std::max(change, total > 0.0 ? diff / total : (diff > 0.0 ? 1.0 : 0.0));
     }
     if (moved >= options_.frozen_displacement_m || change >= options_.frozen_load_change) return {};
-    return "settled frozen at " + Fixed(now, 1) + " s: " + r.reason + "; for the last " +
-           FormatNumber(options_.frozen_window_s) + " s nobody moved more than " + Fixed(100.0 * moved, 1) +
+    return "settled frozen at " + FormatFixed(now, 1) + " s: " + r.reason + "; for the last " +
+           FormatNumber(options_.frozen_window_s) + " s nobody moved more than " + FormatFixed(100.0 * moved, 1) +
            " cm (limit " + FormatNumber(100.0 * options_.frozen_displacement_m) + " cm) and the loads changed by " +
-           Fixed(100.0 * change, 1) + " % at most (limit " + FormatNumber(100.0 * options_.frozen_load_change) +
+           FormatFixed(100.0 * change, 1) + " % at most (limit " + FormatNumber(100.0 * options_.frozen_load_change) +
            " %)";
   }
   if (r.regime == analysis::Regime::kLanes) {
@@ -200,9 +194,9 @@ std::string SettleDetector::Evaluate() const {
         }
       }
     if (!(slowest >= regime_options.stop_speed_m_per_s)) return {};
-    return "settled in lanes at " + Fixed(now, 1) + " s: " + r.reason + "; for the last " +
+    return "settled in lanes at " + FormatFixed(now, 1) + " s: " + r.reason + "; for the last " +
            FormatNumber(options_.lanes_window_s) + " s no direction stopped (slowest frame: " + slowest_name + " " +
-           Fixed(slowest, 3) + " m/s, stop speed " + FormatNumber(regime_options.stop_speed_m_per_s) + " m/s)";
+           FormatFixed(slowest, 3) + " m/s, stop speed " + FormatNumber(regime_options.stop_speed_m_per_s) + " m/s)";
   }
   return {};
 }

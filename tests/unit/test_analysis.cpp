@@ -20,6 +20,7 @@
 #include "crowdrecon/scenario/run_record.hpp"
 #include "engine_scenes.hpp"
 #include "render_scene.hpp"
+#include "series_helpers.hpp"
 #include "test_util.hpp"
 
 namespace crowdrecon::analysis {
@@ -31,19 +32,8 @@ namespace {
 
 using testing_util::ErrorOf;
 
-// Samples at 10 per second from 0 to duration_s.
-std::vector<double> Times(double duration_s) {
-  std::vector<double> t;
-  for (int k = 0; k <= static_cast<int>(std::lround(duration_s * 10.0)); ++k) t.push_back(k / 10.0);
-  return t;
-}
-
-template <typename F>
-std::vector<double> Series(const std::vector<double>& t, F f) {
-  std::vector<double> v;
-  for (double ti : t) v.push_back(f(ti));
-  return v;
-}
+using test_series::Series;
+using test_series::Times;
 
 // --- regime classifier on synthetic series -----------------------------------
 

@@ -16,6 +16,7 @@
 #include "crowdrecon/analysis/passages.hpp"
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "series_helpers.hpp"
 
 namespace crowdrecon::analysis {
 
@@ -25,18 +26,8 @@ void PrintTo(Regime regime, std::ostream* os);  // test_analysis.cpp
 // test_analysis.cpp, whose helpers have the same names.
 namespace direction_tests {
 
-std::vector<double> Times(double duration_s) {
-  std::vector<double> t;
-  for (int k = 0; k <= static_cast<int>(std::lround(duration_s * 10.0)); ++k) t.push_back(k / 10.0);
-  return t;
-}
-
-template <typename F>
-std::vector<double> Series(const std::vector<double>& t, F f) {
-  std::vector<double> v;
-  for (double ti : t) v.push_back(f(ti));
-  return v;
-}
+using test_series::Series;
+using test_series::Times;
 
 // The crowd's mean speed from two directions of `a` and `b` people.
 std::vector<double> Crowd(const DirectionSeries& a, const DirectionSeries& b) {

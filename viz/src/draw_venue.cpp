@@ -30,12 +30,6 @@ double NiceLength(double extent_m) {
   return power;
 }
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 }  // namespace
 
 void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
@@ -104,7 +98,7 @@ void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
     const Vec2 mid = 0.5 * (e.a + e.b);
     Vec2 normal = Length(e.b - e.a) > 0.0 ? Normalized(Perp(e.b - e.a)) : Vec2{1, 0};
     if (!geometry::IsWalkable(venue, mid + 0.01 * extent * normal)) normal = -normal;
-    const std::string label = e.id + " (" + Fixed(e.width_m(), 2) + " m)";
+    const std::string label = e.id + " (" + FormatFixed(e.width_m(), 2) + " m)";
     const double text_m = 0.55 * 13.0 * static_cast<double>(label.size()) / ppm;  // rough text width
     Vec2 at = mid + 0.025 * extent * normal;
     if (normal.x < -0.5) at.x -= text_m;
@@ -138,12 +132,12 @@ void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
   // Title, scale bar and legend.
   const std::string title = options.title.empty() ? venue.metadata.name : options.title;
   canvas.TextPx(56.0, 24.0, title, 17);
-  std::string subtitle = Fixed(geometry::WalkableArea_m2(venue), 1) + " m2 walkable";
+  std::string subtitle = FormatFixed(geometry::WalkableArea_m2(venue), 1) + " m2 walkable";
   for (const geometry::PeriodicDirection& p : venue.periodic)
     subtitle += "; periodic along (" + FormatNumber(p.direction.x) + ", " + FormatNumber(p.direction.y) + "), " +
                 FormatNumber(p.period_m) + " m";
   if (venue.slope)
-    subtitle += "; slope " + Fixed(100.0 * venue.slope->gradient, 1) + " % toward (" +
+    subtitle += "; slope " + FormatFixed(100.0 * venue.slope->gradient, 1) + " % toward (" +
                 FormatNumber(venue.slope->direction.x) + ", " + FormatNumber(venue.slope->direction.y) + ")" +
                 (venue.slope->enabled ? "" : " (disabled)");
   canvas.TextPx(56.0, 44.0, subtitle, 12, Color::Hex(0x444444));

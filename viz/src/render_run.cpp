@@ -50,12 +50,6 @@ std::optional<double> ParseSeconds(const std::string& s) {
   return value;
 }
 
-std::string Fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
 // Times in messages: six significant digits hide the time-step residue of
 // frame times (2.000149 s for a frame written at the step after 2 s).
 std::string Seconds(double t_s) {
@@ -338,10 +332,10 @@ struct FrameLegend {
 void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend, const FrameStats& stats,
                 double force_n_per_px, double max_force_all_n) {
   const double w = canvas.width_px(), h = canvas.height_px();
-  const std::string line1 = "t = " + Fixed(legend.time_s, 2) + " s    frame " + std::to_string(legend.frame) +
+  const std::string line1 = "t = " + FormatFixed(legend.time_s, 2) + " s    frame " + std::to_string(legend.frame) +
                             "    people " + std::to_string(legend.people) + "    contacts " +
                             std::to_string(stats.contacts) + " (" + std::to_string(stats.wall_contacts) +
-                            " with walls)    max contact force " + Fixed(stats.max_force_n, 0) + " N";
+                            " with walls)    max contact force " + FormatFixed(stats.max_force_n, 0) + " N";
   canvas.TextPx(kMargin_px, 22.0, line1, 15, kText);
 
   // Groups: a swatch and a name each.
@@ -592,7 +586,7 @@ std::string RenderSummary::BriefReport() const {
   std::string s = "rendered " + std::to_string(frames_written) + " frame(s), " + std::to_string(first_frame) +
                   " to " + std::to_string(last_frame) + ", " + std::to_string(width_px) + " x " +
                   std::to_string(height_px) + " px\n";
-  s += "contact force: max " + Fixed(max_contact_force_n, 1) + " N, drawn at " +
+  s += "contact force: max " + FormatFixed(max_contact_force_n, 1) + " N, drawn at " +
        FormatNumber(std::round(force_n_per_px * 1000.0) / 1000.0) + " N per px of line width\n";
   if (branches_left_out > 0)
     s += "note: " + std::to_string(branches_left_out) +
@@ -653,7 +647,7 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
   layout.width_px = static_cast<int>(std::ceil((hi.x - lo.x) * layout.ppm + 2.0 * kMargin_px));
   layout.height_px = static_cast<int>(std::ceil((hi.y - lo.y) * layout.ppm + 2.0 * kMargin_px));
   if (layout.height_px > 20000)
-    throw InputError(file + ": the drawn region is " + Fixed(hi.x - lo.x, 1) + " m x " + Fixed(hi.y - lo.y, 1) +
+    throw InputError(file + ": the drawn region is " + FormatFixed(hi.x - lo.x, 1) + " m x " + FormatFixed(hi.y - lo.y, 1) +
                      " m; at --width " + std::to_string(options.width_px) + " the pictures would be " +
                      std::to_string(layout.height_px) + " px tall (at most 20000): give a larger --width");
   summary->world_min_m = layout.lo;

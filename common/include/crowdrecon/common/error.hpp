@@ -24,6 +24,8 @@ class GeometryError : public InputError {
 
 // Formats a double compactly for messages ("0.05", "1e+05").
 std::string FormatNumber(double value);
+// Formats a double with a fixed number of decimals ("0.405" for 3).
+std::string FormatFixed(double value, int decimals);
 
 // `text` cut to at most `max_chars` characters ("..." marks a cut; a UTF-8
 // sequence is never split), for echoing what a user gave in a message.
