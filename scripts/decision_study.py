@@ -122,10 +122,15 @@ def main():
         md.append(f"| {v} | " + " | ".join(cells) + " |")
     settled = [c for c in checks.values() if c["settles"] == "yes"]
     same = [c for c in settled if c["same"] == "same"]
-    md += ["", f"Early-stop check (`analyze --settle-check`, default options) on these {len(rows)} full-length runs: "
+    complete = [r for r in rows if r["status"] == "complete"]
+    unsettled = [r for r in complete if checks[r["run_id"]]["settles"] == "no"]
+    md += ["", f"Early-stop check (`analyze --settle-check`, default options) on the {len(complete)} complete "
+           f"full-length runs (of {len(rows)}): "
            f"{len(settled)} would have stopped early ({sum(1 for c in settled if c['kind'] == 'frozen')} frozen, "
            f"{sum(1 for c in settled if c['kind'] == 'lanes')} in lanes), and the verdict at the stop equals the "
-           f"240 s verdict in {len(same)} of them."]
+           f"240 s verdict in {len(same)} of them. The {len(unsettled)} that run to 240 s: " +
+           ", ".join(f"{r['variant']} {float(r['population.density_per_m2']):g} /m² seed {r['seed']} ({r['regime']})"
+                     for r in unsettled) + "."]
     if settled:
         stops = sorted(float(c["stop_s"]) for c in settled)
         md.append(f"Stop times: median {stops[len(stops) // 2]:.1f} s, range {stops[0]:.1f}–{stops[-1]:.1f} s.")
