@@ -388,7 +388,22 @@ const std::vector<Metric> kMetrics = {
     {"avalanche_rate_per_min", "Avalanches per minute of the stationary stage", "1/min"},
     {"max_load_n", "Largest load on a person", "N"},
     {"above_load_person_frames", "Fraction of person-frames above 400 N", ""},
+    // Classifier version 2 (issue 19): per direction, and the field's measures
+    // of clogs at the line; tables written before it lack them (not drawn).
+    {"frozen_at_end_g1", "Counter-flow frozen at the end (mean over seeds)", ""},
+    {"clogged_fraction_g0", "Main flow: fraction of the time clogged at the line (lapses > 2 s)", ""},
+    {"clogged_fraction_g1", "Counter-flow: fraction of the time clogged at the line (lapses > 2 s)", ""},
+    {"lapse_tail_exponent_g1", "Counter-flow: tail exponent of the lapses between passages", ""},
+    {"avalanche_mean_rise_time_s", "Rise time of the avalanches' releases", "s"},
 };
+
+// The metrics a results table can show: derived ones, and those whose column it has.
+std::vector<const Metric*> AvailableMetrics(const ResultsTable& t) {
+  std::vector<const Metric*> available;
+  for (const Metric& m : kMetrics)
+    if (std::string(m.name) == "avalanche_rate_per_min" || t.FindColumn(m.name)) available.push_back(&m);
+  return available;
+}
 
 Color Viridis(double t) {
   static const std::array<unsigned, 9> stops = {0x440154, 0x472c7a, 0x3b518b, 0x2c718e, 0x21908d,
@@ -548,6 +563,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   const std::size_t c_count = t.Column("avalanche_count"), c_duration = t.Column("duration_s"),
                     c_stationary = t.Column("stationary_start_s");
   const std::optional<std::size_t> c_classifier = t.FindColumn("regime_classifier_version");
+  const std::vector<const Metric*> metrics = AvailableMetrics(t);
 
   // Panels in variant order, then in order of first appearance of the other
   // axes' values.
@@ -583,7 +599,8 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
       point.votes.push_back(category);
       point.seeds.push_back(static_cast<std::uint64_t>(row[c_seed].number));
       if (category == kFailed) continue;
-      for (const Metric& m : kMetrics) {
+      for (const Metric* metric : metrics) {
+        const Metric& m = *metric;
         double v = std::numeric_limits<double>::quiet_NaN();
         if (std::string(m.name) == "avalanche_rate_per_min") {
           const double stationary_s = row[c_duration].number - row[c_stationary].number;
@@ -640,7 +657,8 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   if (options.heat_maps) {
     for (const Panel& p : panels) {
       html += "<h2>Metrics, " + Html(PanelTitle(p)) + "</h2>\n<div class=\"grid\">\n";
-      for (const Metric& m : kMetrics) {
+      for (const Metric* metric : metrics) {
+        const Metric& m = *metric;
         const std::string stem = "heat-" + p.stem.substr(6) + "-" + m.name;
         const fs::path png = out / (stem + ".png"), svg = out / (stem + ".svg");
         DrawHeatMap(p, layout, m, sweep_name, png);
