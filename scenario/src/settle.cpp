@@ -17,12 +17,21 @@ namespace {
 constexpr double kTimeTolerance_s = 1e-6;  // frame times exceed nominal ones by less than a step
 constexpr char kStateMagic[8] = {'S', 'E', 'T', 'T', 'L', 'E', '1', '\0'};
 
-bool InRange(double value, double lo, double hi, const char* name, const char* unit, std::string* error) {
-  if (value >= lo && value <= hi) return true;
-  *error = std::string("run.stop_when_settled.") + name + " = " + FormatNumber(value) + (*unit ? " " : "") + unit +
-           ", expected [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
-  return false;
-}
+// The numbers of run.stop_when_settled with their ranges: one list for the
+// reader and for IsValid.
+struct SettleKey {
+  const char* name;
+  double SettleOptions::*field;
+  double min, max;
+  const char* unit;
+};
+constexpr SettleKey kSettleKeys[] = {
+    {"frozen_window_s", &SettleOptions::frozen_window_s, 1.0, 3600.0, "s"},
+    {"frozen_displacement_m", &SettleOptions::frozen_displacement_m, 0.0, 1.0, "m"},
+    {"frozen_load_change", &SettleOptions::frozen_load_change, 0.0, 1.0, ""},
+    {"lanes_window_s", &SettleOptions::lanes_window_s, 1.0, 3600.0, "s"},
+    {"sample_interval_s", &SettleOptions::sample_interval_s, 0.01, 60.0, "s"},
+};
 
 // Plain bytes in the machine's order: a checkpoint is resumed by the same build.
 class StateWriter {
@@ -74,11 +83,14 @@ class StateReader {
 }  // namespace
 
 bool SettleOptions::IsValid(std::string* error) const {
-  return InRange(frozen_window_s, 1.0, 3600.0, "frozen_window_s", "s", error) &&
-         InRange(frozen_displacement_m, 0.0, 1.0, "frozen_displacement_m", "m", error) &&
-         InRange(frozen_load_change, 0.0, 1.0, "frozen_load_change", "", error) &&
-         InRange(lanes_window_s, 1.0, 3600.0, "lanes_window_s", "s", error) &&
-         InRange(sample_interval_s, 0.01, 60.0, "sample_interval_s", "s", error);
+  for (const SettleKey& k : kSettleKeys) {
+    const double value = this->*k.field;
+    if (value >= k.min && value <= k.max) continue;
+    *error = std::string("run.stop_when_settled.") + k.name + " = " + FormatNumber(value) + (*k.unit ? " " : "") +
+             k.unit + ", expected [" + FormatNumber(k.min) + ", " + FormatNumber(k.max) + "]";
+    return false;
+  }
+  return true;
 }
 
 SettleOptions ReadSettleOptions(const JsonReader& settle) {
@@ -87,11 +99,7 @@ SettleOptions ReadSettleOptions(const JsonReader& settle) {
                 "defaults), found " + settle.ValueText());
   SettleOptions o;
   o.enabled = true;
-  o.frozen_window_s = settle.Number("frozen_window_s", o.frozen_window_s, 1.0, 3600.0);
-  o.frozen_displacement_m = settle.Number("frozen_displacement_m", o.frozen_displacement_m, 0.0, 1.0);
-  o.frozen_load_change = settle.Number("frozen_load_change", o.frozen_load_change, 0.0, 1.0);
-  o.lanes_window_s = settle.Number("lanes_window_s", o.lanes_window_s, 1.0, 3600.0);
-  o.sample_interval_s = settle.Number("sample_interval_s", o.sample_interval_s, 0.01, 60.0);
+  for (const SettleKey& k : kSettleKeys) o.*k.field = settle.Number(k.name, o.*k.field, k.min, k.max);
   settle.Finish();
   return o;
 }
