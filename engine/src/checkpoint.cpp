@@ -6,6 +6,7 @@
 
 #include "binary_io.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/parameter_table.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -17,7 +18,11 @@ using namespace detail;  // the stages' shared helpers (simulation_internals.hpp
 
 namespace {
 
-constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
+// Version 2 adds what the incident timeline changes (who is in each slot,
+// their body, group, the per-group drive, the model parameters); version 1 is
+// still read (a run without a timeline changes none of it).
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
+constexpr char kStateMagicV1[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
 
 // The checkpoint's writer and reader (binary_io.hpp, shared with world files).
 class StateWriter : public detail::BinaryWriter {
@@ -27,8 +32,40 @@ class StateWriter : public detail::BinaryWriter {
 
 class StateReader : public detail::BinaryReader {
  public:
-  explicit StateReader(const std::string& data) : BinaryReader(data, kStateMagic, "checkpoint", "state") {}
+  StateReader(const std::string& data, bool v1)
+      : BinaryReader(data, v1 ? kStateMagicV1 : kStateMagic, "checkpoint", "state") {}
 };
+
+// The model parameters, every entry of the parameter table in its order.
+void PutParameters(StateWriter& w, const ModelParameters& p) {
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    switch (info.kind) {
+      case ParameterInfo::Kind::kNumber: w.Put(p.*info.number); break;
+      case ParameterInfo::Kind::kFlag: w.Put(static_cast<std::uint8_t>(p.*info.flag)); break;
+      case ParameterInfo::Kind::kChoice: w.Put(static_cast<std::uint8_t>(info.get_choice(p))); break;
+    }
+  }
+}
+
+ModelParameters GetParameters(StateReader& r, ModelParameters p) {
+  for (const ParameterInfo& info : ModelParameterTable()) {
+    switch (info.kind) {
+      case ParameterInfo::Kind::kNumber: p.*info.number = r.Get<double>(); break;
+      case ParameterInfo::Kind::kFlag: p.*info.flag = r.Get<std::uint8_t>() != 0; break;
+      case ParameterInfo::Kind::kChoice: {
+        const int c = r.Get<std::uint8_t>();
+        if (c >= static_cast<int>(info.choice_count)) throw InputError("checkpoint: damaged model parameters");
+        info.set_choice(p, c);
+        break;
+      }
+    }
+  }
+  return p;
+}
+
+bool HasMagic(const std::string& data, const char* magic) {
+  return data.size() >= sizeof kStateMagic && std::memcmp(data.data(), magic, sizeof kStateMagic) == 0;
+}
 
 }  // namespace
 
@@ -60,11 +97,21 @@ std::string Simulation::SaveState() const {
   // Only with BackForceTrigger::kAveragedVelocity (the definition, which the
   // checkpoint is restored into, says which).
   if (!in_->averaged_along.empty()) w.PutVector(in_->averaged_along);
+  w.PutVector(bodies_.id);
+  w.PutVector(bodies_.shape);
+  w.PutVector(bodies_.mass_kg);
+  w.PutVector(bodies_.inertia_kg_m2);
+  w.PutVector(bodies_.group);
+  w.PutVector(in_->group_gamma);
+  w.PutVector(in_->group_lambda);
+  PutParameters(w, def_.parameters);
+  w.PutVector(wall_enabled_);
   return w.Finish();
 }
 
 void Simulation::LoadState(const std::string& data) {
-  StateReader r(data);
+  const bool v1 = HasMagic(data, kStateMagicV1);
+  StateReader r(data, v1);
   const auto n = r.Get<std::uint64_t>();
   if (n != bodies_.size())
     throw InputError("checkpoint: holds " + std::to_string(n) + " people where this run has " +
@@ -95,6 +142,34 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
   if (!in_->averaged_along.empty()) r.GetVector(in_->averaged_along, n);
+  if (!v1) {
+    r.GetVector(bodies_.id, n);
+    r.GetVector(bodies_.shape, n);
+    r.GetVector(bodies_.mass_kg, n);
+    r.GetVector(bodies_.inertia_kg_m2, n);
+    r.GetVector(bodies_.group, n);
+    r.GetVector(in_->group_gamma);
+    r.GetVector(in_->group_lambda);
+    if (in_->group_gamma.size() != in_->group_lambda.size() || in_->group_gamma.size() > 1024)
+      throw InputError("checkpoint: damaged per-group drive");
+    const ModelParameters p = GetParameters(r, def_.parameters);
+    std::string error;
+    if (!p.IsValid(&error)) throw InputError("checkpoint: damaged model parameters: " + error);
+    def_.parameters = p;
+    r.GetVector(wall_enabled_);
+    if (!wall_enabled_.empty() && wall_enabled_.size() != def_.walls.size())
+      throw InputError("checkpoint: damaged wall switches");
+    in_->restitution_factor = RestitutionDampingFactor(p.restitution);
+    in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (bodies_.shape[i] >= def_.shapes.size() || !(bodies_.mass_kg[i] > 0) || !(bodies_.inertia_kg_m2[i] > 0))
+        throw InputError("checkpoint: damaged body of slot " + std::to_string(i));
+      const std::uint32_t s = bodies_.shape[i];
+      in_->bound_m[i] = def_.shapes[s].core_radius_m + def_.shapes[s].radius_m;
+      in_->rotation_arm_m[i] =
+          in_->family_geometry[in_->shape_family[s]].core_radius_m * in_->shape_scale[s] * (1.0 + 1e-12);
+    }
+  }
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
   in_->cuda_has_history = false;  // the device's last contacts are not these
   PlaceShapes();  // orientations of the restored angles (Drive reads them)

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "crowdrecon/common/error.hpp"
@@ -92,6 +93,25 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   in_->previous_contacts = contacts_;
 }
 
+// Slot i's person: their state, body and identity (LoadBodies, Spawn).
+void Simulation::LoadPerson(std::size_t i, const PersonDef& p, std::uint32_t id) {
+  bodies_.position_m[i] = p.position_m;
+  detail::Wrap(def_.periodic, bodies_.position_m[i]);
+  bodies_.angle_rad[i] = p.angle_rad;
+  bodies_.velocity_m_per_s[i] = p.velocity_m_per_s;
+  bodies_.angular_velocity_rad_per_s[i] = p.angular_velocity_rad_per_s;
+  bodies_.mass_kg[i] = p.mass_kg;
+  bodies_.inertia_kg_m2[i] = p.inertia_kg_m2;
+  bodies_.shape[i] = p.shape;
+  bodies_.desired_speed_m_per_s[i] = p.desired_speed_m_per_s;
+  bodies_.target[i] = p.target;
+  bodies_.group[i] = p.group;
+  bodies_.state[i] = p.state;
+  bodies_.id[i] = id;
+  const BodyShape& s = def_.shapes[p.shape];
+  in_->bound_m[i] = s.core_radius_m + s.radius_m;
+}
+
 // The bodies' state from the people of the world, wrapped into the periodic box.
 void Simulation::LoadBodies() {
   const std::size_t n = def_.people.size();
@@ -111,24 +131,9 @@ void Simulation::LoadBodies() {
   bodies_.target.resize(n);
   bodies_.group.resize(n);
   bodies_.state.resize(n);
+  bodies_.id.resize(n);
   in_->bound_m.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const PersonDef& p = def_.people[i];
-    bodies_.position_m[i] = p.position_m;
-    bodies_.angle_rad[i] = p.angle_rad;
-    bodies_.velocity_m_per_s[i] = p.velocity_m_per_s;
-    bodies_.angular_velocity_rad_per_s[i] = p.angular_velocity_rad_per_s;
-    bodies_.mass_kg[i] = p.mass_kg;
-    bodies_.inertia_kg_m2[i] = p.inertia_kg_m2;
-    bodies_.shape[i] = p.shape;
-    bodies_.desired_speed_m_per_s[i] = p.desired_speed_m_per_s;
-    bodies_.target[i] = p.target;
-    bodies_.group[i] = p.group;
-    bodies_.state[i] = p.state;
-    const BodyShape& s = def_.shapes[p.shape];
-    in_->bound_m[i] = s.core_radius_m + s.radius_m;
-    detail::Wrap(def_.periodic, bodies_.position_m[i]);
-  }
+  for (std::size_t i = 0; i < n; ++i) LoadPerson(i, def_.people[i], static_cast<std::uint32_t>(i));
   in_->cos_angle.assign(n, 1.0);
   // People are placed at rest: u_i = 0, no back force until pushed back.
   if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
@@ -291,7 +296,185 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
     bodies_.velocity_m_per_s[person] = {};
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
   }
+  if (state == PersonState::kRemoved) {
+    // Their contacts go with them: the next step's springs start without
+    // them, and a frame written now lists no contact with someone absent.
+    std::erase_if(contacts_, [person](const Contact& c) { return c.a == person || (!c.wall && c.b == person); });
+    in_->cuda_has_history = false;
+  }
   in_->pairs_valid = false;
+}
+
+// ---------------------------------------------------------------------------
+// The incident timeline's changes (between steps)
+
+// The world as it is now (every slot's body, whoever holds it) with other
+// parameters: for the time-step estimate of a change.
+WorldDef Simulation::ProbeWorld(const ModelParameters& parameters) const {
+  WorldDef probe;
+  probe.parameters = parameters;
+  probe.shapes = def_.shapes;
+  probe.people.resize(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    probe.people[i].shape = bodies_.shape[i];
+    probe.people[i].mass_kg = bodies_.mass_kg[i];
+    probe.people[i].inertia_kg_m2 = bodies_.inertia_kg_m2[i];
+  }
+  return probe;
+}
+
+void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id) {
+  if (slot >= bodies_.size()) throw InputError("slot " + std::to_string(slot) + " out of range");
+  if (bodies_.state[slot] != PersonState::kRemoved)
+    throw InputError("slot " + std::to_string(slot) + " is taken (" + PersonText(slot) + " is in the venue)");
+  if (p.shape >= def_.shapes.size() || p.target >= def_.targets.size() || !(p.mass_kg > 0) ||
+      !(p.inertia_kg_m2 > 0) || !std::isfinite(p.position_m.x) || !std::isfinite(p.position_m.y) ||
+      !std::isfinite(p.angle_rad) || p.state != PersonState::kWalking)
+    throw InputError("spawn into slot " + std::to_string(slot) + ": an invalid person (shape, target, mass or pose)");
+  {
+    WorldDef probe;
+    probe.parameters = def_.parameters;
+    probe.shapes = {def_.shapes[p.shape]};
+    probe.people = {p};
+    probe.people[0].shape = 0;
+    if (const TimeStepEstimate e = EstimateTimeStep(probe); dt_s_ > e.stability_limit_s)
+      throw InputError("spawn into slot " + std::to_string(slot) + ": this person (" + FormatNumber(p.mass_kg) +
+                       " kg) needs a time step below " + FormatNumber(e.stability_limit_s) + " s, the run's is " +
+                       FormatNumber(dt_s_) + " s (choose the step for every arrival)");
+  }
+  LoadPerson(slot, p, id);
+  bodies_.force_n[slot] = {};
+  bodies_.torque_n_m[slot] = 0.0;
+  bodies_.contact_force_n[slot] = {};
+  bodies_.contact_torque_n_m[slot] = 0.0;
+  bodies_.external_force_n[slot] = {};
+  Internals& in = *in_;
+  in.rotation_arm_m[slot] =
+      in.family_geometry[in.shape_family[p.shape]].core_radius_m * in.shape_scale[p.shape] * (1.0 + 1e-12);
+  in.cos_angle[slot] = std::cos(p.angle_rad);
+  in.sin_angle[slot] = std::sin(p.angle_rad);
+  in.travel_m[slot] = 0.0;
+  in.travel_position[slot] = bodies_.position_m[slot];
+  in.travel_angle[slot] = p.angle_rad;
+  if (slot < in.leading_force.size()) in.leading_force[slot] = {};
+  if (slot < in.trailing_force.size()) in.trailing_force[slot] = {};
+  if (slot < in.leading_torque.size()) in.leading_torque[slot] = 0.0;
+  if (slot < in.trailing_torque.size()) in.trailing_torque[slot] = 0.0;
+  if (slot < in.gear_xy.size()) in.gear_xy[slot] = {};
+  if (slot < in.gear_theta.size()) in.gear_theta[slot] = {};
+  if (!in.averaged_along.empty()) in.averaged_along[slot] = 0.0;
+  in.pairs_valid = false;
+  in.cuda_has_history = false;
+  Drive();  // the newcomer's own forces enter the current evaluation (the others' are unchanged)
+}
+
+bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) const {
+  if (shape >= def_.shapes.size()) throw InputError("shape index " + std::to_string(shape) + " out of range");
+  const Internals& in = *in_;
+  PlacedShape me;
+  me.geometry = &in.family_geometry[in.shape_family[shape]];
+  me.scale = in.shape_scale[shape];
+  me.position = position_m;
+  me.cos_angle = std::cos(angle_rad);
+  me.sin_angle = std::sin(angle_rad);
+  std::vector<ContactPoint> hits;
+  for (std::size_t w = 0; w < in.wall_geometry.size(); ++w) {
+    if (!WallEnabled(static_cast<std::uint32_t>(w))) continue;
+    PlacedShape wall;
+    wall.geometry = &in.wall_geometry[w];
+    wall.position = in.wall_origin[w];
+    if (CollideShapes(me, wall, hits); !hits.empty()) return false;
+  }
+  const BodyShape& mine = def_.shapes[shape];
+  const double my_bound = mine.core_radius_m + mine.radius_m;
+  for (std::size_t j = 0; j < bodies_.size(); ++j) {
+    if (bodies_.state[j] == PersonState::kRemoved) continue;
+    const Vec2 separation = Separation(position_m, bodies_.position_m[j]);
+    const double reach = my_bound + in.bound_m[j];
+    if (LengthSquared(separation) >= reach * reach) continue;
+    PlacedShape other;
+    const std::uint32_t s = bodies_.shape[j];
+    other.geometry = &in.family_geometry[in.shape_family[s]];
+    other.scale = in.shape_scale[s];
+    other.position = position_m - separation;  // the image nearest to the candidate
+    other.cos_angle = std::cos(bodies_.angle_rad[j]);
+    other.sin_angle = std::sin(bodies_.angle_rad[j]);
+    if (CollideShapes(me, other, hits); !hits.empty()) return false;
+  }
+  return true;
+}
+
+void Simulation::SetTarget(std::uint32_t person, std::uint32_t target) {
+  if (person >= bodies_.size() || target >= def_.targets.size())
+    throw InputError("person " + std::to_string(person) + " or target " + std::to_string(target) + " out of range");
+  bodies_.target[person] = target;
+  Drive();
+}
+
+void Simulation::SetDesiredSpeed(std::uint32_t person, double speed_m_per_s) {
+  if (person >= bodies_.size() || !(speed_m_per_s >= 0.0) || !std::isfinite(speed_m_per_s))
+    throw InputError("person " + std::to_string(person) + ": desired speed " + FormatNumber(speed_m_per_s) +
+                     " m/s; expected a person in range and a finite speed >= 0");
+  bodies_.desired_speed_m_per_s[person] = speed_m_per_s;
+  Drive();
+}
+
+void Simulation::SetParameters(const ModelParameters& parameters) {
+  std::string error;
+  if (!parameters.IsValid(&error)) throw InputError("model parameters: " + error);
+  ModelParameters p = parameters;
+  p.time_step_s = def_.parameters.time_step_s;
+  if (p.integrator != def_.parameters.integrator || p.back_force_trigger != def_.parameters.back_force_trigger ||
+      p.tangential_spring != def_.parameters.tangential_spring)
+    throw InputError("model parameters: the integrator, the back force's trigger and the tangential spring are "
+                     "fixed for a run; only numbers may change during it");
+  const TimeStepEstimate estimate = EstimateTimeStep(ProbeWorld(p));
+  if (dt_s_ > estimate.stability_limit_s)
+    throw InputError("model parameters: the run's time step " + FormatNumber(dt_s_) +
+                     " s is above the stability limit " + FormatNumber(estimate.stability_limit_s) +
+                     " s of the new parameters (limited by " + estimate.limited_by + ")");
+  def_.parameters = p;
+  in_->restitution_factor = RestitutionDampingFactor(p.restitution);
+  in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
+  Drive();
+}
+
+void Simulation::SetWallEnabled(std::uint32_t wall, bool enabled) {
+  if (wall >= def_.walls.size()) throw InputError("wall " + std::to_string(wall) + " out of range");
+  if (WallEnabled(wall) == enabled) return;
+  if (wall_enabled_.empty()) wall_enabled_.assign(def_.walls.size(), 1);
+  wall_enabled_[wall] = enabled ? 1 : 0;
+  if (!enabled) std::erase_if(contacts_, [wall](const Contact& c) { return c.wall && c.b == wall; });
+  in_->pairs_valid = false;
+  if (step_count_ == 0) {  // the forces at t = 0 as the constructor computes them, with this wall as it is now
+    ComputeForces();
+    in_->previous_contacts = contacts_;
+  }
+}
+
+void Simulation::SetGroupDrive(std::uint32_t group, double back_force_gamma, double torsion_stiffness_lambda) {
+  if (group > 1023) throw InputError("group " + std::to_string(group) + " out of range (0..1023)");
+  const auto bad = [](double x) { return !std::isnan(x) && !(x >= 0.0 && x <= 1e6); };
+  if (bad(back_force_gamma) || bad(torsion_stiffness_lambda))
+    throw InputError("group " + std::to_string(group) + ": back force or torsion stiffness out of range");
+  Internals& in = *in_;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (in.group_gamma.size() <= group) {
+    in.group_gamma.resize(group + 1, nan);
+    in.group_lambda.resize(group + 1, nan);
+  }
+  in.group_gamma[group] = back_force_gamma;
+  in.group_lambda[group] = torsion_stiffness_lambda;
+  if (!std::isnan(torsion_stiffness_lambda)) {
+    ModelParameters p = def_.parameters;
+    p.torsion_stiffness_lambda = torsion_stiffness_lambda;
+    if (dt_s_ > EstimateTimeStep(ProbeWorld(p)).stability_limit_s) {
+      in.group_lambda[group] = nan;
+      throw InputError("group " + std::to_string(group) + ": torsion stiffness " + FormatNumber(torsion_stiffness_lambda) +
+                       " needs a shorter time step than the run's " + FormatNumber(dt_s_) + " s");
+    }
+  }
+  Drive();
 }
 
 Vec2 Simulation::LinearMomentum() const {

@@ -250,6 +250,10 @@ struct Simulation::Internals {
   detail::PairClearances pair_clear, wall_pair_clear;
   bool pair_memory = true;  // SetPairMemory
 
+  // Per-group back force Gamma and torsion stiffness lambda (SetGroupDrive),
+  // NaN where the group uses the model's; empty when no group has its own.
+  std::vector<double> group_gamma, group_lambda;
+
   // Contact-law constants.
   double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
   double wall_restitution_factor = 0.0;  // same for walls

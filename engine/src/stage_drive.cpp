@@ -86,9 +86,15 @@ void Simulation::Drive() {
         // only, ERRATA 9), along e plus e x k, which points to the person's right.
         // (With the averaged trigger, Theta reads u_i, see AverageBackForceTrigger.)
         const double along = averaged_trigger ? in.averaged_along[i] : Dot(e, v);
-        if (-along > 0.0) force += (e + Vec2{e.y, -e.x}) * (back_factor * m * v0);
+        // A group's own Gamma and lambda (Simulation::SetGroupDrive), if any.
+        double back = back_factor, torsion = torsion_factor;
+        if (const std::uint32_t g = bodies_.group[i]; g < in.group_gamma.size()) {
+          if (!std::isnan(in.group_gamma[g])) back = in.group_gamma[g] * inverse_tau;
+          if (!std::isnan(in.group_lambda[g])) torsion = in.group_lambda[g] * inverse_tau * inverse_tau;
+        }
+        if (-along > 0.0) force += (e + Vec2{e.y, -e.x}) * (back * m * v0);
         // Motive torque, eq. (16) with the restoring sign (ERRATA 4).
-        if (turning[k]) torque += torsion_factor * inertia * gain[k] * angle[k];
+        if (turning[k]) torque += torsion * inertia * gain[k] * angle[k];
         // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
         torque -= inertia * rotation_damping * bodies_.angular_velocity_rad_per_s[i];
         force += slope_acceleration * m;

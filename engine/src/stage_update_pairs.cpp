@@ -128,6 +128,7 @@ void Simulation::UpdatePairs() {
       std::sort(candidates.begin(), candidates.end());
       for (std::uint32_t j : candidates) pairs.emplace_back(i, j);
       for (std::uint32_t w = 0; w < def_.walls.size(); ++w) {
+        if (!WallEnabled(w)) continue;  // an open door (SetWallEnabled)
         const Wall& wall = def_.walls[w];
         const double range = in.bound_m[i] + wall.radius_m + in.skin_m;
         if (Length(pi - in.wall_origin[w]) > in.wall_geometry[w].core_radius_m + range) continue;

@@ -11,20 +11,14 @@
 
 namespace crowdrecon::engine {
 
-namespace {
 
-// True when the path p -> q crosses the segment [a, b]: it starts on one
-// side of the segment's line and ends on it or beyond, and the segment's
-// ends lie on either side of the path's line (or on it).
-bool Crosses(Vec2 p, Vec2 q, Vec2 a, Vec2 b) {
+bool PathCrossesSegment(Vec2 p, Vec2 q, Vec2 a, Vec2 b) {
   const double o1 = Cross(b - a, p - a), o2 = Cross(b - a, q - a);
   const bool path_crosses_line = (o1 > 0.0 && o2 <= 0.0) || (o1 < 0.0 && o2 >= 0.0);
   const double o3 = Cross(q - p, a - p), o4 = Cross(q - p, b - p);
   const bool segment_meets_path = (o3 <= 0.0 && o4 >= 0.0) || (o3 >= 0.0 && o4 <= 0.0);
   return path_crosses_line && segment_meets_path;
 }
-
-}  // namespace
 
 void CheckCentresStayInsideWalls(const Simulation& sim, const std::vector<Vec2>& centres_before) {
   const BodyState& bodies = sim.bodies();
@@ -34,10 +28,11 @@ void CheckCentresStayInsideWalls(const Simulation& sim, const std::vector<Vec2>&
     const Vec2 from = centres_before[i];
     const Vec2 to = from + sim.Separation(bodies.position_m[i], from);  // the path, across a periodic seam
     for (std::size_t w = 0; w < walls.size(); ++w) {
+      if (!sim.WallEnabled(static_cast<std::uint32_t>(w))) continue;  // an open door
       const Wall& wall = walls[w];
       const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
       for (std::size_t k = 0; k < segments; ++k)
-        if (Crosses(from, to, wall.points[k], wall.points[(k + 1) % wall.points.size()]))
+        if (PathCrossesSegment(from, to, wall.points[k], wall.points[(k + 1) % wall.points.size()]))
           throw SimulationError("the centre of person " + std::to_string(i + 1) + " went through wall " +
                                     std::to_string(w) + " before t = " + FormatNumber(sim.time_s()) +
                                     " s: its path since the last check runs from (" + FormatNumber(from.x) + ", " +

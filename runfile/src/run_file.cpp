@@ -222,6 +222,10 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
     db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
   {
+    Statement census(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'census'");
+    if (census.Next() && census.Int(0) > 0) db.Exec("DELETE FROM census WHERE frame > " + after);
+  }
+  {
     Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
     if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
     w.impl_->geometry_hash = geo.Int(0);
@@ -281,6 +285,14 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
     ft.Bind(1, frame).Bind(2, f.time_s).Run();
     Statement fd(db, "INSERT INTO frame_data VALUES(?, ?)");
     fd.Bind(1, frame).Bind(2, impl_->geometry_hash).Run();
+    if (f.with_census) {
+      db.Exec("CREATE TABLE IF NOT EXISTS census(frame INTEGER PRIMARY KEY, time_s REAL NOT NULL, "
+              "walking INTEGER NOT NULL, fallen INTEGER NOT NULL, removed INTEGER NOT NULL, queued INTEGER NOT NULL, "
+              "entered INTEGER NOT NULL)");
+      Statement c(db, "INSERT INTO census VALUES(?, ?, ?, ?, ?, ?, ?)");
+      c.Bind(1, frame).Bind(2, f.time_s).Bind(3, f.census.walking).Bind(4, f.census.fallen)
+          .Bind(5, f.census.removed).Bind(6, f.census.queued).Bind(7, f.census.entered).Run();
+    }
     Statement ev(db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
     for (const Event& e : f.events)
       ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
@@ -680,6 +692,29 @@ std::vector<Event> RunFileReader::Events() const {
     events.push_back(std::move(e));
   }
   return events;
+}
+
+std::vector<CensusRow> RunFileReader::CensusRows() const {
+  std::vector<CensusRow> rows;
+  {
+    Statement exists(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'census'");
+    if (!exists.Next() || exists.Int(0) == 0) return rows;
+  }
+  Statement s(*impl_->db,
+              "SELECT frame, time_s, walking, fallen, removed, queued, entered FROM census ORDER BY frame");
+  s.Describe("census", {0});
+  while (s.Next()) {
+    CensusRow r;
+    r.frame = s.Integer(0, 0, run_limits::kFrame);
+    r.time_s = s.Real(1, 0.0, run_limits::kTime_s);
+    r.census.walking = s.Integer(2, 0, run_limits::kPersonId);
+    r.census.fallen = s.Integer(3, 0, run_limits::kPersonId);
+    r.census.removed = s.Integer(4, 0, run_limits::kPersonId);
+    r.census.queued = s.Integer(5, 0, run_limits::kPersonId);
+    r.census.entered = s.Integer(6, 0, run_limits::kPersonId);
+    rows.push_back(r);
+  }
+  return rows;
 }
 
 std::vector<Person> RunFileReader::People() const {

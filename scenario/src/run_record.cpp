@@ -24,8 +24,13 @@ runfile::RunSetup RunSetupOf(const engine::Simulation& sim, const std::vector<st
 
 runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
                                      const engine::Simulation& sim, const std::vector<std::string>& target_names) {
+  return CreateRunFileOf(file, std::move(header), sim, RunSetupOf(sim, target_names));
+}
+
+runfile::RunFileWriter CreateRunFileOf(const std::filesystem::path& file, runfile::RunHeader header,
+                                       const engine::Simulation& sim, const runfile::RunSetup& setup) {
   header.periodic_box = sim.definition().periodic;
-  return runfile::RunFileWriter::Create(file, header, RunSetupOf(sim, target_names));
+  return runfile::RunFileWriter::Create(file, header, setup);
 }
 
 void PersonLoads(const engine::Simulation& sim, std::vector<double>* load) {
@@ -54,7 +59,7 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
   std::size_t kept = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (b.state[i] == engine::PersonState::kRemoved) continue;
-    f.person.push_back(static_cast<std::uint32_t>(i));
+    f.person.push_back(b.id[i]);  // who is in this slot (a timeline's slots change hands)
     f.position_m.push_back(b.position_m[i]);
     f.velocity_m_per_s.push_back(b.velocity_m_per_s[i]);
     f.angle_rad.push_back(b.angle_rad[i]);
@@ -68,9 +73,11 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
   if (with_contacts) {
     f.contacts.reserve(sim.contacts().size());
     for (const engine::Contact& c : sim.contacts())
-      f.contacts.push_back({c.a, c.b, c.wall, c.point_m, c.normal, c.overlap_m, c.normal_force_n, c.tangential_force_n});
+      f.contacts.push_back({b.id[c.a], c.wall ? c.b : b.id[c.b], c.wall, c.point_m, c.normal, c.overlap_m,
+                            c.normal_force_n, c.tangential_force_n});
   }
   f.events = events;
+  f.with_census = false;
 }
 
 void WriteFrame(runfile::RunFileWriter& writer, const engine::Simulation& sim, std::int64_t frame,

@@ -26,35 +26,58 @@
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/settle.hpp"
+#include "timeline_systems.hpp"
 
 namespace crowdrecon::scenario::detail {
+
+// Frame `frame` into the run file; with a timeline, with its head count and
+// the events since the last frame (which are then cleared).
+inline void WriteTimelineFrame(runfile::FrameWriterThread& frames, const engine::Simulation& sim, std::int64_t frame,
+                               bool with_contacts, TimelineState* timeline) {
+  frames.Write([&](runfile::FrameSnapshot& f) {
+    TakeSnapshot(sim, frame, timeline ? timeline->events : std::vector<runfile::Event>{}, with_contacts, &f);
+    if (timeline) {
+      f.with_census = true;
+      f.census = timeline->Count(sim);
+      timeline->events.clear();
+    }
+  });
+}
 
 // Nobody went through a wall between two frames (a safety net behind the
 // engine's contact check: walls x people segment tests per frame).
 class WallCheckSystem : public RunSystem {
  public:
-  explicit WallCheckSystem(const engine::Simulation& sim) : centres_(sim.bodies().position_m) {}
+  explicit WallCheckSystem(const engine::Simulation& sim) : centres_(sim.bodies().position_m), ids_(sim.bodies().id) {}
   std::string_view name() const override { return "wall_check"; }
   void AtFrame(FrameContext& c) override {
+    // A slot that changed hands since (a timeline's arrival) has no path to check.
+    const engine::BodyState& b = c.sim.bodies();
+    for (std::size_t i = 0; i < b.size(); ++i)
+      if (b.id[i] != ids_[i]) centres_[i] = b.position_m[i];
     engine::CheckCentresStayInsideWalls(c.sim, centres_);
-    centres_ = c.sim.bodies().position_m;
+    centres_ = b.position_m;
+    ids_ = b.id;
   }
 
  private:
   std::vector<Vec2> centres_;  // at the last frame (a checkpoint is taken at a frame: they are the positions then)
+  std::vector<std::uint32_t> ids_;  // who held each slot then
 };
 
+// Writes the frame; with a timeline, also its head count and the events
+// since the last frame (timeline_systems.hpp).
 class FrameOutputSystem : public RunSystem {
  public:
-  FrameOutputSystem(runfile::FrameWriterThread& frames, bool with_contacts) : frames_(frames), with_contacts_(with_contacts) {}
+  FrameOutputSystem(runfile::FrameWriterThread& frames, bool with_contacts, TimelineState* timeline = nullptr)
+      : frames_(frames), with_contacts_(with_contacts), timeline_(timeline) {}
   std::string_view name() const override { return "frames"; }
-  void AtFrame(FrameContext& c) override {
-    frames_.Write([&](runfile::FrameSnapshot& f) { TakeSnapshot(c.sim, c.frame, {}, with_contacts_, &f); });
-  }
+  void AtFrame(FrameContext& c) override { WriteTimelineFrame(frames_, c.sim, c.frame, with_contacts_, timeline_); }
 
  private:
   runfile::FrameWriterThread& frames_;
   bool with_contacts_;
+  TimelineState* timeline_;
 };
 
 // The GPU failed and the processor took over (same results): say so, on the

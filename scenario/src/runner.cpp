@@ -21,6 +21,7 @@
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
 #include "run_systems.hpp"
+#include "crowdrecon/engine/parameter_table.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -188,9 +189,32 @@ using Clock = std::chrono::steady_clock;
 //    apart, the rate JuPedSim's format declares), never lengthened. A step
 //    above the stability limit is refused; one above the accurate step is
 //    allowed with a warning (returned). Sets the world's step.
+//    With a timeline, the step serves every body that will arrive and every
+//    parameter set its events give (the smallest of their steps).
+engine::TimeStepEstimate TimelineTimeStep(const Scenario& scenario, const BuiltWorld& built) {
+  engine::WorldDef probe = built.world;
+  for (const auto& list : built.timeline.arrivals) probe.people.insert(probe.people.end(), list.begin(), list.end());
+  engine::TimeStepEstimate estimate = engine::EstimateTimeStep(probe);
+  engine::ModelParameters p = probe.parameters;
+  for (const TimelineEvent& e : scenario.timeline.events) {
+    if (e.kind != TimelineEvent::Kind::kSetParameters) continue;
+    for (const auto& [name, value] : e.parameters)
+      if (const engine::ParameterInfo* info = engine::FindModelParameter(name)) {
+        // Per group only Gamma and lambda change; the step bounds them as if for everyone.
+        if (name == "torsion_stiffness_lambda") p.torsion_stiffness_lambda = std::max(p.torsion_stiffness_lambda, value);
+        else p.*(info->number) = value;
+      }
+    probe.parameters = p;
+    const engine::TimeStepEstimate here = engine::EstimateTimeStep(probe);
+    if (here.stability_limit_s < estimate.stability_limit_s) estimate = here;
+  }
+  return estimate;
+}
+
 std::string ChooseTimeStep(const Scenario& scenario, BuiltWorld& built, std::int64_t* steps_per_frame) {
   const double frame_dt = 1.0 / scenario.run.output_fps;
-  const engine::TimeStepEstimate estimate = engine::EstimateTimeStep(built.world);
+  const engine::TimeStepEstimate estimate =
+      scenario.timeline.enabled ? TimelineTimeStep(scenario, built) : engine::EstimateTimeStep(built.world);
   if (const std::string unstable =
           engine::TimeStepAboveLimit(scenario.model.time_step_s, scenario.model.integrator, estimate);
       !unstable.empty())
@@ -236,7 +260,16 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
   header.output_fps = scenario.run.output_fps;
   header.time_step_s = sim.time_step_s();
   header.seed = scenario.population.seed;
-  return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
+  if (!scenario.timeline.enabled) return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
+  // A timeline's people: those of the start, then every arrival the schedule
+  // may bring (ids in that order, BuiltTimeline), whether or not they come.
+  runfile::RunSetup setup = RunSetupOf(sim, built.target_names);
+  setup.people.resize(built.timeline.initial_people);
+  for (const auto& list : built.timeline.arrivals)
+    for (const engine::PersonDef& p : list)
+      setup.people.push_back({p.shape, p.mass_kg, p.inertia_kg_m2, p.desired_speed_m_per_s, p.group,
+                              built.target_names[p.target]});
+  return {CreateRunFileOf(options.output, header, sim, setup), -1, {}};
 }
 
 }  // namespace
@@ -252,13 +285,24 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const std::string step_warning = ChooseTimeStep(scenario, built, &steps_per_frame);
   built.world.device = options.device;
   engine::Simulation sim(built.world);
+  // The incident timeline's shared state; its doors as at t = 0.
+  std::unique_ptr<detail::TimelineState> timeline;
+  if (scenario.timeline.enabled) {
+    timeline = std::make_unique<detail::TimelineState>(scenario, built);
+    detail::OpenDoorsAtStart(sim, *timeline);
+  }
 
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
   OpenedRun opened = OpenRunFile(scenario, options, built, sim, fingerprint, say);
   runfile::RunFileWriter& writer = opened.writer;
   std::int64_t last_frame = opened.last_frame;
-  writer.SetRunValue("people", std::to_string(sim.bodies().size()));
+  writer.SetRunValue("people", std::to_string(timeline ? built.timeline.initial_people : sim.bodies().size()));
+  if (timeline) {
+    std::string groups;
+    for (const std::string& g : scenario.timeline.groups) groups += (groups.empty() ? "" : ",") + g;
+    writer.SetRunValue("groups", groups);
+  }
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));
   if (!step_warning.empty()) {
     writer.SetRunValue("time_step_warning", step_warning);
@@ -283,7 +327,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
   runfile::FrameWriterThread frames(writer, core_free);
   if (last_frame < 0) {
-    frames.Write([&](runfile::FrameSnapshot& f) { TakeSnapshot(sim, 0, {}, scenario.run.write_contacts, &f); });
+    detail::WriteTimelineFrame(frames, sim, 0, scenario.run.write_contacts, timeline.get());
     last_frame = 0;
   }
 
@@ -308,8 +352,14 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     frames.Flush();
     WriteCheckpoint(file, fingerprint, Checkpoint{frame, sim.SaveState(), loop.SaveStates()});
   };
+  if (timeline) {  // the incident timeline's systems, around the steps (timeline_systems.hpp)
+    loop.Add(detail::MakeTimelineEventSystem(*timeline));
+    loop.Add(detail::MakeInflowSystem(*timeline));
+    loop.Add(detail::MakeExitSystem(*timeline));
+    loop.Add(detail::MakeFallSystem(*timeline));
+  }
   loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
-  loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts));
+  loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts, timeline.get()));
   loop.Add(std::make_unique<detail::DeviceFallbackSystem>(options.show_progress));
   if (scenario.run.settle.enabled) {
     // Directions of travel by group, named after their target.
@@ -361,8 +411,19 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
                      failed.string());
   }
 
-  // 7. Status and summary.
+  // 7. Status and summary (a timeline's totals: run values).
   frames.Flush();
+  if (timeline) {
+    const runfile::Census c = timeline->Count(sim);
+    writer.SetRunValue("timeline_entered", std::to_string(c.entered));
+    writer.SetRunValue("timeline_removed", std::to_string(c.removed));
+    writer.SetRunValue("timeline_fallen", std::to_string(c.fallen));
+    writer.SetRunValue("timeline_queued", std::to_string(c.queued));
+    std::string exits = "{";
+    for (std::size_t x = 0; x < scenario.venue.exits.size(); ++x)
+      exits += (x ? ", \"" : "\"") + scenario.venue.exits[x].id + "\": " + std::to_string(timeline->exit_count[x]);
+    writer.SetRunValue("timeline_exit_counts", exits + "}");
+  }
   if (options.show_progress) std::fprintf(stderr, "\n");
   writer.SetStatus(status);
   if (status == "complete") {

@@ -87,7 +87,10 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     };
     if (pop.Has("count") == pop.Has("density_per_m2"))
       pop.Fail("give exactly one of \"count\" and \"density_per_m2\"");
-    if (pop.Has("count")) p.count = static_cast<std::size_t>(number(pop, "count", 0.0));
+    // 0 is allowed here for a venue that starts empty and fills by inflow
+    // (checked against /timeline below); the population table's range is 1...
+    if (pop.Has("count"))
+      p.count = static_cast<std::size_t>(pop.Integer("count", 0, static_cast<long long>(geometry::PopulationKey("count").max)));
     if (pop.Has("density_per_m2")) p.density_per_m2 = number(pop, "density_per_m2", 0.0);
     p.counter_flow_fraction = number(pop, "counter_flow_fraction", p.counter_flow_fraction);
     p.target = pop.String("target");
@@ -151,6 +154,21 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     if (auto settle = run->Find("stop_when_settled")) s.run.settle = ReadSettleOptions(*settle);
     run->Finish();
   }
+  if (auto timeline = root.Find("timeline")) {
+    s.timeline = ReadTimeline(*timeline, s.venue, base_dir, s.population.target, s.population.counter_target);
+    if (s.run.settle.enabled && s.timeline.HasInflow())
+      root.At("run").At("stop_when_settled").Fail(
+          "a run with inflow never settles into a closed regime; drop run.stop_when_settled or the inflows");
+    const auto due_by_end = [&](const InflowSpec& f) { return double(ArrivalsDue(f.rate, s.run.duration_s)); };
+    double arrivals = 0.0;
+    for (const InflowSpec& f : s.timeline.inflows) arrivals += due_by_end(f);
+    if (arrivals > static_cast<double>(geometry::kMaxPeople))
+      timeline->At("inflows").Fail("the inflows bring " + FormatNumber(arrivals) + " people in " +
+                                   FormatNumber(s.run.duration_s) + " s; expected at most " +
+                                   std::to_string(geometry::kMaxPeople) + " (check the rates' unit: persons per second)");
+  }
+  if (s.population.count && *s.population.count == 0 && !s.timeline.HasInflow())
+    root.At("population").At("count").Fail("0 people and no inflow (/timeline/inflows): nothing to simulate");
   root.Finish();
   return s;
 }

@@ -9,8 +9,12 @@
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "state_bytes.hpp"
 
 namespace crowdrecon::scenario {
+
+using detail::StateReader;
+using detail::StateWriter;
 
 namespace {
 
@@ -33,52 +37,6 @@ constexpr SettleKey kSettleKeys[] = {
     {"sample_interval_s", &SettleOptions::sample_interval_s, 0.01, 60.0, "s"},
 };
 
-// Plain bytes in the machine's order: a checkpoint is resumed by the same build.
-class StateWriter {
- public:
-  template <typename T>
-  void Put(const T& value) {
-    out.append(reinterpret_cast<const char*>(&value), sizeof value);
-  }
-  void PutDoubles(const std::vector<double>& v) {
-    Put<std::uint64_t>(v.size());
-    if (!v.empty()) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
-  }
-  std::string out;
-};
-
-class StateReader {
- public:
-  explicit StateReader(const std::string& in) : in_(in) {}
-  template <typename T>
-  T Get() {
-    T value;
-    Need(sizeof value);
-    std::memcpy(&value, in_.data() + at_, sizeof value);
-    at_ += sizeof value;
-    return value;
-  }
-  std::vector<double> GetDoubles(std::size_t expected = static_cast<std::size_t>(-1)) {
-    const auto n = Get<std::uint64_t>();
-    if (expected != static_cast<std::size_t>(-1) && n != expected) Fail();
-    if (n > (in_.size() - at_) / sizeof(double)) Fail();
-    std::vector<double> v(n);
-    if (n > 0) std::memcpy(v.data(), in_.data() + at_, n * sizeof(double));  // (no null pointer to memcpy)
-    at_ += n * sizeof(double);
-    return v;
-  }
-  void Need(std::size_t bytes) const {
-    if (bytes > in_.size() - at_) Fail();
-  }
-  bool AtEnd() const { return at_ == in_.size(); }
-  [[noreturn]] static void Fail() {
-    throw InputError("checkpoint: the state of the run's settle check is damaged");
-  }
-
- private:
-  const std::string& in_;
-  std::size_t at_ = 0;
-};
 
 }  // namespace
 
@@ -233,17 +191,17 @@ std::string SettleDetector::SaveState() const {
 }
 
 void SettleDetector::LoadState(const std::string& state) {
-  StateReader r(state);
+  StateReader r(state, "the run's settle check");
   r.Need(sizeof kStateMagic);
-  if (state.compare(0, sizeof kStateMagic, std::string(kStateMagic, sizeof kStateMagic)) != 0) StateReader::Fail();
+  if (state.compare(0, sizeof kStateMagic, std::string(kStateMagic, sizeof kStateMagic)) != 0) r.Fail();
   for (std::size_t i = 0; i < sizeof kStateMagic; ++i) r.Get<char>();
-  if (r.Get<std::uint64_t>() != group_.size() || r.Get<std::uint64_t>() != group_names_.size()) StateReader::Fail();
+  if (r.Get<std::uint64_t>() != group_.size() || r.Get<std::uint64_t>() != group_names_.size()) r.Fail();
   next_sample_s_ = r.Get<double>();
   time_s_ = r.GetDoubles();
   crowd_speed_ = r.GetDoubles(time_s_.size());
   for (std::vector<double>& g : group_speed_) g = r.GetDoubles(time_s_.size());
   const auto samples = r.Get<std::uint64_t>();
-  if (samples > 1000000) StateReader::Fail();
+  if (samples > 1000000) r.Fail();
   samples_.assign(samples, {});
   for (Sample& s : samples_) {
     s.time_s = r.Get<double>();
@@ -251,7 +209,7 @@ void SettleDetector::LoadState(const std::string& state) {
     for (std::size_t i = 0; i < group_.size(); ++i) s.position_m.push_back({xy[2 * i], xy[2 * i + 1]});
     s.load_n = r.GetDoubles(group_.size());
   }
-  if (!r.AtEnd()) StateReader::Fail();
+  if (!r.AtEnd()) r.Fail();
 }
 
 }  // namespace crowdrecon::scenario

@@ -341,6 +341,110 @@ Relaxation GrowAndRelax(const engine::WorldDef& def, Placement& placement, doubl
   return result;
 }
 
+namespace {
+
+// The engine index of venue target `name`, added to the world if new.
+std::uint32_t TargetIndex(const geometry::Venue& venue, BuiltWorld& built, const std::string& name) {
+  const auto known = std::find(built.target_names.begin(), built.target_names.end(), name);
+  if (known != built.target_names.end()) return static_cast<std::uint32_t>(known - built.target_names.begin());
+  built.target_names.push_back(name);
+  built.world.targets.push_back(geometry::NavigationField::ForTarget(venue, name));
+  return static_cast<std::uint32_t>(built.target_names.size() - 1);
+}
+
+// The timeline's people to come (issue 20): per inflow, every arrival the
+// schedule can bring within the run (its rate integrated over the whole run,
+// as if always on), drawn from the population's rules with a seed of the
+// inflow's own, so that the k-th arrival of an inflow is the same person
+// whatever else the scenario holds; their shapes join the world's. Then the
+// empty slots that arrivals fill (engine::Simulation::Spawn), and the targets
+// every group and every event may name.
+void AddArrivals(const Scenario& scenario, const geometry::Body& reference,
+                 const std::vector<geometry::AnsurRecord>& records, BuiltWorld& built,
+                 const std::function<void(const std::string&)>& say) {
+  const TimelineSpec& timeline = scenario.timeline;
+  const PopulationSpec& spec = scenario.population;
+  const geometry::Venue& venue = scenario.venue;
+  engine::WorldDef& def = built.world;
+  BuiltTimeline& out = built.timeline;
+  out.initial_people = def.people.size();
+  std::uint32_t next_id = static_cast<std::uint32_t>(def.people.size());
+  std::size_t total = 0;
+  double smallest = 1e300;  // the smallest arriving body's area (m^2)
+  for (std::size_t j = 0; j < timeline.inflows.size(); ++j) {
+    const InflowSpec& inflow = timeline.inflows[j];
+    const std::size_t count = ArrivalsDue(inflow.rate, scenario.run.duration_s);
+    out.first_id.push_back(next_id);
+    out.arrivals.emplace_back();
+    if (count == 0) continue;
+    // A seed per inflow (splitmix64 of the population's seed and the index).
+    std::uint64_t z = spec.seed + 0x9e3779b97f4a7c15ull * (j + 1);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    geometry::PopulationOptions options;
+    options.mode = spec.body_mode;
+    options.count = count;
+    options.seed = z;
+    options.female_fraction = spec.female_fraction;
+    options.vertex_count = spec.vertex_count;
+    say("building " + std::to_string(count) + " " + geometry::ToString(spec.body_mode) + " bodies for inflow \"" +
+        inflow.id + "\"");
+    const geometry::Population population = geometry::MakePopulation(options, reference.shape, records);
+    std::mt19937_64 rng(z ^ 0x9e3779b97f4a7c15ull);
+    const auto [v_lo, v_hi] = inflow.desired_speed_m_per_s.value_or(
+        std::pair{spec.desired_speed_min_m_per_s, spec.desired_speed_max_m_per_s});
+    const std::uint32_t group = static_cast<std::uint32_t>(
+        std::find(timeline.groups.begin(), timeline.groups.end(), inflow.group) - timeline.groups.begin());
+    const std::uint32_t target = TargetIndex(venue, built, inflow.target);
+    for (const geometry::Person& person : population.people) {
+      engine::PersonDef p;
+      p.shape = static_cast<std::uint32_t>(def.shapes.size());
+      def.shapes.push_back(ToBodyShape(person.shape, 1.0));
+      smallest = std::min(smallest, person.shape.area());
+      p.mass_kg = person.mass_kg;
+      p.inertia_kg_m2 = person.moment_of_inertia_kgm2;
+      p.desired_speed_m_per_s = v_lo + (v_hi - v_lo) * Uniform(rng);
+      p.group = group;
+      p.target = target;
+      out.arrivals.back().push_back(p);
+    }
+    next_id += static_cast<std::uint32_t>(count);
+    total += count;
+  }
+  // Every target an event may give.
+  for (const TimelineEvent& e : timeline.events)
+    if (e.kind == TimelineEvent::Kind::kTarget) TargetIndex(venue, built, e.name);
+  // Empty slots: as many as the venue can hold at once (its walkable area over
+  // the smallest arriving body's area: a crowd packed without gaps), or the
+  // scenario's max_present; never more than the arrivals.
+  std::size_t slots = 0;
+  if (total > 0) {
+    const double capacity = std::ceil(geometry::WalkableArea_m2(venue) / smallest);
+    slots = timeline.max_present > 0
+                ? (timeline.max_present > out.initial_people ? timeline.max_present - out.initial_people : 0)
+                : static_cast<std::size_t>(std::min(capacity, double(total)));
+    slots = std::min(slots, total);
+  }
+  Vec2 lo, hi;
+  geometry::WalkableBounds(venue, &lo, &hi);
+  for (std::size_t k = 0; k < slots; ++k) {
+    engine::PersonDef empty;
+    for (const auto& list : out.arrivals)
+      if (!list.empty()) {
+        empty = list.front();
+        break;
+      }
+    empty.position_m = lo;
+    empty.state = engine::PersonState::kRemoved;
+    def.people.push_back(empty);
+  }
+  say("timeline: " + std::to_string(total) + " arrivals scheduled, " + std::to_string(out.initial_people) +
+      " people at the start, " + std::to_string(def.people.size()) + " places in the engine");
+}
+
+}  // namespace
+
 BuiltWorld BuildWorld(const Scenario& scenario, int threads,
                       const std::function<void(const std::string&)>& progress) {
   const auto say = [&](const std::string& line) {
@@ -369,10 +473,12 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
                      " people; expected at most " + std::to_string(geometry::kMaxPeople) +
                      " (check the venue's scale: is it drawn in metres?)");
   const std::size_t count = spec.count ? *spec.count : static_cast<std::size_t>(std::llround(wanted));
-  if (count == 0) throw InputError(scenario.file.string() + ": /population: the density gives 0 people in " +
-                                   FormatNumber(built.placement_area_m2) + " m^2");
+  if (count == 0 && !scenario.timeline.HasInflow())
+    throw InputError(scenario.file.string() + ": /population: the density gives 0 people in " +
+                     FormatNumber(built.placement_area_m2) + " m^2");
 
-  // Targets: the main flow first, the counter-flow second.
+  // Targets: the main flow first, the counter-flow second (then those only
+  // the timeline names: TargetIndex).
   built.target_names.push_back(spec.target);
   def.targets.push_back(geometry::NavigationField::ForTarget(venue, spec.target));
   if (spec.counter_flow_fraction > 0.0) {
@@ -391,7 +497,8 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
   const geometry::Body reference = geometry::ReadBodyJson(spec.reference_body);
   std::vector<geometry::AnsurRecord> records;
   if (spec.body_mode == geometry::PopulationMode::kAnthropometric) records = geometry::ReadAnsurExtract(spec.anthropometry);
-  const geometry::Population population = geometry::MakePopulation(options, reference.shape, records);
+  const geometry::Population population =
+      count > 0 ? geometry::MakePopulation(options, reference.shape, records) : geometry::Population{};
 
   // Groups, desired speeds: a second generator stream so that they do not
   // depend on how many draws the body modes consumed.
@@ -399,7 +506,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
   const std::size_t counter = static_cast<std::size_t>(std::llround(spec.counter_flow_fraction * double(count)));
   std::vector<std::uint32_t> group(count, 0);
   for (std::size_t i = 0; i < counter; ++i) group[i] = 1;
-  for (std::size_t i = count - 1; i > 0; --i) {  // Fisher-Yates with explicit draws
+  for (std::size_t i = count - 1; count > 0 && i > 0; --i) {  // Fisher-Yates with explicit draws
     const std::size_t j = static_cast<std::size_t>(Uniform(rng) * double(i + 1));
     std::swap(group[i], group[std::min(j, i)]);
   }
@@ -437,6 +544,17 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
   }
   if (venue.slope && venue.slope->enabled) def.slope = {venue.slope->direction, venue.slope->gradient};
   built.walkable_wkt = WalkableAreaWkt(venue);
+  // A timeline's doors: a wall across every exit, switched off while the
+  // exit is open (engine::Simulation::SetWallEnabled).
+  if (scenario.timeline.enabled)
+    for (const geometry::Exit& e : venue.exits) {
+      built.timeline.exit_wall.push_back(static_cast<std::uint32_t>(def.walls.size()));
+      def.walls.push_back({{e.a, e.b}, false, 0.0});
+    }
+  if (count == 0) {
+    AddArrivals(scenario, reference, records, built, say);
+    return built;
+  }
 
   // --- Placement --------------------------------------------------------
   double body_area = 0.0, max_bound = 0.0;
@@ -472,6 +590,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
                        " was pushed out of the walkable area while relaxing the placement; lower the density");
   }
   built.max_initial_overlap_m = residual;
+  if (scenario.timeline.enabled) AddArrivals(scenario, reference, records, built, say);
   return built;
 }
 

@@ -23,7 +23,7 @@ crowdrecon_refused_test(json.number_overflow 2
   "bad-number-overflow.json:7:[0-9]+: number 1e400 is beyond the range of a double .*expected a finite number"
   -- ${EXE} simulate ${S}/bad-number-overflow.json -o @OUT@/x.sqlite -q)
 crowdrecon_refused_test(json.unsigned_count 2
-  "bad-count-unsigned.json: /population/count: value 18446744073709551615 is out of range. expected an integer in \\[1, 200000\\]"
+  "bad-count-unsigned.json: /population/count: value 18446744073709551615 is out of range. expected an integer in \\[0, 200000\\]"
   -- ${EXE} simulate ${S}/bad-count-unsigned.json -o @OUT@/x.sqlite -q)
 crowdrecon_refused_test(json.long_unknown_key_shortened 2 "long.json: /: unknown key\\(s\\) \"k{57}\\.\\.\\.\" "
   --long-key 10000000 long.json -- ${EXE} shape @TMP@/long.json -o @OUT@/body.json)
@@ -52,7 +52,7 @@ crowdrecon_refused_test(dir.scenario_body_reference 2 "bad-body-directory.json: 
 
 # --- limits ----------------------------------------------------------------------
 crowdrecon_refused_test(limit.scenario_count 2
-  "bad-count-limit.json: /population/count: value 1000000 is out of range. expected an integer in \\[1, 200000\\]"
+  "bad-count-limit.json: /population/count: value 1000000 is out of range. expected an integer in \\[0, 200000\\]"
   -- ${EXE} simulate ${S}/bad-count-limit.json -o @OUT@/x.sqlite -q)
 crowdrecon_refused_test(limit.density_in_wrong_units 2
   "bad-density-scale.json: /population/density_per_m2: 2 /m\\^2 over 39000000 m\\^2 gives 78000000 people. expected at most 200000 \\(check the venue's scale"

@@ -13,7 +13,7 @@ tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "$0")/run_tables.sh"  # dump RUN.sqlite: hash of its per-frame tables
 "$exe" simulate "$scenario" -o "$tmp/t1.sqlite" --threads 1 -q >/dev/null
 "$exe" simulate "$scenario" -o "$tmp/t2.sqlite" --threads 2 -q >/dev/null
-h1=$(dump "$tmp/t1.sqlite"); h2=$(dump "$tmp/t2.sqlite")
+h1=$(dump_all "$tmp/t1.sqlite"); h2=$(dump_all "$tmp/t2.sqlite")
 rows=$(sqlite3 "$tmp/t1.sqlite" "SELECT COUNT(*) FROM trajectory_data")
 echo "1 thread: $h1 ($rows trajectory rows)"; echo "2 threads: $h2"
 [[ "$h1" == "$h2" ]] || { echo "FAIL: thread count changed the results"; exit 1; }
@@ -26,7 +26,7 @@ set -e
 grep -q -- "--resume" "$tmp/stop.txt" || { echo "FAIL: no resume hint"; exit 1; }
 [[ $(sqlite3 "$tmp/r.sqlite" "SELECT value FROM run WHERE key='status'") == interrupted ]] || { echo "FAIL: status"; exit 1; }
 "$exe" simulate "$scenario" -o "$tmp/r.sqlite" --threads 1 -q --resume >/dev/null
-hr=$(dump "$tmp/r.sqlite")
+hr=$(dump_all "$tmp/r.sqlite")
 echo "interrupted + resumed: $hr"
 [[ "$hr" == "$h1" ]] || { echo "FAIL: resumed run differs"; exit 1; }
 [[ ! -e "$tmp/r.sqlite.checkpoint" ]] || { echo "FAIL: checkpoint left after completion"; exit 1; }
@@ -44,7 +44,7 @@ wait $pid 2>/dev/null || true
 frames=$(sqlite3 "$tmp/k.sqlite" "SELECT MAX(frame) FROM frame_time")
 echo "killed after frame $frames"
 "$exe" simulate "$scenario" -o "$tmp/k.sqlite" --threads 2 -q --resume >/dev/null
-hk=$(dump "$tmp/k.sqlite")
+hk=$(dump_all "$tmp/k.sqlite")
 echo "killed + resumed: $hk"
 [[ "$hk" == "$h1" ]] || { echo "FAIL: killed-and-resumed run differs"; exit 1; }
 echo "determinism and restart: OK"

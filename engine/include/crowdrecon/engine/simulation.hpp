@@ -42,6 +42,10 @@ struct BodyState {
   std::vector<std::uint32_t> target;
   std::vector<std::uint32_t> group;
   std::vector<PersonState> state;
+  // Who is in each slot: the person's index in the run (its run-file id - 1).
+  // i at the start; Simulation::Spawn puts another person into a free slot,
+  // so that an open venue's people come and go through a fixed set of slots.
+  std::vector<std::uint32_t> id;
   std::size_t size() const { return position_m.size(); }
 };
 
@@ -114,8 +118,38 @@ class Simulation {
   // used by verification scenes and crash tests (pushing, pressing).
   void SetExternalForce(std::uint32_t person, Vec2 force_n);
 
-  // Changes a person's state (a fall makes them an obstacle; removal takes them out).
+  // Changes a person's state (a fall makes them an obstacle; removal takes them
+  // out, with their contacts of the last evaluation).
   void SetPersonState(std::uint32_t person, PersonState state);
+
+  // The incident timeline's changes between two steps (scenario/timeline.hpp).
+  // Results stay independent of the thread count, and checkpoints keep all of it.
+  //
+  // Puts `person` (every field of PersonDef; its shape one of the world's
+  // shapes) into `slot`, which must be empty (kRemoved), as run person `id`:
+  // walking, with no history (no integrator derivatives, no contacts).
+  void Spawn(std::uint32_t slot, const PersonDef& person, std::uint32_t id);
+  // True if a body of world shape `shape` at `position_m`, facing
+  // `angle_rad`, touches no wall and no one in the venue (walking or fallen).
+  bool IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) const;
+  void SetTarget(std::uint32_t person, std::uint32_t target);
+  void SetDesiredSpeed(std::uint32_t person, double speed_m_per_s);
+  // Replaces the model parameters (a timed change of the back force, the
+  // torsion stiffness, the restitution, ...). Throws InputError if they are
+  // invalid or need a shorter time step than the run's (the runner chooses the
+  // step for every parameter set of the timeline, so that never happens there).
+  // The per-group values of SetGroupDrive stay where set.
+  void SetParameters(const ModelParameters& parameters);
+  // Switches wall `wall` off (an open door: no contacts, not in the wall
+  // check) or on again (a closed door). Before the first step the forces of
+  // t = 0 are evaluated again, as the constructor did.
+  void SetWallEnabled(std::uint32_t wall, bool enabled);
+  bool WallEnabled(std::uint32_t wall) const {
+    return wall_enabled_.empty() || wall >= wall_enabled_.size() || wall_enabled_[wall] != 0;
+  }
+  // Group `group`'s own back force Gamma and torsion stiffness lambda (eqs.
+  // 15-16), in place of the model's; NaN: the model's value again.
+  void SetGroupDrive(std::uint32_t group, double back_force_gamma, double torsion_stiffness_lambda);
 
   // Checkpoints: the complete dynamic state (bodies, contacts with their
   // tangential springs, integrator history, time), so that a run restored from
@@ -148,6 +182,8 @@ class Simulation {
   // The constructor's steps, in order (after validating the world): the
   // bodies' state, the shape families the narrow phase uses, the walls.
   void LoadBodies();
+  void LoadPerson(std::size_t i, const PersonDef& person, std::uint32_t id);
+  WorldDef ProbeWorld(const ModelParameters& parameters) const;
   void BuildShapeFamilies();
   void BuildWalls();
   void UpdatePairs();
@@ -179,6 +215,8 @@ class Simulation {
   std::uint64_t step_count_ = 0;
   bool advance_springs_ = false;
   std::string device_fallback_;
+  // Per wall: 0 while switched off (SetWallEnabled); empty while all are on.
+  std::vector<std::uint8_t> wall_enabled_;
 };
 
 // True when this build has the CUDA force computation (ComputeDevice::kCuda)
@@ -206,5 +244,11 @@ double RestitutionErrorAtStep(const WorldDef& def, double time_step_s);
 // wall line), for the run loop once per output frame (walls x people
 // segment tests; engine/src/wall_passage.cpp).
 void CheckCentresStayInsideWalls(const Simulation& sim, const std::vector<Vec2>& centres_before);
+
+// True when the path p -> q crosses the segment [a, b]: it starts on one
+// side of the segment's line and ends on it or beyond, and the segment's
+// ends lie on either side of the path's line (or on it). (The wall check
+// above; a timeline's exits.)
+bool PathCrossesSegment(Vec2 p, Vec2 q, Vec2 a, Vec2 b);
 
 }  // namespace crowdrecon::engine

@@ -38,7 +38,8 @@ struct Wall {
 enum class PersonState : std::uint8_t {
   kWalking = 0,
   kFallen = 1,   // an obstacle: neither translates nor rotates (paper, "falls")
-  kRemoved = 2,  // left the venue; takes no part in the dynamics
+  kRemoved = 2,  // not in the venue (left it, or not yet arrived: an empty
+                 // slot that Simulation::Spawn may fill); takes no part in the dynamics
 };
 
 struct PersonDef {

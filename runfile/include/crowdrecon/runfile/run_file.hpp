@@ -21,6 +21,11 @@
 //           normal and along Perp(normal) = (-normal_y, normal_x)
 //   event(frame, time_s, kind TEXT, person INTEGER, other INTEGER, detail TEXT)
 //   wall(id INTEGER PRIMARY KEY, closed INTEGER, radius_m REAL, points TEXT)
+//   census(frame INTEGER PRIMARY KEY, time_s, walking, fallen, removed, queued, entered)
+//           a timeline's head count per frame (runs with a timeline only):
+//           people walking and fallen in the venue, removed through an exit,
+//           waiting at an entry, and entered so far (the people of the start
+//           included); entered = walking + fallen + removed in every frame
 // Person ids in every table are 1-based in trajectory_data/person (as PedPy
 // expects ids), i.e. person index + 1; contact.a/b use the same ids. In this
 // library's records (Contact, PersonFrame.person, Event) people are 0-based
@@ -114,6 +119,17 @@ struct Contact {
   constexpr Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
 };
 
+// A timeline's head count at a frame (table census).
+struct Census {
+  std::int64_t walking = 0, fallen = 0, removed = 0, queued = 0, entered = 0;
+};
+
+struct CensusRow {
+  std::int64_t frame = 0;
+  double time_s = 0.0;
+  Census census;
+};
+
 struct Event {
   double time_s = 0.0;
   std::string kind;          // e.g. "fall", "avalanche_start", "numerical_failure"
@@ -139,6 +155,8 @@ struct FrameSnapshot {
   bool with_contacts = false;
   std::vector<Contact> contacts;  // every contact when with_contacts, else empty
   std::vector<Event> events;
+  bool with_census = false;  // a timeline's run: census holds the head count
+  Census census;
 };
 
 class RunFileWriter {
@@ -288,6 +306,8 @@ class RunFileReader {
   // The sum of every recorded velocity of each group's people (index = group).
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;
+  // A timeline's head count per frame (empty for a run without a timeline).
+  std::vector<CensusRow> CensusRows() const;
   // Shapes (body frame) and each person's shape index.
   std::vector<Shape> Shapes() const;
   std::vector<Person> People() const;  // index = person index (id - 1)

@@ -20,6 +20,10 @@ runfile::RunSetup RunSetupOf(const engine::Simulation& sim, const std::vector<st
 // simulation) and RunSetupOf(sim, target_names).
 runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile::RunHeader header,
                                      const engine::Simulation& sim, const std::vector<std::string>& target_names);
+// The same with the records given (a timeline's: the people of the start and
+// every arrival, RunSetupOf lists the engine's slots).
+runfile::RunFileWriter CreateRunFileOf(const std::filesystem::path& file, runfile::RunHeader header,
+                                       const engine::Simulation& sim, const runfile::RunSetup& setup);
 
 // Each person's load (engine index; 0 for the removed): the sum of the
 // magnitudes of the contact forces on them, the quantity compared with the
@@ -27,7 +31,7 @@ runfile::RunFileWriter CreateRunFile(const std::filesystem::path& file, runfile:
 void PersonLoads(const engine::Simulation& sim, std::vector<double>* load);
 
 // Copies frame `frame` of the simulation into `out`, reusing its storage:
-// every person still in the venue, their loads (the sum of the magnitudes of
+// every person still in the venue (by run id, BodyState::id), their loads (the sum of the magnitudes of
 // the contact forces on each, the quantity compared with the 400 N
 // threshold), every contact when `with_contacts`, and the frame's events.
 void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::vector<runfile::Event>& events,

@@ -14,7 +14,8 @@
 //       "seed": 2012
 //     },
 //     "model": { "restitution": 0.4, "back_force_gamma": 1.2, ... },   (engine::ModelParameters)
-//     "run": {"duration_s": 60, "output_fps": 10, "checkpoint_interval_s": 10, "contacts": true}
+//     "run": {"duration_s": 60, "output_fps": 10, "checkpoint_interval_s": 10, "contacts": true},
+//     "timeline": { "inflows": [...], "events": [...], "falls": {...} }   (optional: timeline.hpp)
 //   }
 //
 // Unknown keys and out-of-range values are errors naming the file, the JSON
@@ -32,6 +33,7 @@
 #include "crowdrecon/geometry/population_table.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/scenario/settle.hpp"
+#include "crowdrecon/scenario/timeline.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -75,6 +77,7 @@ struct Scenario {
   PopulationSpec population;
   engine::ModelParameters model;
   RunSpec run;
+  TimelineSpec timeline;  // "timeline": inflow, exits, timed events, falls (timeline.hpp)
 };
 
 Scenario LoadScenario(const std::filesystem::path& file);

@@ -26,8 +26,23 @@
 
 namespace crowdrecon::scenario {
 
+// What a timeline adds to the world (timeline.hpp): the people to come and
+// the doors. The world's people are engine slots: the first initial_people
+// hold the people placed at the start, the rest are empty (kRemoved) until
+// an arrival fills one.
+struct BuiltTimeline {
+  std::size_t initial_people = 0;
+  // Per inflow, each arrival in order (body, mass, desired speed, group,
+  // target; the pose is chosen when they enter), and the run id (person
+  // index) of its first: ids run on inflow by inflow after the initial people.
+  std::vector<std::vector<engine::PersonDef>> arrivals;
+  std::vector<std::uint32_t> first_id;
+  std::vector<std::uint32_t> exit_wall;  // per venue exit: the engine wall of its door
+};
+
 struct BuiltWorld {
   engine::WorldDef world;
+  BuiltTimeline timeline;  // empty without a timeline
   std::vector<std::string> target_names;  // by engine target index
   std::string walkable_wkt;               // for the run file
   double placement_area_m2 = 0.0;

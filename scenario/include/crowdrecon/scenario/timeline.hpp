@@ -1,0 +1,148 @@
+// The incident timeline of a scenario (issue 20): an open venue whose people
+// arrive through entry zones on an inflow schedule and leave through exits,
+// timed events (a parameter change, an evacuation order, an exit opened or
+// closed, an inflow started or stopped) and people who fall. Scenario key
+// "timeline" (docs/scenarios.md, "Timelines"):
+//
+//   "timeline": {
+//     "inflows": [
+//       {"id": "leaving", "entry": "court_side", "group": "main",
+//        "rate_per_s": [[0, 0.5], [600, 1.5]], "interpolation": "linear"},
+//       {"id": "arriving", "entry": "street_side", "group": "counter", "rate_csv": "arrivals.csv"}
+//     ],
+//     "exits": ["street", "court"],            (default: every exit of the venue)
+//     "closed_exits": [],                      (exits closed at t = 0: a door, a wall)
+//     "events": [
+//       {"time_s": 300, "set": {"back_force_gamma": 2.0}, "group": "main"},
+//       {"time_s": 600, "target": "street", "group": "counter"},
+//       {"time_s": 900, "close_exit": "court"}, {"time_s": 950, "stop_inflow": "arriving"}
+//     ],
+//     "falls": {"criterion": "acceleration", "threshold_m_per_s2": 5, "window_s": 0.5}
+//   }
+//
+// The schedule is deterministic: the k-th arrival of an inflow is due when
+// the integral of its rate (counted while the inflow is on) reaches k; who
+// arrives (body, desired speed) is drawn when the world is built, from the
+// population's rules and the seed. Everything here is plain data; the systems
+// that act on it are in scenario/src/timeline_systems.hpp.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace crowdrecon {
+class JsonReader;
+}  // namespace crowdrecon
+
+namespace crowdrecon::geometry {
+struct Venue;
+}  // namespace crowdrecon::geometry
+
+namespace crowdrecon::scenario {
+
+// A rate over time (persons/s): points (t_k, r_k) with t ascending; "step":
+// r_k on [t_k, t_k+1), "linear": interpolated between points; before the
+// first point the rate is 0, after the last it stays r_last.
+struct RateSchedule {
+  std::vector<std::pair<double, double>> points;
+  bool linear = false;
+  // The integral from the first point to each point (Prepare); lets
+  // Cumulative take O(log n) for a schedule of many rows.
+  std::vector<double> prefix;
+
+  // Fills `prefix` (after the points change).
+  void Prepare();
+  double RateAt(double t_s) const;
+  // The integral of the rate from -infinity to t (people due by t if always
+  // on), exact for both kinds.
+  double Cumulative(double t_s) const;
+  // The integral over [a, b]: Cumulative(b) - Cumulative(a), 0 if b <= a.
+  double Integral(double a_s, double b_s) const;
+};
+
+struct InflowSpec {
+  std::string id;
+  std::string entry;            // venue entry zone
+  std::size_t entry_index = 0;  // index into venue.entries
+  std::string group;            // "main", "counter" or a name of its own
+  std::string target;           // venue target of the arrivals (default: the group's)
+  RateSchedule rate;
+  bool on_at_start = true;      // "active": false waits for a start_inflow event
+  // Desired speeds of the arrivals, v0 ~ U(min, max) (default: the population's).
+  std::optional<std::pair<double, double>> desired_speed_m_per_s;
+  std::string where;            // JSON path, for messages
+};
+
+struct TimelineEvent {
+  enum class Kind { kSetParameters, kTarget, kOpenExit, kCloseExit, kStartInflow, kStopInflow };
+  double time_s = 0.0;
+  Kind kind = Kind::kSetParameters;
+  std::string group;  // "" = everyone (kSetParameters, kTarget)
+  // kSetParameters: model parameters by name (engine parameter table), plus
+  // "desired_speed_m_per_s" (everyone of the group, and later arrivals of it).
+  std::vector<std::pair<std::string, double>> parameters;
+  std::string name;   // kTarget: target; k*Exit: exit id; k*Inflow: inflow id
+  std::string where;  // JSON path, for messages
+};
+
+// ERRATA 10: "if pedestrians accelerate above 5 m/s^2 they were assumed to
+// fall down", then lie as obstacles that neither rotate nor translate.
+struct FallSpec {
+  enum class Criterion { kNone, kAcceleration, kLoad };
+  Criterion criterion = Criterion::kNone;
+  // Acceleration criterion: |v(t) - v(t - window_s)| / window_s, the mean
+  // acceleration over the window, above the threshold. The window: the
+  // relaxation time tau = 0.5 s of eq. (3), the time on which a person takes
+  // up a change of velocity of their own; single contacts last milliseconds
+  // (2 pi / omega_max ~ 2-3 ms) and their spikes average out. A head-on
+  // bump of two walkers (1.2 m/s each, restitution 0.4) changes a velocity
+  // by 1.7 m/s: 3.4 m/s^2 over tau, not a fall; over 0.25 s it would be
+  // 6.7 m/s^2, and every such bump would fell someone (measured in an open
+  // hallway with counter-flow: docs/decisions.md, "Falls").
+  double threshold_m_per_s2 = 5.0;
+  double window_s = 0.5;
+  // Load criterion: the person's load (the quantity of person_state.load_n)
+  // above load_n for load_duration_s without a break.
+  double load_n = 2000.0;
+  double load_duration_s = 5.0;
+  // Velocities are sampled for the filter this often (s); the window holds
+  // window_s / sample_s samples.
+  double sample_s = 0.05;
+};
+
+struct TimelineSpec {
+  bool enabled = false;  // a "timeline" key is present
+  std::vector<InflowSpec> inflows;
+  std::vector<std::string> exits;         // where people are removed (default: every exit)
+  std::vector<std::string> closed_exits;  // closed at t = 0
+  std::vector<TimelineEvent> events;      // in time order (stable for equal times)
+  FallSpec falls;
+  // Group names by index: 0 "main", 1 "counter", then the inflows' own.
+  std::vector<std::string> groups;
+  // Most people in the venue at once (engine slots); 0: from the venue's area.
+  std::size_t max_present = 0;
+
+  bool HasInflow() const { return !inflows.empty(); }
+};
+
+// Reads scenario key "timeline" (`reader` is its value). `venue` is the
+// scenario's (entries, exits and targets are checked against it); `base_dir`
+// resolves rate_csv files; `default_targets` are the population's main and
+// counter targets (group defaults). Errors name the file, the JSON path or the
+// CSV line, the value and what was expected.
+TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue, const std::filesystem::path& base_dir,
+                          const std::string& main_target, const std::string& counter_target);
+
+// A rate CSV: a header "time_s,rate_per_s", then one row per point (times
+// ascending, rates >= 0). Throws InputError naming the file and line.
+RateSchedule ReadRateCsv(const std::filesystem::path& file);
+
+// The number of arrivals due by time t for a schedule always on: floor of
+// the integral from 0 (the pool the world is built with).
+std::size_t ArrivalsDue(const RateSchedule& rate, double t_s);
+
+}  // namespace crowdrecon::scenario

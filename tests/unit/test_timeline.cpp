@@ -1,0 +1,330 @@
+// Incident timelines (issue 20, scenario/timeline.hpp): inflow at a constant
+// rate delivers rate x time people when there is room and queues them when
+// there is not; exits remove exactly those who cross them; a timed
+// evacuation order turns everyone; an exit closed at t removes no one after
+// t; falls (a person hit hard falls, one jostled at the same density does
+// not; the fallen never move again and still carry load); conservation in
+// every frame; the rate schedules and their parser.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/scenario/runner.hpp"
+#include "crowdrecon/scenario/scenario.hpp"
+#include "crowdrecon/scenario/timeline.hpp"
+#include "scratch.hpp"
+
+namespace crowdrecon::scenario {
+namespace timeline_tests {
+
+const std::filesystem::path kSource = CROWDRECON_SOURCE_DIR;
+
+// A scenario in the open hallway (12 m x 3 m, exits "court" at x = 0 and
+// "exit" at x = 12, entries 1.5 m deep at both ends) with `population`,
+// `run` and `timeline` spliced in.
+std::string Hallway(const std::string& population, const std::string& run, const std::string& timeline,
+                    const std::string& venue = "venues/madrid-arena/hallway-open.json") {
+  return R"({"format": "crowdrecon-scenario", "version": 1, "name": "timeline test",
+    "venue": ")" + (kSource / venue).string() + R"(",
+    "population": )" + population + R"(,
+    "run": )" + run + R"(,
+    "timeline": )" + timeline + "}";
+}
+
+struct TimelineRun {
+  std::filesystem::path file;
+  std::vector<runfile::CensusRow> census;
+  std::vector<runfile::Event> events;
+  std::string Value(const std::string& key) const { return runfile::RunFileReader(file).RunValue(key); }
+  std::vector<runfile::Event> Kind(const std::string& kind) const {
+    std::vector<runfile::Event> out;
+    for (const runfile::Event& e : events)
+      if (e.kind == kind) out.push_back(e);
+    return out;
+  }
+};
+
+TimelineRun Simulate(const std::string& json, const std::string& name, int threads = 1) {
+  const Scenario s = ParseScenario(json, name + ".json", kSource);
+  RunOptions options;
+  options.output = crowdrecon::testing::ScratchFile(name + ".sqlite");
+  std::filesystem::remove(options.output);
+  options.threads = threads;
+  RunScenario(s, options);
+  TimelineRun run;
+  run.file = options.output;
+  const runfile::RunFileReader reader(run.file);
+  run.census = reader.CensusRows();
+  run.events = reader.Events();
+  return run;
+}
+
+void ExpectConservation(const TimelineRun& run) {
+  ASSERT_FALSE(run.census.empty());
+  for (const runfile::CensusRow& r : run.census)
+    ASSERT_EQ(r.census.entered, r.census.walking + r.census.fallen + r.census.removed) << "frame " << r.frame;
+}
+
+TEST(RateSchedule, StepAndLinearIntegralsAreExact) {
+  RateSchedule step;
+  step.points = {{0.0, 1.0}, {10.0, 3.0}};
+  step.Prepare();
+  EXPECT_DOUBLE_EQ(step.RateAt(5.0), 1.0);
+  EXPECT_DOUBLE_EQ(step.RateAt(10.0), 3.0);
+  EXPECT_DOUBLE_EQ(step.Integral(0.0, 20.0), 10.0 + 30.0);
+  EXPECT_DOUBLE_EQ(step.Integral(5.0, 12.0), 5.0 + 6.0);
+  RateSchedule linear = step;
+  linear.linear = true;
+  linear.Prepare();
+  EXPECT_DOUBLE_EQ(linear.RateAt(5.0), 2.0);
+  EXPECT_DOUBLE_EQ(linear.Integral(0.0, 10.0), 20.0);           // trapezium
+  EXPECT_NEAR(linear.Integral(0.0, 5.0), 7.5, 1e-12);            // 0..5: 1 -> 2
+  EXPECT_DOUBLE_EQ(linear.Integral(10.0, 12.0), 6.0);            // after the last point: constant
+  EXPECT_EQ(ArrivalsDue(linear, 10.0), 20u);
+  RateSchedule late;  // before the first point: nothing
+  late.points = {{5.0, 2.0}};
+  late.Prepare();
+  EXPECT_DOUBLE_EQ(late.Integral(0.0, 5.0), 0.0);
+  EXPECT_EQ(ArrivalsDue(late, 7.25), 4u);
+}
+
+TEST(RateSchedule, CsvIsReadAndBadRowsNameTheLine) {
+  const auto file = crowdrecon::testing::ScratchFile("rate.csv");
+  {
+    std::ofstream out(file);
+    out << "time_s,rate_per_s\n0,0.5\n60,1.5\n";
+  }
+  const RateSchedule r = ReadRateCsv(file);
+  ASSERT_EQ(r.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(r.Integral(0.0, 120.0), 30.0 + 90.0);
+  {
+    std::ofstream out(file);
+    out << "time_s,rate_per_s\n0,0.5\n30,-1\n";
+  }
+  try {
+    ReadRateCsv(file);
+    FAIL() << "a negative rate was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rate.csv:3: rate \"-1\""), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream out(file);
+    out << "time_s,rate_per_s\n10,0.5\n5,1\n";
+  }
+  EXPECT_THROW(ReadRateCsv(file), InputError);
+}
+
+TEST(Timeline, ConstantInflowIntoAnEmptyCorridorDeliversRateTimesTime) {
+  // 1.5 persons/s for 8 s from the court end, toward the exit 12 m away: no
+  // one reaches it, nothing blocks the entry.
+  const TimelineRun run = Simulate(Hallway(R"({"count": 0, "target": "to_exit", "seed": 3})",
+                                   R"({"duration_s": 8, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+                                   R"({"inflows": [{"id": "in", "entry": "from_court", "rate_per_s": 1.5}]})"),
+                           "constant_inflow");
+  ExpectConservation(run);
+  const runfile::CensusRow& last = run.census.back();
+  EXPECT_NEAR(static_cast<double>(last.census.entered), 1.5 * 8.0, 1.0);
+  // (An arrival due within the frame's last step is placed at the next step.)
+  EXPECT_LE(last.census.queued, 1);
+  EXPECT_EQ(run.Kind("enter").size(), static_cast<std::size_t>(last.census.entered));
+  // At every frame: entered = floor(1.5 t) (+-1: an arrival due within the frame's last step).
+  for (const runfile::CensusRow& r : run.census)
+    EXPECT_NEAR(static_cast<double>(r.census.entered), std::floor(1.5 * r.time_s + 1e-9), 1.0) << r.time_s;
+}
+
+TEST(Timeline, WithoutRoomTheQueueHoldsArrivalsAndTheyEnterLater) {
+  // 50 persons/s into the 1.5 m x 3 m entry for 1.2 s, walking off at
+  // 0.5 m/s: far more than fit; the queue grows and empties as people walk
+  // on, and no one is dropped.
+  const TimelineRun run = Simulate(Hallway(R"({"count": 0, "target": "to_exit", "seed": 3})",
+                                   R"({"duration_s": 12, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+                                   R"({"inflows": [{"id": "rush", "entry": "from_court", "desired_speed_m_per_s": [0.5, 0.5],
+                                                    "rate_per_s": [[0, 50], [1.2, 0]]}]})"),
+                           "queue");
+  ExpectConservation(run);
+  std::int64_t longest = 0;
+  for (const runfile::CensusRow& r : run.census) longest = std::max(longest, r.census.queued);
+  EXPECT_GT(longest, 10) << "the entry should have been full";
+  // Everyone due (60) has entered or still waits: entered + queued = 60.
+  const runfile::CensusRow& last = run.census.back();
+  EXPECT_EQ(last.census.entered + last.census.queued, 60);
+  EXPECT_GT(last.census.entered, 30) << "the queue should have drained as people walked on";
+  const auto at = [&](double t) {
+    return *std::min_element(run.census.begin(), run.census.end(), [&](const auto& a, const auto& b) {
+      return std::abs(a.time_s - t) < std::abs(b.time_s - t);
+    });
+  };
+  EXPECT_GT(at(1.2).census.queued, 10);
+  EXPECT_GT(at(8.0).census.entered, at(1.2).census.entered) << "people queued at 1.2 s entered later";
+}
+
+TEST(Timeline, AnExitRemovesExactlyThoseWhoCrossItAndAClosedExitNoOne) {
+  // 40 people walking toward the exit at x = 12; the exit closes at 6 s.
+  const TimelineRun run = Simulate(Hallway(R"({"count": 40, "target": "to_exit", "seed": 5,
+                                      "desired_speed_m_per_s": [1.4, 1.6]})",
+                                   R"({"duration_s": 10, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+                                   R"({"events": [{"time_s": 6, "close_exit": "exit"}]})"),
+                           "exit_closes");
+  ExpectConservation(run);
+  const std::vector<runfile::Event> exits = run.Kind("exit");
+  ASSERT_GT(exits.size(), 3u) << "people should have left before 6 s";
+  for (const runfile::Event& e : exits) {
+    EXPECT_EQ(e.detail, "exit");
+    EXPECT_LE(e.time_s, 6.0 + 1e-9) << "removed after the exit closed";
+  }
+  ASSERT_EQ(run.Kind("exit_closed").size(), 1u);
+  EXPECT_DOUBLE_EQ(run.Kind("exit_closed")[0].time_s, 6.0);
+  // Each person removed was last seen within a step's walk of the exit line,
+  // and no one present was ever beyond it.
+  const runfile::RunFileReader reader(run.file);
+  std::map<std::int64_t, Vec2> last_seen;
+  runfile::PersonFrame frame;
+  auto stream = reader.PersonFrames(1 << 30);
+  while (stream.Next(&frame))
+    for (std::size_t k = 0; k < frame.person.size(); ++k) {
+      last_seen[frame.person[k]] = frame.position_m[k];
+      EXPECT_LE(frame.position_m[k].x, 12.0) << "person " << frame.person[k] + 1 << " beyond the exit";
+    }
+  for (const runfile::Event& e : exits) EXPECT_GT(last_seen.at(e.person).x, 12.0 - 0.25) << e.person;
+  EXPECT_EQ(run.census.back().census.removed, static_cast<std::int64_t>(exits.size()));
+  EXPECT_EQ(run.Value("timeline_exit_counts"), "{\"court\": 0, \"exit\": " + std::to_string(exits.size()) + "}");
+}
+
+TEST(Timeline, ATimedEvacuationOrderTurnsEveryoneAtItsTime) {
+  // Everyone walks to the exit; at 3 s everyone is told to head for the court.
+  const TimelineRun run = Simulate(Hallway(R"({"count": 30, "target": "to_exit", "seed": 9})",
+                                   R"({"duration_s": 6, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+                                   R"({"exits": [], "events": [{"time_s": 3, "target": "to_court"}]})"),
+                           "evacuation_order");
+  ASSERT_EQ(run.Kind("target").size(), 1u);
+  EXPECT_DOUBLE_EQ(run.Kind("target")[0].time_s, 3.0);
+  const runfile::RunFileReader reader(run.file);
+  runfile::PersonFrame frame;
+  auto stream = reader.PersonFrames(1 << 30);
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  std::size_t k = 0;
+  while (stream.Next(&frame)) {
+    const double t = times[k++].time_s;
+    double vx = 0.0;
+    for (const Vec2& v : frame.velocity_m_per_s) vx += v.x;
+    vx /= static_cast<double>(frame.velocity_m_per_s.size());
+    if (t > 1.5 && t <= 3.0) {
+      EXPECT_GT(vx, 0.3) << "t = " << t << ": before the order, toward the exit";
+    }
+    if (t >= 5.0) {
+      EXPECT_LT(vx, -0.3) << "t = " << t << ": after it, toward the court";
+    }
+  }
+}
+
+// A closed corridor (both exits closed) with a standing crowd and runners
+// sent in from the court end at `runner_speed`.
+TimelineRun Runners(double runner_speed, const std::string& name) {
+  const std::string speed = std::to_string(runner_speed);
+  return Simulate(Hallway(R"({"count": 60, "target": "to_court", "seed": 4, "desired_speed_m_per_s": [0.0, 0.0],
+                              "placement": {"region": "walkable"}})",
+                          R"({"duration_s": 5, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": true})",
+                          R"({"closed_exits": ["court", "exit"],
+                              "inflows": [{"id": "runners", "entry": "from_court", "group": "runners", "target": "to_exit",
+                                           "rate_per_s": [[0, 3], [2, 0]], "desired_speed_m_per_s": [)" +
+                              speed + ", " + speed + R"(]}],
+                              "falls": {"criterion": "acceleration"}})"),
+                  name);
+}
+
+TEST(Timeline, APersonHitHardFallsAndOneJostledDoesNot) {
+  const TimelineRun walked = Runners(1.0, "jostled");
+  ExpectConservation(walked);
+  EXPECT_EQ(walked.Kind("fall").size(), 0u) << "walkers bumping into a standing crowd fell";
+  const TimelineRun hard = Runners(6.0, "hit_hard");
+  ExpectConservation(hard);
+  const std::vector<runfile::Event> falls = hard.Kind("fall");
+  ASSERT_GE(falls.size(), 1u) << "runners at 6 m/s into a standing crowd felled no one";
+  for (const runfile::Event& f : falls) EXPECT_EQ(f.detail.rfind("acceleration: mean ", 0), 0u) << f.detail;
+  EXPECT_EQ(hard.census.back().census.fallen, static_cast<std::int64_t>(falls.size()));
+  // The fallen never move again, and still carry load.
+  const runfile::RunFileReader reader(hard.file);
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  std::map<std::int64_t, double> fell_at;
+  for (const runfile::Event& f : falls) fell_at[f.person] = f.time_s;
+  std::map<std::int64_t, Vec2> pose;
+  std::map<std::int64_t, double> most_load;
+  runfile::PersonFrame frame;
+  auto stream = reader.PersonFrames(1 << 30);
+  std::size_t k = 0;
+  while (stream.Next(&frame)) {
+    const double t = times[k++].time_s;
+    for (std::size_t i = 0; i < frame.person.size(); ++i) {
+      const auto it = fell_at.find(frame.person[i]);
+      if (it == fell_at.end() || t < it->second + 0.1) continue;
+      EXPECT_EQ(frame.state[i], runfile::PersonStatus::kFallen);
+      EXPECT_EQ(frame.velocity_m_per_s[i].x, 0.0);
+      if (auto seen = pose.find(frame.person[i]); seen != pose.end()) {
+        EXPECT_EQ(seen->second.x, frame.position_m[i].x);
+        EXPECT_EQ(seen->second.y, frame.position_m[i].y);
+      }
+      pose[frame.person[i]] = frame.position_m[i];
+      most_load[frame.person[i]] = std::max(most_load[frame.person[i]], frame.load_n[i]);
+    }
+  }
+  double loaded = 0.0;
+  for (const auto& [person, load] : most_load) loaded = std::max(loaded, load);
+  EXPECT_GT(loaded, 0.0) << "no fallen person carried any load";
+}
+
+TEST(Timeline, ThreadCountDoesNotChangeATimeline) {
+  const std::string json = Hallway(R"({"count": 20, "target": "to_exit", "counter_target": "to_court",
+                                      "counter_flow_fraction": 0.3, "seed": 2})",
+                                   R"({"duration_s": 3, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": true})",
+                                   R"({"inflows": [{"id": "a", "entry": "from_court", "rate_per_s": 2},
+                                                  {"id": "b", "entry": "from_outside", "group": "counter", "rate_per_s": 1}],
+                                      "events": [{"time_s": 1, "set": {"back_force_gamma": 2.0}, "group": "counter"}],
+                                      "falls": {}})");
+  const TimelineRun one = Simulate(json, "threads1", 1), two = Simulate(json, "threads2", 2);
+  ASSERT_EQ(one.census.size(), two.census.size());
+  for (std::size_t k = 0; k < one.census.size(); ++k) EXPECT_EQ(one.census[k].census.entered, two.census[k].census.entered);
+  const runfile::RunFileReader a(one.file), b(two.file);
+  runfile::PersonFrame fa, fb;
+  auto sa = a.PersonFrames(1 << 30), sb = b.PersonFrames(1 << 30);
+  while (sa.Next(&fa)) {
+    ASSERT_TRUE(sb.Next(&fb));
+    ASSERT_EQ(fa.person, fb.person);
+    for (std::size_t i = 0; i < fa.person.size(); ++i) {
+      ASSERT_EQ(fa.position_m[i].x, fb.position_m[i].x);
+      ASSERT_EQ(fa.position_m[i].y, fb.position_m[i].y);
+    }
+  }
+}
+
+TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
+  const auto refuse = [](const std::string& timeline, const std::string& expected) {
+    try {
+      ParseScenario(Hallway(R"({"count": 10, "target": "to_exit"})", R"({"duration_s": 10})", timeline), "bad.json",
+                    kSource);
+      ADD_FAILURE() << "accepted: " << timeline;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refuse(R"({"inflows": [{"entry": "nowhere", "rate_per_s": 1}]})", "/timeline/inflows/0/entry: the venue has no entry zone \"nowhere\"");
+  refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": [[5, 1], [2, 1]]}]})", "/timeline/inflows/0/rate_per_s: times must increase");
+  refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": -1}]})", "/timeline/inflows/0/rate_per_s");
+  refuse(R"({"inflows": [{"entry": "from_court", "group": "staff", "rate_per_s": 1}]})", "group \"staff\" needs a \"target\"");
+  refuse(R"({"events": [{"time_s": 1, "close_exit": "door"}]})", "/timeline/events/0/close_exit: the venue has no exit \"door\"");
+  refuse(R"({"events": [{"time_s": 1, "set": {"restitution": 0.5}, "group": "main"}]})", "is the same for everyone");
+  refuse(R"({"events": [{"time_s": 1, "set": {"integrator": 1}}]})", "cannot change during a run");
+  refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
+  refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
+  refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
+}
+
+}  // namespace timeline_tests
+}  // namespace crowdrecon::scenario
