@@ -16,6 +16,7 @@ void RegisterRenderCommand(CLI::App& app);  // render (pictures and video of a r
 void RegisterAnalyzeCommand(CLI::App& app);  // analyze (metrics and regime of a run)
 void RegisterSweepCommand(CLI::App& app);  // sweep (grids of runs, local or MPI)
 void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat maps of a sweep)
+void RegisterTimelineCommand(CLI::App& app);  // timeline (the figure of an incident timeline's run)
 
 // The --force flag of every command that writes: replace a file, or write into
 // a folder, that is not a previous output of the command (see

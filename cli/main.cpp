@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterAnalyzeCommand(app);
   crowdrecon::cli::RegisterSweepCommand(app);
   crowdrecon::cli::RegisterPhaseCommand(app);
+  crowdrecon::cli::RegisterTimelineCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

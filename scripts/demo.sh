@@ -4,7 +4,7 @@
 set -euo pipefail
 exe=${1:?usage: demo.sh CROWDRECON OUTDIR}
 out=${2:?usage: demo.sh CROWDRECON OUTDIR}
-mkdir -p "$out/venues" "$out/bodies" "$out/hallway" "$out/phase"
+mkdir -p "$out/venues" "$out/bodies" "$out/hallway" "$out/phase" "$out/madrid-night"
 
 echo "== Madrid Arena venues"
 for venue in venues/madrid-arena/*.json; do
@@ -32,9 +32,17 @@ echo "== Rendering the hallway run (every other frame, as PNG and as a real-time
 echo "== Analysis of the hallway run (regime, flows, lanes, loads against 400 N)"
 "$exe" analyze "$out/hallway/run.sqlite" --json "$out/hallway/analysis.json" | tee "$out/hallway/analysis.txt"
 
+echo "== The Madrid Arena night, shortened (open hallway: inflow at both ends, exits, falls; the full 95-minute"
+echo "   reconstruction is venues/madrid-arena/scenarios/madrid-night.json, docs/scenarios.md)"
+"$exe" simulate venues/madrid-arena/scenarios/madrid-night-demo.json -o "$out/madrid-night/run.sqlite" \
+  | tee "$out/madrid-night/summary.txt"
+"$exe" timeline "$out/madrid-night/run.sqlite" -o "$out/madrid-night/timeline.png" -o "$out/madrid-night/timeline.svg" \
+  --phase results/sweeps/madrid-arena/hallway-bodies --phase-output "$out/madrid-night/phase" --path-step 10 \
+  | tee -a "$out/madrid-night/summary.txt"
+
 echo "== Phase diagrams of the shipped Madrid Arena sweeps (results/sweeps/madrid-arena/)"
 for sweep in hallway-bodies hallway-gamma hallway-lambda; do
   "$exe" phase "results/sweeps/madrid-arena/$sweep" -o "$out/phase/$sweep" | tail -n 1
 done
 
-echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), phase/"
+echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), madrid-night/ (timeline run, its figure and its path over the phase diagram), phase/"

@@ -297,8 +297,13 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
   }
   if (state == PersonState::kRemoved) {
-    // Their contacts go with them: the next step's springs start without
-    // them, and a frame written now lists no contact with someone absent.
+    // No forces on an empty slot (the stages skip it), and their contacts go
+    // with them: the next step's springs start without them, and a frame
+    // written now lists no contact with someone absent.
+    bodies_.force_n[person] = {};
+    bodies_.torque_n_m[person] = 0.0;
+    bodies_.contact_force_n[person] = {};
+    bodies_.contact_torque_n_m[person] = 0.0;
     std::erase_if(contacts_, [person](const Contact& c) { return c.a == person || (!c.wall && c.b == person); });
     in_->cuda_has_history = false;
   }
@@ -368,7 +373,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
   Drive();  // the newcomer's own forces enter the current evaluation (the others' are unchanged)
 }
 
-bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) const {
+bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad, double clearance_m) const {
   if (shape >= def_.shapes.size()) throw InputError("shape index " + std::to_string(shape) + " out of range");
   const Internals& in = *in_;
   PlacedShape me;
@@ -383,14 +388,14 @@ bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) 
     PlacedShape wall;
     wall.geometry = &in.wall_geometry[w];
     wall.position = in.wall_origin[w];
-    if (CollideShapes(me, wall, hits); !hits.empty()) return false;
+    if (CollideShapes(me, wall, hits) < clearance_m || !hits.empty()) return false;
   }
   const BodyShape& mine = def_.shapes[shape];
   const double my_bound = mine.core_radius_m + mine.radius_m;
   for (std::size_t j = 0; j < bodies_.size(); ++j) {
     if (bodies_.state[j] == PersonState::kRemoved) continue;
     const Vec2 separation = Separation(position_m, bodies_.position_m[j]);
-    const double reach = my_bound + in.bound_m[j];
+    const double reach = my_bound + in.bound_m[j] + clearance_m;
     if (LengthSquared(separation) >= reach * reach) continue;
     PlacedShape other;
     const std::uint32_t s = bodies_.shape[j];
@@ -399,7 +404,7 @@ bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) 
     other.position = position_m - separation;  // the image nearest to the candidate
     other.cos_angle = std::cos(bodies_.angle_rad[j]);
     other.sin_angle = std::sin(bodies_.angle_rad[j]);
-    if (CollideShapes(me, other, hits); !hits.empty()) return false;
+    if (CollideShapes(me, other, hits) < clearance_m || !hits.empty()) return false;
   }
   return true;
 }

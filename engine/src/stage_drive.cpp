@@ -74,6 +74,7 @@ void Simulation::Drive() {
     // Pass 3: forces and torques.
     for (std::size_t i = first; i < last; ++i) {
       const std::size_t k = i - first;
+      if (bodies_.state[i] == PersonState::kRemoved) continue;  // no forces (zeroed when removed)
       Vec2 force = bodies_.contact_force_n[i] + bodies_.external_force_n[i];
       double torque = bodies_.contact_torque_n_m[i];
       if (driven[k]) {

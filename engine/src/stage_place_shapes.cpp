@@ -19,6 +19,7 @@ void Simulation::PlaceShapes() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (n >= kParallelBodies)
   for (std::int64_t ii = 0; ii < n; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
+    if (bodies_.state[i] == PersonState::kRemoved) continue;  // an empty slot (Spawn places it afresh)
     SinCos(bodies_.angle_rad[i], in.sin_angle[i], in.cos_angle[i]);  // common/fast_math.hpp
     // Travel since the last evaluation: a core point at distance r <= arm
     // from the centre moves by at most |translation| + r |rotation|.

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/engine/simulation.hpp"
@@ -302,6 +304,12 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     std::string groups;
     for (const std::string& g : scenario.timeline.groups) groups += (groups.empty() ? "" : ",") + g;
     writer.SetRunValue("groups", groups);
+    // What the figure marks (timeline.hpp: RecordedMark), as JSON.
+    if (!scenario.timeline.clock_start.empty()) writer.SetRunValue("timeline_clock_start", scenario.timeline.clock_start);
+    nlohmann::json marks = nlohmann::json::array();
+    for (const RecordedMark& m : scenario.timeline.recorded)
+      marks.push_back({{"time_s", m.time_s}, {"label", m.label}, {"kind", m.kind}});
+    writer.SetRunValue("timeline_recorded", marks.dump());
   }
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));
   if (!step_warning.empty()) {
@@ -357,6 +365,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     loop.Add(detail::MakeInflowSystem(*timeline));
     loop.Add(detail::MakeExitSystem(*timeline));
     loop.Add(detail::MakeFallSystem(*timeline));
+    loop.Add(detail::MakeAvalancheSystem(*timeline));
   }
   loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
   loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts, timeline.get()));

@@ -64,6 +64,10 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     root.At("format").Fail("\"" + format + "\" is not a scenario; expected \"crowdrecon-scenario\"");
   root.Integer("version", 1, 1, 1);
   s.name = root.String("name", std::filesystem::path(origin).stem().string());
+  if (auto notes = root.Find("notes")) {  // the scenario's assumptions and sources, one per entry
+    if (!notes->IsArray()) notes->Fail("expected a list of notes [\"...\", ...]");
+    for (std::size_t k = 0; k < notes->Size(); ++k) s.notes.push_back(notes->Element(k).AsString());
+  }
 
   {
     const JsonReader venue = root.At("venue");

@@ -1,6 +1,7 @@
 #include "crowdrecon/scenario/timeline.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -319,6 +320,30 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     falls->Finish();
   }
   t.max_present = static_cast<std::size_t>(reader.Integer("max_present", 0, 0, 200000));
+  t.entry_clearance_m = reader.Number("entry_clearance_m", t.entry_clearance_m, 0.0, 2.0);
+  if (auto clock = reader.Find("clock_start")) {
+    t.clock_start = clock->AsString();
+    const std::string& c = t.clock_start;
+    const bool ok = c.size() == 5 && std::isdigit(static_cast<unsigned char>(c[0])) &&
+                    std::isdigit(static_cast<unsigned char>(c[1])) && c[2] == ':' &&
+                    std::isdigit(static_cast<unsigned char>(c[3])) && std::isdigit(static_cast<unsigned char>(c[4])) &&
+                    std::stoi(c.substr(0, 2)) < 24 && std::stoi(c.substr(3, 2)) < 60;
+    if (!ok) clock->Fail("\"" + c + "\" is not a time of day; expected \"HH:MM\" (24-hour clock)");
+  }
+  if (auto recorded = reader.Find("recorded")) {
+    if (!recorded->IsArray()) recorded->Fail("expected a list of marks [{\"time_s\": ..., \"label\": ...}]");
+    for (std::size_t k = 0; k < recorded->Size(); ++k) {
+      const JsonReader item = recorded->Element(k);
+      if (!item.IsObject()) item.Fail("expected a mark {\"time_s\": ..., \"label\": ..., \"kind\": ...}");
+      RecordedMark m;
+      m.time_s = item.Number("time_s", 0.0, kMaxTime_s);
+      m.label = item.String("label", "");
+      if (m.label.size() > 200) item.At("label").Fail("a label of at most 200 characters");
+      m.kind = item.Choice("kind", "avalanche", {"avalanche", "fatal", "other"});
+      item.Finish();
+      t.recorded.push_back(std::move(m));
+    }
+  }
   reader.Finish();
   return t;
 }

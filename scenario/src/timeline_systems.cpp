@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
 #include "crowdrecon/geometry/population.hpp"
@@ -191,7 +192,7 @@ class InflowSystem : public RunSystem {
       const Vec2 e = field.Direction(at);
       const double jitter = 0.3 * (geometry::UniformUnit(rng()) - 0.5);
       const double theta = (e.x != 0.0 || e.y != 0.0 ? std::atan2(e.y, e.x) : 0.0) + jitter;
-      if (!sim.IsFree(p.shape, at, theta)) continue;
+      if (!sim.IsFree(p.shape, at, theta, s_.spec.entry_clearance_m)) continue;
       p.position_m = at;
       p.angle_rad = theta;
       p.velocity_m_per_s = e * p.desired_speed_m_per_s;  // walking in at their own pace
@@ -227,6 +228,10 @@ class ExitSystem : public RunSystem {
       for (std::size_t x : removing_) {
         if (!s_.exit_open[x]) continue;
         const geometry::Exit& exit = venue.exits[x];
+        // Most paths are nowhere near: a box test first.
+        if (std::max(from.x, to.x) < std::min(exit.a.x, exit.b.x) || std::min(from.x, to.x) > std::max(exit.a.x, exit.b.x) ||
+            std::max(from.y, to.y) < std::min(exit.a.y, exit.b.y) || std::min(from.y, to.y) > std::max(exit.a.y, exit.b.y))
+          continue;
         if (!engine::PathCrossesSegment(from, to, exit.a, exit.b)) continue;
         const std::uint32_t id = b.id[i];
         sim.SetPersonState(i, engine::PersonState::kRemoved);
@@ -336,6 +341,75 @@ class FallSystem : public RunSystem {
 
 // ---------------------------------------------------------------------------
 
+
+// ---------------------------------------------------------------------------
+
+// Avalanches as they happen: the analysis's detector (analysis/regime.hpp,
+// FindAvalanches with the default RegimeOptions) on each direction's mean
+// speed along its desired direction (a group: the people walking to one
+// target) and the crowd's, frame by frame, run again every second on the
+// series so far; each avalanche is written once, when it is first seen
+// (the burst reached), as an event `avalanche` at its start time.
+class AvalancheSystem : public RunSystem {
+ public:
+  explicit AvalancheSystem(TimelineState& s) : s_(s), series_(s.spec.groups.size() + 1), reported_(series_.size(), 0.0) {
+    std::fill(reported_.begin(), reported_.end(), -1.0);
+  }
+  std::string_view name() const override { return "avalanches"; }
+  void AtFrame(FrameContext& c) override {
+    const engine::BodyState& b = c.sim.bodies();
+    const std::size_t groups = s_.spec.groups.size();
+    std::vector<double> sum(groups + 1, 0.0);
+    std::vector<std::size_t> count(groups + 1, 0);
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      if (b.state[i] != engine::PersonState::kWalking || b.group[i] >= groups) continue;
+      const double along = Dot(b.velocity_m_per_s[i], c.sim.definition().targets[b.target[i]].Direction(b.position_m[i]));
+      sum[b.group[i]] += along;
+      ++count[b.group[i]];
+      sum[groups] += along;
+      ++count[groups];
+    }
+    time_.push_back(c.sim.time_s());
+    for (std::size_t g = 0; g <= groups; ++g)
+      series_[g].push_back(count[g] > 0 ? sum[g] / static_cast<double>(count[g]) : 0.0);
+    if (c.sim.time_s() + 1e-9 < next_check_s_) return;
+    next_check_s_ = c.sim.time_s() + 1.0;
+    const analysis::RegimeOptions options;
+    for (std::size_t g = 0; g <= groups; ++g) {
+      for (const analysis::Avalanche& a : analysis::FindAvalanches(time_, series_[g], options)) {
+        if (a.start_time_s <= reported_[g]) continue;
+        reported_[g] = a.start_time_s;
+        const std::string who = g < groups ? "direction " + s_.spec.groups[g] : "crowd";
+        s_.Event(a.start_time_s, "avalanche", -1,
+                 who + ": released after a stop of " + FormatFixed(a.stopped_before_s, 1) + " s, rise time " +
+                     FormatFixed(a.rise_time_s, 2) + " s, peak " + FormatFixed(a.peak_speed_m_per_s, 2) + " m/s so far");
+      }
+    }
+  }
+  std::string SaveState() const override {
+    StateWriter w;
+    w.Put(next_check_s_);
+    w.PutVector(time_);
+    for (const std::vector<double>& s : series_) w.PutVector(s);
+    w.PutVector(reported_);
+    return w.out;
+  }
+  void LoadState(const std::string& state) override {
+    StateReader r(state, "the timeline's avalanche detector");
+    next_check_s_ = r.Get<double>();
+    time_ = r.GetVector<double>();
+    for (std::vector<double>& s : series_) s = r.GetVector<double>(time_.size());
+    reported_ = r.GetVector<double>(series_.size());
+    if (!r.AtEnd()) r.Fail();
+  }
+
+ private:
+  TimelineState& s_;
+  std::vector<double> time_;
+  std::vector<std::vector<double>> series_;  // per group, then the crowd
+  std::vector<double> reported_;             // start of the last avalanche written, per series
+  double next_check_s_ = 0.0;
+};
 
 }  // namespace
 
@@ -470,6 +544,7 @@ std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& s) { return st
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& s) { return std::make_unique<InflowSystem>(s); }
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& s) { return std::make_unique<ExitSystem>(s); }
 std::unique_ptr<RunSystem> MakeFallSystem(TimelineState& s) { return std::make_unique<FallSystem>(s); }
+std::unique_ptr<RunSystem> MakeAvalancheSystem(TimelineState& s) { return std::make_unique<AvalancheSystem>(s); }
 
 void OpenDoorsAtStart(engine::Simulation& sim, const TimelineState& s) {
   for (std::size_t x = 0; x < s.exit_open.size(); ++x)

@@ -6,6 +6,8 @@
 //                    there is room, otherwise queued there (FIFO) and placed later
 //   exits            a walking person whose centre crosses an open exit is removed
 //   falls            the fall criterion (filtered acceleration, or a sustained load)
+//   avalanches       (per frame) the analysis's avalanche detector on each direction's
+//                    mean speed, events as avalanches are first seen
 //
 // They share a TimelineState (queues, exits open, inflows on, counts, the
 // events of the frame), saved in checkpoints by timeline_events; the falls
@@ -73,6 +75,7 @@ std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeFallSystem(TimelineState& state);
+std::unique_ptr<RunSystem> MakeAvalancheSystem(TimelineState& state);
 
 // Opens and closes the doors as the timeline starts (before the first step).
 void OpenDoorsAtStart(engine::Simulation& sim, const TimelineState& state);

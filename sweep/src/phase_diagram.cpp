@@ -306,7 +306,32 @@ std::size_t SeedCount(const Panel& panel) {
   return n;
 }
 
-void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_name, const fs::path& file) {
+// The run's path over the plot (PathOverlay), clamped to the plotted range.
+void DrawPath(Page& page, const Layout& L, const PathOverlay& path) {
+  if (path.points.size() < 2) return;
+  const auto at = [&](std::size_t i) {
+    const double x = std::clamp(path.points[i].first, L.x->lo, L.x->hi);
+    const double y = std::clamp(path.points[i].second, L.y->lo, L.y->hi);
+    return std::pair{L.PX(x), L.PY(y)};
+  };
+  std::vector<std::pair<double, double>> pts;
+  for (std::size_t i = 0; i < path.points.size(); ++i) pts.push_back(at(i));
+  const Color ink = Color::Hex(0x7a0177);
+  page.canvas.StrokePolyline(page.Poly(pts), Color::White(), 6.0);
+  page.canvas.StrokePolyline(page.Poly(pts), ink, 3.0);
+  page.canvas.Arrow(page.P(pts[pts.size() - 2].first, pts[pts.size() - 2].second),
+                    page.P(pts.back().first, pts.back().second), ink, 3.0);
+  for (const auto& [index, text] : path.labels) {
+    if (index >= pts.size()) continue;
+    page.canvas.Dot(page.P(pts[index].first, pts[index].second), 4.5, ink);
+    page.canvas.TextPxAligned(pts[index].first + 7, pts[index].second - 7, text, 12, 0.0, 1.0, ink, 0.0, true);
+  }
+  if (!path.caption.empty())
+    page.canvas.TextPxAligned(L.left, L.height - 32, path.caption, 12, 0.0, 0.0, ink);
+}
+
+void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_name, const fs::path& file,
+               const PathOverlay& path = {}) {
   Page page(file, L.width, L.height);
   DrawTitle(page, L, sweep_name,
             "Phase diagram, " + PanelTitle(panel) + ": regime of the majority of " +
@@ -369,6 +394,7 @@ void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_nam
   page.canvas.TextPxAligned(L.left, L.height - 14,
                             RunsText(panel) + "; regimes as defined in docs/analysis.md", 12, 0.0, 0.0,
                             Color::Hex(0x555555));
+  DrawPath(page, L, path);
   page.canvas.Finish();
 }
 
@@ -645,8 +671,8 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   html += "<h2>Phase diagrams</h2>\n<div class=\"grid\">\n";
   for (const Panel& p : panels) {
     const fs::path png = out / (p.stem + ".png"), svg = out / (p.stem + ".svg");
-    DrawPhase(p, layout, sweep_name, png);
-    DrawPhase(p, layout, sweep_name, svg);
+    DrawPhase(p, layout, sweep_name, png, options.path);
+    DrawPhase(p, layout, sweep_name, svg, options.path);
     summary.pictures.push_back(png);
     summary.pictures.push_back(svg);
     ++summary.diagrams;

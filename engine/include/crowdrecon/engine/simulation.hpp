@@ -130,8 +130,10 @@ class Simulation {
   // walking, with no history (no integrator derivatives, no contacts).
   void Spawn(std::uint32_t slot, const PersonDef& person, std::uint32_t id);
   // True if a body of world shape `shape` at `position_m`, facing
-  // `angle_rad`, touches no wall and no one in the venue (walking or fallen).
-  bool IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad) const;
+  // `angle_rad`, touches no wall and no one in the venue (walking or fallen),
+  // and keeps at least `clearance_m` from each (as far as the narrow phase's
+  // lower bound on the gap shows: a place a little farther may be refused).
+  bool IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad, double clearance_m = 0.0) const;
   void SetTarget(std::uint32_t person, std::uint32_t target);
   void SetDesiredSpeed(std::uint32_t person, double speed_m_per_s);
   // Replaces the model parameters (a timed change of the back force, the

@@ -27,6 +27,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "crowdrecon/engine/parameters.hpp"
 #include "crowdrecon/geometry/population.hpp"
@@ -70,6 +71,7 @@ struct RunSpec {
 
 struct Scenario {
   std::string name;
+  std::vector<std::string> notes;  // "notes": assumptions and their sources (free text)
   std::filesystem::path file;  // where it was read from ("" if from text)
   std::string json_text;       // as given (kept in the run file)
   std::filesystem::path venue_file;

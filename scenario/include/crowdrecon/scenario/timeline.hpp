@@ -114,6 +114,16 @@ struct FallSpec {
   double sample_s = 0.05;
 };
 
+// Something recorded of the real incident at a time of the run (an
+// avalanche on camera, the fatal clog): drawn on the timeline figure and,
+// for the calibration, compared with what the run gives. Never an input of
+// the simulation.
+struct RecordedMark {
+  double time_s = 0.0;
+  std::string label;  // "avalanche 02:18"
+  std::string kind;   // "avalanche", "fatal" or "other"
+};
+
 struct TimelineSpec {
   bool enabled = false;  // a "timeline" key is present
   std::vector<InflowSpec> inflows;
@@ -123,8 +133,19 @@ struct TimelineSpec {
   FallSpec falls;
   // Group names by index: 0 "main", 1 "counter", then the inflows' own.
   std::vector<std::string> groups;
+  // Room for an arrival: a place in the entry zone where their body keeps
+  // this gap (m) from everyone and every wall. A person steps into a crowd
+  // where there is room for a step, not into every gap that their body
+  // fits: 0.1 m, a third of a step's length (~0.3 m at the slow walk of a
+  // dense crowd). Without it, arrivals fill an entry zone to the densest
+  // packing the bodies allow (15 persons/m^2 in the hallway, measured).
+  double entry_clearance_m = 0.1;
   // Most people in the venue at once (engine slots); 0: from the venue's area.
   std::size_t max_present = 0;
+  // The wall-clock time of t = 0 ("02:00", for the figure's axis), and what
+  // was recorded of the incident (the figure marks it; the run ignores it).
+  std::string clock_start;
+  std::vector<RecordedMark> recorded;
 
   bool HasInflow() const { return !inflows.empty(); }
 };

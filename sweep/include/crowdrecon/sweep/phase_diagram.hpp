@@ -20,17 +20,28 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowdrecon/common/output_path.hpp"
 
 namespace crowdrecon::sweep {
 
+// A run's path through the diagram's plane (the Madrid night's density and
+// counter-flow over time, like the arrow of the paper's Figure 5), drawn over
+// every phase diagram as a line ending in an arrow, with labelled points.
+struct PathOverlay {
+  std::vector<std::pair<double, double>> points;  // (x, y) in the diagram's units, in time order
+  std::vector<std::pair<std::size_t, std::string>> labels;  // index into points, text ("02:30")
+  std::string caption;  // one line under the diagram ("path of madrid-night.sqlite, 5-s means")
+};
+
 struct PhaseOptions {
   std::filesystem::path results;     // DIR, or DIR/results.sqlite
   std::filesystem::path output_dir;  // FIGDIR; "" = DIR/phase
   bool heat_maps = true;
   bool heat_map_svg = true;  // false: heat maps as PNG only (each ~200 kB as SVG), linked to their PNG
+  PathOverlay path;          // drawn over the phase diagrams when it has points
 };
 
 struct PhaseSummary {

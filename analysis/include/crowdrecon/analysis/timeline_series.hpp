@@ -1,0 +1,55 @@
+// The time series of an incident timeline's run (issue 20), for its figure
+// and for the calibration: density in the venue, the counter-flow's share,
+// each direction's mean speed, the flow through the measurement line, the
+// people waiting at the entries, the avalanches and falls the run recorded,
+// and what was recorded of the real incident (the scenario's marks).
+//
+//   density        people in the venue (walking and fallen: table census, or
+//                  the frame's people) over the walkable area;
+//   counter share  people of group 1 (the counter-flow) over people present;
+//   speeds, flows  AnalyzeRun's series (run_analysis.hpp): each group's mean
+//                  speed along its desired direction; crossings of the line
+//                  per metre and second, trailing 2 s window;
+//   smoothing      each series is also given as a centred moving mean over
+//                  smooth_s (default 10 s), what the figure draws.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace crowdrecon::analysis {
+
+struct TimelineMark {
+  double time_s = 0.0;
+  std::string label;
+  std::string kind;  // recorded: "avalanche", "fatal", "other"; detected: the event's kind
+};
+
+struct TimelineSeries {
+  std::string run_file;
+  std::string clock_start;  // "HH:MM" of t = 0, or ""
+  double area_m2 = 0.0;
+  std::vector<double> time_s;
+  std::vector<double> density_per_m2;
+  std::vector<double> counter_fraction;  // NaN where nobody is present
+  std::vector<double> queued;            // waiting at the entries (0 without a census)
+  std::vector<std::string> group_names;
+  std::vector<std::vector<double>> group_speed_m_per_s;  // [group][frame]
+  std::vector<double> flow_forward_per_m_s, flow_backward_per_m_s;
+  std::vector<TimelineMark> avalanches;  // detected during the run (events `avalanche`)
+  std::vector<TimelineMark> falls;       // events `fall`
+  std::vector<TimelineMark> recorded;    // the scenario's marks (run value timeline_recorded)
+  double smooth_s = 10.0;
+};
+
+// Reads a run file; throws InputError if it is not a run or has no frames.
+TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smooth_s = 10.0);
+
+// Centred moving mean over `window_s` (NaN values left out; NaN where a window has none).
+std::vector<double> MovingMean(const std::vector<double>& time_s, const std::vector<double>& values, double window_s);
+
+// "02:37" for t seconds after clock_start "02:00"; "" clock: minutes ("37 min").
+std::string ClockText(const std::string& clock_start, double t_s);
+
+}  // namespace crowdrecon::analysis

@@ -1,0 +1,128 @@
+#include "crowdrecon/analysis/timeline_series.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/analysis/run_analysis.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+
+namespace crowdrecon::analysis {
+
+std::vector<double> MovingMean(const std::vector<double>& t, const std::vector<double>& v, double window_s) {
+  std::vector<double> out(v.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t lo = 0, hi = 0, count = 0;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    while (hi < v.size() && t[hi] <= t[i] + 0.5 * window_s) {
+      if (!std::isnan(v[hi])) sum += v[hi], ++count;
+      ++hi;
+    }
+    while (lo < hi && t[lo] < t[i] - 0.5 * window_s) {
+      if (!std::isnan(v[lo])) sum -= v[lo], --count;
+      ++lo;
+    }
+    if (count > 0) out[i] = sum / static_cast<double>(count);
+  }
+  return out;
+}
+
+std::string ClockText(const std::string& clock_start, double t_s) {
+  char text[32];
+  if (clock_start.size() != 5) {
+    std::snprintf(text, sizeof text, "%.0f min", t_s / 60.0);
+    return text;
+  }
+  const int start = std::stoi(clock_start.substr(0, 2)) * 60 + std::stoi(clock_start.substr(3, 2));
+  const int minutes = (start + static_cast<int>(std::floor(t_s / 60.0 + 1e-9))) % (24 * 60);
+  std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);
+  return text;
+}
+
+TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smooth_s) {
+  const runfile::RunFileReader reader(run_file);
+  TimelineSeries s;
+  s.run_file = run_file.string();
+  s.smooth_s = smooth_s;
+  s.clock_start = reader.RunValue("timeline_clock_start");
+  const std::string venue = reader.venue_json();
+  if (venue.empty()) throw InputError(run_file.string() + ": the run file holds no venue (written before format 2)");
+  s.area_m2 = geometry::WalkableArea_m2(geometry::ParseVenue(venue, run_file.string() + ": run value venue"));
+
+  // People present and the counter-flow's share, frame by frame.
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  if (times.empty()) throw InputError(run_file.string() + ": the run has no frames");
+  const std::vector<std::uint32_t> group = reader.PersonGroups();
+  auto stream = reader.PersonFrames(times.back().frame);
+  runfile::PersonFrame frame;
+  for (const runfile::FrameTime& ft : times) s.time_s.push_back(ft.time_s);
+  s.density_per_m2.assign(times.size(), 0.0);  // a frame nobody is in has no rows
+  s.counter_fraction.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t k = 0;
+  while (stream.Next(&frame)) {
+    while (k < times.size() && times[k].frame < frame.frame) ++k;
+    if (k == times.size()) break;
+    std::size_t counter = 0;
+    for (std::uint32_t p : frame.person)
+      if (p < group.size() && group[p] == 1) ++counter;
+    const std::size_t present = frame.person.size();
+    s.density_per_m2[k] = static_cast<double>(present) / s.area_m2;
+    if (present > 0) s.counter_fraction[k] = static_cast<double>(counter) / static_cast<double>(present);
+  }
+  s.queued.assign(s.time_s.size(), 0.0);
+  for (const runfile::CensusRow& row : reader.CensusRows())
+    if (row.frame >= 0 && static_cast<std::size_t>(row.frame) < s.queued.size())
+      s.queued[static_cast<std::size_t>(row.frame)] = static_cast<double>(row.census.queued);
+
+  // Speeds and flows: the analysis of the run.
+  const RunAnalysis a = AnalyzeRun(run_file);
+  s.group_names = a.group_name;
+  const std::size_t n = std::min(s.time_s.size(), a.series.time_s.size());
+  const auto fit = [n](std::vector<double> v) {
+    v.resize(n, std::numeric_limits<double>::quiet_NaN());
+    return v;
+  };
+  s.time_s.resize(n);
+  s.density_per_m2.resize(n);
+  s.counter_fraction.resize(n);
+  s.queued.resize(n);
+  for (const std::vector<double>& g : a.series.group_mean_speed_m_per_s) s.group_speed_m_per_s.push_back(fit(g));
+  s.flow_forward_per_m_s = fit(a.series.flow_forward_per_m_s);
+  s.flow_backward_per_m_s = fit(a.series.flow_backward_per_m_s);
+  const std::string groups = reader.RunValue("groups");  // "main,counter,..." for a timeline
+  if (!groups.empty()) {
+    std::vector<std::string> names;
+    std::size_t at = 0;
+    while (at <= groups.size()) {
+      const std::size_t comma = groups.find(',', at);
+      names.push_back(groups.substr(at, comma == std::string::npos ? std::string::npos : comma - at));
+      if (comma == std::string::npos) break;
+      at = comma + 1;
+    }
+    for (std::size_t g = 0; g < s.group_names.size() && g < names.size(); ++g)
+      s.group_names[g] = names[g] + " (" + s.group_names[g] + ")";
+  }
+
+  for (const runfile::Event& e : reader.Events()) {
+    if (e.kind == "avalanche") s.avalanches.push_back({e.time_s, e.detail, e.kind});
+    if (e.kind == "fall") s.falls.push_back({e.time_s, e.detail, e.kind});
+  }
+  const std::string recorded = reader.RunValue("timeline_recorded");
+  if (!recorded.empty()) {
+    const nlohmann::json marks = nlohmann::json::parse(recorded, nullptr, false);
+    if (!marks.is_array())
+      throw InputError(run_file.string() + ": run value timeline_recorded is not a list of marks (damaged file)");
+    for (const nlohmann::json& m : marks) {
+      if (!m.is_object() || !m.contains("time_s") || !m["time_s"].is_number())
+        throw InputError(run_file.string() + ": run value timeline_recorded holds a mark without a time (damaged file)");
+      s.recorded.push_back({m["time_s"].get<double>(), m.value("label", ""), m.value("kind", "avalanche")});
+    }
+  }
+  return s;
+}
+
+}  // namespace crowdrecon::analysis

@@ -1,0 +1,117 @@
+// `crowdrecon timeline RUN`: the figure of an incident timeline's run
+// (density, counter-flow, speeds per direction, flow, queues, the run's
+// avalanches and falls, the incident's recorded marks) and the run's path
+// through density x counter-flow over a sweep's phase diagrams (issue 20;
+// analysis/timeline_series.hpp, viz/timeline_figure.hpp).
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "crowdrecon/analysis/timeline_series.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/sweep/phase_diagram.hpp"
+#include "crowdrecon/viz/timeline_figure.hpp"
+#include "option_checks.hpp"
+
+namespace crowdrecon::cli {
+
+namespace {
+
+struct TimelineArgs {
+  std::string run;
+  std::vector<std::string> figures;
+  std::string phase;
+  std::string phase_output;
+  double smooth_s = 10.0;
+  double path_step_s = 60.0;
+  bool force = false;
+};
+
+// The run's path through the diagram's plane: means over path_step_s of
+// the density and the counter-flow share, labelled every quarter of the run.
+sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
+  sweep::PathOverlay path;
+  if (s.time_s.empty()) return path;
+  const double t0 = s.time_s.front(), t1 = s.time_s.back();
+  const double label_every = std::max(step_s, std::round((t1 - t0) / 6.0 / step_s) * step_s);
+  for (double a = t0; a < t1; a += step_s) {
+    double d = 0.0, c = 0.0;
+    std::size_t nd = 0, nc = 0;
+    for (std::size_t i = 0; i < s.time_s.size(); ++i) {
+      if (s.time_s[i] < a || s.time_s[i] >= a + step_s) continue;
+      d += s.density_per_m2[i], ++nd;
+      if (!std::isnan(s.counter_fraction[i])) c += s.counter_fraction[i], ++nc;
+    }
+    if (nd == 0 || nc == 0) continue;
+    path.points.emplace_back(d / static_cast<double>(nd), c / static_cast<double>(nc));
+    if (std::fmod(a - t0 + 1e-9, label_every) < step_s * 0.5)
+      path.labels.emplace_back(path.points.size() - 1, analysis::ClockText(s.clock_start, a));
+  }
+  path.caption = "path of " + s.run_file + ": density and counter-flow share, " + FormatNumber(step_s) +
+                 "-s means (clamped to the diagram's range)";
+  return path;
+}
+
+void RunTimeline(const TimelineArgs& args) {
+  std::vector<PlannedOutput> outputs;
+  for (const std::string& f : args.figures) outputs.push_back({"-o", f, PictureOutputKind()});
+  sweep::PhaseOptions phase;
+  if (!args.phase.empty()) {
+    phase.results = args.phase;
+    phase.output_dir = args.phase_output;
+    phase.heat_maps = false;
+    outputs.push_back({"--phase-output", sweep::PhaseOutputFolder(phase), sweep::PhaseFolderOutput()});
+  }
+  CheckOutputs(outputs, {{"the run file", args.run}, {"the sweep results", args.phase}}, args.force);
+  if (!runfile::IsRunFile(args.run)) throw InputError(args.run + ": " + DescribeExisting(args.run) + ", not a crowdrecon run file");
+  const analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
+  // The title: the scenario's name, from the scenario stored in the run.
+  const nlohmann::json scenario =
+      nlohmann::json::parse(runfile::RunFileReader(args.run).RunValue("scenario"), nullptr, false);
+  const std::string title =
+      scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
+  for (const std::string& f : args.figures) {
+    viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, f);
+    std::printf("wrote %s\n", f.c_str());
+  }
+  std::printf("%zu frames from %s to %s; %zu avalanches and %zu falls in the run; %zu recorded marks\n",
+              s.time_s.size(), analysis::ClockText(s.clock_start, s.time_s.front()).c_str(),
+              analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
+              s.recorded.size());
+  if (!args.phase.empty()) {
+    phase.path = PathOf(s, args.path_step_s);
+    const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
+    std::printf("%s", summary.BriefReport().c_str());
+  }
+}
+
+}  // namespace
+
+void RegisterTimelineCommand(CLI::App& app) {
+  auto args = std::make_shared<TimelineArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "timeline",
+      "Draw the figure of an incident timeline's run: density, counter-flow, speed per direction, flow, people waiting "
+      "at the entries, the run's avalanches and falls and the incident's recorded marks over time; with --phase, the "
+      "run's path over a sweep's phase diagrams");
+  cmd->add_option("RUN", args->run, "Run file of a scenario with a timeline")->required();
+  cmd->add_option("-o,--output", args->figures, "Figure file(s): .png, .svg or .pdf (repeat for several)")->required();
+  cmd->add_option("--phase", args->phase, "Sweep output folder whose phase diagrams the run's path is drawn over");
+  cmd->add_option("--phase-output", args->phase_output, "Folder for those diagrams (default: the sweep's phase/)");
+  cmd->add_option("--smooth", args->smooth_s, "Moving-mean window of the figure's lines (s)")
+      ->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--path-step", args->path_step_s, "Averaging step of the path's points (s)")
+      ->check(CLI::Range(1.0, 3600.0));
+  AddForceFlag(cmd, &args->force);
+  cmd->callback([args] { RunTimeline(*args); });
+}
+
+}  // namespace crowdrecon::cli
