@@ -81,7 +81,9 @@ void RunCheck(const CheckArgs& args) {
     std::printf("  periodic: along %s, period %s m\n", VecText(p.direction).c_str(), FormatNumber(p.period_m).c_str());
   for (const geo::Target& t : v.targets)
     std::printf("  target %-16s %s\n", t.id.c_str(),
-                t.kind == geo::Target::Kind::kExit ? ("exit \"" + t.exit_id + "\"").c_str()
+                t.kind == geo::Target::Kind::kExit
+                    ? (t.exit_ids.size() > 1 ? "the nearest of " + std::to_string(t.exit_ids.size()) + " exits"
+                                             : "exit \"" + t.exit_id + "\"").c_str()
                                                    : ("direction " + VecText(t.direction)).c_str());
   if (v.slope)
     std::printf("  slope: gradient %s (%s %%) downhill toward %s, %s\n", FormatNumber(v.slope->gradient).c_str(),

@@ -126,14 +126,24 @@ NavigationField NavigationField::ForTarget(const Venue& venue, std::string_view 
                      (known.empty() ? std::string("(none declared)") : known));
   }
   if (target->kind == Target::Kind::kDirection) return Constant(target->direction);
-  return ToExit(venue, target->exit_id, options);
+  return ToExits(venue, target->exit_ids.empty() ? std::vector<std::string>{target->exit_id} : target->exit_ids, options);
 }
 
 NavigationField NavigationField::ToExit(const Venue& venue, std::string_view exit_id,
                                         const NavigationOptions& options) {
+  return ToExits(venue, {std::string(exit_id)}, options);
+}
+
+NavigationField NavigationField::ToExits(const Venue& venue, const std::vector<std::string>& exit_ids,
+                                         const NavigationOptions& options) {
   if (std::string error; !options.IsValid(&error)) throw InputError("navigation: " + error);
-  const Exit* exit = venue.FindExit(exit_id);
-  if (!exit) throw GeometryError(venue.origin + ": no exit named \"" + std::string(exit_id) + "\"");
+  std::vector<const Exit*> exits;
+  for (const std::string& id : exit_ids) {
+    const Exit* e = venue.FindExit(id);
+    if (!e) throw GeometryError(venue.origin + ": no exit named \"" + id + "\"");
+    exits.push_back(e);
+  }
+  if (exits.empty()) throw GeometryError(venue.origin + ": a target with no exit");
   const double h = options.grid_spacing_m;
 
   // 1. Grid over the walkable area's bounds. The origin is offset by an
@@ -209,24 +219,26 @@ NavigationField NavigationField::ToExit(const Venue& venue, std::string_view exi
       }
   }
 
-  // 4. Sources: inside nodes within 1.5 cells of the exit take their exact
-  // distance to it, which makes the front start as the right shape (a flat
-  // front across a doorway, round around its ends).
+  // 4. Sources: inside nodes within 1.5 cells of an exit take their exact
+  // distance to it (the nearest exit's), which makes the front start as the
+  // right shape (a flat front across a doorway, round around its ends).
   std::vector<double> source(n, kUnreachable);
-  std::size_t sources = 0;
-  for (std::size_t j = 0; j < ny; ++j)
-    for (std::size_t i = 0; i < nx; ++i) {
-      const std::size_t k = j * nx + i;
-      if (!grid.inside[k]) continue;
-      const double d = DistanceToSegment(node(i, j), exit->a, exit->b);
-      if (d <= 1.5 * h) {
-        source[k] = d;
-        ++sources;
+  for (const Exit* exit : exits) {
+    std::size_t sources = 0;
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::size_t k = j * nx + i;
+        if (!grid.inside[k]) continue;
+        const double d = DistanceToSegment(node(i, j), exit->a, exit->b);
+        if (d <= 1.5 * h) {
+          source[k] = std::min(source[k], d);
+          ++sources;
+        }
       }
-    }
-  if (sources == 0)
-    throw GeometryError(venue.origin + ": exit \"" + exit->id + "\" has no grid node of the walkable area within " +
-                        FormatNumber(1.5 * h) + " m; expected a smaller navigation grid spacing");
+    if (sources == 0)
+      throw GeometryError(venue.origin + ": exit \"" + exit->id + "\" has no grid node of the walkable area within " +
+                          FormatNumber(1.5 * h) + " m; expected a smaller navigation grid spacing");
+  }
 
   // 5. March, then -grad T at each node by central differences where both
   // neighbours are reachable and not walled off, one-sided otherwise.

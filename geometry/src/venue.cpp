@@ -78,6 +78,7 @@ std::optional<Target> Venue::FindTarget(std::string_view id) const {
     t.id = e->id;
     t.kind = Target::Kind::kExit;
     t.exit_id = e->id;
+    t.exit_ids = {e->id};
     return t;
   }
   return std::nullopt;
@@ -250,12 +251,20 @@ class VenueReader {
     ForEachObject("targets", [&](const JsonReader& t, std::size_t) {
       Target target;
       target.id = ReadId(t);
-      const bool has_exit = t.Has("exit"), has_direction = t.Has("direction");
-      if (has_exit == has_direction)
-        t.Fail("a target needs exactly one of \"exit\" (an exit id) or \"direction\" ([x, y])");
+      const bool has_exit = t.Has("exit"), has_exits = t.Has("exits"), has_direction = t.Has("direction");
+      if (int(has_exit) + int(has_exits) + int(has_direction) != 1)
+        t.Fail("a target needs exactly one of \"exit\" (an exit id), \"exits\" (a list of exit ids: the nearest) "
+               "or \"direction\" ([x, y])");
       if (has_exit) {
         target.kind = Target::Kind::kExit;
         target.exit_id = t.String("exit");
+        target.exit_ids = {target.exit_id};
+      } else if (has_exits) {
+        const JsonReader list = t.At("exits");
+        if (!list.IsArray() || list.Size() == 0) list.Fail("expected a non-empty list of exit ids");
+        target.kind = Target::Kind::kExit;
+        for (std::size_t k = 0; k < list.Size(); ++k) target.exit_ids.push_back(list.Element(k).AsString());
+        target.exit_id = target.exit_ids.front();
       } else {
         target.kind = Target::Kind::kDirection;
         target.direction = ReadDirection(t.At("direction"));
@@ -506,7 +515,8 @@ std::string VenueToJson(const Venue& v) {
     for (const Target& t : v.targets) {
       Json j;
       j["id"] = t.id;
-      if (t.kind == Target::Kind::kExit) j["exit"] = t.exit_id;
+      if (t.kind == Target::Kind::kExit && t.exit_ids.size() > 1) j["exits"] = t.exit_ids;
+      else if (t.kind == Target::Kind::kExit) j["exit"] = t.exit_id;
       else j["direction"] = PointJson(t.direction);
       list.push_back(j);
     }

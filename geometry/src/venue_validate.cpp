@@ -397,12 +397,16 @@ class Checker {
   void CheckTargets() {
     for (std::size_t i = 0; i < v_.targets.size(); ++i) {
       const Target& t = v_.targets[i];
-      if (t.kind != Target::Kind::kExit || v_.FindExit(t.exit_id)) continue;
-      std::string known;
-      for (const Exit& e : v_.exits) known += (known.empty() ? "\"" : ", \"") + e.id + "\"";
-      Problem("/targets/" + Index(i) + "/exit",
-              "target \"" + t.id + "\" names exit \"" + t.exit_id + "\", which does not exist; expected one of " +
-                  (known.empty() ? std::string("(no exits declared)") : known));
+      if (t.kind != Target::Kind::kExit) continue;
+      const std::vector<std::string> ids = t.exit_ids.empty() ? std::vector<std::string>{t.exit_id} : t.exit_ids;
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        if (v_.FindExit(ids[k])) continue;
+        std::string known;
+        for (const Exit& e : v_.exits) known += (known.empty() ? "\"" : ", \"") + e.id + "\"";
+        Problem("/targets/" + Index(i) + (t.exit_ids.size() > 1 ? "/exits/" + Index(k) : "/exit"),
+                "target \"" + t.id + "\" names exit \"" + ids[k] + "\", which does not exist; expected one of " +
+                    (known.empty() ? std::string("(no exits declared)") : known));
+      }
     }
   }
 

@@ -366,6 +366,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     loop.Add(detail::MakeExitSystem(*timeline));
     loop.Add(detail::MakeFallSystem(*timeline));
     loop.Add(detail::MakeAvalancheSystem(*timeline));
+    loop.Add(detail::MakeLeftSystem(*timeline));
   }
   loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
   loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts, timeline.get()));
@@ -395,7 +396,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     last_frame = loop.summary().last_frame;
     if (loop.summary().finished) {
       frames.Flush();
-      writer.SetRunValue("settled", loop.summary().finish_reason);
+      writer.SetRunValue(scenario.run.settle.enabled ? "settled" : "finished_early", loop.summary().finish_reason);
       say(loop.summary().finish_reason);
     } else if (loop.summary().stopped) {
       checkpoint_at(checkpoint, last_frame);

@@ -321,6 +321,7 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
   }
   t.max_present = static_cast<std::size_t>(reader.Integer("max_present", 0, 0, 200000));
   t.entry_clearance_m = reader.Number("entry_clearance_m", t.entry_clearance_m, 0.0, 2.0);
+  t.stop_when_left_fraction = reader.Number("stop_when_left_fraction", 0.0, 0.0, 1.0);
   if (auto clock = reader.Find("clock_start")) {
     t.clock_start = clock->AsString();
     const std::string& c = t.clock_start;

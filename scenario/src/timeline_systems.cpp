@@ -411,6 +411,28 @@ class AvalancheSystem : public RunSystem {
   double next_check_s_ = 0.0;
 };
 
+// Ends an evacuation once the stated share of the people who entered has
+// left (timeline.stop_when_left_fraction).
+class LeftSystem : public RunSystem {
+ public:
+  explicit LeftSystem(TimelineState& s) : s_(s) {}
+  std::string_view name() const override { return "left"; }
+  void AtFrame(FrameContext& c) override {
+    const double fraction = s_.spec.stop_when_left_fraction;
+    const std::uint64_t entered = s_.Entered();
+    if (!(fraction > 0.0) || entered == 0 || static_cast<double>(s_.removed) < fraction * static_cast<double>(entered))
+      return;
+    c.finish = true;
+    c.finish_reason = FormatNumber(100.0 * fraction) + " % of the people who entered have left (" +
+                      std::to_string(s_.removed) + " of " + std::to_string(entered) + ") at t = " +
+                      FormatNumber(c.sim.time_s()) + " s";
+    s_.Event(c.sim.time_s(), "left", -1, c.finish_reason);
+  }
+
+ private:
+  TimelineState& s_;
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -545,6 +567,7 @@ std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& s) { return std::make
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& s) { return std::make_unique<ExitSystem>(s); }
 std::unique_ptr<RunSystem> MakeFallSystem(TimelineState& s) { return std::make_unique<FallSystem>(s); }
 std::unique_ptr<RunSystem> MakeAvalancheSystem(TimelineState& s) { return std::make_unique<AvalancheSystem>(s); }
+std::unique_ptr<RunSystem> MakeLeftSystem(TimelineState& s) { return std::make_unique<LeftSystem>(s); }
 
 void OpenDoorsAtStart(engine::Simulation& sim, const TimelineState& s) {
   for (std::size_t x = 0; x < s.exit_open.size(); ++x)

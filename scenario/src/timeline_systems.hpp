@@ -8,6 +8,7 @@
 //   falls            the fall criterion (filtered acceleration, or a sustained load)
 //   avalanches       (per frame) the analysis's avalanche detector on each direction's
 //                    mean speed, events as avalanches are first seen
+//   left             (per frame) ends an evacuation once stop_when_left_fraction has left
 //
 // They share a TimelineState (queues, exits open, inflows on, counts, the
 // events of the frame), saved in checkpoints by timeline_events; the falls
@@ -76,6 +77,7 @@ std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeFallSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeAvalancheSystem(TimelineState& state);
+std::unique_ptr<RunSystem> MakeLeftSystem(TimelineState& state);
 
 // Opens and closes the doors as the timeline starts (before the first step).
 void OpenDoorsAtStart(engine::Simulation& sim, const TimelineState& state);

@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -43,6 +44,10 @@ class NavigationField {
   // Geodesic field toward the exit `exit_id` (GeometryError if there is none).
   static NavigationField ToExit(const Venue& venue, std::string_view exit_id,
                                 const NavigationOptions& options = {});
+  // Geodesic field toward the nearest of several exits (T = 0 on each: the
+  // walking distance to the closest one).
+  static NavigationField ToExits(const Venue& venue, const std::vector<std::string>& exit_ids,
+                                 const NavigationOptions& options = {});
   // Constant field.
   static NavigationField Constant(Vec2 direction);
   // Constant field whose direction is kept exactly as given, not normalised

@@ -102,7 +102,10 @@ struct Target {
   enum class Kind { kExit, kDirection };
   std::string id;
   Kind kind = Kind::kDirection;
-  std::string exit_id;  // for kExit
+  std::string exit_id;  // for kExit: the (first) exit
+  // For kExit: every exit of the target, the first being exit_id; with
+  // several ("exits": [...]) people walk to the nearest by walking distance.
+  std::vector<std::string> exit_ids;
   Vec2 direction;       // for kDirection: unit vector
 };
 

@@ -142,6 +142,9 @@ struct TimelineSpec {
   double entry_clearance_m = 0.1;
   // Most people in the venue at once (engine slots); 0: from the venue's area.
   std::size_t max_present = 0;
+  // End the run (complete) once this share of the people who entered has
+  // left through the exits (an evacuation "until 95 % have left"); 0: never.
+  double stop_when_left_fraction = 0.0;
   // The wall-clock time of t = 0 ("02:00", for the figure's axis), and what
   // was recorded of the incident (the figure marks it; the run ignores it).
   std::string clock_start;
