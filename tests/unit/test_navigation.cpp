@@ -50,6 +50,33 @@ TEST(FastMarch, BlockedLinksStopTheFront) {
   EXPECT_TRUE(std::isinf(t[5]));
 }
 
+TEST(Navigation, SeveralExitsLeadToTheNearest) {
+  // A 20 m x 4 m corridor with exits across both ends; the target "nearest"
+  // names both: its distance is the smaller of the two, and people walk to
+  // the nearer end.
+  const Venue v = Parse(R"({"version": 1, "walkable_area": [[[0, 0], [20, 0], [20, 4], [0, 4]]],
+    "walls": [{"id": "w", "polygon": [[0, 0], [20, 0], [20, 4], [0, 4]]}],
+    "exits": [{"id": "west", "segment": [[0, 0], [0, 4]]}, {"id": "east", "segment": [[20, 0], [20, 4]]}],
+    "targets": [{"id": "nearest", "exits": ["west", "east"]}]})");
+  const NavigationField f = NavigationField::ForTarget(v, "nearest");
+  EXPECT_NEAR(f.Distance({3.0, 2.0}), 3.0, 0.05);
+  EXPECT_NEAR(f.Distance({16.0, 2.0}), 4.0, 0.05);
+  EXPECT_LT(f.Direction({3.0, 2.0}).x, -0.99);
+  EXPECT_GT(f.Direction({16.0, 2.0}).x, 0.99);
+  // Written back as "exits" and read again the same.
+  EXPECT_NE(VenueToJson(v).find("\"exits\": ["), std::string::npos);
+  EXPECT_EQ(ParseVenue(VenueToJson(v), "again.json").targets.at(0).exit_ids, (std::vector<std::string>{"west", "east"}));
+  // An unknown exit in the list is named with its path.
+  try {
+    Parse(R"({"version": 1, "walkable_area": [[[0, 0], [20, 0], [20, 4], [0, 4]]],
+      "exits": [{"id": "west", "segment": [[0, 0], [0, 4]]}],
+      "targets": [{"id": "nearest", "exits": ["west", "north"]}]})");
+    ADD_FAILURE() << "an unknown exit was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/targets/0/exits/1"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Navigation, CorridorDistanceIsExact) {
   const Venue v = Parse(R"({"walkable_area": [[[0, 0], [20, 0], [20, 4], [0, 4]]],
                            "exits": [{"id": "end", "segment": [[20, 0], [20, 4]]}]})");
