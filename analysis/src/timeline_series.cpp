@@ -1,5 +1,6 @@
 #include "crowdrecon/analysis/timeline_series.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -31,6 +32,19 @@ std::vector<double> MovingMean(const std::vector<double>& t, const std::vector<d
   return out;
 }
 
+double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit) {
+  if (exit >= s.exit_left.size() || s.exit_left[exit].empty()) return std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double>& left = s.exit_left[exit];
+  const double total = left.back();
+  if (total < 10.0 || !(s.exit_width_m[exit] > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  const auto when = [&](double count) {
+    return s.time_s[static_cast<std::size_t>(std::lower_bound(left.begin(), left.end(), count) - left.begin())];
+  };
+  const double t10 = when(0.1 * total), t90 = when(0.9 * total);
+  if (!(t90 > t10)) return std::numeric_limits<double>::quiet_NaN();
+  return 0.8 * total / (t90 - t10) / s.exit_width_m[exit];
+}
+
 std::string ClockText(const std::string& clock_start, double t_s) {
   char text[32];
   if (clock_start.size() != 5) {
@@ -51,7 +65,12 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   s.clock_start = reader.RunValue("timeline_clock_start");
   const std::string venue = reader.venue_json();
   if (venue.empty()) throw InputError(run_file.string() + ": the run file holds no venue (written before format 2)");
-  s.area_m2 = geometry::WalkableArea_m2(geometry::ParseVenue(venue, run_file.string() + ": run value venue"));
+  const geometry::Venue stored = geometry::ParseVenue(venue, run_file.string() + ": run value venue");
+  s.area_m2 = geometry::WalkableArea_m2(stored);
+  for (const geometry::Exit& e : stored.exits) {
+    s.exit_names.push_back(e.id);
+    s.exit_width_m.push_back(e.width_m());
+  }
 
   // People present and the counter-flow's share, frame by frame.
   const std::vector<runfile::FrameTime> times = reader.FrameTimes();
@@ -107,7 +126,16 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
       s.group_names[g] = names[g] + " (" + s.group_names[g] + ")";
   }
 
+  s.exit_left.assign(s.exit_names.size(), std::vector<double>(s.time_s.size(), 0.0));
   for (const runfile::Event& e : reader.Events()) {
+    if (e.kind == "exit") {
+      const auto x = std::find(s.exit_names.begin(), s.exit_names.end(), e.detail);
+      if (x != s.exit_names.end()) {
+        std::vector<double>& left = s.exit_left[static_cast<std::size_t>(x - s.exit_names.begin())];
+        const auto from = std::lower_bound(s.time_s.begin(), s.time_s.end(), e.time_s - 1e-9);
+        for (auto f = static_cast<std::size_t>(from - s.time_s.begin()); f < left.size(); ++f) left[f] += 1.0;
+      }
+    }
     if (e.kind == "avalanche") s.avalanches.push_back({e.time_s, e.detail, e.kind});
     if (e.kind == "fall") s.falls.push_back({e.time_s, e.detail, e.kind});
   }

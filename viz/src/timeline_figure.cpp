@@ -86,7 +86,7 @@ double Max(const std::vector<double>& v, double floor_value) {
 }  // namespace
 
 void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& title, const std::filesystem::path& file) {
-  const int panels = 5;
+  const int panels = 6;
   const double height = kTop + panels * (kPanel + kGap) + 50;
   Sheet s(file, height);
   s.canvas.FillPolygon({s.P(0, 0), s.P(kWidth, 0), s.P(kWidth, height), s.P(0, height)}, Color::White());
@@ -126,6 +126,10 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   DrawFrame(s, p[2], "speed along desired dir., m/s");
   DrawFrame(s, p[3], "flow, persons/(m s)");
   DrawFrame(s, p[4], "waiting at entries");
+  double left_max = 10.0;
+  for (const auto& left : ts.exit_left) left_max = std::max(left_max, Max(left, 0.0));
+  p[5].hi = NiceStep(left_max) * std::ceil(left_max / NiceStep(left_max));
+  DrawFrame(s, p[5], "left, by exit (persons)");
   // Marks across every panel: what was recorded of the incident.
   for (const analysis::TimelineMark& m : ts.recorded) {
     if (m.time_s < t0 || m.time_s > t1) continue;
@@ -142,6 +146,7 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   DrawSeries(s, p[3], ts.time_s, forward, kSeries[0], 2.0);
   DrawSeries(s, p[3], ts.time_s, backward, kSeries[1], 2.0);
   DrawSeries(s, p[4], ts.time_s, queued, kSeries[2], 2.0);
+  for (std::size_t x = 0; x < ts.exit_left.size(); ++x) DrawSeries(s, p[5], ts.time_s, ts.exit_left[x], kSeries[(x + 2) % 4], 2.0);
   // What the run recorded: detected avalanches (triangles on the speed
   // panel), falls (crosses on the density panel).
   for (const analysis::TimelineMark& a : ts.avalanches) {
@@ -179,6 +184,14 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   ly += 8;
   entry(kSeries[0], "flow along group 0's direction", false);
   entry(kSeries[1], "flow against it", false);
+  ly += 8;
+  for (std::size_t x = 0; x < ts.exit_names.size(); ++x) {
+    const double flow = analysis::ExitSpecificFlow(ts, x);
+    entry(kSeries[(x + 2) % 4],
+          "exit " + ts.exit_names[x] + " (" + Number(ts.exit_width_m[x]) + " m)" +
+              (std::isnan(flow) ? "" : ": " + Number(std::round(flow * 100.0) / 100.0) + " /(m s)"),
+          false);
+  }
   ly += 8;
   if (!ts.recorded.empty()) {
     entry(kRecorded, "recorded avalanche", true);

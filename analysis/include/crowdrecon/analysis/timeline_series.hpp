@@ -10,6 +10,7 @@
 //   speeds, flows  AnalyzeRun's series (run_analysis.hpp): each group's mean
 //                  speed along its desired direction; crossings of the line
 //                  per metre and second, trailing 2 s window;
+//   exits          people removed through each exit by each frame;
 //   smoothing      each series is also given as a centred moving mean over
 //                  smooth_s (default 10 s), what the figure draws.
 #pragma once
@@ -37,6 +38,11 @@ struct TimelineSeries {
   std::vector<std::string> group_names;
   std::vector<std::vector<double>> group_speed_m_per_s;  // [group][frame]
   std::vector<double> flow_forward_per_m_s, flow_backward_per_m_s;
+  // Per exit of the venue: its id and width, and the people who left
+  // through it by each frame (cumulative, from the events `exit`).
+  std::vector<std::string> exit_names;
+  std::vector<double> exit_width_m;
+  std::vector<std::vector<double>> exit_left;  // [exit][frame]
   std::vector<TimelineMark> avalanches;  // detected during the run (events `avalanche`)
   std::vector<TimelineMark> falls;       // events `fall`
   std::vector<TimelineMark> recorded;    // the scenario's marks (run value timeline_recorded)
@@ -48,6 +54,11 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
 
 // Centred moving mean over `window_s` (NaN values left out; NaN where a window has none).
 std::vector<double> MovingMean(const std::vector<double>& time_s, const std::vector<double>& values, double window_s);
+
+// An exit's specific flow: people per metre of its width and second between
+// the times when 10 % and 90 % of those it let out had left (NaN if fewer
+// than 10 left).
+double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit);
 
 // "02:37" for t seconds after clock_start "02:00"; "" clock: minutes ("37 min").
 std::string ClockText(const std::string& clock_start, double t_s);
