@@ -50,6 +50,8 @@ int RunSimulate(const SimulateArgs& args) {
   scenario::InstallInterruptHandlers();
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
   std::printf("scenario: %s\n", sc.name.c_str());
+  if (s.slots > 0)
+    std::printf("timeline: %zu people at the start, room in the engine for %zu at once\n", s.people, s.slots);
   std::printf("people: %zu, time step %.6g s, %d thread(s)%s\n", s.people, s.time_step_s, options.threads,
               options.device != engine::ComputeDevice::kCuda ? ""
               : s.device_fallback.empty()                      ? ", person-pair forces on CUDA"

@@ -323,7 +323,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
           ? std::max<std::int64_t>(1, std::llround(scenario.run.checkpoint_interval_s * scenario.run.output_fps))
           : 0;
   RunSummary summary;
-  summary.people = sim.bodies().size();
+  summary.people = timeline ? built.timeline.initial_people : sim.bodies().size();
+  summary.slots = timeline ? sim.bodies().size() : 0;
   summary.time_step_s = sim.time_step_s();
   const auto start = Clock::now();
   const double start_sim = sim.time_s();

@@ -43,7 +43,8 @@ struct RunSummary {
   double simulated_s = 0.0;
   double wall_s = 0.0;
   double time_step_s = 0.0;
-  std::size_t people = 0;
+  std::size_t people = 0;       // at the start
+  std::size_t slots = 0;        // a timeline's engine slots (people of the start and places for arrivals); 0 without
   std::int64_t frames = 0;      // frames in the run file
   double real_time_factor = 0.0;  // simulated / wall seconds (this invocation)
   engine::Profile profile;         // time per engine stage (this invocation)
