@@ -321,8 +321,14 @@ void DrawPath(Page& page, const Layout& L, const PathOverlay& path) {
   page.canvas.StrokePolyline(page.Poly(pts), ink, 3.0);
   page.canvas.Arrow(page.P(pts[pts.size() - 2].first, pts[pts.size() - 2].second),
                     page.P(pts.back().first, pts.back().second), ink, 3.0);
+  std::vector<std::pair<double, double>> labelled;  // a label per place: clamped points pile up at the edges
   for (const auto& [index, text] : path.labels) {
     if (index >= pts.size()) continue;
+    const bool crowded = std::any_of(labelled.begin(), labelled.end(), [&](const std::pair<double, double>& q) {
+      return std::abs(q.first - pts[index].first) < 40.0 && std::abs(q.second - pts[index].second) < 14.0;
+    });
+    if (crowded) continue;
+    labelled.push_back(pts[index]);
     page.canvas.Dot(page.P(pts[index].first, pts[index].second), 4.5, ink);
     page.canvas.TextPxAligned(pts[index].first + 7, pts[index].second - 7, text, 12, 0.0, 1.0, ink, 0.0, true);
   }
