@@ -376,12 +376,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
 bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad, double clearance_m) const {
   if (shape >= def_.shapes.size()) throw InputError("shape index " + std::to_string(shape) + " out of range");
   const Internals& in = *in_;
-  PlacedShape me;
-  me.geometry = &in.family_geometry[in.shape_family[shape]];
-  me.scale = in.shape_scale[shape];
-  me.position = position_m;
-  me.cos_angle = std::cos(angle_rad);
-  me.sin_angle = std::sin(angle_rad);
+  const PlacedShape me = in.ShapeAt(shape, position_m, std::cos(angle_rad), std::sin(angle_rad));
   std::vector<ContactPoint> hits;
   for (std::size_t w = 0; w < in.wall_geometry.size(); ++w) {
     if (!WallEnabled(static_cast<std::uint32_t>(w))) continue;
@@ -397,13 +392,9 @@ bool Simulation::IsFree(std::uint32_t shape, Vec2 position_m, double angle_rad, 
     const Vec2 separation = Separation(position_m, bodies_.position_m[j]);
     const double reach = my_bound + in.bound_m[j] + clearance_m;
     if (LengthSquared(separation) >= reach * reach) continue;
-    PlacedShape other;
-    const std::uint32_t s = bodies_.shape[j];
-    other.geometry = &in.family_geometry[in.shape_family[s]];
-    other.scale = in.shape_scale[s];
-    other.position = position_m - separation;  // the image nearest to the candidate
-    other.cos_angle = std::cos(bodies_.angle_rad[j]);
-    other.sin_angle = std::sin(bodies_.angle_rad[j]);
+    // The image nearest to the candidate, at the angle it has now.
+    const PlacedShape other = in.ShapeAt(bodies_.shape[j], position_m - separation, std::cos(bodies_.angle_rad[j]),
+                                         std::sin(bodies_.angle_rad[j]));
     if (CollideShapes(me, other, hits) < clearance_m || !hits.empty()) return false;
   }
   return true;

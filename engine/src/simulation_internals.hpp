@@ -196,6 +196,16 @@ struct Simulation::Internals {
   std::vector<ShapeGeometry> family_geometry;
   std::vector<std::uint32_t> shape_family;
   std::vector<double> shape_scale;
+  // Shape `shape` for the narrow phase, at `position` turned by (cos, sin).
+  PlacedShape ShapeAt(std::uint32_t shape, Vec2 position, double c, double s) const {
+    PlacedShape p;
+    p.geometry = &family_geometry[shape_family[shape]];
+    p.scale = shape_scale[shape];
+    p.position = position;
+    p.cos_angle = c;
+    p.sin_angle = s;
+    return p;
+  }
   std::vector<ShapeGeometry> wall_geometry;
   std::vector<Vec2> wall_origin;  // world position of each wall's frame
   std::vector<double> bound_m;  // core radius + sphero-radius per body

@@ -69,14 +69,7 @@ class PairCollider {
 
  private:
   PlacedShape Placed(std::uint32_t i, Vec2 position) const {
-    PlacedShape p;
-    const std::uint32_t shape = bodies_.shape[i];
-    p.geometry = &in_.family_geometry[in_.shape_family[shape]];
-    p.scale = in_.shape_scale[shape];
-    p.position = position;
-    p.cos_angle = in_.cos_angle[i];
-    p.sin_angle = in_.sin_angle[i];
-    return p;
+    return in_.ShapeAt(bodies_.shape[i], position, in_.cos_angle[i], in_.sin_angle[i]);
   }
   Vec2 VelocityAt(std::uint32_t i, Vec2 arm) const {
     if (bodies_.state[i] != PersonState::kWalking) return Vec2{};

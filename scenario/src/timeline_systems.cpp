@@ -199,8 +199,7 @@ class InflowSystem : public RunSystem {
       const std::uint32_t id = s_.built.first_id[f] + static_cast<std::uint32_t>(k);
       sim.Spawn(slot, p, id);
       ++s_.placed[f];
-      const double due_at = t;  // (the queue's wait is in the census)
-      s_.Event(due_at, "enter", id, s_.spec.inflows[f].id + " at " + s_.spec.inflows[f].entry);
+      s_.Event(t, "enter", id, s_.spec.inflows[f].id + " at " + s_.spec.inflows[f].entry);
       return true;
     }
     return false;
@@ -496,7 +495,10 @@ std::uint64_t TimelineState::Due(std::size_t f, double t) const {
 
 std::uint64_t TimelineState::Queued(double t) const {
   std::uint64_t q = 0;
-  for (std::size_t f = 0; f < spec.inflows.size(); ++f) q += Due(f, t) - std::min(Due(f, t), placed[f]);
+  for (std::size_t f = 0; f < spec.inflows.size(); ++f) {
+    const std::uint64_t due = Due(f, t);
+    q += due - std::min(due, placed[f]);
+  }
   return q;
 }
 
