@@ -3,6 +3,8 @@
 // crowdrecon::InputError and reported by main().
 #pragma once
 
+#include <string>
+
 namespace CLI {
 class App;
 }
@@ -17,6 +19,11 @@ void RegisterAnalyzeCommand(CLI::App& app);  // analyze (metrics and regime of a
 void RegisterSweepCommand(CLI::App& app);  // sweep (grids of runs, local or MPI)
 void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat maps of a sweep)
 void RegisterTimelineCommand(CLI::App& app);  // timeline (the figure of an incident timeline's run)
+void RegisterReportCommand(CLI::App& app);  // report (injury risk of runs: HTML, PDF, CSV)
+
+// The command line as given (for the records of reports), set by main.
+const std::string& CommandLine();
+void SetCommandLine(int argc, char** argv);
 
 // The --force flag of every command that writes: replace a file, or write into
 // a folder, that is not a previous output of the command (see

@@ -2,11 +2,27 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 #include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::cli {
+namespace {
+std::string command_line;
+}
+const std::string& CommandLine() { return command_line; }
+void SetCommandLine(int argc, char** argv) {
+  command_line.clear();
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool plain = !arg.empty() && arg.find_first_of(" \t'\"$`\\") == std::string::npos;
+    command_line += (i ? " " : "") + (plain ? arg : "'" + arg + "'");
+  }
+}
+}  // namespace crowdrecon::cli
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -22,6 +38,8 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterSweepCommand(app);
   crowdrecon::cli::RegisterPhaseCommand(app);
   crowdrecon::cli::RegisterTimelineCommand(app);
+  crowdrecon::cli::RegisterReportCommand(app);
+  crowdrecon::cli::SetCommandLine(argc, argv);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

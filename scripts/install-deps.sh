@@ -21,6 +21,8 @@ packages=(
   nlohmann-json3-dev libcli11-dev libdxflib-dev libsqlite3-dev sqlite3
   # sweeps spread over several machines (crowdrecon sweep under mpirun)
   libopenmpi-dev openmpi-bin
+  # reports: report.pdf printed by headless Chromium; its pages checked as pictures (pdftoppm)
+  chromium poppler-utils
   # tests and benchmarks (GNU time: peak memory in bench/run_benchmarks.py)
   libgtest-dev libgmock-dev libbenchmark-dev time
 )

@@ -494,6 +494,27 @@ std::vector<std::int64_t> RunFileReader::Frames() const {
   return frames;
 }
 
+namespace {
+// The columns of a contact row, as ReadContact reads them.
+constexpr const char* kContactColumns =
+    "SELECT frame, rowid, a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m, normal_force_n, "
+    "tangential_force_n";
+
+Contact ReadContact(Statement& c) {
+  using namespace run_limits;
+  Contact k;
+  k.a = static_cast<std::uint32_t>(c.Integer(2, 1, kPersonId) - 1);
+  k.wall = c.Integer(4, 0, 1) != 0;
+  k.b = static_cast<std::uint32_t>(k.wall ? c.Integer(3, 0, kPersonId) : c.Integer(3, 1, kPersonId) - 1);
+  k.point_m = {c.Real(5, -kCoordinate_m, kCoordinate_m), c.Real(6, -kCoordinate_m, kCoordinate_m)};
+  k.normal = {c.Real(7, -kUnit, kUnit), c.Real(8, -kUnit, kUnit)};
+  k.overlap_m = c.Real(9, -kCoordinate_m, kCoordinate_m);
+  k.normal_force_n = c.Real(10, -kForce_n, kForce_n);
+  k.tangential_force_n = c.Real(11, -kForce_n, kForce_n);
+  return k;
+}
+}  // namespace
+
 RunFrame RunFileReader::Frame(std::int64_t frame) const {
   RunFrame f;
   f.frame = frame;
@@ -512,22 +533,9 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
     f.position_m.push_back({s.Real(2, -kCoordinate_m, kCoordinate_m), s.Real(3, -kCoordinate_m, kCoordinate_m)});
     f.orientation.push_back({s.Real(4, -kUnit, kUnit), s.Real(5, -kUnit, kUnit)});
   }
-  Statement c(*impl_->db,
-              "SELECT frame, rowid, a, b, wall, point_x, point_y, normal_x, normal_y, overlap_m, normal_force_n, "
-              "tangential_force_n FROM contact WHERE frame = ? ORDER BY rowid");
+  Statement c(*impl_->db, std::string(kContactColumns) + " FROM contact WHERE frame = ? ORDER BY rowid");
   c.Bind(1, frame).Describe("contact", {0, 1});
-  while (c.Next()) {
-    Contact k;
-    k.a = static_cast<std::uint32_t>(c.Integer(2, 1, kPersonId) - 1);
-    k.wall = c.Integer(4, 0, 1) != 0;
-    k.b = static_cast<std::uint32_t>(k.wall ? c.Integer(3, 0, kPersonId) : c.Integer(3, 1, kPersonId) - 1);
-    k.point_m = {c.Real(5, -kCoordinate_m, kCoordinate_m), c.Real(6, -kCoordinate_m, kCoordinate_m)};
-    k.normal = {c.Real(7, -kUnit, kUnit), c.Real(8, -kUnit, kUnit)};
-    k.overlap_m = c.Real(9, -kCoordinate_m, kCoordinate_m);
-    k.normal_force_n = c.Real(10, -kForce_n, kForce_n);
-    k.tangential_force_n = c.Real(11, -kForce_n, kForce_n);
-    f.contacts.push_back(k);
-  }
+  while (c.Next()) f.contacts.push_back(ReadContact(c));
   return f;
 }
 
@@ -660,6 +668,36 @@ PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
       "JOIN person_state s ON s.frame = t.frame AND s.id = t.id WHERE t.frame <= ?1 "
       "ORDER BY t.frame, t.id");
   stream.impl_->query->Bind(1, last_frame).Describe("trajectory_data", {0, 1});
+  stream.impl_->have_row = stream.impl_->query->Next();
+  return stream;
+}
+
+struct ContactFrameStream::Impl {
+  std::unique_ptr<Statement> query;
+  bool have_row = false;
+};
+
+ContactFrameStream::ContactFrameStream() : impl_(std::make_unique<Impl>()) {}
+ContactFrameStream::ContactFrameStream(ContactFrameStream&&) noexcept = default;
+ContactFrameStream::~ContactFrameStream() = default;
+
+bool ContactFrameStream::Next(std::int64_t* frame, std::vector<Contact>* out) {
+  if (!impl_->have_row) return false;
+  Statement& q = *impl_->query;
+  *frame = q.Int(0);
+  out->clear();
+  while (impl_->have_row && q.Int(0) == *frame) {
+    out->push_back(ReadContact(q));
+    impl_->have_row = q.Next();
+  }
+  return true;
+}
+
+ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {
+  ContactFrameStream stream;
+  stream.impl_->query = std::make_unique<Statement>(
+      *impl_->db, std::string(kContactColumns) + " FROM contact WHERE frame <= ?1 ORDER BY frame, rowid");
+  stream.impl_->query->Bind(1, last_frame).Describe("contact", {0, 1});
   stream.impl_->have_row = stream.impl_->query->Next();
   return stream;
 }

@@ -281,6 +281,22 @@ class PersonFrameStream {
   std::unique_ptr<Impl> impl_;
 };
 
+// The contacts of a run frame by frame, in order (one query; frames without
+// contacts are skipped: compare the frame numbers).
+class ContactFrameStream {
+ public:
+  ContactFrameStream(ContactFrameStream&&) noexcept;
+  ~ContactFrameStream();
+  // Fills `frame` and `out` with the next frame that has contacts; false after the last.
+  bool Next(std::int64_t* frame, std::vector<Contact>* out);
+
+ private:
+  friend class RunFileReader;
+  ContactFrameStream();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 class RunFileReader {
  public:
   explicit RunFileReader(const std::filesystem::path& file);
@@ -303,6 +319,8 @@ class RunFileReader {
   RunFrame Frame(std::int64_t frame) const;
   // Every frame up to `last_frame` inclusive, in order.
   PersonFrameStream PersonFrames(std::int64_t last_frame) const;
+  // Every frame's contacts up to `last_frame` inclusive, in order.
+  ContactFrameStream ContactFrames(std::int64_t last_frame) const;
   // The sum of every recorded velocity of each group's people (index = group).
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;

@@ -1,0 +1,86 @@
+// The injury-risk report: from one run or an ensemble of runs (seeds), and
+// optionally a second ensemble to compare with, DIR/report.html (self-
+// contained: figures as inline SVG), DIR/report.pdf (the same page printed
+// by headless Chromium) and DIR/people.csv (one row per person and run).
+//
+//   reports::ReportOptions options;
+//   options.inputs = {"hallway.sqlite"};
+//   options.compare = {"evacuation.sqlite"};
+//   options.output_dir = "out/report";
+//   reports::ReportSummary summary = reports::WriteReport(options);
+//   std::puts(summary.BriefReport().c_str());
+//
+// Used by `crowdrecon report`; docs/reports.md describes every section.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/reports/risk.hpp"
+
+namespace crowdrecon::reports {
+
+struct ReportOptions {
+  // Run files, or folders whose *.sqlite run files (recursively) are taken:
+  // one ensemble of seeds of one scenario.
+  std::vector<std::filesystem::path> inputs;
+  std::vector<std::filesystem::path> compare;  // a second ensemble (may be empty)
+  std::string label = "runs";                  // names of the two ensembles in the report
+  std::string compare_label = "comparison";
+  std::filesystem::path output_dir;
+  RiskOptions risk;
+  bool pdf = true;          // print report.pdf with headless Chromium
+  std::string chromium;     // the browser to print with; "" = chromium, chromium-browser, google-chrome on PATH
+  std::string command_line; // recorded in the reproducibility section
+  std::size_t table_rows = 40;  // people listed in the HTML table (all of them in people.csv)
+  bool force = false;           // replace what is at output_dir (never an input)
+  std::function<void(const std::string&)> progress;  // one line per step (may be empty)
+
+  bool IsValid(std::string* error) const;
+};
+
+// An interval across the runs of an ensemble: the median and the smallest
+// and largest value over its runs.
+struct Spread {
+  double median = 0.0, low = 0.0, high = 0.0;
+  std::size_t runs = 0;
+};
+
+struct EnsembleSummary {
+  std::string label;
+  std::size_t runs = 0;
+  std::array<Spread, kZones> zone;  // people per zone
+  Spread people;                    // people who appeared
+  Spread beyond_tolerance;          // dose >= 1
+  Spread danger_fraction;           // danger / people
+  double longest_exposure_s = 0.0;  // over every person of every run
+  double max_load_n = 0.0;
+};
+
+struct ReportSummary {
+  std::filesystem::path html, pdf, csv;
+  EnsembleSummary main, other;  // other.runs = 0 without --compare
+  // Ratio of the fraction of people in danger (other / main), median and
+  // range over every pair of runs; runs = 0 when there is nothing to compare
+  // or the main ensemble has nobody in danger.
+  Spread danger_ratio;
+  double seconds = 0.0;
+  std::string BriefReport() const;
+};
+
+ReportSummary WriteReport(const ReportOptions& options);
+
+// A previous report folder (report.html written by crowdrecon, report.pdf,
+// people.csv, and nothing else), which report -o may write into.
+OutputKind ReportFolderOutput();
+
+// Expands inputs into run files (folders: every *.sqlite run file below,
+// sorted); throws InputError naming an input that is neither.
+std::vector<std::filesystem::path> RunFilesOf(const std::vector<std::filesystem::path>& inputs);
+
+}  // namespace crowdrecon::reports

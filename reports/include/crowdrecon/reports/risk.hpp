@@ -1,0 +1,128 @@
+// Injury risk of a run: each person's chest load over time (chest_load.hpp),
+// exposure against tolerance, and the paper's safe / uncomfortable / danger
+// zones (docs/reports.md gives the tolerance model, its sources and limits).
+//
+//   reports::RiskOptions options;             // F0 = 400 N, ...
+//   reports::RunRisk risk = reports::AnalyseRunRisk("run.sqlite", options);
+//   risk.counts[reports::Zone::kDanger] ...
+//
+// The run's contacts are read frame by frame (never the whole table at once).
+// Errors a user can cause (no run file, a run without contacts, an option out
+// of range) are InputError naming the file or the option.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/common/vec2.hpp"
+
+namespace crowdrecon::reports {
+
+// The paper's zones (Figure 6 c-d), per person from the peak of the smoothed
+// chest load: below F0, between F0 and the danger load, above it.
+enum class Zone : std::uint8_t { kSafe = 0, kUncomfortable = 1, kDanger = 2 };
+inline constexpr std::size_t kZones = 3;
+const char* ToString(Zone z);
+
+struct RiskOptions {
+  // F0: the load the paper takes as the onset of risk ("a reasonable
+  // estimation of the load might be 400 N"; Figure 6 scales forces by it).
+  double f0_n = 400.0;
+  // The danger zone's lower edge: the smallest load Hopkins et al. (1993)
+  // report as fatal (death after 4-6 minutes at 1112 N).
+  double danger_n = 1112.0;
+  // Tolerance time T(F) = short_s (F / short_n)^-k, a power law through
+  // Hopkins et al.'s two points (6227 N for about 15 s; 1112 N for 4-6 min,
+  // taken as 5 min); loads at or below F0 add no dose.
+  double lethal_short_n = 6227.0, lethal_short_s = 15.0;
+  double lethal_long_n = 1112.0, lethal_long_s = 300.0;
+  // The chest load is a moving mean over this window (s): a contact model's
+  // loads spike within single steps; a chest is compressed over a breath.
+  double smoothing_s = 1.0;
+  // Called after each frame with (frames done, frames in all); may be empty.
+  std::function<void(std::size_t, std::size_t)> progress;
+
+  bool IsValid(std::string* error) const;
+  // The exponent k of the tolerance power law.
+  double ToleranceExponent() const;
+  // T(F) in seconds; infinite at or below F0.
+  double ToleranceTime_s(double load_n) const;
+  Zone ZoneOf(double load_n) const;
+};
+
+// One person's exposure over the run (loads are the smoothed chest load,
+// the larger of across the chest and across the shoulders).
+struct PersonRisk {
+  std::uint32_t id = 0;  // 1-based, as in the run file
+  std::uint32_t group = 0;
+  double first_seen_s = std::numeric_limits<double>::quiet_NaN();
+  double last_seen_s = std::numeric_limits<double>::quiet_NaN();
+  double max_load_n = 0.0;
+  double max_load_time_s = 0.0;
+  Vec2 max_load_position_m;
+  double max_raw_load_n = 0.0;        // the largest single-frame load (unsmoothed)
+  double time_above_f0_s = 0.0;
+  double longest_above_f0_s = 0.0;    // the longest continuous stretch
+  double time_above_danger_s = 0.0;
+  double dose = 0.0;                  // sum of dt / T(F): 1 = the tolerance reached
+  bool fell = false;                  // fallen at some frame
+  Zone zone = Zone::kSafe;
+};
+
+// The crowd at one frame.
+struct FrameRisk {
+  std::int64_t frame = 0;
+  double time_s = 0.0;
+  std::uint32_t present = 0;
+  std::uint32_t above_f0 = 0;      // smoothed load above F0
+  std::uint32_t above_danger = 0;  // smoothed load above the danger load
+  std::uint32_t contacts = 0;
+  double max_load_n = 0.0;
+};
+
+// Counts of a histogram over log10(force / F0) from kLow to kHigh in
+// kPerDecade bins per decade (below: bin 0, above: the last bin), for the
+// distribution of contact forces over a whole run without holding them.
+struct ForceHistogram {
+  static constexpr double kLow = -4.0, kHigh = 3.0;
+  static constexpr int kPerDecade = 20;
+  static constexpr int kBins = static_cast<int>((kHigh - kLow) * kPerDecade);
+  std::array<std::uint64_t, kBins> counts{};
+  std::uint64_t zero = 0;   // contacts with no force
+  std::uint64_t total = 0;
+  void Add(double force_over_f0);
+  // The fraction of recorded forces above force_over_f0 (at bin edges).
+  double FractionAbove(double force_over_f0) const;
+  static double UpperEdge(int bin);  // in units of F0
+};
+
+struct RunRisk {
+  std::filesystem::path file;
+  std::string scenario_name;
+  std::string venue_name;
+  std::string seed;
+  double fps = 0.0;
+  double duration_s = 0.0;
+  std::vector<PersonRisk> people;  // everyone who appeared, by id
+  std::vector<FrameRisk> frames;
+  ForceHistogram contact_forces;   // every contact of every frame, |F| / F0
+  // The worst moment: the frame with the most people above F0 (ties: the
+  // largest load), for the force network and the per-contact distribution.
+  std::int64_t worst_frame = 0;
+  double worst_time_s = 0.0;
+  std::vector<double> worst_contact_forces_n;  // every contact's |F| at the worst frame
+  std::vector<double> worst_person_loads_n;    // every present person's smoothed load then
+  std::array<std::uint32_t, kZones> counts{};  // people per zone
+  std::uint32_t beyond_tolerance = 0;          // dose >= 1
+  std::uint32_t fallen = 0;
+  std::uint64_t contact_rows = 0;
+};
+
+RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions& options);
+
+}  // namespace crowdrecon::reports

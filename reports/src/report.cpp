@@ -1,0 +1,728 @@
+#include "crowdrecon/reports/report.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <sys/wait.h>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/sha256.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/viz/render_run.hpp"
+#include "crowdrecon/sweep/version.hpp"
+#include "svg.hpp"
+
+namespace crowdrecon::reports {
+
+namespace fs = std::filesystem;
+using svg::Escape;
+using svg::Short;
+
+namespace {
+
+constexpr const char* kGenerator = "<meta name=\"generator\" content=\"crowdrecon report\">";
+constexpr std::array<const char*, kZones> kZoneColor = {"#2e8b57", "#e0a800", "#c0392b"};
+constexpr const char* kOtherColor = "#7b3f98";
+
+Spread SpreadOf(std::vector<double> v) {
+  Spread s;
+  s.runs = v.size();
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.low = v.front();
+  s.high = v.back();
+  const std::size_t m = v.size() / 2;
+  s.median = v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+  return s;
+}
+
+// Counts whole (a median of an even number of runs may end in .5); other
+// values with `digits` significant digits.
+std::string Value(double v, int digits) {
+  if (std::abs(v) >= 1.0 && std::abs(v - std::round(v * 2.0) / 2.0) < 1e-9) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, v == std::round(v) ? "%.0f" : "%.1f", v);
+    return buf;
+  }
+  return Short(v, digits);
+}
+
+std::string SpreadText(const Spread& s, int digits = 3) {
+  if (s.runs == 0) return "–";
+  if (s.runs == 1 || s.low == s.high) return Value(s.median, digits);
+  return Value(s.median, digits) + " <span class=\"range\">[" + Value(s.low, digits) + "–" + Value(s.high, digits) + "]</span>";
+}
+
+EnsembleSummary Summarise(const std::string& label, const std::vector<RunRisk>& runs) {
+  EnsembleSummary e;
+  e.label = label;
+  e.runs = runs.size();
+  for (std::size_t z = 0; z < kZones; ++z) {
+    std::vector<double> v;
+    for (const RunRisk& r : runs) v.push_back(r.counts[z]);
+    e.zone[z] = SpreadOf(v);
+  }
+  std::vector<double> people, beyond, fraction;
+  for (const RunRisk& r : runs) {
+    const double n = double(r.people.size());
+    people.push_back(n);
+    beyond.push_back(r.beyond_tolerance);
+    fraction.push_back(n > 0 ? r.counts[2] / n : 0.0);
+    for (const PersonRisk& p : r.people) {
+      e.longest_exposure_s = std::max(e.longest_exposure_s, p.longest_above_f0_s);
+      e.max_load_n = std::max(e.max_load_n, p.max_load_n);
+    }
+  }
+  e.people = SpreadOf(people);
+  e.beyond_tolerance = SpreadOf(beyond);
+  e.danger_fraction = SpreadOf(fraction);
+  return e;
+}
+
+// Ids of an SVG written by Cairo (glyphs, clips) made unique within the page.
+std::string PrefixSvgIds(std::string text, const std::string& prefix) {
+  const auto replace_all = [&text](const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+      text.replace(at, from.size(), to);
+  };
+  replace_all("id=\"", "id=\"" + prefix);
+  replace_all("href=\"#", "href=\"#" + prefix);
+  replace_all("url(#", "url(#" + prefix);
+  const std::size_t start = text.find("<svg");
+  return start == std::string::npos ? text : text.substr(start);
+}
+
+std::string ReadText(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The force network of `frame` of a run, drawn by viz (the paper's Figure 6 a-b).
+std::string ForceNetworkSvg(const fs::path& run, std::int64_t frame, const std::string& id_prefix) {
+  std::mt19937_64 rng(std::random_device{}());
+  const fs::path dir = fs::temp_directory_path() / ("crowdrecon-report-" + std::to_string(rng()));
+  viz::RenderOptions o;
+  o.output_dir = dir;
+  o.frames = viz::ParseFrameSelection(std::to_string(frame));
+  o.svg = true;
+  o.width_px = 1100;
+  std::string text;
+  try {
+    viz::RenderRun(run, o);
+    text = ReadText(viz::FramePicturePath(dir, frame, ".svg"));
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  std::string svg = PrefixSvgIds(text, id_prefix);
+  // Scale with the page (Cairo writes fixed sizes in pt).
+  const std::size_t tag_end = svg.find('>');
+  if (tag_end != std::string::npos) svg.insert(tag_end, " class=\"network\"");
+  return svg;
+}
+
+std::vector<std::vector<Vec2>> RingsOfWkt(const std::string& wkt) {
+  // POLYGON ((x y, ...), (...)) or MULTIPOLYGON (((...)), ...): every ring.
+  std::vector<std::vector<Vec2>> rings;
+  std::vector<Vec2> ring;
+  std::size_t i = 0;
+  int depth = 0;
+  while (i < wkt.size()) {
+    const char c = wkt[i];
+    if (c == '(') {
+      ++depth;
+      ++i;
+    } else if (c == ')') {
+      if (!ring.empty()) rings.push_back(std::move(ring));
+      ring.clear();
+      --depth;
+      ++i;
+    } else if ((c >= '0' && c <= '9') || c == '-' || c == '.') {
+      char* end = nullptr;
+      const double x = std::strtod(wkt.c_str() + i, &end);
+      const double y = std::strtod(end, &end);
+      ring.push_back({x, y});
+      i = static_cast<std::size_t>(end - wkt.c_str());
+    } else {
+      ++i;
+    }
+  }
+  return rings;
+}
+
+std::string CdfChart(const std::string& title, const std::string& x_label,
+                     const std::vector<std::pair<std::string, std::vector<double>>>& sets, const RiskOptions& o,
+                     const std::vector<std::string>& colors) {
+  // 1 - CDF of each sorted set (values in N), plotted against F / F0.
+  svg::Chart c;
+  c.title = title;
+  c.x_label = x_label;
+  c.y_label = "fraction above";
+  c.log_x = c.log_y = true;
+  c.x_min = 1e-2;
+  c.x_max = 1e2;
+  double smallest = 1.0;
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    svg::Series s;
+    s.label = sets[k].first;
+    s.color = colors[k % colors.size()];
+    s.step = true;
+    const auto& v = sets[k].second;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      s.x.push_back(v[i] / o.f0_n);
+      s.y.push_back(double(v.size() - i) / double(v.size()));
+    }
+    if (!v.empty()) smallest = std::min(smallest, 1.0 / double(v.size()));
+    c.series.push_back(std::move(s));
+  }
+  c.y_min = std::max(1e-5, std::pow(10.0, std::floor(std::log10(smallest))));
+  c.y_max = 1.0;
+  c.legend_left = c.legend_bottom = true;
+  c.bands = {{1e-3, 1.0, kZoneColor[0], "safe"},
+             {1.0, o.danger_n / o.f0_n, kZoneColor[1], "uncomfortable"},
+             {o.danger_n / o.f0_n, 1e3, kZoneColor[2], "danger"}};
+  return c.ToSvg();
+}
+
+std::string Table(const std::vector<std::string>& head, const std::vector<std::vector<std::string>>& rows) {
+  std::string s = "<table><thead><tr>";
+  for (const auto& h : head) s += "<th>" + h + "</th>";
+  s += "</tr></thead><tbody>\n";
+  for (const auto& r : rows) {
+    s += "<tr>";
+    for (const auto& cell : r) s += "<td>" + cell + "</td>";
+    s += "</tr>\n";
+  }
+  return s + "</tbody></table>\n";
+}
+
+std::string FindChromium(const std::string& given) {
+  if (!given.empty()) return given;
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "/usr/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':'))
+    for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+      const fs::path p = fs::path(dir) / name;
+      std::error_code ec;
+      if (fs::is_regular_file(p, ec)) return p.string();
+    }
+  return "";
+}
+
+std::string ShellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+void PrintPdf(const std::string& chromium, const fs::path& html, const fs::path& pdf) {
+  if (chromium.empty())
+    throw InputError("report.pdf: no Chromium found (looked for chromium, chromium-browser and google-chrome on PATH); "
+                     "install Debian's chromium (scripts/install-deps.sh) or give --chromium PATH, or --no-pdf");
+  const fs::path profile = pdf.parent_path() / ".chromium-profile";
+  const std::string cmd = ShellQuote(chromium) + " --headless --no-sandbox --disable-gpu --no-first-run" +
+                          " --user-data-dir=" + ShellQuote(profile.string()) +
+                          " --no-pdf-header-footer --print-to-pdf=" + ShellQuote(pdf.string()) + " " +
+                          ShellQuote("file://" + fs::absolute(html).string()) + " > " +
+                          ShellQuote((pdf.parent_path() / ".chromium.log").string()) + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::error_code ec;
+  fs::remove_all(profile, ec);
+  const bool ok = status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::is_regular_file(pdf, ec) &&
+                  fs::file_size(pdf, ec) > 0;
+  const fs::path log = pdf.parent_path() / ".chromium.log";
+  const std::string log_text = ok ? "" : ReadText(log);
+  fs::remove(log, ec);
+  if (!ok)
+    throw InputError("report.pdf: " + chromium + " could not print " + html.string() + " (exit status " +
+                     std::to_string(status) + "): " + log_text.substr(0, 400));
+}
+
+std::string Css() {
+  return R"CSS(
+body { font-family: "DejaVu Sans", Arial, sans-serif; color: #222; max-width: 1120px; margin: 24px auto; padding: 0 16px; line-height: 1.45; font-size: 14px; }
+h1 { font-size: 24px; margin-bottom: 4px; } h2 { font-size: 19px; border-bottom: 2px solid #ddd; padding-bottom: 3px; margin-top: 30px; }
+h3 { font-size: 16px; }
+.sub { color: #555; margin-top: 0; }
+table { border-collapse: collapse; margin: 8px 0 14px; font-size: 13px; }
+th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; vertical-align: top; }
+th { background: #f1f1ee; } td:first-child, th:first-child { text-align: left; }
+.range { color: #666; font-size: 12px; }
+.zone-safe { color: #2e8b57; font-weight: bold; } .zone-uncomfortable { color: #a07800; font-weight: bold; } .zone-danger { color: #c0392b; font-weight: bold; }
+.key { display: grid; grid-template-columns: repeat(4, 1fr); gap: 10px; margin: 12px 0; }
+.key div { border: 1px solid #ddd; border-radius: 6px; padding: 8px 10px; background: #fafaf8; }
+.key b { display: block; font-size: 22px; }
+svg.chart, svg.plan { max-width: 100%; height: auto; display: block; margin: 6px 0 14px; }
+svg.network { max-width: 100%; height: auto; display: block; border: 1px solid #ddd; }
+figure { margin: 10px 0 18px; page-break-inside: avoid; } figcaption { color: #444; font-size: 13px; }
+pre { background: #f6f6f3; padding: 8px; overflow-x: auto; font-size: 11px; white-space: pre-wrap; word-break: break-all; }
+code { font-size: 12px; } .note { color: #555; font-size: 13px; }
+@page { size: A4; margin: 14mm; }
+@media print { body { max-width: none; margin: 0; font-size: 11px; } h2 { page-break-after: avoid; } details { display: block; } details > summary { display: none; } }
+)CSS";
+}
+
+// The page checks itself in the browser: any missing image or figure is a
+// console error (the browser test fails on console errors).
+std::string SelfCheckScript(std::size_t figures) {
+  return "<script>\nwindow.addEventListener('load', function () {\n"
+         "  for (const img of document.images) if (!img.complete || img.naturalWidth === 0) console.error('missing image: ' + img.src);\n"
+         "  const n = document.querySelectorAll('svg').length;\n"
+         "  if (n < " + std::to_string(figures) + ") console.error('expected " + std::to_string(figures) + " figures, found ' + n);\n"
+         "  document.body.setAttribute('data-figures', String(n));\n});\n</script>\n";
+}
+
+}  // namespace
+
+bool ReportOptions::IsValid(std::string* error) const {
+  if (inputs.empty()) {
+    if (error) *error = "no run given; expected run files or folders of run files";
+    return false;
+  }
+  if (output_dir.empty()) {
+    if (error) *error = "-o: expected the report's folder";
+    return false;
+  }
+  if (table_rows == 0 || table_rows > 100000) {
+    if (error) *error = "table rows = " + std::to_string(table_rows) + ", expected in [1, 100000]";
+    return false;
+  }
+  return risk.IsValid(error);
+}
+
+OutputKind ReportFolderOutput() {
+  return {"a report folder (report.html, report.pdf, people.csv)", true, [](const fs::path& dir) {
+            std::error_code ec;
+            if (!fs::is_regular_file(dir / "report.html", ec)) return false;
+            if (ReadText(dir / "report.html").find(kGenerator) == std::string::npos) return false;
+            return FolderHoldsOnly(dir, [](const fs::directory_entry& e) {
+              const std::string name = e.path().filename().string();
+              return name == "report.html" || name == "report.pdf" || name == "people.csv";
+            });
+          }};
+}
+
+std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs) {
+  std::vector<fs::path> files;
+  for (const fs::path& in : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      std::vector<fs::path> found;
+      for (const auto& e : fs::recursive_directory_iterator(in, ec))
+        if (e.is_regular_file() && e.path().extension() == ".sqlite" && runfile::IsRunFile(e.path()))
+          found.push_back(e.path());
+      if (found.empty())
+        throw InputError(in.string() + ": a folder without crowdrecon run files (*.sqlite); expected run files, e.g. "
+                         "a sweep's folder made with \"keep_runs\": true");
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::is_regular_file(in, ec)) {
+      if (!runfile::IsRunFile(in))
+        throw InputError(in.string() + ": not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
+      files.push_back(in);
+    } else {
+      throw InputError(in.string() + ": no such file or folder; expected a run file or a folder of run files");
+    }
+  }
+  return files;
+}
+
+std::string ReportSummary::BriefReport() const {
+  std::string s = "report: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + ", " + csv.string() + "\n";
+  const auto line = [](const EnsembleSummary& e) {
+    return "  " + e.label + " (" + std::to_string(e.runs) + (e.runs == 1 ? " run" : " runs") + "): people " +
+           Value(e.people.median, 3) + "; safe " + Value(e.zone[0].median, 3) + ", uncomfortable " +
+           Value(e.zone[1].median, 3) + ", danger " + Value(e.zone[2].median, 3) + " (medians); beyond tolerance " +
+           Value(e.beyond_tolerance.median, 3) +
+           "; longest exposure above F0 " + Short(e.longest_exposure_s) + " s; largest load " + Short(e.max_load_n, 4) +
+           " N\n";
+  };
+  s += line(main);
+  if (other.runs > 0) s += line(other);
+  if (danger_ratio.runs > 0)
+    s += "  danger fraction, " + other.label + " / " + main.label + ": " + Short(danger_ratio.median) + " [" +
+         Short(danger_ratio.low) + ", " + Short(danger_ratio.high) + "] over " + std::to_string(danger_ratio.runs) +
+         " pairs of runs\n";
+  s += "  " + Short(seconds) + " s\n";
+  return s;
+}
+
+ReportSummary WriteReport(const ReportOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("report: " + why);
+  {
+    std::vector<NamedInput> named;
+    for (const fs::path& f : options.inputs) named.push_back({"an input", f});
+    for (const fs::path& f : options.compare) named.push_back({"an input", f});
+    CheckOutputs({{"-o", options.output_dir, ReportFolderOutput()}}, named, options.force);
+  }
+  const std::vector<fs::path> main_files = RunFilesOf(options.inputs);
+  const std::vector<fs::path> other_files = options.compare.empty() ? std::vector<fs::path>{} : RunFilesOf(options.compare);
+  const std::string chromium = options.pdf ? FindChromium(options.chromium) : "";
+  if (options.pdf && chromium.empty()) PrintPdf(chromium, {}, {});  // the clear error, before any work
+  const auto say = [&](const std::string& text) {
+    if (options.progress) options.progress(text);
+  };
+  const auto analyse = [&](const std::vector<fs::path>& files) {
+    std::vector<RunRisk> runs;
+    for (std::size_t k = 0; k < files.size(); ++k) {
+      say("reading " + files[k].string() + " (" + std::to_string(k + 1) + " of " + std::to_string(files.size()) + ")");
+      runs.push_back(AnalyseRunRisk(files[k], options.risk));
+    }
+    return runs;
+  };
+  const std::vector<RunRisk> main_runs = analyse(main_files);
+  const std::vector<RunRisk> other_runs = analyse(other_files);
+  ReportSummary summary;
+  summary.main = Summarise(options.label, main_runs);
+  summary.other = Summarise(options.compare_label, other_runs);
+  if (!other_runs.empty()) {
+    std::vector<double> ratios;
+    for (const RunRisk& a : main_runs)
+      for (const RunRisk& b : other_runs) {
+        const double fa = a.people.empty() ? 0.0 : a.counts[2] / double(a.people.size());
+        const double fb = b.people.empty() ? 0.0 : b.counts[2] / double(b.people.size());
+        if (fa > 0.0) ratios.push_back(fb / fa);
+      }
+    summary.danger_ratio = SpreadOf(ratios);
+  }
+  const RiskOptions& o = options.risk;
+
+  // --- The page ------------------------------------------------------------
+  say("writing the report");
+  std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">" + std::string(kGenerator) +
+                  "<title>Injury-risk report: " + Escape(main_runs.front().scenario_name) + "</title><style>" + Css() +
+                  "</style></head><body>\n";
+  const RunRisk& first = main_runs.front();
+  h += "<h1>Injury-risk report</h1>\n<p class=\"sub\">" + Escape(first.scenario_name) + " — venue: " +
+       Escape(first.venue_name) + "<br>" + std::to_string(main_runs.size()) +
+       (main_runs.size() == 1 ? " run" : " runs (seeds)") +
+       (other_runs.empty() ? "" : ", compared with " + Escape(other_runs.front().scenario_name) + " (" +
+                                      std::to_string(other_runs.size()) + (other_runs.size() == 1 ? " run)" : " runs)")) +
+       ". crowdrecon " + Escape(CROWDRECON_GIT_VERSION) + ".</p>\n";
+
+  // Summary.
+  h += "<h2>1. Summary</h2>\n";
+  const auto key_boxes = [&](const EnsembleSummary& e) {
+    std::string k = "<div class=\"key\">";
+    k += "<div>people in the runs<b>" + SpreadText(e.people) + "</b></div>";
+    k += "<div>in the <span class=\"zone-uncomfortable\">uncomfortable</span> zone<b>" + SpreadText(e.zone[1]) + "</b></div>";
+    k += "<div>in the <span class=\"zone-danger\">danger</span> zone<b>" + SpreadText(e.zone[2]) + "</b></div>";
+    k += "<div>beyond the tolerance dose<b>" + SpreadText(e.beyond_tolerance) + "</b></div>";
+    return k + "</div>\n";
+  };
+  h += "<h3>" + Escape(options.label) + "</h3>" + key_boxes(summary.main);
+  if (!other_runs.empty()) h += "<h3>" + Escape(options.compare_label) + "</h3>" + key_boxes(summary.other);
+  {
+    std::vector<std::vector<std::string>> rows;
+    const auto row = [&](const std::string& what, auto get) {
+      std::vector<std::string> r{what, get(summary.main)};
+      if (!other_runs.empty()) r.push_back(get(summary.other));
+      rows.push_back(r);
+    };
+    row("runs (seeds)", [](const EnsembleSummary& e) { return std::to_string(e.runs); });
+    row("people in the runs", [](const EnsembleSummary& e) { return SpreadText(e.people); });
+    for (std::size_t z = 0; z < kZones; ++z)
+      row(std::string("<span class=\"zone-") + ToString(Zone(z)) + "\">" + ToString(Zone(z)) + "</span>",
+          [z](const EnsembleSummary& e) { return SpreadText(e.zone[z]); });
+    row("fraction in danger", [](const EnsembleSummary& e) { return SpreadText(e.danger_fraction); });
+    row("beyond the tolerance dose (D ≥ 1)", [](const EnsembleSummary& e) { return SpreadText(e.beyond_tolerance); });
+    row("longest continuous exposure above F0", [](const EnsembleSummary& e) { return Short(e.longest_exposure_s) + " s"; });
+    row("largest chest load (1 s mean)", [](const EnsembleSummary& e) { return Short(e.max_load_n, 4) + " N"; });
+    std::vector<std::string> head{"", Escape(options.label)};
+    if (!other_runs.empty()) head.push_back(Escape(options.compare_label));
+    h += Table(head, rows);
+    h += "<p class=\"note\">Counts are the median over the runs, with the smallest and largest run in brackets; each run "
+         "is one seed, one possible course of events. Zones from each person's largest chest load (mean over " +
+         Short(o.smoothing_s) + " s): safe up to F0 = " + Short(o.f0_n) + " N, uncomfortable up to " + Short(o.danger_n) +
+         " N, danger above (section 7).</p>\n";
+    if (summary.danger_ratio.runs > 0)
+      h += "<p><b>Fraction of people in danger, " + Escape(options.compare_label) + " / " + Escape(options.label) +
+           ": " + Short(summary.danger_ratio.median) + "</b> (range " + Short(summary.danger_ratio.low) + "–" +
+           Short(summary.danger_ratio.high) + " over " + std::to_string(summary.danger_ratio.runs) +
+           " pairs of runs).</p>\n";
+    else if (!other_runs.empty())
+      h += "<p><b>No ratio of the fractions in danger</b>: nobody reached the danger zone in " + Escape(options.label) +
+           ".</p>\n";
+  }
+
+  // Force network at the worst moment.
+  std::size_t figures = 0;
+  h += "<h2>2. The force network at the worst moment</h2>\n";
+  const auto network = [&](const RunRisk& r, const std::string& label, const std::string& prefix) {
+    say("drawing the force network of " + r.file.string() + " at t = " + Short(r.worst_time_s) + " s");
+    std::string f = "<figure>" + ForceNetworkSvg(r.file, r.worst_frame, prefix) + "<figcaption>" + Escape(label) +
+                    ": frame " + std::to_string(r.worst_frame) + " (t = " + Short(r.worst_time_s, 4) +
+                    " s) of " + Escape(r.file.filename().string()) +
+                    ", the moment with the most people above F0. A line from each body's centre to each contact point, "
+                    "its thickness the contact force (the paper's Figure 6 a–b).</figcaption></figure>\n";
+    ++figures;
+    return f;
+  };
+  h += network(first, options.label, "n1-");
+  if (!other_runs.empty()) h += network(other_runs.front(), options.compare_label, "n2-");
+
+  // Distributions.
+  h += "<h2>3. Distribution of contact forces and chest loads</h2>\n";
+  {
+    std::vector<std::pair<std::string, std::vector<double>>> sets{{options.label + ", contacts at the worst moment", first.worst_contact_forces_n}};
+    if (!other_runs.empty()) sets.push_back({options.compare_label + ", contacts at the worst moment", other_runs.front().worst_contact_forces_n});
+    h += "<figure>" + CdfChart("Contact forces scaled by F0 = " + Short(o.f0_n) + " N (paper, Figure 6 c–d)", "F / F0", sets, o,
+                                {"#1f4e79", kOtherColor}) +
+         "<figcaption>The fraction of contacts whose force exceeds F (one minus the cumulative distribution), at the "
+         "worst moment of the first run of each set, with the zones.</figcaption></figure>\n";
+    ++figures;
+    // Whole-run distribution from the histogram, per set.
+    svg::Chart c;
+    c.title = "Contact forces over the whole run";
+    c.x_label = "F / F0";
+    c.y_label = "fraction above";
+    c.log_x = c.log_y = true;
+    c.x_min = 1e-2;
+    c.x_max = 1e2;
+    c.y_min = 1e-7;
+    c.y_max = 1.0;
+    c.legend_left = c.legend_bottom = true;
+    c.bands = {{1e-3, 1.0, kZoneColor[0], "safe"},
+               {1.0, o.danger_n / o.f0_n, kZoneColor[1], "uncomfortable"},
+               {o.danger_n / o.f0_n, 1e3, kZoneColor[2], "danger"}};
+    const auto add = [&](const std::vector<RunRisk>& runs, const std::string& label, const std::string& color) {
+      for (std::size_t k = 0; k < runs.size(); ++k) {
+        svg::Series s;
+        s.color = color;
+        s.width = k == 0 ? 2.0 : 0.8;
+        s.label = k == 0 ? label + (runs.size() > 1 ? " (thin: other seeds)" : "") : "";
+        for (int b = 0; b < ForceHistogram::kBins; ++b) {
+          s.x.push_back(ForceHistogram::UpperEdge(b));
+          s.y.push_back(runs[k].contact_forces.FractionAbove(ForceHistogram::UpperEdge(b)));
+        }
+        c.series.push_back(std::move(s));
+      }
+    };
+    add(main_runs, options.label, "#1f4e79");
+    add(other_runs, options.compare_label, kOtherColor);
+    h += "<figure>" + c.ToSvg() + "<figcaption>Every contact of every frame (" + std::to_string(first.contact_rows) +
+         " contact records in the first run), binned in " + std::to_string(ForceHistogram::kPerDecade) +
+         " bins per decade.</figcaption></figure>\n";
+    ++figures;
+    std::vector<std::pair<std::string, std::vector<double>>> loads;
+    const auto peak_loads = [](const RunRisk& r) {
+      std::vector<double> v;
+      for (const PersonRisk& p : r.people) v.push_back(p.max_load_n);
+      std::sort(v.begin(), v.end());
+      return v;
+    };
+    loads.push_back({options.label + ": each person's largest chest load", peak_loads(first)});
+    if (!other_runs.empty()) loads.push_back({options.compare_label + ": each person's largest chest load", peak_loads(other_runs.front())});
+    h += "<figure>" + CdfChart("Chest loads per person (largest 1 s mean), scaled by F0", "chest load / F0", loads, o,
+                                {"#1f4e79", kOtherColor}) +
+         "<figcaption>The fraction of people whose largest chest load exceeds the value: the per-person measure of "
+         "section 7, from which the zones are counted.</figcaption></figure>\n";
+    ++figures;
+  }
+
+  // Exposure over time.
+  h += "<h2>4. Exposure over time</h2>\n";
+  const auto exposure_chart = [&](const std::vector<RunRisk>& runs, const std::string& label) {
+    svg::Chart c;
+    c.title = label + ": people above F0 and in the danger zone";
+    c.x_label = "time (s)";
+    c.y_label = "people";
+    c.legend_left = true;
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      svg::Series a, d;
+      a.color = kZoneColor[1];
+      d.color = kZoneColor[2];
+      a.width = d.width = k == 0 ? 2.0 : 0.7;
+      a.step = d.step = true;
+      if (k == 0) {
+        a.label = "above F0 = " + Short(o.f0_n) + " N";
+        d.label = "above " + Short(o.danger_n) + " N";
+      }
+      for (const FrameRisk& f : runs[k].frames) {
+        a.x.push_back(f.time_s);
+        a.y.push_back(f.above_f0);
+        d.x.push_back(f.time_s);
+        d.y.push_back(f.above_danger);
+      }
+      c.series.push_back(std::move(a));
+      c.series.push_back(std::move(d));
+    }
+    c.x_marks.push_back({runs.front().worst_time_s, "worst moment"});
+    ++figures;
+    return "<figure>" + c.ToSvg() + "<figcaption>Smoothed chest loads (" + Short(o.smoothing_s) +
+           " s mean); thick: the first run, thin: the other seeds.</figcaption></figure>\n";
+  };
+  h += exposure_chart(main_runs, options.label);
+  if (!other_runs.empty()) h += exposure_chart(other_runs, options.compare_label);
+
+  // Map.
+  h += "<h2>5. Where the people at risk were</h2>\n";
+  const auto map = [&](const RunRisk& r, const std::string& label) {
+    const runfile::RunFileReader reader(r.file);
+    svg::Plan p;
+    p.title = label + ": each person at the place of their largest chest load";
+    p.area = RingsOfWkt(reader.walkable_wkt());
+    for (const runfile::Wall& w : reader.Walls()) {
+      std::vector<Vec2> pts = w.points;
+      if (w.closed && !pts.empty()) pts.push_back(pts.front());
+      p.walls.push_back(pts);
+    }
+    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+    const auto grow = [&](Vec2 q) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    };
+    for (const auto& ring : p.area) for (Vec2 q : ring) grow(q);
+    for (const auto& wall : p.walls) for (Vec2 q : wall) grow(q);
+    std::vector<const PersonRisk*> order;
+    for (const PersonRisk& pr : r.people) order.push_back(&pr);
+    std::stable_sort(order.begin(), order.end(), [](const PersonRisk* a, const PersonRisk* b) { return a->zone < b->zone; });
+    for (const PersonRisk* pr : order) {
+      grow(pr->max_load_position_m);
+      const double radius = pr->zone == Zone::kSafe ? 0.06 : 0.14;
+      p.dots.push_back({pr->max_load_position_m, kZoneColor[static_cast<std::size_t>(pr->zone)], radius,
+                        "person " + std::to_string(pr->id) + ": " + Short(pr->max_load_n, 4) + " N at " +
+                            Short(pr->max_load_time_s, 4) + " s"});
+    }
+    p.min_m = {lo.x - 0.5, lo.y - 0.5};
+    p.max_m = {hi.x + 0.5, hi.y + 0.5};
+    p.legend = {{kZoneColor[0], "safe"}, {kZoneColor[1], "uncomfortable"}, {kZoneColor[2], "danger"}};
+    ++figures;
+    return "<figure>" + p.ToSvg() + "<figcaption>" + Escape(r.file.filename().string()) +
+           "; hover a dot for the person, the load and the time.</figcaption></figure>\n";
+  };
+  h += map(first, options.label);
+  if (!other_runs.empty()) h += map(other_runs.front(), options.compare_label);
+
+  // People.
+  h += "<h2>6. The people most exposed</h2>\n";
+  std::string csv =
+      "set,run,id,group,first_seen_s,last_seen_s,max_load_n,max_load_time_s,max_load_x_m,max_load_y_m,max_raw_load_n,"
+      "time_above_f0_s,longest_above_f0_s,time_above_danger_s,dose,fell,zone\n";
+  const auto people_rows = [&](const std::vector<RunRisk>& runs, const std::string& set) {
+    std::vector<std::pair<const RunRisk*, const PersonRisk*>> all;
+    for (const RunRisk& r : runs)
+      for (const PersonRisk& p : r.people) {
+        all.push_back({&r, &p});
+        char line[512];
+        std::snprintf(line, sizeof line, "%s,%s,%u,%u,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n",
+                      set.c_str(), r.file.filename().string().c_str(), p.id, p.group, p.first_seen_s, p.last_seen_s,
+                      p.max_load_n, p.max_load_time_s, p.max_load_position_m.x, p.max_load_position_m.y,
+                      p.max_raw_load_n, p.time_above_f0_s, p.longest_above_f0_s, p.time_above_danger_s, p.dose,
+                      p.fell ? 1 : 0, ToString(p.zone));
+        csv += line;
+      }
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+      return a.second->dose != b.second->dose ? a.second->dose > b.second->dose : a.second->max_load_n > b.second->max_load_n;
+    });
+    std::vector<std::vector<std::string>> rows;
+    for (std::size_t k = 0; k < all.size() && k < options.table_rows; ++k) {
+      const PersonRisk& p = *all[k].second;
+      rows.push_back({Escape(all[k].first->file.filename().string()), std::to_string(p.id), std::to_string(p.group),
+                      Short(p.max_load_n, 4), Short(p.max_load_time_s, 4), Short(p.time_above_f0_s),
+                      Short(p.longest_above_f0_s), Short(p.time_above_danger_s), Short(p.dose),
+                      p.fell ? "yes" : "", std::string("<span class=\"zone-") + ToString(p.zone) + "\">" + ToString(p.zone) + "</span>"});
+    }
+    return Table({"run", "person", "group", "largest load (N)", "at (s)", "above F0 (s)", "longest above F0 (s)",
+                  "above danger (s)", "dose D", "fell", "zone"},
+                 rows);
+  };
+  h += "<p>The " + std::to_string(options.table_rows) +
+       " people with the largest dose (then the largest load); every person of every run is in <code>people.csv</code>.</p>\n";
+  h += "<h3>" + Escape(options.label) + "</h3>" + people_rows(main_runs, options.label);
+  if (!other_runs.empty()) h += "<h3>" + Escape(options.compare_label) + "</h3>" + people_rows(other_runs, options.compare_label);
+
+  // Methods.
+  h += "<h2>7. Methods</h2>\n";
+  h += "<p><b>Chest load.</b> For each person and frame, from every contact force on the body (other people, walls, "
+       "barriers and fallen people alike): along the chest direction d, the contacts on the front push the body back "
+       "with P<sub>+</sub> = Σ max(0, −F·d), those on the back push it on with P<sub>−</sub> = Σ max(0, F·d); the load "
+       "across the chest is min(P<sub>+</sub>, P<sub>−</sub>), what both sides press together — the rest accelerates "
+       "the body. The same across the shoulders (perpendicular to d); the person's load is the larger of the two, "
+       "averaged over " + Short(o.smoothing_s) + " s (a breath; single steps of a contact model show spikes). For "
+       "contacts on the two faces of the chest this is the force moment tensor's −d·M·d / depth less half the net "
+       "force along d, which the moment tensor would count as load on a body pushed from one side only.</p>\n";
+  h += "<p><b>Zones</b> (the paper's Figure 6): safe at most F0 = " + Short(o.f0_n) +
+       " N (the paper's estimate of the load behind the Madrid Arena deaths; a 2024 wearable-sensor study found "
+       "flow stable below 400 N), uncomfortable above F0 (the Surrey barrier tests found loads intolerable after a "
+       "few seconds at 116–774 N, mean 418 N; Evans &amp; Hayden 623 N), danger above " + Short(o.danger_n) +
+       " N (Hopkins et al. 1993: death after 4–6 minutes at 1112 N).</p>\n";
+  h += "<p><b>Dose.</b> A tolerance time T(F) = " + Short(o.lethal_short_s) + " s × (F / " + Short(o.lethal_short_n) +
+       " N)<sup>−k</sup>, a power law through Hopkins et al.'s two points (" + Short(o.lethal_short_n) + " N for about " +
+       Short(o.lethal_short_s) + " s; " + Short(o.lethal_long_n) + " N for about " + Short(o.lethal_long_s / 60.0) +
+       " min), k = " + Short(o.ToleranceExponent(), 4) + "; T(F0) = " + Short(o.ToleranceTime_s(o.f0_n * 1.0000001) / 60.0) +
+       " min. The dose D = Σ Δt / T(F) sums the exposure of every frame above F0 (Miner's rule); D ≥ 1 means the "
+       "tolerance was reached. Two points from one source fix the curve: its shape between and beyond them, and "
+       "individual differences (the Surrey subjects differed sevenfold), are not known; the counts beyond the dose are an "
+       "order of magnitude, not a prediction of deaths.</p>\n";
+  h += "<p><b>The model's simplifications.</b> A 2D model of torsos (spheropolygons) with contact forces, a drive "
+       "toward the target, a back force and a torque (the paper's equations 1–19); loads are horizontal forces on the "
+       "torso; people cannot climb, stack or be lifted; a fall (when the run's timeline has them) turns a person into a "
+       "fixed obstacle on the floor that still carries load. Forces of a soft contact model grow with overlap: where "
+       "loads reach kilonewtons the bodies overlap by centimetres.</p>\n";
+  h += "<p><b>Options of this report:</b> F0 " + Short(o.f0_n) + " N, danger " + Short(o.danger_n) + " N, tolerance (" +
+       Short(o.lethal_short_n) + " N, " + Short(o.lethal_short_s) + " s) and (" + Short(o.lethal_long_n) + " N, " +
+       Short(o.lethal_long_s) + " s), smoothing " + Short(o.smoothing_s) + " s.</p>\n";
+
+  // Reproducibility.
+  h += "<h2>8. Reproducibility</h2>\n<p>crowdrecon " + Escape(CROWDRECON_GIT_VERSION) + "; command: <code>" +
+       Escape(options.command_line) + "</code></p>\n";
+  {
+    std::vector<std::vector<std::string>> rows;
+    const auto list = [&](const std::vector<RunRisk>& runs, const std::string& set) {
+      for (const RunRisk& r : runs) {
+        say("checksum of " + r.file.string());
+        const runfile::RunFileReader reader(r.file);
+        rows.push_back({Escape(set), Escape(r.file.string()), Escape(r.seed), Short(r.duration_s, 5) + " s",
+                        std::to_string(r.people.size()), "<code>" + Sha256OfFile(r.file) + "</code>",
+                        "<code>" + Sha256Hex(reader.RunValue("scenario")) + "</code>",
+                        "<code>" + Sha256Hex(reader.venue_json()) + "</code>"});
+      }
+    };
+    list(main_runs, options.label);
+    list(other_runs, options.compare_label);
+    h += Table({"set", "run file", "seed", "simulated", "people", "SHA-256 of the run file", "of its scenario", "of its venue"}, rows);
+    h += "<p class=\"note\">The scenario and venue as given are stored in each run file (table run, keys scenario and "
+         "venue); their checksums are of that text. Check a run file with <code>sha256sum</code>; regenerate it with "
+         "<code>crowdrecon simulate</code> on the scenario (same input and seed give the same file content, whatever "
+         "the number of threads).</p>\n";
+    const runfile::RunFileReader reader(first.file);
+    h += "<details><summary>The scenario of " + Escape(first.file.filename().string()) + "</summary><pre>" +
+         Escape(reader.RunValue("scenario")) + "</pre></details>\n";
+  }
+  h += SelfCheckScript(figures);
+  h += "</body></html>\n";
+
+  // --- Files: written complete or not at all --------------------------------
+  fs::create_directories(options.output_dir);
+  summary.html = options.output_dir / "report.html";
+  summary.csv = options.output_dir / "people.csv";
+  WriteFileAtomically(summary.csv, csv);
+  WriteFileAtomically(summary.html, h);
+  if (options.pdf) {
+    say("printing report.pdf with " + chromium);
+    summary.pdf = options.output_dir / "report.pdf";
+    const fs::path partial = PartialPath(summary.pdf);
+    PrintPdf(chromium, summary.html, partial);
+    fs::rename(partial, summary.pdf);
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return summary;
+}
+
+}  // namespace crowdrecon::reports

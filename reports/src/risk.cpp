@@ -1,0 +1,281 @@
+#include "crowdrecon/reports/risk.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <string>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/reports/chest_load.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+
+namespace crowdrecon::reports {
+
+const char* ToString(Zone z) {
+  switch (z) {
+    case Zone::kSafe: return "safe";
+    case Zone::kUncomfortable: return "uncomfortable";
+    case Zone::kDanger: return "danger";
+  }
+  return "?";
+}
+
+bool RiskOptions::IsValid(std::string* error) const {
+  const auto fail = [error](const std::string& text) {
+    if (error) *error = text;
+    return false;
+  };
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(f0_n)) return fail("F0 = " + FormatNumber(f0_n) + " N, expected a positive load");
+  if (!positive(danger_n) || !(danger_n > f0_n))
+    return fail("danger load = " + FormatNumber(danger_n) + " N, expected a load above F0 = " + FormatNumber(f0_n) + " N");
+  if (!positive(lethal_short_n) || !positive(lethal_short_s) || !positive(lethal_long_n) || !positive(lethal_long_s))
+    return fail("tolerance points must be positive loads and times");
+  if (!(lethal_short_n > lethal_long_n) || !(lethal_short_s < lethal_long_s))
+    return fail("tolerance points (" + FormatNumber(lethal_short_n) + " N, " + FormatNumber(lethal_short_s) + " s) and (" +
+                FormatNumber(lethal_long_n) + " N, " + FormatNumber(lethal_long_s) +
+                " s): expected the larger load to be tolerated for the shorter time");
+  if (!(lethal_long_n > f0_n))
+    return fail("the tolerance point " + FormatNumber(lethal_long_n) + " N must lie above F0 = " + FormatNumber(f0_n) + " N");
+  if (!(smoothing_s >= 0.0 && smoothing_s <= 60.0))
+    return fail("smoothing = " + FormatNumber(smoothing_s) + " s, expected in [0, 60]");
+  return true;
+}
+
+double RiskOptions::ToleranceExponent() const {
+  return std::log(lethal_long_s / lethal_short_s) / std::log(lethal_short_n / lethal_long_n);
+}
+
+double RiskOptions::ToleranceTime_s(double load_n) const {
+  if (!(load_n > f0_n)) return std::numeric_limits<double>::infinity();
+  return lethal_short_s * std::pow(load_n / lethal_short_n, -ToleranceExponent());
+}
+
+Zone RiskOptions::ZoneOf(double load_n) const {
+  if (load_n > danger_n) return Zone::kDanger;
+  if (load_n > f0_n) return Zone::kUncomfortable;
+  return Zone::kSafe;
+}
+
+void ForceHistogram::Add(double force_over_f0) {
+  ++total;
+  if (!(force_over_f0 > 0.0)) {
+    ++zero;
+    return;
+  }
+  const int bin = static_cast<int>(std::floor((std::log10(force_over_f0) - kLow) * kPerDecade));
+  ++counts[static_cast<std::size_t>(std::clamp(bin, 0, kBins - 1))];
+}
+
+double ForceHistogram::UpperEdge(int bin) { return std::pow(10.0, kLow + double(bin + 1) / kPerDecade); }
+
+double ForceHistogram::FractionAbove(double force_over_f0) const {
+  if (total == 0) return 0.0;
+  std::uint64_t above = 0;
+  for (int b = 0; b < kBins; ++b)
+    if (UpperEdge(b) > force_over_f0 * (1.0 + 1e-12)) above += counts[static_cast<std::size_t>(b)];
+  return double(above) / double(total);
+}
+
+namespace {
+
+// A moving mean over the last `window` samples of one person.
+class Smoother {
+ public:
+  explicit Smoother(std::size_t window) : window_(std::max<std::size_t>(window, 1)) {}
+  double Add(double v) {
+    samples_.push_back(v);
+    sum_ += v;
+    if (samples_.size() > window_) {
+      sum_ -= samples_.front();
+      samples_.pop_front();
+    }
+    // Re-add from scratch now and then: no drift from round-off.
+    if (++since_exact_ >= 4096) {
+      sum_ = 0.0;
+      for (double s : samples_) sum_ += s;
+      since_exact_ = 0;
+    }
+    return std::max(0.0, sum_ / double(samples_.size()));
+  }
+  void Reset() {
+    samples_.clear();
+    sum_ = 0.0;
+  }
+
+ private:
+  std::size_t window_;
+  std::deque<double> samples_;
+  double sum_ = 0.0;
+  std::size_t since_exact_ = 0;
+};
+
+std::string JsonName(const std::string& json_text) {
+  try {
+    const nlohmann::json j = nlohmann::json::parse(json_text);
+    if (j.contains("name") && j["name"].is_string()) return j["name"].get<std::string>();
+    if (j.contains("metadata") && j["metadata"].contains("name") && j["metadata"]["name"].is_string())
+      return j["metadata"]["name"].get<std::string>();
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
+}  // namespace
+
+RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("risk options: " + why);
+  if (!runfile::IsRunFile(run_file))
+    throw InputError(run_file.string() + ": not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
+  const runfile::RunFileReader reader(run_file);
+  RunRisk risk;
+  risk.file = run_file;
+  risk.fps = reader.fps();
+  risk.scenario_name = JsonName(reader.RunValue("scenario"));
+  risk.venue_name = JsonName(reader.venue_json());
+  risk.seed = reader.RunValue("seed");
+  const std::vector<runfile::Person> setup = reader.People();
+  const PeriodicBox box = reader.periodic_box();
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  if (times.empty()) throw InputError(run_file.string() + ": the run has no frames; expected a run with at least one frame");
+  risk.duration_s = times.back().time_s - times.front().time_s;
+
+  const std::size_t n = setup.size();
+  risk.people.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    risk.people[i].id = static_cast<std::uint32_t>(i + 1);
+    risk.people[i].group = setup[i].group;
+  }
+  const std::size_t window = static_cast<std::size_t>(std::lround(options.smoothing_s * risk.fps));
+  std::vector<Smoother> smooth(n, Smoother(window));
+  std::vector<double> smoothed(n, 0.0), run_above(n, 0.0);
+  std::vector<bool> was_present(n, false);
+  std::vector<Pose> poses(n);
+  std::vector<LoadContact> load_contacts;
+  std::vector<runfile::Contact> contacts;
+
+  runfile::PersonFrameStream people = reader.PersonFrames(times.back().frame);
+  runfile::ContactFrameStream contact_stream = reader.ContactFrames(times.back().frame);
+  std::int64_t contact_frame = -1;
+  bool more_contacts = contact_stream.Next(&contact_frame, &contacts);
+  runfile::PersonFrame pf;
+  double previous_time = times.front().time_s;
+  std::size_t done = 0;
+  std::size_t time_index = 0;
+  bool worst_set = false;
+  while (people.Next(&pf)) {
+    while (time_index < times.size() && times[time_index].frame < pf.frame) ++time_index;
+    const double t = time_index < times.size() && times[time_index].frame == pf.frame ? times[time_index].time_s
+                                                                                        : previous_time;
+    const double dt = std::max(0.0, t - previous_time);
+    previous_time = t;
+    for (Pose& p : poses) p.present = false;
+    for (std::size_t k = 0; k < pf.person.size(); ++k) {
+      const std::uint32_t i = pf.person[k];
+      if (i >= n) throw InputError(run_file.string() + ": frame " + std::to_string(pf.frame) + " has person id " +
+                                   std::to_string(std::uint64_t{i} + 1) + " not in table person (the run file is damaged)");
+      poses[i] = {pf.position_m[k], pf.angle_rad[k], true};
+    }
+    load_contacts.clear();
+    if (more_contacts && contact_frame < pf.frame)
+      throw InputError(run_file.string() + ": table contact has rows of frame " + std::to_string(contact_frame) +
+                       ", which has no people (the run file is damaged)");
+    const bool have_contacts = more_contacts && contact_frame == pf.frame;
+    FrameRisk fr;
+    fr.frame = pf.frame;
+    fr.time_s = t;
+    if (have_contacts) {
+      for (const runfile::Contact& c : contacts) {
+        const Vec2 f = c.Force();
+        load_contacts.push_back({c.a, c.b, c.wall, c.point_m, f});
+        risk.contact_forces.Add(Length(f) / options.f0_n);
+      }
+      fr.contacts = static_cast<std::uint32_t>(contacts.size());
+      risk.contact_rows += contacts.size();
+    }
+    std::vector<ChestLoad> loads;
+    try {
+      loads = ChestLoads(poses, load_contacts, box);
+    } catch (const InputError& e) {
+      throw InputError(run_file.string() + ": frame " + std::to_string(pf.frame) + ": " + e.what());
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (!poses[i].present && was_present[i]) {  // left, or not here this frame
+        smooth[i].Reset();
+        smoothed[i] = 0.0;
+        run_above[i] = 0.0;
+        was_present[i] = false;
+      }
+    for (std::size_t k = 0; k < pf.person.size(); ++k) {
+      const std::uint32_t i = pf.person[k];
+      PersonRisk& pr = risk.people[i];
+      const double raw = loads[i].load_n();
+      const double s = smooth[i].Add(raw);
+      smoothed[i] = s;
+      was_present[i] = true;
+      if (std::isnan(pr.first_seen_s)) pr.first_seen_s = t;
+      pr.last_seen_s = t;
+      if (pf.state[k] == runfile::PersonStatus::kFallen) pr.fell = true;
+      pr.max_raw_load_n = std::max(pr.max_raw_load_n, raw);
+      if (s > pr.max_load_n) {
+        pr.max_load_n = s;
+        pr.max_load_time_s = t;
+        pr.max_load_position_m = pf.position_m[k];
+      }
+      // Each sample stands for the interval since the previous frame.
+      if (s > options.f0_n) {
+        pr.time_above_f0_s += dt;
+        run_above[i] += dt;
+        pr.longest_above_f0_s = std::max(pr.longest_above_f0_s, run_above[i]);
+        pr.dose += dt / options.ToleranceTime_s(s);
+        ++fr.above_f0;
+      } else {
+        run_above[i] = 0.0;
+      }
+      if (s > options.danger_n) {
+        pr.time_above_danger_s += dt;
+        ++fr.above_danger;
+      }
+      fr.max_load_n = std::max(fr.max_load_n, s);
+    }
+    fr.present = static_cast<std::uint32_t>(pf.person.size());
+    const bool worse = !worst_set || fr.above_f0 > risk.frames[static_cast<std::size_t>(risk.worst_frame)].above_f0 ||
+                       (fr.above_f0 == risk.frames[static_cast<std::size_t>(risk.worst_frame)].above_f0 &&
+                        fr.max_load_n > risk.frames[static_cast<std::size_t>(risk.worst_frame)].max_load_n);
+    risk.frames.push_back(fr);
+    if (worse) {
+      // worst_frame holds the index into frames while streaming (the frame number at the end)
+      risk.worst_frame = static_cast<std::int64_t>(risk.frames.size() - 1);
+      worst_set = true;
+      risk.worst_contact_forces_n.clear();
+      for (const LoadContact& c : load_contacts) risk.worst_contact_forces_n.push_back(Length(c.force_on_a_n));
+      risk.worst_person_loads_n.clear();
+      for (std::uint32_t i : pf.person) risk.worst_person_loads_n.push_back(smoothed[i]);
+    }
+    if (have_contacts) more_contacts = contact_stream.Next(&contact_frame, &contacts);
+    if (options.progress) options.progress(++done, times.size());
+  }
+  if (risk.frames.empty()) throw InputError(run_file.string() + ": the run has no people in any frame");
+  const FrameRisk& worst = risk.frames[static_cast<std::size_t>(risk.worst_frame)];
+  risk.worst_time_s = worst.time_s;
+  risk.worst_frame = worst.frame;
+  // Everyone who appeared: their zone, and the counts.
+  std::vector<PersonRisk> appeared;
+  for (PersonRisk& pr : risk.people) {
+    if (std::isnan(pr.first_seen_s)) continue;
+    pr.zone = options.ZoneOf(pr.max_load_n);
+    ++risk.counts[static_cast<std::size_t>(pr.zone)];
+    if (pr.dose >= 1.0) ++risk.beyond_tolerance;
+    if (pr.fell) ++risk.fallen;
+    appeared.push_back(pr);
+  }
+  risk.people = std::move(appeared);
+  std::sort(risk.worst_contact_forces_n.begin(), risk.worst_contact_forces_n.end());
+  std::sort(risk.worst_person_loads_n.begin(), risk.worst_person_loads_n.end());
+  return risk;
+}
+
+}  // namespace crowdrecon::reports
