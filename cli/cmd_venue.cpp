@@ -67,8 +67,8 @@ void RunCheck(const CheckArgs& args) {
         for (const geo::WallSegment& s : segments) clearance = std::min(clearance, DistanceToSegment(p, s.a, s.b));
         if (clearance > 1.5 * field.spacing_m()) ++unreachable;
       }
-    std::printf("    %-16s width %s m, from %s to %s; longest walk to it %s m%s\n", e.id.c_str(),
-                FormatFixed(e.width_m(), 2).c_str(), VecText(e.a).c_str(), VecText(e.b).c_str(),
+    std::printf("    %-16s free width %s m, from %s to %s; longest walk to it %s m%s\n", e.id.c_str(),
+                FormatFixed(v.FreeWidth_m(e), 2).c_str(), VecText(e.a).c_str(), VecText(e.b).c_str(),
                 FormatFixed(farthest, 1).c_str(),
                 unreachable > 0 ? (", " + std::to_string(unreachable) + " grid nodes cannot reach it").c_str() : "");
   }

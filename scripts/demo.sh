@@ -4,7 +4,7 @@
 set -euo pipefail
 exe=${1:?usage: demo.sh CROWDRECON OUTDIR}
 out=${2:?usage: demo.sh CROWDRECON OUTDIR}
-mkdir -p "$out/venues" "$out/bodies" "$out/hallway" "$out/phase" "$out/madrid-night"
+mkdir -p "$out/venues" "$out/bodies" "$out/hallway" "$out/phase" "$out/madrid-night" "$out/evacuation"
 
 echo "== Madrid Arena venues"
 for venue in venues/madrid-arena/*.json; do
@@ -40,9 +40,19 @@ echo "   reconstruction is venues/madrid-arena/scenarios/madrid-night.json, docs
   --phase results/sweeps/madrid-arena/hallway-bodies --phase-output "$out/madrid-night/phase" --path-step 10 \
   | tee -a "$out/madrid-night/summary.txt"
 
+echo "== The 6,800-person evacuation of the ground floor, its first 20 s (the run to 95 % is"
+echo "   venues/madrid-arena/scenarios/evacuation-6800.json, docs/scenarios.md)"
+"$exe" simulate venues/madrid-arena/scenarios/evacuation-6800-demo.json -o "$out/evacuation/run.sqlite" \
+  | tee "$out/evacuation/summary.txt"
+
+echo "== Injury-risk report: the Madrid night (demo) compared with the evacuation (docs/reports.md)"
+"$exe" report "$out/madrid-night/run.sqlite" --label "Madrid night (demo)" \
+  --compare "$out/evacuation/run.sqlite" --compare-label "evacuation, first 20 s" -o "$out/report" \
+  | tee "$out/report-summary.txt"
+
 echo "== Phase diagrams of the shipped Madrid Arena sweeps (results/sweeps/madrid-arena/)"
 for sweep in hallway-bodies hallway-gamma hallway-lambda; do
   "$exe" phase "results/sweeps/madrid-arena/$sweep" -o "$out/phase/$sweep" | tail -n 1
 done
 
-echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), madrid-night/ (timeline run, its figure and its path over the phase diagram), phase/"
+echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), madrid-night/ (timeline run, its figure and its path over the phase diagram), evacuation/, report/ (report.html, report.pdf, people.csv), phase/"

@@ -69,7 +69,7 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   s.area_m2 = geometry::WalkableArea_m2(stored);
   for (const geometry::Exit& e : stored.exits) {
     s.exit_names.push_back(e.id);
-    s.exit_width_m.push_back(e.width_m());
+    s.exit_width_m.push_back(stored.FreeWidth_m(e));  // between the jambs: flows per metre of opening
   }
 
   // People present and the counter-flow's share, frame by frame.

@@ -173,6 +173,16 @@ std::vector<WallSegment> WallSegments(const Venue& venue) {
   return segments;
 }
 
+double Venue::FreeWidth_m(const Exit& exit) const {
+  double jamb_a = 0.0, jamb_b = 0.0;
+  for (const WallSegment& w : WallSegments(*this))
+    for (Vec2 end : {w.a, w.b}) {
+      if (Length(end - exit.a) <= kVenueTolerance_m) jamb_a = std::max(jamb_a, w.radius_m);
+      if (Length(end - exit.b) <= kVenueTolerance_m) jamb_b = std::max(jamb_b, w.radius_m);
+    }
+  return std::max(0.0, exit.width_m() - jamb_a - jamb_b);
+}
+
 // ---------------------------------------------------------------------------
 // Reading
 // ---------------------------------------------------------------------------

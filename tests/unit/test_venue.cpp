@@ -102,7 +102,9 @@ TEST(Venue, MadridArenaVenuesLoad) {
   // The paper's 7,700 people on the ground floor at "four people per m2".
   EXPECT_NEAR(7700.0 / WalkableArea_m2(floor), 4.0, 1e-12);
   ASSERT_NE(floor.FindExit("hallway"), nullptr);
-  EXPECT_DOUBLE_EQ(floor.FindExit("hallway")->width_m(), 3.0);
+  // The hallway entrance: 3 m between the faces of its 0.15 m jambs.
+  EXPECT_NEAR(floor.FindExit("hallway")->width_m(), 3.3, 1e-12);
+  EXPECT_NEAR(floor.FreeWidth_m(*floor.FindExit("hallway")), 3.0, 1e-12);
 }
 
 // --- invalid inputs: each error names the file, the JSON path and the problem.

@@ -98,7 +98,7 @@ void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
     const Vec2 mid = 0.5 * (e.a + e.b);
     Vec2 normal = Length(e.b - e.a) > 0.0 ? Normalized(Perp(e.b - e.a)) : Vec2{1, 0};
     if (!geometry::IsWalkable(venue, mid + 0.01 * extent * normal)) normal = -normal;
-    const std::string label = e.id + " (" + FormatFixed(e.width_m(), 2) + " m)";
+    const std::string label = e.id + " (" + FormatFixed(venue.FreeWidth_m(e), 2) + " m)";
     const double text_m = 0.55 * 13.0 * static_cast<double>(label.size()) / ppm;  // rough text width
     Vec2 at = mid + 0.025 * extent * normal;
     if (normal.x < -0.5) at.x -= text_m;

@@ -69,6 +69,8 @@ struct Wall {
 struct Exit {
   std::string id;
   Vec2 a, b;
+  // The segment's length; the opening people pass through is narrower by
+  // the jambs' thickness: Venue::FreeWidth_m.
   double width_m() const { return Length(b - a); }
 };
 
@@ -133,6 +135,10 @@ struct Venue {
   std::string origin;
 
   const Exit* FindExit(std::string_view id) const;
+  // The free width of an exit: its segment's length less the sphero-radius
+  // of the wall that ends at each of its ends (a door's jambs), the width
+  // people pass through and flows per metre are measured against.
+  double FreeWidth_m(const Exit& exit) const;
   // A target by id: first the declared targets, then an exit of that id (every
   // exit is implicitly a target). nullopt if there is neither.
   std::optional<Target> FindTarget(std::string_view id) const;
