@@ -13,11 +13,14 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "crowdrecon/analysis/density_map.hpp"
 #include "crowdrecon/analysis/timeline_series.hpp"
+#include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/sweep/phase_diagram.hpp"
+#include "crowdrecon/viz/density_figure.hpp"
 #include "crowdrecon/viz/timeline_figure.hpp"
 #include "option_checks.hpp"
 
@@ -32,6 +35,9 @@ struct TimelineArgs {
   std::string phase_output;
   double smooth_s = 10.0;
   double path_step_s = 60.0;
+  std::vector<std::string> density_maps;
+  std::vector<double> density_times_s;
+  double density_cell_m = 0.5, density_sigma_m = 0.5;
   bool force = false;
 };
 
@@ -63,6 +69,7 @@ sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
 void RunTimeline(const TimelineArgs& args) {
   std::vector<PlannedOutput> outputs;
   for (const std::string& f : args.figures) outputs.push_back({"-o", f, PictureOutputKind()});
+  for (const std::string& f : args.density_maps) outputs.push_back({"--density-maps", f, PictureOutputKind()});
   sweep::PhaseOptions phase;
   if (!args.phase.empty()) {
     phase.results = args.phase;
@@ -86,6 +93,24 @@ void RunTimeline(const TimelineArgs& args) {
               s.time_s.size(), analysis::ClockText(s.clock_start, s.time_s.front()).c_str(),
               analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
               s.recorded.size());
+  if (!args.density_maps.empty()) {
+    analysis::DensityMapOptions o;
+    o.times_s = args.density_times_s;
+    o.cell_m = args.density_cell_m;
+    o.sigma_m = args.density_sigma_m;
+    const std::vector<analysis::DensityMap> maps = analysis::ComputeDensityMaps(args.run, o);
+    const geometry::Venue venue =
+        geometry::ParseVenue(runfile::RunFileReader(args.run).venue_json(), args.run + ": run value venue");
+    for (const std::string& f : args.density_maps) {
+      viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, f);
+      std::printf("wrote %s\n", f.c_str());
+    }
+    for (const analysis::DensityMap& m : maps)
+      std::printf("density at %s: %zu people, densest %.2f persons/m2\n",
+                  s.clock_start.empty() ? ("t = " + FormatNumber(m.time_s) + " s").c_str()
+                                        : analysis::ClockText(s.clock_start, m.time_s).c_str(),
+                  m.people, m.max_per_m2);
+  }
   if (!args.phase.empty()) {
     phase.path = PathOf(s, args.path_step_s);
     const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
@@ -110,6 +135,14 @@ void RegisterTimelineCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--path-step", args->path_step_s, "Averaging step of the path's points (s)")
       ->check(CLI::Range(1.0, 3600.0));
+  cmd->add_option("--density-maps", args->density_maps,
+                  "Figure of density maps (persons/m2 over the venue) at --density-times: .png, .svg or .pdf (repeat for several)");
+  cmd->add_option("--density-times", args->density_times_s,
+                  "Times of the density maps (s, comma-separated; default: the start and the quarters of the run)")
+      ->delimiter(',');
+  cmd->add_option("--density-cell", args->density_cell_m, "Cell of the density maps (m)")->check(CLI::Range(0.05, 10.0));
+  cmd->add_option("--density-sigma", args->density_sigma_m, "Width of each person's Gaussian in the density maps (m)")
+      ->check(CLI::Range(0.05, 10.0));
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] { RunTimeline(*args); });
 }
