@@ -464,6 +464,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
   std::size_t figures = 0;
   h += "<h2>2. The force network at the worst moment</h2>\n";
   const auto network = [&](const RunRisk& r, const std::string& label, const std::string& prefix) {
+    if (!r.has_contacts)
+      return "<p class=\"note\">" + Escape(label) + ": " + Escape(r.file.filename().string()) +
+             " records no contacts, so its force network cannot be drawn (its chest loads come from table "
+             "person_load); simulate with <code>\"run\": {\"contacts\": true}</code> to see it.</p>\n";
     say("drawing the force network of " + r.file.string() + " at t = " + Short(r.worst_time_s) + " s");
     std::string f = "<figure>" + ForceNetworkSvg(r.file, r.worst_frame, prefix) + "<figcaption>" + Escape(label) +
                     ": frame " + std::to_string(r.worst_frame) + " (t = " + Short(r.worst_time_s, 4) +
@@ -479,8 +483,14 @@ ReportSummary WriteReport(const ReportOptions& options) {
   // Distributions.
   h += "<h2>3. Distribution of contact forces and chest loads</h2>\n";
   {
-    std::vector<std::pair<std::string, std::vector<double>>> sets{{options.label + ", contacts at the worst moment", first.worst_contact_forces_n}};
-    if (!other_runs.empty()) sets.push_back({options.compare_label + ", contacts at the worst moment", other_runs.front().worst_contact_forces_n});
+    std::vector<std::pair<std::string, std::vector<double>>> sets;
+    if (first.has_contacts) sets.push_back({options.label + ", contacts at the worst moment", first.worst_contact_forces_n});
+    if (!other_runs.empty() && other_runs.front().has_contacts)
+      sets.push_back({options.compare_label + ", contacts at the worst moment", other_runs.front().worst_contact_forces_n});
+    if (sets.empty()) {
+      h += "<p class=\"note\">No contacts recorded in these runs: the distributions of contact forces (the paper's "
+           "Figure 6 c–d) need runs simulated with <code>\"run\": {\"contacts\": true}</code>.</p>\n";
+    } else {
     h += "<figure>" + CdfChart("Contact forces scaled by F0 = " + Short(o.f0_n) + " N (paper, Figure 6 c–d)", "F / F0", sets, o,
                                 {"#1f4e79", kOtherColor}) +
          "<figcaption>The fraction of contacts whose force exceeds F (one minus the cumulative distribution), at the "
@@ -502,6 +512,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
                {o.danger_n / o.f0_n, 1e3, kZoneColor[2], "danger"}};
     const auto add = [&](const std::vector<RunRisk>& runs, const std::string& label, const std::string& color) {
       for (std::size_t k = 0; k < runs.size(); ++k) {
+        if (!runs[k].has_contacts) continue;
         svg::Series s;
         s.color = color;
         s.width = k == 0 ? 2.0 : 0.8;
@@ -519,6 +530,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
          " contact records in the first run), binned in " + std::to_string(ForceHistogram::kPerDecade) +
          " bins per decade.</figcaption></figure>\n";
     ++figures;
+    }
     std::vector<std::pair<std::string, std::vector<double>>> loads;
     const auto peak_loads = [](const RunRisk& r) {
       std::vector<double> v;

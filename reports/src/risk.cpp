@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <string>
 
 #include "crowdrecon/common/error.hpp"
@@ -161,6 +162,21 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   runfile::ContactFrameStream contact_stream = reader.ContactFrames(times.back().frame);
   std::int64_t contact_frame = -1;
   bool more_contacts = contact_stream.Next(&contact_frame, &contacts);
+  // The chest loads the run loop recorded (table person_load), or, in runs
+  // written before it did, computed here from the contacts.
+  risk.loads_recorded = reader.HasPersonLoads();
+  if (!risk.loads_recorded && !more_contacts)
+    throw InputError(run_file.string() + ": the run records neither chest loads (table person_load) nor contacts; "
+                     "expected a run written by this crowdrecon, or one simulated with \"run\": {\"contacts\": true}");
+  risk.has_contacts = more_contacts;
+  std::optional<runfile::PersonLoadStream> load_stream;
+  std::int64_t load_frame = -1;
+  std::vector<runfile::PersonLoad> recorded;
+  bool more_loads = false;
+  if (risk.loads_recorded) {
+    load_stream.emplace(reader.PersonLoads(times.back().frame));
+    more_loads = load_stream->Next(&load_frame, &recorded);
+  }
   runfile::PersonFrame pf;
   double previous_time = times.front().time_s;
   std::size_t done = 0;
@@ -197,10 +213,26 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
       risk.contact_rows += contacts.size();
     }
     std::vector<ChestLoad> loads;
-    try {
-      loads = ChestLoads(poses, load_contacts, box);
-    } catch (const InputError& e) {
-      throw InputError(run_file.string() + ": frame " + std::to_string(pf.frame) + ": " + e.what());
+    if (risk.loads_recorded) {
+      loads.assign(n, ChestLoad{});
+      if (more_loads && load_frame < pf.frame)
+        throw InputError(run_file.string() + ": table person_load has rows of frame " + std::to_string(load_frame) +
+                         ", which has no people (the run file is damaged)");
+      if (more_loads && load_frame == pf.frame) {
+        for (const runfile::PersonLoad& l : recorded) {
+          if (l.person >= n || !poses[l.person].present)
+            throw InputError(run_file.string() + ": table person_load, frame " + std::to_string(pf.frame) + ": person " +
+                             std::to_string(std::uint64_t{l.person} + 1) + " is not in the frame (the run file is damaged)");
+          loads[l.person] = {l.chest_n, l.lateral_n};
+        }
+        more_loads = load_stream->Next(&load_frame, &recorded);
+      }
+    } else {
+      try {
+        loads = ChestLoads(poses, load_contacts, box);
+      } catch (const InputError& e) {
+        throw InputError(run_file.string() + ": frame " + std::to_string(pf.frame) + ": " + e.what());
+      }
     }
     for (std::size_t i = 0; i < n; ++i)
       if (!poses[i].present && was_present[i]) {  // left, or not here this frame

@@ -110,6 +110,8 @@ CREATE TABLE contact(frame INTEGER NOT NULL, a INTEGER NOT NULL, b INTEGER NOT N
   point_x REAL NOT NULL, point_y REAL NOT NULL, normal_x REAL NOT NULL, normal_y REAL NOT NULL,
   overlap_m REAL NOT NULL, normal_force_n REAL NOT NULL, tangential_force_n REAL NOT NULL);
 CREATE INDEX contact_frame_idx ON contact(frame);
+CREATE TABLE person_load(frame INTEGER NOT NULL, id INTEGER NOT NULL, chest_n REAL NOT NULL, lateral_n REAL NOT NULL);
+CREATE INDEX person_load_idx ON person_load(frame, id);
 CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT NULL, person INTEGER NOT NULL,
   other INTEGER NOT NULL, detail TEXT NOT NULL);
 )SQL";
@@ -119,7 +121,8 @@ CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT N
 struct RunFileWriter::Impl {
   std::unique_ptr<Database> db;
   // The frame tables' inserts, prepared once (WriteFrame).
-  std::unique_ptr<sqlite::BatchInsert> trajectory, person_state, contact;
+  std::unique_ptr<sqlite::BatchInsert> trajectory, person_state, contact, person_load;
+  bool has_person_load = true;  // false for a resumed run file written before the table existed
   std::int64_t geometry_hash = 0;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
   double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
@@ -132,6 +135,7 @@ RunFileWriter::~RunFileWriter() {
   if (!impl_ || !impl_->db) return;  // moved from
   impl_->trajectory.reset();
   impl_->person_state.reset();
+  impl_->person_load.reset();
   impl_->contact.reset();
   try {
     impl_->db->Exec("PRAGMA journal_mode=DELETE");  // see kJournal
@@ -222,6 +226,11 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
     db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
   {
+    Statement loads(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'person_load'");
+    w.impl_->has_person_load = loads.Next() && loads.Int(0) > 0;
+    if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
+  }
+  {
     Statement census(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'census'");
     if (census.Next() && census.Int(0) > 0) db.Exec("DELETE FROM census WHERE frame > " + after);
   }
@@ -251,10 +260,12 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
       impl_->trajectory = std::make_unique<sqlite::BatchInsert>(db, "trajectory_data", 6);
       impl_->person_state = std::make_unique<sqlite::BatchInsert>(db, "person_state", 8);
       impl_->contact = std::make_unique<sqlite::BatchInsert>(db, "contact", 11);
+      if (impl_->has_person_load) impl_->person_load = std::make_unique<sqlite::BatchInsert>(db, "person_load", 4);
     }
     sqlite::BatchInsert& traj = *impl_->trajectory;
     sqlite::BatchInsert& state = *impl_->person_state;
     for (sqlite::BatchInsert* batch : {&traj, &state, impl_->contact.get()}) batch->Discard();
+    if (impl_->person_load) impl_->person_load->Discard();
     for (std::size_t k = 0; k < f.person.size(); ++k) {
       const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
       const Vec2 x = f.position_m[k];
@@ -271,6 +282,13 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
     }
     traj.Finish();
     state.Finish();
+    if (impl_->person_load && f.chest_load_n.size() == f.person.size() && f.lateral_load_n.size() == f.person.size()) {
+      sqlite::BatchInsert& loads = *impl_->person_load;
+      for (std::size_t k = 0; k < f.person.size(); ++k)
+        if (f.chest_load_n[k] != 0.0 || f.lateral_load_n[k] != 0.0)
+          loads.Add(frame).Add(static_cast<std::int64_t>(f.person[k]) + 1).Add(f.chest_load_n[k]).Add(f.lateral_load_n[k]);
+      loads.Finish();
+    }
     if (f.with_contacts) {
       sqlite::BatchInsert& contact = *impl_->contact;
       for (const Contact& c : f.contacts)
@@ -691,6 +709,43 @@ bool ContactFrameStream::Next(std::int64_t* frame, std::vector<Contact>* out) {
     impl_->have_row = q.Next();
   }
   return true;
+}
+
+struct PersonLoadStream::Impl {
+  std::unique_ptr<Statement> query;
+  bool have_row = false;
+};
+
+PersonLoadStream::PersonLoadStream() : impl_(std::make_unique<Impl>()) {}
+PersonLoadStream::PersonLoadStream(PersonLoadStream&&) noexcept = default;
+PersonLoadStream::~PersonLoadStream() = default;
+
+bool PersonLoadStream::Next(std::int64_t* frame, std::vector<PersonLoad>* out) {
+  using namespace run_limits;
+  if (!impl_->have_row) return false;
+  Statement& q = *impl_->query;
+  *frame = q.Int(0);
+  out->clear();
+  while (impl_->have_row && q.Int(0) == *frame) {
+    out->push_back({static_cast<std::uint32_t>(q.Integer(1, 1, kPersonId) - 1), q.Real(2, 0.0, kForce_n),
+                    q.Real(3, 0.0, kForce_n)});
+    impl_->have_row = q.Next();
+  }
+  return true;
+}
+
+bool RunFileReader::HasPersonLoads() const {
+  Statement s(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'person_load'");
+  return s.Next() && s.Int(0) > 0;
+}
+
+PersonLoadStream RunFileReader::PersonLoads(std::int64_t last_frame) const {
+  PersonLoadStream stream;
+  stream.impl_->query = std::make_unique<Statement>(
+      *impl_->db, "SELECT frame, id, chest_n, lateral_n FROM person_load WHERE frame <= ?1 ORDER BY frame, id");
+  stream.impl_->query->Bind(1, last_frame).Describe("person_load", {0, 1});
+  stream.impl_->have_row = stream.impl_->query->Next();
+  return stream;
 }
 
 ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {

@@ -1,5 +1,10 @@
 #include "crowdrecon/scenario/run_record.hpp"
 
+#include <algorithm>
+#include <vector>
+
+#include "crowdrecon/reports/chest_load.hpp"
+
 namespace crowdrecon::scenario {
 
 static_assert(static_cast<int>(engine::PersonState::kWalking) == static_cast<int>(runfile::PersonStatus::kWalking) &&
@@ -42,6 +47,29 @@ void PersonLoads(const engine::Simulation& sim, std::vector<double>* load) {
   }
 }
 
+void ChestLoadsOf(const engine::Simulation& sim, std::vector<double>* chest, std::vector<double>* lateral) {
+  const engine::BodyState& b = sim.bodies();
+  std::vector<reports::Pose> poses(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i)
+    poses[i] = {b.position_m[i], b.angle_rad[i], b.state[i] != engine::PersonState::kRemoved};
+  std::vector<reports::LoadContact> contacts;
+  contacts.reserve(sim.contacts().size());
+  for (const engine::Contact& c : sim.contacts()) contacts.push_back({c.a, c.b, c.wall, c.point_m, c.Force()});
+  const std::vector<reports::ChestLoad> loads = reports::ChestLoads(poses, contacts, sim.definition().periodic);
+  chest->resize(b.size());
+  lateral->resize(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    (*chest)[i] = loads[i].chest_n;
+    (*lateral)[i] = loads[i].lateral_n;
+  }
+}
+
+void PersonChestLoads(const engine::Simulation& sim, std::vector<double>* load) {
+  std::vector<double> lateral;
+  ChestLoadsOf(sim, load, &lateral);
+  for (std::size_t i = 0; i < load->size(); ++i) (*load)[i] = std::max((*load)[i], lateral[i]);
+}
+
 void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::vector<runfile::Event>& events,
                   bool with_contacts, runfile::FrameSnapshot* out) {
   runfile::FrameSnapshot& f = *out;
@@ -56,6 +84,7 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
   f.state.clear();
   std::vector<double>& load = f.load_n;
   PersonLoads(sim, &load);
+  ChestLoadsOf(sim, &f.chest_load_n, &f.lateral_load_n);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < b.size(); ++i) {
     if (b.state[i] == engine::PersonState::kRemoved) continue;
@@ -65,9 +94,13 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
     f.angle_rad.push_back(b.angle_rad[i]);
     f.angular_velocity_rad_per_s.push_back(b.angular_velocity_rad_per_s[i]);
     f.state.push_back(static_cast<runfile::PersonStatus>(b.state[i]));
+    f.chest_load_n[kept] = f.chest_load_n[i];
+    f.lateral_load_n[kept] = f.lateral_load_n[i];
     load[kept++] = load[i];  // kept <= i: compacts in place
   }
   load.resize(kept);
+  f.chest_load_n.resize(kept);
+  f.lateral_load_n.resize(kept);
   f.with_contacts = with_contacts;
   f.contacts.clear();
   if (with_contacts) {

@@ -297,7 +297,7 @@ class FallSystem : public RunSystem {
       history_.assign(n * (depth_ + 1), Vec2{});
       above_s_.assign(n, 0.0);
     }
-    if (spec_.criterion == FallSpec::Criterion::kLoad) PersonLoads(sim, &load_);
+    if (spec_.criterion == FallSpec::Criterion::kLoad) PersonChestLoads(sim, &load_);
     for (std::uint32_t i = 0; i < n; ++i) {
       if (b.state[i] != engine::PersonState::kWalking) continue;
       if (id_[i] != b.id[i]) {  // someone new in this slot
@@ -322,7 +322,7 @@ class FallSystem : public RunSystem {
       } else {
         above_s_[i] = load_[i] > spec_.load_n ? above_s_[i] + sample_s : 0.0;
         if (above_s_[i] >= spec_.load_duration_s - 1e-9 && load_[i] > spec_.load_n)
-          cause = "load: above " + FormatNumber(spec_.load_n) + " N for " + FormatNumber(above_s_[i]) + " s (now " +
+          cause = "chest load: above " + FormatNumber(spec_.load_n) + " N for " + FormatNumber(above_s_[i]) + " s (now " +
                   FormatFixed(load_[i], 0) + " N)";
       }
       if (cause.empty()) continue;

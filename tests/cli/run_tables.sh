@@ -8,9 +8,9 @@ dump() {
     sqlite3 -separator ' ' "$1" ".mode quote" "$q"
   done | sha256sum | cut -d' ' -f1
 }
-# dump_all FILE: the same with the events and a timeline's head count (table
-# census) where the run has one: what a resumed run must reproduce besides
-# the frames.
+# dump_all FILE: the same with the events, the chest loads (table person_load)
+# and a timeline's head count (table census) where the run has one: what a
+# resumed run must reproduce besides the frames.
 dump_all() {
   local census="SELECT 'no census'"
   if [[ $(sqlite3 "$1" "SELECT COUNT(*) FROM sqlite_master WHERE name = 'census'") == 1 ]]; then
@@ -18,5 +18,6 @@ dump_all() {
   fi
   { dump "$1"
     sqlite3 -separator ' ' "$1" ".mode quote" "SELECT * FROM event ORDER BY frame, rowid"
+    sqlite3 -separator ' ' "$1" ".mode quote" "SELECT * FROM person_load ORDER BY frame, id"
     sqlite3 -separator ' ' "$1" ".mode quote" "$census"; } | sha256sum | cut -d' ' -f1
 }

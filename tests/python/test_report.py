@@ -71,6 +71,31 @@ def main():
                 minus += 0.5 * max(0.0, push)
         return min(plus, minus)
 
+    # The chest loads the run loop recorded (table person_load) against the
+    # same equations on the recorded contacts.
+    recorded = {}
+    if db.execute("SELECT COUNT(*) FROM sqlite_master WHERE name = 'person_load'").fetchone()[0]:
+        for frame, pid, chest, lateral in db.execute("SELECT frame, id, chest_n, lateral_n FROM person_load"):
+            recorded[(frame, pid)] = (chest, lateral)
+    load_failures = 0
+    if recorded:
+        for frame in sorted(pose):
+            per = defaultdict(list)
+            for pid, l, f in contacts.get(frame, []):
+                per[pid].append((l, f))
+            for pid, (x, y, ang) in pose[frame].items():
+                items = per.get(pid, [])
+                want = (0.0, 0.0)
+                if len(items) >= 2:
+                    d = (math.cos(ang), math.sin(ang))
+                    want = (compression(d, items), compression((-d[1], d[0]), items))
+                got = recorded.get((frame, pid), (0.0, 0.0))
+                if any(abs(g - w) > 1e-6 * max(1.0, w) for g, w in zip(got, want)):
+                    if load_failures < 5:
+                        print(f"frame {frame} person {pid}: person_load {got}, recomputed from the contacts {want}")
+                    load_failures += 1
+        print(f"table person_load: {len(recorded)} rows, {load_failures} differences from the contacts")
+
     k = math.log(a.long[1] / a.short[1]) / math.log(a.short[0] / a.long[0])
     window = max(1, int(round(a.smoothing * fps)))
     buf = defaultdict(deque)
@@ -135,7 +160,7 @@ def main():
             failures += 1
     print(f"{len(rows)} people checked; recomputed zones: " + ", ".join(f"{z} {counts[z]}" for z in ("safe", "uncomfortable", "danger")) +
           f"; largest load {max(s['max'] for s in stat.values()):.1f} N; {failures} differences")
-    return 1 if failures else 0
+    return 1 if failures or load_failures else 0
 
 
 if __name__ == "__main__":

@@ -121,6 +121,8 @@ struct RunRisk {
   std::uint32_t beyond_tolerance = 0;          // dose >= 1
   std::uint32_t fallen = 0;
   std::uint64_t contact_rows = 0;
+  bool loads_recorded = false;  // chest loads from table person_load (else computed from the contacts)
+  bool has_contacts = false;    // the run has a contact table with rows: force network and force distributions
 };
 
 RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions& options);

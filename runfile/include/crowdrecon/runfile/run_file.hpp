@@ -152,6 +152,9 @@ struct FrameSnapshot {
   std::vector<double> angular_velocity_rad_per_s;
   std::vector<PersonStatus> state;
   std::vector<double> load_n;  // sum of the magnitudes of the contact forces on the person
+  // The load across the chest and across the shoulders (reports/chest_load.hpp),
+  // written to table person_load where not both zero; empty: none written.
+  std::vector<double> chest_load_n, lateral_load_n;
   bool with_contacts = false;
   std::vector<Contact> contacts;  // every contact when with_contacts, else empty
   std::vector<Event> events;
@@ -281,6 +284,28 @@ class PersonFrameStream {
   std::unique_ptr<Impl> impl_;
 };
 
+// One person's chest loads in a frame (table person_load; people without
+// load have no row).
+struct PersonLoad {
+  std::uint32_t person = 0;  // person index (id - 1)
+  double chest_n = 0.0, lateral_n = 0.0;
+};
+
+// The person_load rows of a run frame by frame, in order (frames where nobody
+// is loaded are skipped: compare the frame numbers).
+class PersonLoadStream {
+ public:
+  PersonLoadStream(PersonLoadStream&&) noexcept;
+  ~PersonLoadStream();
+  bool Next(std::int64_t* frame, std::vector<PersonLoad>* out);
+
+ private:
+  friend class RunFileReader;
+  PersonLoadStream();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // The contacts of a run frame by frame, in order (one query; frames without
 // contacts are skipped: compare the frame numbers).
 class ContactFrameStream {
@@ -321,6 +346,10 @@ class RunFileReader {
   PersonFrameStream PersonFrames(std::int64_t last_frame) const;
   // Every frame's contacts up to `last_frame` inclusive, in order.
   ContactFrameStream ContactFrames(std::int64_t last_frame) const;
+  // Whether the run records chest loads (table person_load; runs written
+  // before 2026-11-26 do not), and those loads frame by frame.
+  bool HasPersonLoads() const;
+  PersonLoadStream PersonLoads(std::int64_t last_frame) const;
   // The sum of every recorded velocity of each group's people (index = group).
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;

@@ -29,6 +29,11 @@ runfile::RunFileWriter CreateRunFileOf(const std::filesystem::path& file, runfil
 // magnitudes of the contact forces on them, the quantity compared with the
 // 400 N threshold.
 void PersonLoads(const engine::Simulation& sim, std::vector<double>* load);
+// The load across each person's chest and across the shoulders
+// (reports/chest_load.hpp: what both sides press together), by engine slot,
+// as the reports compare with tolerance data; PersonChestLoads: the larger.
+void ChestLoadsOf(const engine::Simulation& sim, std::vector<double>* chest, std::vector<double>* lateral);
+void PersonChestLoads(const engine::Simulation& sim, std::vector<double>* load);
 
 // Copies frame `frame` of the simulation into `out`, reusing its storage:
 // every person still in the venue (by run id, BodyState::id), their loads (the sum of the magnitudes of

@@ -105,7 +105,8 @@ struct FallSpec {
   // hallway with counter-flow: docs/decisions.md, "Falls").
   double threshold_m_per_s2 = 5.0;
   double window_s = 0.5;
-  // Load criterion: the person's load (the quantity of person_state.load_n)
+  // Load criterion: the person's chest load (the larger of across the chest
+  // and across the shoulders, reports/chest_load.hpp; table person_load)
   // above load_n for load_duration_s without a break.
   double load_n = 2000.0;
   double load_duration_s = 5.0;
