@@ -23,6 +23,8 @@ struct ReportArgs {
   bool no_pdf = false;
   std::string chromium;
   std::size_t table_rows = 40;
+  std::string envelope_metric = "people_danger";
+  double envelope_level = 0.0;
   bool force = false, quiet = false;
 };
 
@@ -37,6 +39,8 @@ void RunReport(const ReportArgs& args) {
   o.pdf = !args.no_pdf;
   o.chromium = args.chromium;
   o.table_rows = args.table_rows;
+  o.envelope_metric = args.envelope_metric;
+  o.envelope_level = args.envelope_level;
   o.force = args.force;
   o.command_line = CommandLine();
   if (!args.quiet) o.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
@@ -54,7 +58,9 @@ void RegisterReportCommand(CLI::App& app) {
       "paper's safe / uncomfortable / danger zones with intervals over seeds, the force network at the worst moment, "
       "a comparison with a second set of runs; writes DIR/report.html, DIR/report.pdf and DIR/people.csv "
       "(docs/reports.md)");
-  cmd->add_option("RUN", args->inputs, "Run files (with contacts), or folders of run files: one ensemble of seeds")
+  cmd->add_option("RUN", args->inputs,
+                  "Run files, or folders of run files: one ensemble of seeds; or a sweep's folder alone: its "
+                  "venue-design envelope")
       ->required();
   cmd->add_option("--compare", args->compare, "Run files or folders of a second ensemble to compare with");
   cmd->add_option("-o,--output", args->output, "Folder of the report")->required();
@@ -68,6 +74,12 @@ void RegisterReportCommand(CLI::App& app) {
   cmd->add_option("--tolerance-long-time", args->risk.lethal_long_s, "Tolerance point 2: time (s)");
   cmd->add_option("--smoothing", args->risk.smoothing_s, "Moving mean of the chest load (s)");
   cmd->add_option("--table-rows", args->table_rows, "People listed in the HTML table (all are in people.csv)");
+  cmd->add_option("--envelope-metric", args->envelope_metric,
+                  "For a sweep's folder: the risk column of its results the design envelope bounds (people_danger, "
+                  "people_uncomfortable, people_beyond_tolerance, ...)");
+  cmd->add_option("--envelope-level", args->envelope_level,
+                  "For a sweep's folder: the envelope holds the cells whose median over seeds is at most this")
+      ->check(CLI::Range(0.0, 1e12));
   cmd->add_flag("--no-pdf", args->no_pdf, "Write no report.pdf (no Chromium needed)");
   cmd->add_option("--chromium", args->chromium, "The browser that prints report.pdf (default: chromium on PATH)");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress lines");

@@ -105,12 +105,19 @@ struct Reader {
 
 }  // namespace
 
+const std::vector<std::string>& RiskColumns() {
+  static const std::vector<std::string> columns = {"people_uncomfortable", "people_danger", "people_beyond_tolerance",
+                                                   "max_chest_load_n", "longest_above_f0_s"};
+  return columns;
+}
+
 const std::vector<std::string>& MetricColumns() {
   static const std::vector<std::string> columns = [] {
     analysis::RunAnalysis template_run;
     template_run.group_mean_speed_m_per_s = {0.0, 0.0};  // main flow and counter-flow
     std::vector<std::string> names;
     for (const analysis::SummaryValue& v : template_run.SummaryTable()) names.push_back(v.name);
+    for (const std::string& name : RiskColumns()) names.push_back(name);
     return names;
   }();
   return columns;

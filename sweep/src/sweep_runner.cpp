@@ -21,6 +21,7 @@
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/scenario/runner.hpp"
+#include "crowdrecon/reports/risk.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
 #include "mpi_transport.hpp"
@@ -179,6 +180,31 @@ ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
   return row;
 }
 
+// The run's injury-risk counts (default options) into the risk columns; a run
+// without chest loads or contacts leaves them empty.
+void AddRiskColumns(const fs::path& file, ResultRow* row) {
+  static const std::map<std::string, std::size_t> column_of = [] {
+    std::map<std::string, std::size_t> m;
+    for (std::size_t i = 0; i < MetricColumns().size(); ++i) m[MetricColumns()[i]] = i;
+    return m;
+  }();
+  reports::RunRisk risk;
+  try {
+    risk = reports::AnalyseRunRisk(file, reports::RiskOptions{});
+  } catch (const InputError&) {
+    return;
+  }
+  double longest = 0.0;
+  for (const reports::PersonRisk& p : risk.people) longest = std::max(longest, p.longest_above_f0_s);
+  row->metrics[column_of.at("people_uncomfortable")] = risk.counts[1];
+  row->metrics[column_of.at("people_danger")] = risk.counts[2];
+  row->metrics[column_of.at("people_beyond_tolerance")] = risk.beyond_tolerance;
+  double max_load = 0.0;
+  for (const reports::PersonRisk& p : risk.people) max_load = std::max(max_load, p.max_load_n);
+  row->metrics[column_of.at("max_chest_load_n")] = max_load;
+  row->metrics[column_of.at("longest_above_f0_s")] = longest;
+}
+
 // Simulates and analyses one run. No row (nullopt) if it was interrupted: its
 // run file and checkpoint stay for the next attempt.
 std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
@@ -213,6 +239,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
     }
     if (summary.status != "complete") return std::nullopt;
     row = RowOf(run, analysis::AnalyzeRun(file, ctx.analysis));
+    AddRiskColumns(file, &row);
   } catch (const InputError& e) {
     // The crowd cannot be placed, or the run went numerically wrong: a result
     // of these parameters, recorded as such. Messages name run files as

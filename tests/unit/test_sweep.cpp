@@ -225,7 +225,10 @@ TEST(SweepResults, ColumnsAndRowRoundTrip) {
   // Per direction (classifier version 2), for both groups.
   EXPECT_NE(std::find(c.begin(), c.end(), "regime_code_g1"), c.end());
   EXPECT_NE(std::find(c.begin(), c.end(), "lapse_tail_exponent_g0"), c.end());
-  EXPECT_EQ(c.back(), "lapse_tail_exponent_error_g1");
+  // The analysis' columns, then the injury-risk columns (issue 21).
+  EXPECT_NE(std::find(c.begin(), c.end(), "lapse_tail_exponent_error_g1"), c.end());
+  EXPECT_EQ(std::vector<std::string>(c.end() - static_cast<std::ptrdiff_t>(RiskColumns().size()), c.end()), RiskColumns());
+  EXPECT_EQ(c.back(), "longest_above_f0_s");
 
   ResultRow row;
   row.run_index = 42;

@@ -38,6 +38,12 @@ struct ReportOptions {
   std::string chromium;     // the browser to print with; "" = chromium, chromium-browser, google-chrome on PATH
   std::string command_line; // recorded in the reproducibility section
   std::size_t table_rows = 40;  // people listed in the HTML table (all of them in people.csv)
+  // A sweep's folder (DIR/results.sqlite) as the only input gives the
+  // venue-design envelope: the region of the sweep's diagram where the median
+  // over seeds of `envelope_metric` (a risk column of the results) stays at or
+  // below `envelope_level`.
+  std::string envelope_metric = "people_danger";
+  double envelope_level = 0.0;
   bool force = false;           // replace what is at output_dir (never an input)
   std::function<void(const std::string&)> progress;  // one line per step (may be empty)
 
@@ -69,6 +75,9 @@ struct ReportSummary {
   // range over every pair of runs; runs = 0 when there is nothing to compare
   // or the main ensemble has nobody in danger.
   Spread danger_ratio;
+  bool envelope = false;            // a sweep's design envelope (then main/other are empty)
+  std::size_t envelope_runs = 0;
+  std::vector<std::string> envelope_lines;  // per variant and row of the diagram: the envelope's reach
   double seconds = 0.0;
   std::string BriefReport() const;
 };

@@ -39,6 +39,10 @@ namespace crowdrecon::sweep {
 // RunAnalysis::SummaryTable() for a run with a main flow and a counter-flow
 // (groups 0 and 1).
 const std::vector<std::string>& MetricColumns();
+// The injury-risk columns among them (reports/risk.hpp with its default
+// options: F0 400 N, danger 1112 N): people per zone, beyond the tolerance
+// dose, the largest chest load (1 s mean) and the longest exposure above F0.
+const std::vector<std::string>& RiskColumns();
 
 struct ResultRow {
   std::size_t run_index = 0;
