@@ -107,19 +107,42 @@ std::string ReadText(const fs::path& file) {
   return ss.str();
 }
 
+std::string Base64(const std::string& bytes) {
+  static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::uint32_t b0 = static_cast<unsigned char>(bytes[i]);
+    const std::uint32_t b1 = i + 1 < bytes.size() ? static_cast<unsigned char>(bytes[i + 1]) : 0u;
+    const std::uint32_t b2 = i + 2 < bytes.size() ? static_cast<unsigned char>(bytes[i + 2]) : 0u;
+    const std::uint32_t v = (b0 << 16) | (b1 << 8) | b2;
+    out += kDigits[(v >> 18) & 63];
+    out += kDigits[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kDigits[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kDigits[v & 63] : '=';
+  }
+  return out;
+}
+
+// Above this many people the force network goes into the page as a PNG
+// (a data URI, still inside the one file) rather than SVG: the SVG of the
+// 6,800-person evacuation's network is 24 MB, its PNG about 1 MB.
+constexpr std::uint32_t kNetworkSvgPeople = 2000;
+
 // The force network of `frame` of a run, drawn by viz (the paper's Figure 6 a-b).
-std::string ForceNetworkSvg(const fs::path& run, std::int64_t frame, const std::string& id_prefix) {
+std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uint32_t people, const std::string& id_prefix) {
   std::mt19937_64 rng(std::random_device{}());
   const fs::path dir = fs::temp_directory_path() / ("crowdrecon-report-" + std::to_string(rng()));
   viz::RenderOptions o;
   o.output_dir = dir;
   o.frames = viz::ParseFrameSelection(std::to_string(frame));
-  o.svg = true;
-  o.width_px = 1100;
+  const bool as_svg = people <= kNetworkSvgPeople;
+  o.svg = as_svg;
+  o.width_px = as_svg ? 1100 : 2000;
   std::string text;
   try {
     viz::RenderRun(run, o);
-    text = ReadText(viz::FramePicturePath(dir, frame, ".svg"));
+    text = ReadText(viz::FramePicturePath(dir, frame, as_svg ? ".svg" : ".png"));
   } catch (...) {
     std::error_code ec;
     fs::remove_all(dir, ec);
@@ -127,6 +150,8 @@ std::string ForceNetworkSvg(const fs::path& run, std::int64_t frame, const std::
   }
   std::error_code ec;
   fs::remove_all(dir, ec);
+  if (!as_svg)
+    return "<img class=\"network\" alt=\"force network\" src=\"data:image/png;base64," + Base64(text) + "\">";
   std::string svg = PrefixSvgIds(text, id_prefix);
   // Scale with the page (Cairo writes fixed sizes in pt).
   const std::size_t tag_end = svg.find('>');
@@ -267,7 +292,7 @@ th { background: #f1f1ee; } td:first-child, th:first-child { text-align: left; }
 .key div { border: 1px solid #ddd; border-radius: 6px; padding: 8px 10px; background: #fafaf8; }
 .key b { display: block; font-size: 22px; }
 svg.chart, svg.plan { max-width: 100%; height: auto; display: block; margin: 6px 0 14px; }
-svg.network { max-width: 100%; height: auto; display: block; border: 1px solid #ddd; }
+img.network, svg.network { max-width: 100%; height: auto; display: block; border: 1px solid #ddd; }
 figure { margin: 10px 0 18px; page-break-inside: avoid; } figcaption { color: #444; font-size: 13px; }
 pre { background: #f6f6f3; padding: 8px; overflow-x: auto; font-size: 11px; white-space: pre-wrap; word-break: break-all; }
 code { font-size: 12px; } .note { color: #555; font-size: 13px; }
@@ -281,7 +306,7 @@ code { font-size: 12px; } .note { color: #555; font-size: 13px; }
 std::string SelfCheckScript(std::size_t figures) {
   return "<script>\nwindow.addEventListener('load', function () {\n"
          "  for (const img of document.images) if (!img.complete || img.naturalWidth === 0) console.error('missing image: ' + img.src);\n"
-         "  const n = document.querySelectorAll('svg').length;\n"
+         "  const n = document.querySelectorAll('svg, img').length;\n"
          "  if (n < " + std::to_string(figures) + ") console.error('expected " + std::to_string(figures) + " figures, found ' + n);\n"
          "  document.body.setAttribute('data-figures', String(n));\n});\n</script>\n";
 }
@@ -562,7 +587,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
              " records no contacts, so its force network cannot be drawn (its chest loads come from table "
              "person_load); simulate with <code>\"run\": {\"contacts\": true}</code> to see it.</p>\n";
     say("drawing the force network of " + r.file.string() + " at t = " + Short(r.worst_time_s) + " s");
-    std::string f = "<figure>" + ForceNetworkSvg(r.file, r.worst_frame, prefix) + "<figcaption>" + Escape(label) +
+    std::uint32_t people = 0;
+    for (const FrameRisk& fr : r.frames)
+      if (fr.frame == r.worst_frame) people = fr.present;
+    std::string f = "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix) + "<figcaption>" + Escape(label) +
                     ": frame " + std::to_string(r.worst_frame) + " (t = " + Short(r.worst_time_s, 4) +
                     " s) of " + Escape(r.file.filename().string()) +
                     ", the moment with the most people above F0. A line from each body's centre to each contact point, "
