@@ -155,7 +155,8 @@ std::string RunAnalysis::BriefReport() const {
          Printf(", %.1f people moved on average", avalanche_mean_people) +
          Printf(", rise time %.2f s on average", avalanche_mean_rise_time_s);
   r += "\n";
-  r += "load: max " + Printf("%.0f N", max_load_n) + " (person " + std::to_string(max_load_person) +
+  r += std::string(chest_loads ? "chest load" : "load (sum of contact forces; the run records no chest loads)") +
+       ": max " + Printf("%.0f N", max_load_n) + " (person " + std::to_string(max_load_person) +
        Printf(" at %.1f s)", max_load_time_s) + Printf("; mean %.1f N", mean_load_n) +
        Printf(", p50 %.1f", load_p50_n) + Printf(", p90 %.1f", load_p90_n) + Printf(", p99 %.1f N", load_p99_n) +
        Printf("; above threshold: %.2f %% of person-frames", 100.0 * above_load_person_frames) + ", " +

@@ -348,6 +348,16 @@ class FramePass {
     runfile::PersonFrameStream stream = run.PersonFrames(c_.frame.back());
     runfile::PersonFrame rows;
     bool have_rows = stream.Next(&rows);
+    // The chest loads, where the run records them (else person_state.load_n).
+    out_.chest_loads = run.HasPersonLoads();
+    std::optional<runfile::PersonLoadStream> loads;
+    std::int64_t load_frame = -1;
+    std::vector<runfile::PersonLoad> load_rows;
+    bool have_loads = false;
+    if (out_.chest_loads) {
+      loads.emplace(run.PersonLoads(c_.frame.back()));
+      have_loads = loads->Next(&load_frame, &load_rows);
+    }
     for (std::size_t k = 0; k < n_frames_; ++k) {
       std::fill(present_.begin(), present_.end(), 0);
       // Rows of frames without a frame_time entry cannot exist (a frame is
@@ -360,9 +370,15 @@ class FramePass {
           present_[i] = 1;
           position_[i] = rows.position_m[r];
           velocity_[i] = rows.velocity_m_per_s[r];
-          load_[i] = rows.load_n[r];
+          load_[i] = out_.chest_loads ? 0.0 : rows.load_n[r];
         }
         have_rows = stream.Next(&rows);
+      }
+      while (have_loads && load_frame < c_.frame[k]) have_loads = loads->Next(&load_frame, &load_rows);
+      if (have_loads && load_frame == c_.frame[k]) {
+        for (const runfile::PersonLoad& l : load_rows)
+          if (l.person < n_people_ && present_[l.person]) load_[l.person] = std::max(l.chest_n, l.lateral_n);
+        have_loads = loads->Next(&load_frame, &load_rows);
       }
       Process(k);
       previous_ = position_;

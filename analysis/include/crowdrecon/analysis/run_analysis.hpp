@@ -144,7 +144,11 @@ struct RunAnalysis {
   double avalanche_mean_distance_m = 0.0;
   double avalanche_mean_people = 0.0;
   // Loads, over every person and frame of the stationary stage except where
-  // marked "whole run".
+  // marked "whole run". The load is the chest load (the larger of across the
+  // chest and across the shoulders, table person_load; docs/reports.md) in
+  // runs that record it, else the sum of the magnitudes of the contact
+  // forces (person_state.load_n, older runs): chest_loads says which.
+  bool chest_loads = false;
   double max_load_n = 0.0;          // whole run
   std::int64_t max_load_person = 0;  // id (1-based), whole run
   double max_load_time_s = 0.0;      // whole run
