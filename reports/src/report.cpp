@@ -341,16 +341,6 @@ OutputKind ReportFolderOutput() {
           }};
 }
 
-namespace {
-// The run files below a folder (none: empty).
-std::vector<fs::path> RunFilesOfOrEmpty(const fs::path& dir) {
-  std::vector<fs::path> found;
-  std::error_code ec;
-  for (const auto& e : fs::recursive_directory_iterator(dir, ec))
-    if (e.is_regular_file() && e.path().extension() == ".sqlite" && runfile::IsRunFile(e.path())) found.push_back(e.path());
-  return found;
-}
-}  // namespace
 
 std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs) {
   std::vector<fs::path> files;
@@ -479,9 +469,14 @@ ReportSummary WriteReport(const ReportOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   std::string why;
   if (!options.IsValid(&why)) throw InputError("report: " + why);
-  if (options.inputs.size() == 1 && options.compare.empty() && IsSweepFolder(options.inputs.front()) &&
-      RunFilesOfOrEmpty(options.inputs.front()).empty())
+  // A sweep's folder: its runs differ in their parameters, not only in their
+  // seeds, so they are no ensemble; its results give the design envelope.
+  if (options.inputs.size() == 1 && options.compare.empty() && IsSweepFolder(options.inputs.front()))
     return WriteEnvelopeReport(options);
+  for (const fs::path& in : options.inputs)
+    if (IsSweepFolder(in))
+      throw InputError(in.string() + ": a sweep's folder; expected it alone (its design envelope), or run files of one "
+                       "scenario's seeds");
   {
     std::vector<NamedInput> named;
     for (const fs::path& f : options.inputs) named.push_back({"an input", f});
@@ -837,6 +832,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
     const runfile::RunFileReader reader(first.file);
     h += "<details><summary>The scenario of " + Escape(first.file.filename().string()) + "</summary><pre>" +
          Escape(reader.RunValue("scenario")) + "</pre></details>\n";
+    h += "<details><summary>Its venue</summary><pre>" + Escape(reader.venue_json()) + "</pre></details>\n";
   }
   h += SelfCheckScript(figures);
   h += "</body></html>\n";
