@@ -140,12 +140,14 @@ std::string EnvelopeSvg(const Envelope& e, const std::string& variant) {
                              : ": no complete run")) +
            "</title></rect>\n";
       if (!have) continue;
+      const bool dark = std::sqrt(std::clamp(c->median / top, 0.0, 1.0)) > 0.7;  // white text on dark cells
       s += "<text x=\"" + svg::Short(X(ix) + kCell / 2, 6) + "\" y=\"" + svg::Short(Y(iy) + kCell / 2 - 2, 6) +
-           "\" text-anchor=\"middle\" font-size=\"13\" font-weight=\"bold\">" + svg::Short(c->median) + "</text>\n";
+           "\" text-anchor=\"middle\" font-size=\"13\" font-weight=\"bold\" fill=\"" + (dark ? "#ffffff" : "#111111") +
+           "\">" + svg::Short(c->median) + "</text>\n";
       if (c->low != c->high)
         s += "<text x=\"" + svg::Short(X(ix) + kCell / 2, 6) + "\" y=\"" + svg::Short(Y(iy) + kCell / 2 + 13, 6) +
-             "\" text-anchor=\"middle\" font-size=\"10\" fill=\"#444\">[" + svg::Short(c->low) + "–" + svg::Short(c->high) +
-             "]</text>\n";
+             "\" text-anchor=\"middle\" font-size=\"10\" fill=\"" + (dark ? "#f4f4f4" : "#444444") + "\">[" +
+             svg::Short(c->low) + "–" + svg::Short(c->high) + "]</text>\n";
       // Seeds on both sides of the level: the envelope's edge is uncertain here.
       if (c->low <= e.level && c->high > e.level)
         s += "<rect x=\"" + svg::Short(X(ix) + 3, 6) + "\" y=\"" + svg::Short(Y(iy) + 3, 6) + "\" width=\"" +
