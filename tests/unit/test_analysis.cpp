@@ -452,12 +452,19 @@ TEST(AnalyzeRun, StopAndGoRunFile) {
            std::to_string(1.0 + i) + ", 1, 0)");
       exec("INSERT INTO person_state VALUES(" + frame + ", " + id + ", " + std::to_string(vx) + ", 0, 0, 0, 0, " +
            std::to_string(load_n) + ")");
+      // The chest load the analysis reads (table person_load): the same load
+      // across the chest; person_state.load_n gets twice it, which must not
+      // be read where person_load exists.
+      exec("INSERT INTO person_load VALUES(" + frame + ", " + id + ", " + std::to_string(load_n) + ", 0)");
+      exec("UPDATE person_state SET load_n = " + std::to_string(2.0 * load_n) + " WHERE frame = " + frame +
+           " AND id = " + id);
     }
   }
   exec("COMMIT");
   sqlite3_close(db);
 
   const RunAnalysis a = AnalyzeRun(file);
+  EXPECT_TRUE(a.chest_loads);
   EXPECT_EQ(a.regime.regime, Regime::kAvalanches) << a.regime.reason;
   ASSERT_EQ(a.regime.avalanches.size(), 6u);
   for (const Avalanche& av : a.regime.avalanches) {
