@@ -121,12 +121,7 @@ std::string EnvelopeSvg(const Envelope& e, const std::string& variant) {
   };
   const auto X = [&](std::size_t ix) { return kLeft + double(ix) * kCell; };
   const auto Y = [&](std::size_t iy) { return kTop + double(ny - 1 - iy) * kCell; };  // y up
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart\" viewBox=\"0 0 " + svg::Short(width, 6) + " " +
-                  svg::Short(height, 6) + "\" width=\"" + svg::Short(width, 6) + "\" height=\"" + svg::Short(height, 6) +
-                  "\" font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"design envelope\">\n";
-  s += "<rect x=\"0\" y=\"0\" width=\"" + svg::Short(width, 6) + "\" height=\"" + svg::Short(height, 6) + "\" fill=\"white\"/>\n";
-  s += "<text x=\"" + svg::Short(kLeft, 6) + "\" y=\"22\" font-size=\"14\" font-weight=\"bold\">" +
-       svg::Escape(variant + ": " + e.metric + ", median over seeds [range]") + "</text>\n";
+  std::string s = svg::Open("chart", width, height, variant + ": " + e.metric + ", median over seeds [range]", kLeft, 22);
   for (std::size_t iy = 0; iy < ny; ++iy)
     for (std::size_t ix = 0; ix < nx; ++ix) {
       const EnvelopeCell* c = cell_at(ix, iy);

@@ -311,6 +311,29 @@ std::string SelfCheckScript(std::size_t figures) {
          "  document.body.setAttribute('data-figures', String(n));\n});\n</script>\n";
 }
 
+// The browser that prints the PDF ("" without --pdf); without one, the clear
+// error before any work.
+std::string ChromiumFor(const ReportOptions& options) {
+  if (!options.pdf) return "";
+  const std::string chromium = FindChromium(options.chromium);
+  if (chromium.empty()) PrintPdf(chromium, {}, {});
+  return chromium;
+}
+
+// Writes DIR/report.html and, with a browser, DIR/report.pdf printed from it
+// (each complete or not at all).
+void WritePage(const ReportOptions& options, const std::string& chromium, const std::string& html, ReportSummary* summary) {
+  fs::create_directories(options.output_dir);
+  summary->html = options.output_dir / "report.html";
+  WriteFileAtomically(summary->html, html);
+  if (!options.pdf) return;
+  if (options.progress) options.progress("printing report.pdf with " + chromium);
+  summary->pdf = options.output_dir / "report.pdf";
+  const fs::path partial = PartialPath(summary->pdf);
+  PrintPdf(chromium, summary->html, partial);
+  fs::rename(partial, summary->pdf);
+}
+
 }  // namespace
 
 bool ReportOptions::IsValid(std::string* error) const {
@@ -400,8 +423,7 @@ ReportSummary WriteEnvelopeReport(const ReportOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path dir = options.inputs.front();
   CheckOutputs({{"-o", options.output_dir, ReportFolderOutput()}}, {{"the sweep folder", dir}}, options.force);
-  const std::string chromium = options.pdf ? FindChromium(options.chromium) : "";
-  if (options.pdf && chromium.empty()) PrintPdf(chromium, {}, {});
+  const std::string chromium = ChromiumFor(options);
   if (options.progress) options.progress("reading " + (dir / "results.sqlite").string());
   const Envelope e = ReadEnvelope(dir, options.envelope_metric, options.envelope_level);
   ReportSummary summary;
@@ -450,15 +472,7 @@ ReportSummary WriteEnvelopeReport(const ReportOptions& options) {
        Escape(options.command_line) + "</code>. Rerun the sweep with <code>crowdrecon sweep SWEEP_FILE -o DIR</code> "
        "(identical rows whatever the number of jobs).</p>\n";
   h += SelfCheckScript(figures) + "</body></html>\n";
-  fs::create_directories(options.output_dir);
-  summary.html = options.output_dir / "report.html";
-  WriteFileAtomically(summary.html, h);
-  if (options.pdf) {
-    summary.pdf = options.output_dir / "report.pdf";
-    const fs::path partial = PartialPath(summary.pdf);
-    PrintPdf(chromium, summary.html, partial);
-    fs::rename(partial, summary.pdf);
-  }
+  WritePage(options, chromium, h, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return summary;
 }
@@ -485,8 +499,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
   }
   const std::vector<fs::path> main_files = RunFilesOf(options.inputs);
   const std::vector<fs::path> other_files = options.compare.empty() ? std::vector<fs::path>{} : RunFilesOf(options.compare);
-  const std::string chromium = options.pdf ? FindChromium(options.chromium) : "";
-  if (options.pdf && chromium.empty()) PrintPdf(chromium, {}, {});  // the clear error, before any work
+  const std::string chromium = ChromiumFor(options);
   const auto say = [&](const std::string& text) {
     if (options.progress) options.progress(text);
   };
@@ -839,17 +852,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
 
   // --- Files: written complete or not at all --------------------------------
   fs::create_directories(options.output_dir);
-  summary.html = options.output_dir / "report.html";
+  fs::create_directories(options.output_dir);
   summary.csv = options.output_dir / "people.csv";
   WriteFileAtomically(summary.csv, csv);
-  WriteFileAtomically(summary.html, h);
-  if (options.pdf) {
-    say("printing report.pdf with " + chromium);
-    summary.pdf = options.output_dir / "report.pdf";
-    const fs::path partial = PartialPath(summary.pdf);
-    PrintPdf(chromium, summary.html, partial);
-    fs::rename(partial, summary.pdf);
-  }
+  WritePage(options, chromium, h, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return summary;
 }

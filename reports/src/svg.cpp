@@ -40,6 +40,21 @@ std::string Num(double v) {
   return buf;
 }
 
+}  // namespace
+
+std::string Open(const std::string& css_class, double width, double height, const std::string& title, double title_x,
+                 double title_y) {
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"" + css_class + "\" viewBox=\"0 0 " + Num(width) +
+                  " " + Num(height) + "\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
+                  "\" font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"" + Escape(title) + "\">\n";
+  s += "<rect x=\"0\" y=\"0\" width=\"" + Num(width) + "\" height=\"" + Num(height) + "\" fill=\"white\"/>\n";
+  s += "<text x=\"" + Num(title_x) + "\" y=\"" + Num(title_y) + "\" font-size=\"14\" font-weight=\"bold\">" +
+       Escape(title) + "</text>\n";
+  return s;
+}
+
+namespace {
+
 // Ticks of a linear axis: about `count` round values in [lo, hi].
 std::vector<double> LinearTicks(double lo, double hi, int count) {
   const double span = hi - lo;
@@ -84,11 +99,7 @@ std::string Chart::ToSvg() const {
   const double pw = width - kLeft - kRight, ph = height - kTop - kBottom;
   const auto X = [&](double v) { return kLeft + (fx(v) - fx(x0)) / (fx(x1) - fx(x0)) * pw; };
   const auto Y = [&](double v) { return kTop + ph - (fy(v) - fy(y0)) / (fy(y1) - fy(y0)) * ph; };
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart\" viewBox=\"0 0 " + Num(width) + " " +
-                  Num(height) + "\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
-                  "\" font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"" + Escape(title) + "\">\n";
-  s += "<rect x=\"0\" y=\"0\" width=\"" + Num(width) + "\" height=\"" + Num(height) + "\" fill=\"white\"/>\n";
-  s += "<text x=\"" + Num(kLeft) + "\" y=\"20\" font-size=\"14\" font-weight=\"bold\">" + Escape(title) + "</text>\n";
+  std::string s = Open("chart", width, height, title, kLeft, 20);
   for (const Band& b : bands) {
     const double a = X(std::max(b.from, x0)), e = X(std::min(b.to, x1));
     if (e <= a) continue;
@@ -181,11 +192,7 @@ std::string Plan::ToSvg() const {
   const auto P = [&](Vec2 p) {
     return Num(kMargin + (p.x - min_m.x) * scale) + "," + Num(kTitle + kMargin + (max_m.y - p.y) * scale);
   };
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plan\" viewBox=\"0 0 " + Num(width) + " " +
-                  Num(height) + "\" width=\"" + Num(width) + "\" height=\"" + Num(height) +
-                  "\" font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"" + Escape(title) + "\">\n";
-  s += "<rect x=\"0\" y=\"0\" width=\"" + Num(width) + "\" height=\"" + Num(height) + "\" fill=\"white\"/>\n";
-  s += "<text x=\"" + Num(kMargin) + "\" y=\"18\" font-size=\"14\" font-weight=\"bold\">" + Escape(title) + "</text>\n";
+  std::string s = Open("plan", width, height, title, kMargin, 18);
   for (const auto& ring : area) {
     std::string pts;
     for (Vec2 p : ring) pts += P(p) + " ";

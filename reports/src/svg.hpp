@@ -13,6 +13,10 @@ namespace crowdrecon::reports::svg {
 std::string Escape(const std::string& text);
 // A number with few digits, for ticks and tables.
 std::string Short(double v, int digits = 3);
+// The opening of a figure: <svg> of that size and class, a white ground and
+// the title in bold at (title_x, title_y).
+std::string Open(const std::string& css_class, double width, double height, const std::string& title, double title_x,
+                 double title_y);
 
 struct Series {
   std::vector<double> x, y;
