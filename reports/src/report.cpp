@@ -710,6 +710,58 @@ ReportSummary WriteReport(const ReportOptions& options) {
   };
   h += exposure_chart(main_runs, options.label);
   if (!other_runs.empty()) h += exposure_chart(other_runs, options.compare_label);
+  // The chest load over time of the most exposed people of each set's first
+  // run (a second pass over that run, keeping only their series).
+  const auto timelines = [&](const RunRisk& r, const std::string& label) {
+    std::vector<const PersonRisk*> order;
+    for (const PersonRisk& p : r.people) order.push_back(&p);
+    std::stable_sort(order.begin(), order.end(), [](const PersonRisk* a, const PersonRisk* b) {
+      return a->dose != b->dose ? a->dose > b->dose : a->max_load_n > b->max_load_n;
+    });
+    RiskOptions o2 = o;
+    o2.progress = nullptr;
+    for (std::size_t k = 0; k < order.size() && k < 6; ++k) o2.series_of.push_back(order[k]->id);
+    say("the chest loads over time of the " + std::to_string(o2.series_of.size()) + " most exposed of " + r.file.string());
+    const RunRisk again = AnalyseRunRisk(r.file, o2);
+    static const char* colours[] = {"#c0392b", "#1f4e79", "#2e8b57", "#7b3f98", "#d35400", "#555555"};
+    svg::Chart c;
+    c.title = label + ": chest load of the " + std::to_string(o2.series_of.size()) + " most exposed people";
+    c.x_label = "time (s)";
+    c.y_label = "chest load, 1 s mean (N)";
+    c.legend_left = true;
+    for (std::size_t k = 0; k < again.series.size(); ++k) {
+      svg::Series s;
+      s.color = colours[k % 6];
+      s.width = 1.4;
+      s.label = "person " + std::to_string(o2.series_of[k]) + " (dose " + Short(order[k]->dose) + ")";
+      for (const auto& [t, v] : again.series[k]) {
+        s.x.push_back(t);
+        s.y.push_back(v);
+      }
+      c.series.push_back(std::move(s));
+    }
+    double first_s = 1e300, last_s = -1e300;
+    for (const FrameRisk& f : r.frames) {
+      first_s = std::min(first_s, f.time_s);
+      last_s = std::max(last_s, f.time_s);
+    }
+    svg::Series f0, danger;
+    f0.x = danger.x = {first_s, last_s};
+    f0.y = {o.f0_n, o.f0_n};
+    danger.y = {o.danger_n, o.danger_n};
+    f0.color = kZoneColor[1];
+    danger.color = kZoneColor[2];
+    f0.dashed = danger.dashed = true;
+    f0.label = "F0 = " + Short(o.f0_n) + " N";
+    danger.label = Short(o.danger_n) + " N";
+    c.series.push_back(f0);
+    c.series.push_back(danger);
+    ++figures;
+    return "<figure>" + c.ToSvg() + "<figcaption>Each line one person (the largest doses of " +
+           Escape(r.file.filename().string()) + "), while in the venue; dashed: the zones' edges.</figcaption></figure>\n";
+  };
+  h += timelines(first, options.label);
+  if (!other_runs.empty()) h += timelines(other_runs.front(), options.compare_label);
 
   // Map.
   h += "<h2>5. Where the people at risk were</h2>\n";

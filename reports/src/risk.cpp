@@ -157,6 +157,11 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   std::vector<Pose> poses(n);
   std::vector<LoadContact> load_contacts;
   std::vector<runfile::Contact> contacts;
+  // Which series (if any) each person's smoothed load goes to.
+  std::vector<int> series_slot(n, -1);
+  risk.series.resize(options.series_of.size());
+  for (std::size_t k = 0; k < options.series_of.size(); ++k)
+    if (options.series_of[k] >= 1 && options.series_of[k] <= n) series_slot[options.series_of[k] - 1] = static_cast<int>(k);
 
   runfile::PersonFrameStream people = reader.PersonFrames(times.back().frame);
   runfile::ContactFrameStream contact_stream = reader.ContactFrames(times.back().frame);
@@ -248,6 +253,7 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
       const double s = smooth[i].Add(raw);
       smoothed[i] = s;
       was_present[i] = true;
+      if (series_slot[i] >= 0) risk.series[static_cast<std::size_t>(series_slot[i])].push_back({t, s});
       if (std::isnan(pr.first_seen_s)) pr.first_seen_s = t;
       pr.last_seen_s = t;
       if (pf.state[k] == runfile::PersonStatus::kFallen) pr.fell = true;

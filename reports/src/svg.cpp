@@ -147,7 +147,10 @@ std::string Chart::ToSvg() const {
   // Series, clipped to the plot by clamping (a chart has few points outside).
   const auto cx = [&](double v) { return std::clamp(X(v), kLeft, kLeft + pw); };
   const auto cy = [&](double v) { return std::clamp(Y(v), kTop, kTop + ph); };
-  double legend_y = legend_bottom ? kTop + ph - 10 - 16.0 * double(std::count_if(series.begin(), series.end(), [](const Series& x) { return !x.label.empty(); })) + 16 : kTop + 30;
+  const double labelled = double(std::count_if(series.begin(), series.end(), [](const Series& x) { return !x.label.empty(); }));
+  double legend_y = legend_bottom ? kTop + ph - 10 - 16.0 * labelled + 16 : kTop + 30;
+  const double legend_x = legend_left ? kLeft + 10 : kLeft + pw - 280;
+  std::string legend;  // drawn last, on a light ground, over the lines
   for (const Series& ser : series) {
     std::string path;
     bool pen = false;
@@ -172,14 +175,17 @@ std::string Chart::ToSvg() const {
     s += "<path d=\"" + path + "\" fill=\"none\" stroke=\"" + ser.color + "\" stroke-width=\"" + Num(ser.width) + "\"" +
          (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
     if (!ser.label.empty()) {
-      const double lx = legend_left ? kLeft + 10 : kLeft + pw - 280;
-      s += "<line x1=\"" + Num(lx) + "\" y1=\"" + Num(legend_y) + "\" x2=\"" + Num(lx + 24) + "\" y2=\"" + Num(legend_y) +
+      const double lx = legend_x;
+      legend += "<line x1=\"" + Num(lx) + "\" y1=\"" + Num(legend_y) + "\" x2=\"" + Num(lx + 24) + "\" y2=\"" + Num(legend_y) +
            "\" stroke=\"" + ser.color + "\" stroke-width=\"" + Num(std::max(ser.width, 2.0)) + "\"" +
            (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
-      s += "<text x=\"" + Num(lx + 30) + "\" y=\"" + Num(legend_y + 4) + "\">" + Escape(ser.label) + "</text>\n";
+      legend += "<text x=\"" + Num(lx + 30) + "\" y=\"" + Num(legend_y + 4) + "\">" + Escape(ser.label) + "</text>\n";
       legend_y += 16;
     }
   }
+  if (!legend.empty())
+    s += "<rect x=\"" + Num(legend_x - 6) + "\" y=\"" + Num(legend_y - 16.0 * labelled - 10) + "\" width=\"276\" height=\"" +
+         Num(16.0 * labelled + 8) + "\" fill=\"white\" fill-opacity=\"0.85\"/>\n" + legend;
   s += "</svg>\n";
   return s;
 }

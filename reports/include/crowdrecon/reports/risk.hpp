@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowdrecon/common/vec2.hpp"
@@ -46,6 +47,9 @@ struct RiskOptions {
   double smoothing_s = 1.0;
   // Called after each frame with (frames done, frames in all); may be empty.
   std::function<void(std::size_t, std::size_t)> progress;
+  // People (ids, 1-based) whose smoothed chest-load series RunRisk::series
+  // keeps (the report's exposure timelines of the most exposed).
+  std::vector<std::uint32_t> series_of;
 
   bool IsValid(std::string* error) const;
   // The exponent k of the tolerance power law.
@@ -121,6 +125,8 @@ struct RunRisk {
   std::uint32_t beyond_tolerance = 0;          // dose >= 1
   std::uint32_t fallen = 0;
   std::uint64_t contact_rows = 0;
+  // The smoothed load over time of each of RiskOptions::series_of: (time, load) while present.
+  std::vector<std::vector<std::pair<double, double>>> series;
   bool loads_recorded = false;  // chest loads from table person_load (else computed from the contacts)
   bool has_contacts = false;    // the run has a contact table with rows: force network and force distributions
 };
