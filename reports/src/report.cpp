@@ -13,6 +13,8 @@
 #include <sys/wait.h>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/render_run.hpp"
@@ -100,12 +102,6 @@ std::string PrefixSvgIds(std::string text, const std::string& prefix) {
   return start == std::string::npos ? text : text.substr(start);
 }
 
-std::string ReadText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::string Base64(const std::string& bytes) {
   static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -142,7 +138,7 @@ std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uin
   std::string text;
   try {
     viz::RenderRun(run, o);
-    text = ReadText(viz::FramePicturePath(dir, frame, as_svg ? ".svg" : ".png"));
+    text = ReadInputFile(viz::FramePicturePath(dir, frame, as_svg ? ".svg" : ".png"), "rendered force network");
   } catch (...) {
     std::error_code ec;
     fs::remove_all(dir, ec);
@@ -159,34 +155,6 @@ std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uin
   return svg;
 }
 
-std::vector<std::vector<Vec2>> RingsOfWkt(const std::string& wkt) {
-  // POLYGON ((x y, ...), (...)) or MULTIPOLYGON (((...)), ...): every ring.
-  std::vector<std::vector<Vec2>> rings;
-  std::vector<Vec2> ring;
-  std::size_t i = 0;
-  int depth = 0;
-  while (i < wkt.size()) {
-    const char c = wkt[i];
-    if (c == '(') {
-      ++depth;
-      ++i;
-    } else if (c == ')') {
-      if (!ring.empty()) rings.push_back(std::move(ring));
-      ring.clear();
-      --depth;
-      ++i;
-    } else if ((c >= '0' && c <= '9') || c == '-' || c == '.') {
-      char* end = nullptr;
-      const double x = std::strtod(wkt.c_str() + i, &end);
-      const double y = std::strtod(end, &end);
-      ring.push_back({x, y});
-      i = static_cast<std::size_t>(end - wkt.c_str());
-    } else {
-      ++i;
-    }
-  }
-  return rings;
-}
 
 std::string CdfChart(const std::string& title, const std::string& x_label,
                      const std::vector<std::pair<std::string, std::vector<double>>>& sets, const RiskOptions& o,
@@ -270,7 +238,7 @@ void PrintPdf(const std::string& chromium, const fs::path& html, const fs::path&
   const bool ok = status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::is_regular_file(pdf, ec) &&
                   fs::file_size(pdf, ec) > 0;
   const fs::path log = pdf.parent_path() / ".chromium.log";
-  const std::string log_text = ok ? "" : ReadText(log);
+  const std::string log_text = ok || !fs::is_regular_file(log, ec) ? "" : ReadInputFile(log, "Chromium log");
   fs::remove(log, ec);
   if (!ok)
     throw InputError("report.pdf: " + chromium + " could not print " + html.string() + " (exit status " +
@@ -356,7 +324,7 @@ OutputKind ReportFolderOutput() {
   return {"a report folder (report.html, report.pdf, people.csv)", true, [](const fs::path& dir) {
             std::error_code ec;
             if (!fs::is_regular_file(dir / "report.html", ec)) return false;
-            if (ReadText(dir / "report.html").find(kGenerator) == std::string::npos) return false;
+            if (ReadInputFile(dir / "report.html", "report").find(kGenerator) == std::string::npos) return false;
             return FolderHoldsOnly(dir, [](const fs::directory_entry& e) {
               const std::string name = e.path().filename().string();
               return name == "report.html" || name == "report.pdf" || name == "people.csv";
@@ -769,7 +737,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
     const runfile::RunFileReader reader(r.file);
     svg::Plan p;
     p.title = label + ": each person at the place of their largest chest load";
-    p.area = RingsOfWkt(reader.walkable_wkt());
+    const std::string venue = reader.venue_json();
+    if (!venue.empty())
+      for (const auto& ring : geometry::ParseVenue(venue, r.file.string() + ": run value venue").walkable_area)
+        p.area.push_back(ring);
     for (const runfile::Wall& w : reader.Walls()) {
       std::vector<Vec2> pts = w.points;
       if (w.closed && !pts.empty()) pts.push_back(pts.front());

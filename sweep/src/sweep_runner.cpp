@@ -159,12 +159,18 @@ struct Context {
   analysis::AnalysisOptions analysis;
 };
 
-ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
+// Each metric's position in ResultRow::metrics, by name.
+const std::map<std::string, std::size_t>& MetricColumnOf() {
   static const std::map<std::string, std::size_t> column_of = [] {
     std::map<std::string, std::size_t> m;
     for (std::size_t i = 0; i < MetricColumns().size(); ++i) m[MetricColumns()[i]] = i;
     return m;
   }();
+  return column_of;
+}
+
+ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
+  const std::map<std::string, std::size_t>& column_of = MetricColumnOf();
   ResultRow row;
   row.run_index = run.index;
   row.status = "complete";
@@ -183,24 +189,21 @@ ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
 // The run's injury-risk counts (default options) into the risk columns; a run
 // without chest loads or contacts leaves them empty.
 void AddRiskColumns(const fs::path& file, ResultRow* row) {
-  static const std::map<std::string, std::size_t> column_of = [] {
-    std::map<std::string, std::size_t> m;
-    for (std::size_t i = 0; i < MetricColumns().size(); ++i) m[MetricColumns()[i]] = i;
-    return m;
-  }();
+  const std::map<std::string, std::size_t>& column_of = MetricColumnOf();
   reports::RunRisk risk;
   try {
     risk = reports::AnalyseRunRisk(file, reports::RiskOptions{});
   } catch (const InputError&) {
     return;
   }
-  double longest = 0.0;
-  for (const reports::PersonRisk& p : risk.people) longest = std::max(longest, p.longest_above_f0_s);
+  double longest = 0.0, max_load = 0.0;
+  for (const reports::PersonRisk& p : risk.people) {
+    longest = std::max(longest, p.longest_above_f0_s);
+    max_load = std::max(max_load, p.max_load_n);
+  }
   row->metrics[column_of.at("people_uncomfortable")] = risk.counts[1];
   row->metrics[column_of.at("people_danger")] = risk.counts[2];
   row->metrics[column_of.at("people_beyond_tolerance")] = risk.beyond_tolerance;
-  double max_load = 0.0;
-  for (const reports::PersonRisk& p : risk.people) max_load = std::max(max_load, p.max_load_n);
   row->metrics[column_of.at("max_chest_load_n")] = max_load;
   row->metrics[column_of.at("longest_above_f0_s")] = longest;
 }
