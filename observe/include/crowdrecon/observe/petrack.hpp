@@ -11,37 +11,13 @@
 // expected; nothing is guessed silently (a missing unit is a note).
 #pragma once
 
-#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
-#include <vector>
 
-#include "crowdrecon/common/vec2.hpp"
+#include "crowdrecon/observe/trajectories.hpp"
 
 namespace crowdrecon::observe {
-
-struct TrajectoryPoint {
-  std::uint32_t id = 0;      // the person's id in the file
-  std::int64_t frame = 0;
-  Vec2 position_m;
-  double z_m = 0.0;          // height or 3D position, as the file says (0 without the column)
-};
-
-struct Trajectories {
-  std::string source;        // the file's name, for messages
-  double fps = 0.0;
-  std::string unit = "m";    // of the coordinates in the file: m, cm or mm
-  std::vector<TrajectoryPoint> points;  // in file order
-  std::size_t people = 0;    // distinct ids
-  std::int64_t first_frame = 0, last_frame = 0;
-  std::vector<std::string> notes;  // what the reader assumed (a unit not stated, ...)
-};
-
-// Limits of what a file may hold (an error names them).
-inline constexpr std::uint32_t kMaxPersonId = 10'000'000;
-inline constexpr std::int64_t kMaxFrame = 1'000'000'000;
-inline constexpr double kMaxCoordinate_m = 1e5;
 
 // `fps_override` > 0 replaces the file's frame rate (a file without one needs it).
 Trajectories ParsePeTrack(std::string_view text, const std::string& source, double fps_override = 0.0);
