@@ -1,19 +1,27 @@
 // `crowdrecon observe`: observations from trajectories (PeTrack, JuPedSim,
 // crowdrecon runs) and from footage, in one format (observe/observation.hpp,
 // docs/observations.md).
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/observe/footage.hpp"
 #include "crowdrecon/observe/fundamental_diagram.hpp"
+#include "crowdrecon/observe/homography.hpp"
 #include "crowdrecon/observe/observation.hpp"
+#include "crowdrecon/observe/synthetic_footage.hpp"
 #include "crowdrecon/observe/trajectories.hpp"
 #include "crowdrecon/viz/chart.hpp"
 
@@ -23,6 +31,7 @@ namespace {
 
 struct TrajectoryArgs {
   std::string file;
+  std::string figure;
   std::string spec;
   std::string output;
   double fps = 0.0;
@@ -89,12 +98,17 @@ void CheckObservationOutputs(const std::string& output, const std::vector<NamedI
                inputs, force);
 }
 
+void DrawObservationFigure(const observe::Observation& obs, const observe::Observation* reference,
+                           const std::filesystem::path& file);
+
 void RunTrajectories(const TrajectoryArgs& args) {
   CheckObservationOutputs(args.output, {{"the trajectories", args.file}, {"the spec", args.spec}}, args.force);
+  CheckOutputs({{"--figure", args.figure, PictureOutputKind()}}, {{"the trajectories", args.file}}, args.force);
   const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
   const observe::Trajectories t = observe::ReadTrajectories(args.file, args.fps);
   const observe::Observation obs = observe::ObserveTrajectories(t, spec);
   observe::WriteObservation(obs, args.output);
+  if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
   if (!args.quiet) {
     std::printf("%zu people, frames %lld-%lld at %s fps\n", t.people, static_cast<long long>(t.first_frame),
                 static_cast<long long>(t.last_frame), FormatNumber(t.fps).c_str());
@@ -189,6 +203,233 @@ void RunFundamentalDiagram(const FdArgs& args) {
   }
 }
 
+// "1,2.5,7" -> {1, 2.5, 7}.
+std::vector<double> ParseTimes(const std::string& text, const std::string& option) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v) || v < 0)
+      throw InputError(option + " \"" + text + "\": expected times in seconds separated by commas, e.g. 2,10.5");
+    out.push_back(v);
+  }
+  return out;
+}
+
+// The figure of an observation: per region, the speed of each direction with
+// its uncertainty and the shares moving, with the detected events; a second
+// observation (the reference, e.g. a run's own trajectories) drawn beside it.
+void DrawObservationFigure(const observe::Observation& obs, const observe::Observation* reference,
+                           const std::filesystem::path& file) {
+  const std::vector<double> t = obs.BinTimes();
+  const double t0 = obs.t0_s, t1 = obs.t0_s + obs.bin_s * static_cast<double>(obs.bins);
+  viz::ChartSheet sheet(file, 1200, "Observation of " + std::filesystem::path(obs.source_file).filename().string() + " (" + obs.method + ")",
+                        reference ? "dots with bars: this observation; lines: " +
+                                        std::filesystem::path(reference->source_file).filename().string() + " (" + reference->method +
+                                        "); marks: surges (solid) and stops (dashed)"
+                                  : "dots with bars: values and uncertainties per bin; marks: surges (solid) and stops (dashed)");
+  const auto values = [](const observe::Series* s, bool error) {
+    std::vector<double> v;
+    if (s)
+      for (const observe::SeriesPoint& p : s->points) v.push_back(error ? p.uncertainty : p.value);
+    return v;
+  };
+  for (const observe::Region& region : obs.spec.regions) {
+    double v_hi = 0.5;
+    for (const char* d : {"forward", "backward"})
+      for (double v : values(obs.Find("speed", region.name, d), false))
+        if (std::isfinite(v)) v_hi = std::max(v_hi, v);
+    viz::ChartPanel& speed = sheet.AddPanel("time, s", region.name + ": speed of the movers, m/s", t0, t1, 0,
+                                            std::ceil(v_hi * 1.15 * 4) / 4, 300);
+    viz::ChartPanel& share = sheet.AddPanel("time, s", region.name + ": share moving", t0, t1, 0, 1, 200);
+    int colour = 0;
+    for (const char* d : {"forward", "backward"}) {
+      const std::vector<double> err = values(obs.Find("speed", region.name, d), true);
+      speed.Points(t, values(obs.Find("speed", region.name, d), false), viz::ChartColor(colour), 2.2, std::string(d), &err);
+      share.Points(t, values(obs.Find("share_moving", region.name, d), false), viz::ChartColor(colour), 2.0, std::string(d));
+      if (reference && reference->Find("speed", region.name, d)) {
+        const std::vector<double> rt = reference->BinTimes();
+        speed.Line(rt, values(reference->Find("speed", region.name, d), false), viz::ChartColor(colour), 1.5,
+                   std::string(d) + ", reference");
+        share.Line(rt, values(reference->Find("share_moving", region.name, d), false), viz::ChartColor(colour), 1.5);
+      }
+      ++colour;
+    }
+    share.Line(t, values(obs.Find("counterflow_share", region.name, "all"), false), viz::ChartColor(3), 1.5,
+               "counter-flow share of the movers");
+    for (const observe::Event& e : obs.events) {
+      if (e.where != region.name || e.direction == "all" || e.censored) continue;
+      const viz::Color c = viz::ChartColor(e.direction == "forward" ? 0 : 1);
+      speed.Mark(e.time_s, c, e.kind == "surge" ? "surge" : "stop", e.kind != "surge");
+    }
+  }
+  sheet.Finish();
+}
+
+struct FootageArgs {
+  std::string video, homography, spec, output, picture_dir, picture_at, figure, reference, flow = "dis-medium";
+  double grid_m = 0.1, from_s = 0.0, to_s = -1.0;
+  bool no_enhance = false, quiet = false, force = false;
+};
+
+void RunFootage(const FootageArgs& args) {
+  std::vector<PlannedOutput> outputs = {{"--figure", args.figure, PictureOutputKind()}};
+  CheckObservationOutputs(args.output, {{"the video", args.video}, {"the homography", args.homography}, {"the spec", args.spec}},
+                          args.force);
+  CheckOutputs(outputs, {{"the video", args.video}}, args.force);
+  observe::FootageOptions options;
+  options.flow = args.flow;
+  options.grid_spacing_m = args.grid_m;
+  options.enhance = !args.no_enhance;
+  options.from_s = args.from_s;
+  if (args.to_s >= 0) options.to_s = args.to_s;
+  if (!args.picture_at.empty()) {
+    if (args.picture_dir.empty()) throw InputError("--picture-at needs --pictures FOLDER");
+    options.picture_times_s = ParseTimes(args.picture_at, "--picture-at");
+    options.picture_dir = args.picture_dir;
+  }
+  if (!args.quiet && isatty(fileno(stderr)) != 0)
+    options.progress = [](const observe::FootageProgress& p) {
+      std::fprintf(stderr, "\rfootage: frame %zu%s (video %.1f s), %.0f frames/s   ", p.frames_done,
+                   p.frames_total ? (" of " + std::to_string(p.frames_total)).c_str() : "", p.video_time_s,
+                   p.elapsed_s > 0 ? static_cast<double>(p.frames_done) / p.elapsed_s : 0.0);
+      std::fflush(stderr);
+    };
+  const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
+  const observe::Homography h = observe::ReadHomography(args.homography);
+  std::unique_ptr<observe::Observation> reference;
+  if (!args.reference.empty()) reference = std::make_unique<observe::Observation>(observe::ReadObservation(args.reference));
+  observe::FootageSummary summary;
+  const observe::Observation obs = observe::ObserveFootage(args.video, h, spec, options, &summary);
+  if (options.progress) std::fprintf(stderr, "\n");
+  observe::WriteObservation(obs, args.output);
+  if (!args.figure.empty()) DrawObservationFigure(obs, reference.get(), args.figure);
+  if (!args.quiet) {
+    if (!h.pairs.empty())
+      std::printf("homography: %zu point pairs, rms %s px\n", h.pairs.size(), FormatNumber(h.rms_error_px).c_str());
+    std::printf("%s", summary.BriefReport().c_str());
+    PrintSummary(obs);
+    for (const auto& p : summary.pictures) std::printf("picture: %s\n", p.string().c_str());
+    if (!args.figure.empty()) std::printf("figure: %s\n", args.figure.c_str());
+  }
+  std::printf("observation: %s and %s\n", args.output.c_str(), observe::ObservationCsvPath(args.output).string().c_str());
+}
+
+struct SynthesizeArgs {
+  std::string run, video, homography;
+  observe::SyntheticFootageOptions options;
+  bool force = false;
+};
+
+void RunSynthesize(const SynthesizeArgs& args) {
+  if (std::filesystem::path(args.video).extension() != ".avi")
+    throw InputError("-o " + args.video + ": expected a file name ending in .avi (Motion-JPEG)");
+  CheckOutputs({{"-o", args.video, VideoOutputKind()},
+                {"--homography-out", args.homography,
+                 JsonOutputKind("a homography (format crowdrecon-homography)",
+                                [](const nlohmann::json& j) { return j.contains("format") && j["format"] == "crowdrecon-homography"; })}},
+               {{"the run file", args.run}}, args.force);
+  observe::SyntheticFootageOptions options = args.options;
+  if (isatty(fileno(stderr)) != 0)
+    options.progress = [](std::size_t done, std::size_t total) {
+      if (done % 25 == 0 || done == total) std::fprintf(stderr, "\rsynthesize: frame %zu of %zu   ", done, total);
+      std::fflush(stderr);
+    };
+  const observe::SyntheticFootageSummary s = observe::RenderSyntheticFootage(args.run, options, args.video, args.homography);
+  if (options.progress) std::fprintf(stderr, "\n");
+  std::printf("video: %s (%zu frames at %s fps, from run time %s s; %dx%d; darkness %s, blur %s px, noise %s, JPEG quality %d)\n",
+              args.video.c_str(), s.frames, FormatNumber(s.fps).c_str(), FormatNumber(s.first_time_s).c_str(),
+              options.width_px, options.height_px, FormatNumber(options.darkness).c_str(),
+              FormatNumber(options.blur_sigma_px).c_str(), FormatNumber(options.noise_sigma).c_str(), options.jpeg_quality);
+  std::printf("homography: %s\n", args.homography.c_str());
+}
+
+// Compares an observation with a reference (e.g. footage with the run's own
+// trajectories): per region and direction, the mean speed over the bins both
+// define; the counter-flow share; and each reference surge/stop matched to
+// the nearest one of the same kind within 3 s. Shares of the moving and
+// still, and the mean velocity, are left out: footage counts floor, not
+// people (footage.hpp).
+struct CompareArgs {
+  std::string reference, test, csv;
+  double match_s = 3.0;
+  bool force = false;
+};
+
+void RunCompare(const CompareArgs& args) {
+  CheckOutputs({{"--csv", args.csv, OutputKind{"a comparison (CSV)", false, [](const std::filesystem::path& f) {
+                                                return FileStartsWith(f, "where,quantity,direction,reference,observed");
+                                              }}}},
+               {{"the reference", args.reference}, {"the observation", args.test}}, args.force);
+  const observe::Observation ref = observe::ReadObservation(args.reference);
+  const observe::Observation obs = observe::ReadObservation(args.test);
+  std::string csv = "where,quantity,direction,reference,observed,error,error_percent,bins\n";
+  const std::vector<double> rt = ref.BinTimes(), ot = obs.BinTimes();
+  // The observed value at a reference bin's time (the bin that holds it).
+  const auto at = [&](const observe::Series& s, double time) {
+    const double k = std::floor((time - obs.t0_s) / obs.bin_s);
+    return k >= 0 && k < static_cast<double>(s.points.size()) ? s.points[static_cast<std::size_t>(k)].value : std::nan("");
+  };
+  std::printf("%-10s %-18s %-9s %10s %10s %10s %8s %6s\n", "where", "quantity", "direction", "reference", "observed", "error",
+              "error %", "bins");
+  for (const observe::Region& region : ref.spec.regions)
+    for (const auto& [quantity, direction] : std::vector<std::pair<std::string, std::string>>{
+             {"speed", "forward"}, {"speed", "backward"}, {"counterflow_share", "all"}}) {
+      const observe::Series* r = ref.Find(quantity, region.name, direction);
+      const observe::Series* o = obs.Find(quantity, region.name, direction);
+      if (!r || !o) continue;
+      double sr = 0, so = 0;
+      std::size_t n = 0;
+      for (std::size_t k = 0; k < r->points.size(); ++k) {
+        const double a = r->points[k].value, b = at(*o, rt[k]);
+        // Speeds: bins where the reference has movers that way.
+        if (!std::isfinite(a) || !std::isfinite(b) || (quantity == "speed" && a <= 0)) continue;
+        sr += a, so += b, ++n;
+      }
+      if (n == 0) continue;
+      const double mr = sr / static_cast<double>(n), mo = so / static_cast<double>(n), e = mo - mr;
+      std::printf("%-10s %-18s %-9s %10.4f %10.4f %+10.4f %+8.1f %6zu\n", region.name.c_str(), quantity.c_str(),
+                  direction.c_str(), mr, mo, e, mr != 0 ? 100 * e / std::abs(mr) : std::nan(""), n);
+      csv += region.name + "," + quantity + "," + direction + "," + FormatNumber(mr) + "," + FormatNumber(mo) + "," +
+             FormatNumber(e) + "," + (mr != 0 ? FormatNumber(100 * e / std::abs(mr)) : "") + "," + std::to_string(n) + "\n";
+    }
+  for (const observe::Event& e : ref.events) {
+    if (e.censored || e.direction == "all") continue;
+    const observe::Event* best = nullptr;
+    for (const observe::Event& f : obs.events)
+      if (f.kind == e.kind && f.where == e.where && f.direction == e.direction && !f.censored &&
+          std::abs(f.time_s - e.time_s) <= args.match_s && (!best || std::abs(f.time_s - e.time_s) < std::abs(best->time_s - e.time_s)))
+        best = &f;
+    if (best) {
+      std::printf("%-10s %-18s %-9s %10.2f %10.2f %+10.2f %8s %6s\n", e.where.c_str(), (e.kind + " onset").c_str(),
+                  e.direction.c_str(), e.time_s, best->time_s, best->time_s - e.time_s, "", "");
+      csv += e.where + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + "," +
+             FormatNumber(best->time_s) + "," + FormatNumber(best->time_s - e.time_s) + ",,\n";
+    } else {
+      std::printf("%-10s %-18s %-9s %10.2f %10s\n", e.where.c_str(), (e.kind + " onset").c_str(), e.direction.c_str(), e.time_s,
+                  "missed");
+      csv += e.where + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + ",,,,\n";
+    }
+  }
+  std::size_t extra = 0;
+  for (const observe::Event& f : obs.events) {
+    if (f.censored || f.direction == "all") continue;
+    bool matched = false;
+    for (const observe::Event& e : ref.events)
+      matched = matched || (e.kind == f.kind && e.where == f.where && e.direction == f.direction &&
+                            std::abs(f.time_s - e.time_s) <= args.match_s);
+    extra += !matched;
+  }
+  std::printf("events in the observation with no reference event within %s s: %zu\n", FormatNumber(args.match_s).c_str(), extra);
+  csv += "all,unmatched_events,all,0," + std::to_string(extra) + ",,,\n";
+  if (!args.csv.empty()) {
+    WriteFileAtomically(args.csv, csv);
+    std::printf("comparison: %s\n", args.csv.c_str());
+  }
+}
+
 }  // namespace
 
 void RegisterObserveCommands(CLI::App& app) {
@@ -207,6 +448,7 @@ void RegisterObserveCommands(CLI::App& app) {
       ->required();
   traj->add_option("--fps", targs->fps, "frame rate, replacing the file's (a PeTrack file without one needs it)")
       ->check(CLI::Range(0.001, 10000.0));
+  traj->add_option("--figure", targs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   traj->add_flag("-q,--quiet", targs->quiet, "print only the output's name");
   AddForceFlag(traj, &targs->force);
   traj->callback([targs] { RunTrajectories(*targs); });
@@ -222,6 +464,58 @@ void RegisterObserveCommands(CLI::App& app) {
   fd->add_option("--frame-step", fargs->frame_step, "use every N-th frame (default 5)")->check(CLI::Range(1, 10000));
   AddForceFlag(fd, &fargs->force);
   fd->callback([fargs] { RunFundamentalDiagram(*fargs); });
+
+  auto vargs = std::make_shared<FootageArgs>();
+  CLI::App* footage = observe->add_subcommand(
+      "footage", "Observe a video: dense optical flow carried to the floor through a homography, per direction of travel, "
+                 "with unusable frames flagged (docs/observations.md)");
+  footage->add_option("VIDEO", vargs->video, "video file (AVI, MP4, ...)")->required();
+  footage->add_option("--homography", vargs->homography, "homography (JSON: >= 4 image <-> floor point pairs, or a matrix)")
+      ->required();
+  footage->add_option("--spec", vargs->spec, "observation spec (axis, regions, bins)")->required();
+  footage->add_option("-o,--output", vargs->output, "observation file (.json; its series go to the same name .csv)")->required();
+  footage->add_option("--flow", vargs->flow, "optical flow: dis-medium (DIS, medium preset; default), dis-fast (DIS, fast preset: about three times faster, speeds lower; docs/observations.md) or farneback")->check(CLI::IsMember({"dis-fast", "dis-medium", "farneback"}));
+  footage->add_option("--grid", vargs->grid_m, "spacing of the floor points sampled (m, default 0.1)")->check(CLI::Range(0.01, 2.0));
+  footage->add_option("--from", vargs->from_s, "start at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
+  footage->add_option("--to", vargs->to_s, "stop at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
+  footage->add_option("--pictures", vargs->picture_dir, "folder for the flow-field pictures (with --picture-at)");
+  footage->add_option("--picture-at", vargs->picture_at, "times (s) of the flow-field pictures, e.g. 2,10.5");
+  footage->add_option("--figure", vargs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
+  footage->add_option("--reference", vargs->reference, "an observation to draw beside it in --figure (e.g. the trajectories')");
+  footage->add_flag("--no-enhance", vargs->no_enhance, "no contrast enhancement (CLAHE) before the flow");
+  footage->add_flag("-q,--quiet", vargs->quiet, "no progress, print only the output's name");
+  AddForceFlag(footage, &vargs->force);
+  footage->callback([vargs] { RunFootage(*vargs); });
+
+  auto sargs = std::make_shared<SynthesizeArgs>();
+  CLI::App* synth = observe->add_subcommand(
+      "synthesize", "Synthetic footage of a run: bodies seen by a tilted camera (known homography), darkened, blurred, noisy, "
+                    "compressed; for checking footage analysis against the run's trajectories");
+  synth->add_option("RUN", sargs->run, "run file (.sqlite)")->required();
+  synth->add_option("-o,--output", sargs->video, "video (.avi, Motion-JPEG)")->required();
+  synth->add_option("--homography-out", sargs->homography, "where to write the camera's homography (JSON)")->required();
+  synth->add_option("--width", sargs->options.width_px, "picture width (px, default 960)");
+  synth->add_option("--height", sargs->options.height_px, "picture height (px, default 480)");
+  synth->add_option("--far-width", sargs->options.far_width, "far edge of the floor as a share of the near edge (default 0.6)");
+  synth->add_option("--darkness", sargs->options.darkness, "grey levels scaled by 1 - darkness (0 to <1, default 0)");
+  synth->add_option("--blur", sargs->options.blur_sigma_px, "Gaussian blur (sigma, px)");
+  synth->add_option("--noise", sargs->options.noise_sigma, "sensor noise (sigma, grey levels)");
+  synth->add_option("--quality", sargs->options.jpeg_quality, "Motion-JPEG quality (1-100, default 95)");
+  synth->add_option("--frame-step", sargs->options.frame_step, "every N-th frame of the run (a lower frame rate)");
+  synth->add_option("--seed", sargs->options.seed, "seed of the textures and the noise");
+  AddForceFlag(synth, &sargs->force);
+  synth->callback([sargs] { RunSynthesize(*sargs); });
+
+  auto cargs = std::make_shared<CompareArgs>();
+  CLI::App* compare = observe->add_subcommand(
+      "compare", "Errors of an observation against a reference observation: mean speeds per direction, the counter-flow "
+                 "share, event onsets");
+  compare->add_option("REFERENCE", cargs->reference, "reference observation (.json)")->required();
+  compare->add_option("OBSERVATION", cargs->test, "observation to check (.json)")->required();
+  compare->add_option("--csv", cargs->csv, "also write the table as CSV");
+  compare->add_option("--match", cargs->match_s, "events match within this time (s, default 3)")->check(CLI::Range(0.0, 60.0));
+  AddForceFlag(compare, &cargs->force);
+  compare->callback([cargs] { RunCompare(*cargs); });
 }
 
 }  // namespace crowdrecon::cli

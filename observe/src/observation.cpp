@@ -69,8 +69,10 @@ bool ObservationSpec::IsValid(std::string* error) const {
     return bad("velocity_span_s: " + FormatNumber(velocity_span_s) + ", expected a time in [0.01, 10] s");
   if (!(still_speed_m_per_s >= 0.0 && still_speed_m_per_s <= 2.0))
     return bad("still_speed_m_per_s: " + FormatNumber(still_speed_m_per_s) + ", expected a speed in [0, 2] m/s");
-  if (!(min_moving_share >= 0.0 && min_moving_share < 1.0))
-    return bad("min_moving_share: " + FormatNumber(min_moving_share) + ", expected a share in [0, 1)");
+  if (!(person_area_m2 >= 0.01 && person_area_m2 <= 2.0))
+    return bad("person_area_m2: " + FormatNumber(person_area_m2) + ", expected an area in [0.01, 2] m2");
+  if (!(min_moving_area_m2 >= 0.0 && min_moving_area_m2 <= 1000.0))
+    return bad("min_moving_area_m2: " + FormatNumber(min_moving_area_m2) + ", expected an area in [0, 1000] m2");
   return events.IsValid(error);
 }
 
@@ -116,7 +118,8 @@ ObservationSpec ParseObservationSpec(const std::string& text, const std::string&
   spec.bin_s = root.Number("bin_s", spec.bin_s, 0.01, 3600.0);
   spec.velocity_span_s = root.Number("velocity_span_s", spec.velocity_span_s, 0.01, 10.0);
   spec.still_speed_m_per_s = root.Number("still_speed_m_per_s", spec.still_speed_m_per_s, 0.0, 2.0);
-  spec.min_moving_share = root.Number("min_moving_share", spec.min_moving_share, 0.0, 0.99);
+  spec.person_area_m2 = root.Number("person_area_m2", spec.person_area_m2, 0.01, 2.0);
+  spec.min_moving_area_m2 = root.Number("min_moving_area_m2", spec.min_moving_area_m2, 0.0, 1000.0);
   if (const auto ev = root.Find("events")) {
     spec.events.reference_speed_m_per_s = ev->Number("reference_speed_m_per_s", spec.events.reference_speed_m_per_s, 0.001, 5.0);
     spec.events.threshold_m = ev->Number("threshold_m", spec.events.threshold_m, 0.001, 100.0);
@@ -153,7 +156,8 @@ nlohmann::json SpecJson(const ObservationSpec& spec) {
   j["bin_s"] = spec.bin_s;
   j["velocity_span_s"] = spec.velocity_span_s;
   j["still_speed_m_per_s"] = spec.still_speed_m_per_s;
-  j["min_moving_share"] = spec.min_moving_share;
+  j["person_area_m2"] = spec.person_area_m2;
+  j["min_moving_area_m2"] = spec.min_moving_area_m2;
   j["events"] = {{"reference_speed_m_per_s", spec.events.reference_speed_m_per_s},
                  {"threshold_m", spec.events.threshold_m},
                  {"min_stop_s", spec.events.min_stop_s}};
@@ -181,17 +185,29 @@ std::vector<double> Observation::BinTimes() const {
 
 namespace detail {
 
-SeriesBuilder::SeriesBuilder(const ObservationSpec& spec, double t0_s, std::size_t bins, double correlated_samples)
-    : spec_(spec), t0_s_(t0_s), bins_(bins), correlated_(std::max(1.0, correlated_samples)),
+SeriesBuilder::SeriesBuilder(const ObservationSpec& spec, double t0_s, std::size_t bins, double sample_area_m2)
+    : spec_(spec), t0_s_(t0_s), bins_(bins), growable_(bins == 0), sample_area_m2_(sample_area_m2),
+      correlated_(std::max(1.0, spec.person_area_m2 / sample_area_m2)),
       cells_(spec.regions.size(), std::vector<Cell>(bins)), frames_(bins, 0.0),
       fwd_(spec.lines.size(), std::vector<double>(bins, 0.0)), bwd_(spec.lines.size(), std::vector<double>(bins, 0.0)) {}
 
 std::size_t SeriesBuilder::Bin(double t_s) const {
   const double k = std::floor((t_s - t0_s_) / spec_.bin_s + 1e-9);
-  return k >= 0.0 && k < static_cast<double>(bins_) ? static_cast<std::size_t>(k) : bins_;
+  const double limit = growable_ ? 1e8 : static_cast<double>(bins_);
+  return k >= 0.0 && k < limit ? static_cast<std::size_t>(k) : kNoBin;
+}
+
+void SeriesBuilder::Grow(std::size_t b) {
+  if (b < bins_) return;
+  bins_ = b + 1;
+  for (auto& r : cells_) r.resize(bins_);
+  frames_.resize(bins_, 0.0);
+  for (auto* lines : {&fwd_, &bwd_})
+    for (auto& l : *lines) l.resize(bins_, 0.0);
 }
 
 void SeriesBuilder::AddSample(std::size_t r, std::size_t b, double v) {
+  Grow(b);
   Cell& c = cells_[r][b];
   c.n += 1;
   c.s_all += v;
@@ -208,6 +224,7 @@ void SeriesBuilder::AddSample(std::size_t r, std::size_t b, double v) {
 }
 
 void SeriesBuilder::AddFrame(std::size_t b, const std::vector<double>* counts) {
+  Grow(b);
   frames_[b] += 1;
   if (!counts) return;
   for (std::size_t r = 0; r < cells_.size(); ++r) {
@@ -217,6 +234,7 @@ void SeriesBuilder::AddFrame(std::size_t b, const std::vector<double>* counts) {
 }
 
 void SeriesBuilder::AddCrossing(std::size_t l, std::size_t b, int direction) {
+  Grow(b);
   (direction > 0 ? fwd_ : bwd_)[l][b] += 1;
 }
 
@@ -254,7 +272,8 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
         for (Series* s : {&speed_f, &speed_b, &speed_a, &share_f, &share_b, &still, &counter, &mean_v}) s->points.push_back(none);
       } else {
         const auto speed_of = [&](double n_d, double s_d, double ss_d) {
-          if (n_d < spec_.min_moving_share * c.n || n_d == 0) return SeriesPoint{0.0, spec_.still_speed_m_per_s, n_d};
+          const double moving_area = n_d / std::max(1.0, frames_[b]) * sample_area_m2_;
+          if (n_d == 0 || moving_area < spec_.min_moving_area_m2) return SeriesPoint{0.0, spec_.still_speed_m_per_s, n_d};
           const auto [m, se] = mean_se(n_d, s_d, ss_d, n_d / per);
           return SeriesPoint{m, se, n_d};
         };
@@ -351,7 +370,7 @@ Observation ObserveTrajectories(const Trajectories& t, const ObservationSpec& sp
   const double t0 = static_cast<double>(t.first_frame) / t.fps;
   const double duration = static_cast<double>(t.last_frame - t.first_frame + 1) / t.fps;
   const std::size_t bins = static_cast<std::size_t>(std::ceil(duration / spec.bin_s - 1e-9));
-  detail::SeriesBuilder builder(obs.spec, t0, std::max<std::size_t>(1, bins), 1.0);
+  detail::SeriesBuilder builder(obs.spec, t0, std::max<std::size_t>(1, bins), spec.person_area_m2);
 
   // People per region and frame (classic density).
   const std::size_t frames = static_cast<std::size_t>(t.last_frame - t.first_frame + 1);
@@ -371,7 +390,7 @@ Observation ObserveTrajectories(const Trajectories& t, const ObservationSpec& sp
       for (std::size_t r = 0; r < spec.regions.size(); ++r) {
         if (!spec.regions[r].Contains(track.position_m[k])) continue;
         counts[fi][r] += 1;
-        if (has_v && b < builder.bins()) builder.AddSample(r, b, Dot(v, axis));
+        if (has_v && b != detail::SeriesBuilder::kNoBin) builder.AddSample(r, b, Dot(v, axis));
       }
       // Crossings between consecutive frames.
       if (k > 0 && track.frame[k] - track.frame[k - 1] == 1)
@@ -381,14 +400,14 @@ Observation ObserveTrajectories(const Trajectories& t, const ObservationSpec& sp
                                                       &fraction);
           if (dir == 0) continue;
           const std::size_t cb = builder.Bin((static_cast<double>(track.frame[k - 1]) + fraction) / t.fps);
-          if (cb < builder.bins()) builder.AddCrossing(l, cb, dir);
+          if (cb != detail::SeriesBuilder::kNoBin) builder.AddCrossing(l, cb, dir);
         }
     }
   }
   for (std::size_t fi = 0; fi < frames; ++fi) {
     if (!seen[fi]) continue;  // a frame with nobody in the file: not observed
     const std::size_t b = builder.Bin(static_cast<double>(t.first_frame + static_cast<std::int64_t>(fi)) / t.fps);
-    if (b < builder.bins()) builder.AddFrame(b, &counts[fi]);
+    if (b != detail::SeriesBuilder::kNoBin) builder.AddFrame(b, &counts[fi]);
   }
   // An onset is placed within its bin, and velocities smear it by half their span.
   builder.Finish(&obs, true, true, spec.bin_s + static_cast<double>(half_span) / t.fps);

@@ -12,12 +12,16 @@ namespace crowdrecon::observe::detail {
 
 class SeriesBuilder {
  public:
-  // `correlated_samples`: samples per frame that are one independent
-  // observation (1 for trajectories: a sample is a person; for footage the
-  // grid points one person covers). Standard errors use that many fewer samples.
-  SeriesBuilder(const ObservationSpec& spec, double t0_s, std::size_t bins, double correlated_samples);
+  // `sample_area_m2`: the floor one sample stands for (trajectories: the
+  // spec's person area; footage: a grid cell). The samples within one
+  // person's area count as one independent sample in standard errors.
+  // `bins` = 0: as many as the samples need (a video whose length is not
+  // known in advance); else a fixed number.
+  SeriesBuilder(const ObservationSpec& spec, double t0_s, std::size_t bins, double sample_area_m2);
 
-  std::size_t Bin(double t_s) const;  // bins() when outside
+  // The bin of a time; kNoBin before t0 (and, with a fixed number, after the last).
+  static constexpr std::size_t kNoBin = static_cast<std::size_t>(-1);
+  std::size_t Bin(double t_s) const;
   std::size_t bins() const { return bins_; }
   // A velocity sample (along the axis, m/s) in region r, bin b.
   void AddSample(std::size_t r, std::size_t b, double v_axis_m_per_s);
@@ -39,9 +43,12 @@ class SeriesBuilder {
     double s_all = 0, ss_all = 0;      // v.axis over every sample
     double count = 0, count_sq = 0;    // people in the region, summed over frames
   };
+  void Grow(std::size_t b);
   const ObservationSpec& spec_;
   double t0_s_;
   std::size_t bins_;
+  bool growable_;
+  double sample_area_m2_;
   double correlated_;
   std::vector<std::vector<Cell>> cells_;     // [region][bin]
   std::vector<double> frames_;               // frames per bin

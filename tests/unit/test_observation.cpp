@@ -91,7 +91,8 @@ TEST(Events, ShortDipsAreNoStopsAndAFirstStopIsCensored) {
   EXPECT_EQ(DetectEvents(holes.t, holes.v, bin, 0.3, EventOptions{}, "r", "all").size(), 6u);
 }
 
-// Two groups in a 10 m x 4 m corridor at 25 fps for 8 s: `forward` people
+// Two groups in a 10 m x 4 m corridor (three backward people are enough
+// moving floor, 0.3 m2, for their direction's speed to be defined) at 25 fps for 8 s: `forward` people
 // at 1.2 m/s along +x, `backward` ones at `backward_speed` along -x.
 Trajectories Corridor(int forward, int backward, double backward_speed, PeriodicBox box = {}) {
   Trajectories t;
@@ -125,7 +126,7 @@ ObservationSpec CorridorSpec() {
 }
 
 TEST(Observation, SpeedsSharesDensityAndFlowOfTwoKnownGroups) {
-  const Trajectories t = Corridor(8, 2, 0.8);
+  const Trajectories t = Corridor(8, 3, 0.8);
   const Observation obs = ObserveTrajectories(t, CorridorSpec());
   EXPECT_EQ(obs.bins, 20u);
   const Series* f = obs.Find("speed", "all", "forward");
@@ -138,8 +139,8 @@ TEST(Observation, SpeedsSharesDensityAndFlowOfTwoKnownGroups) {
     EXPECT_NEAR(f->points[k].value, 1.2, 1e-9);
     EXPECT_NEAR(b->points[k].value, 0.8, 1e-9);
     EXPECT_NEAR(f->points[k].uncertainty, 0.0, 1e-6);  // every forward sample is 1.2 m/s
-    EXPECT_NEAR(c->points[k].value, 0.2, 1e-12);
-    EXPECT_NEAR(d->points[k].value, 10.0 / 800.0, 1e-12);
+    EXPECT_NEAR(c->points[k].value, 3.0 / 11.0, 1e-12);
+    EXPECT_NEAR(d->points[k].value, 11.0 / 800.0, 1e-12);
     EXPECT_NEAR(still->points[k].value, 0.0, 1e-12);
   }
   // Crossings of x = 5: every forward person starting left of it that
@@ -149,16 +150,16 @@ TEST(Observation, SpeedsSharesDensityAndFlowOfTwoKnownGroups) {
   for (const SeriesPoint& p : obs.Find("flow", "x5", "backward")->points) backward_crossings += p.value * 0.4 * 4.0;
   int expect_f = 0, expect_b = 0;
   for (int i = 0; i < 8; ++i) expect_f += (0.5 + 0.4 * i < 5.0 && 0.5 + 0.4 * i + 1.2 * 199 / 25.0 >= 5.0);
-  for (int i = 0; i < 2; ++i) expect_b += (9.5 - 0.4 * i > 5.0 && 9.5 - 0.4 * i - 0.8 * 199 / 25.0 <= 5.0);
+  for (int i = 0; i < 3; ++i) expect_b += (9.5 - 0.4 * i > 5.0 && 9.5 - 0.4 * i - 0.8 * 199 / 25.0 <= 5.0);
   EXPECT_NEAR(forward_crossings, expect_f, 1e-9);
   EXPECT_NEAR(backward_crossings, expect_b, 1e-9);
   EXPECT_TRUE(obs.events.empty());
 }
 
 TEST(Observation, AStalledDirectionReadsAsStoppedNotAsItsJitter) {
-  const Observation obs = ObserveTrajectories(Corridor(8, 2, 0.0), CorridorSpec());
+  const Observation obs = ObserveTrajectories(Corridor(8, 3, 0.0), CorridorSpec());
   for (const SeriesPoint& p : obs.Find("speed", "all", "backward")->points) EXPECT_EQ(p.value, 0.0);
-  for (const SeriesPoint& p : obs.Find("share_still", "all", "all")->points) EXPECT_NEAR(p.value, 0.2, 1e-12);
+  for (const SeriesPoint& p : obs.Find("share_still", "all", "all")->points) EXPECT_NEAR(p.value, 3.0 / 11.0, 1e-12);
   for (const SeriesPoint& p : obs.Find("counterflow_share", "all", "all")->points) EXPECT_NEAR(p.value, 0.0, 1e-12);
   // The stalled direction is one censored stop that never ends.
   int stops = 0;
@@ -176,7 +177,7 @@ TEST(Observation, APeriodicSeamIsNoJump) {
   box.x = true;
   box.min_m = {0, 0};
   box.max_m = {10, 4};
-  Trajectories t = Corridor(8, 2, 0.8, box);
+  Trajectories t = Corridor(8, 3, 0.8, box);
   const Observation obs = ObserveTrajectories(t, CorridorSpec());
   for (const SeriesPoint& p : obs.Find("speed", "all", "forward")->points) EXPECT_NEAR(p.value, 1.2, 1e-9);
   for (const SeriesPoint& p : obs.Find("speed", "all", "backward")->points) EXPECT_NEAR(p.value, 0.8, 1e-9);
@@ -190,7 +191,7 @@ TEST(Observation, APeriodicSeamIsNoJump) {
 }
 
 TEST(Observation, WrittenAndReadBackAndAChangedSeriesFileIsRefused) {
-  Observation obs = ObserveTrajectories(Corridor(8, 2, 0.0), CorridorSpec());
+  Observation obs = ObserveTrajectories(Corridor(8, 3, 0.0), CorridorSpec());
   const auto file = ScratchFile("obs.json");
   WriteObservation(obs, file);
   const Observation back = ReadObservation(file);
@@ -302,16 +303,16 @@ TEST(FundamentalDiagram, WeidmannsRelationAndAUniformCrowd) {
   EXPECT_EQ(w.SpeedAt(5.4), 0.0);
   EXPECT_EQ(w.SpeedAt(8.0), 0.0);
   EXPECT_NEAR(w.SpeedAt(1e-6), 1.34, 1e-9);
-  // Ten people always in the corridor (periodic), at 1.2 and 0.8 m/s.
+  // Eleven people always in the corridor (periodic), at 1.2 and 0.8 m/s.
   PeriodicBox box;
   box.x = true;
   box.max_m = {10, 4};
   const FundamentalDiagram fd =
-      ComputeFundamentalDiagram(Corridor(8, 2, 0.8, box), {"all", {{0, 0}, {10, 0}, {10, 4}, {0, 4}}}, 0.2, 5);
+      ComputeFundamentalDiagram(Corridor(8, 3, 0.8, box), {"all", {{0, 0}, {10, 0}, {10, 4}, {0, 4}}}, 0.2, 5);
   ASSERT_EQ(fd.points.size(), 40u);
   for (const FundamentalDiagramPoint& p : fd.points) {
-    EXPECT_NEAR(p.density_per_m2, 10.0 / 40.0, 1e-12);
-    EXPECT_NEAR(p.speed_m_per_s, (8 * 1.2 + 2 * 0.8) / 10.0, 1e-9);
+    EXPECT_NEAR(p.density_per_m2, 11.0 / 40.0, 1e-12);
+    EXPECT_NEAR(p.speed_m_per_s, (8 * 1.2 + 3 * 0.8) / 11.0, 1e-9);
   }
   ASSERT_EQ(fd.classes.size(), 1u);
   EXPECT_EQ(fd.classes[0].frames, 40u);

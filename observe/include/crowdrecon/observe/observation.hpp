@@ -56,11 +56,18 @@ struct ObservationSpec {
   // exceeds this (m/s); below it, it is still: the same tenth of the
   // desired speed as the analysis' stop threshold (docs/analysis.md).
   double still_speed_m_per_s = 0.1;
-  // A direction's speed in a bin is defined only when its moving samples are
-  // at least this share of the region's samples; below it the direction is
-  // counted as stopped (speed 0), so that a few jittering samples of a
-  // standing crowd are not read as a walking speed.
-  double min_moving_share = 0.02;
+  // Floor area one person covers seen from above (m2): a trajectory sample
+  // stands for this much floor, and in footage the grid points within it
+  // move together (standard errors count them as one sample).
+  double person_area_m2 = 0.1;
+  // A direction's speed in a bin is defined only when the floor moving that
+  // way (movers x person_area_m2 for trajectories, moving grid points x
+  // their cell for footage; per frame) is at least this; below it the
+  // direction counts as stopped (speed 0), so that a few people jostled in a
+  // standing crowd are not read as the direction walking. An area, not a
+  // share, so that trajectories (shares of people) and footage (shares of
+  // floor) agree: 0.25 m2 is two or three people.
+  double min_moving_area_m2 = 0.25;
   EventOptions events;
 
   bool IsValid(std::string* error) const;
