@@ -20,6 +20,7 @@ void RegisterSweepCommand(CLI::App& app);  // sweep (grids of runs, local or MPI
 void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat maps of a sweep)
 void RegisterTimelineCommand(CLI::App& app);  // timeline (the figure of an incident timeline's run)
 void RegisterReportCommand(CLI::App& app);  // report (injury risk of runs: HTML, PDF, CSV)
+void RegisterExportCommand(CLI::App& app);  // export (a run's trajectories for tools unaware of periodic boxes)
 
 // The command line as given (for the records of reports), set by main.
 const std::string& CommandLine();

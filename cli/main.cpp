@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterPhaseCommand(app);
   crowdrecon::cli::RegisterTimelineCommand(app);
   crowdrecon::cli::RegisterReportCommand(app);
+  crowdrecon::cli::RegisterExportCommand(app);
   crowdrecon::cli::SetCommandLine(argc, argv);
   try {
     app.parse(argc, argv);
