@@ -21,6 +21,7 @@ void RegisterPhaseCommand(CLI::App& app);  // phase (phase diagrams and heat map
 void RegisterTimelineCommand(CLI::App& app);  // timeline (the figure of an incident timeline's run)
 void RegisterReportCommand(CLI::App& app);  // report (injury risk of runs: HTML, PDF, CSV)
 void RegisterObserveCommands(CLI::App& app);  // observe trajectories / footage (observations)
+void RegisterExportCommand(CLI::App& app);  // export (a run's trajectories for tools unaware of periodic boxes)
 
 // The command line as given (for the records of reports), set by main.
 const std::string& CommandLine();

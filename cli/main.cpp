@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterTimelineCommand(app);
   crowdrecon::cli::RegisterReportCommand(app);
   crowdrecon::cli::RegisterObserveCommands(app);
+  crowdrecon::cli::RegisterExportCommand(app);
   crowdrecon::cli::SetCommandLine(argc, argv);
   try {
     app.parse(argc, argv);

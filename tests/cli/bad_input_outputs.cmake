@@ -124,6 +124,23 @@ crowdrecon_output_test(analyze.json_folder fail "--json a: exists and is an empt
 crowdrecon_output_test(analyze.json_previous_replaced ok "json: a.json"
                        "make_scenario && make_run && $EXE analyze run.sqlite --json a.json >/dev/null" run.sqlite analyze run.sqlite --json a.json)
 
+# --- export ------------------------------------------------------------------------
+crowdrecon_output_test(export.o_is_run_file fail "-o run.sqlite: is the run file \\(run.sqlite\\), an input of this command. ${NOT_EVEN_FORCE}"
+                       "make_scenario && make_run" . export run.sqlite -o run.sqlite --force)
+crowdrecon_output_test(export.o_is_run_file_through_symlink fail "-o link.sqlite: is the run file"
+                       "make_scenario && make_run && ln -s run.sqlite link.sqlite" . export run.sqlite -o link.sqlite)
+crowdrecon_output_test(export.o_other_run fail "-o other.sqlite: exists and is a SQLite file, not a crowdrecon trajectory export. choose another name or --force"
+                       "make_scenario && make_run && cp run.sqlite other.sqlite" . export run.sqlite -o other.sqlite)
+crowdrecon_output_test(export.o_empty_folder fail "-o out: exists and is an empty folder, not a crowdrecon trajectory export. ${NO_FOLDER}"
+                       "make_scenario && make_run && mkdir out" . export run.sqlite -o out --force)
+crowdrecon_output_test(export.o_previous_export_replaced ok "wrote x.sqlite"
+                       "make_scenario && make_run && $EXE export run.sqlite -o x.sqlite >/dev/null" run.sqlite export run.sqlite -o x.sqlite)
+crowdrecon_output_test(export.force_replaces_foreign_file ok "wrote x.sqlite"
+                       "make_scenario && make_run && foreign x.sqlite" run.sqlite export run.sqlite -o x.sqlite --force)
+# A run found damaged while the export is written leaves nothing behind (no partial file).
+crowdrecon_output_test(export.damaged_run_leaves_nothing fail "bad.sqlite: table metadata, row key fps"
+                       "cp $SRC/fuzz/regressions/fuzz_run_file/fps-not-a-number.sqlite bad.sqlite" . export bad.sqlite -o x.sqlite)
+
 # --- sweep, phase ------------------------------------------------------------------
 crowdrecon_output_test(sweep.o_is_sweep_file fail "-o sweep.json: is the sweep file \\(sweep.json\\)"
                        make_sweep . sweep sweep.json -o sweep.json -q --force)

@@ -168,3 +168,25 @@ add_test(NAME cli.analyze.write
          COMMAND bash -c "d=$(mktemp -d) && cp \"$1\" \"$d/r.sqlite\" && \"$0\" analyze \"$d/r.sqlite\" --write >/dev/null && sqlite3 \"$d/r.sqlite\" \"SELECT value FROM run WHERE key = 'regime'\" | grep -qx unclassified && test $(sqlite3 \"$d/r.sqlite\" 'SELECT COUNT(*) FROM metric_summary') -gt 20; rc=$?; rm -rf \"$d\"; exit $rc"
                  $<TARGET_FILE:crowdrecon> ${render_data}/run.sqlite)
 set_tests_properties(cli.analyze.write PROPERTIES FIXTURES_REQUIRED render_data)
+
+# --- export (runfile/trajectory_export.hpp) --------------------------------------
+# The render tests' run is periodic along x (a 3 m box) and nobody passes a
+# seam in its 2 s; python/test_export_periodic.py measures a run with cuts.
+crowdrecon_cli_test(export.periodic_run ok "periodic box x in \\[0, 3\\) m: 0 split\\(s\\) at its seams, 12 ids"
+                    export ${render_data}/run.sqlite -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.empty_run ok "export: 0 rows in 0 frames, 0 people"
+                    export ${render_data}/empty.sqlite -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.missing_file fail "no-such-run.sqlite: no such file. expected a run file \\(.sqlite\\) written by `crowdrecon simulate`"
+                    export ${render_data}/no-such-run.sqlite -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.not_a_run fail "thorax-18.json: is a JSON file, not a crowdrecon run file. expected a run file"
+                    export venues/bodies/thorax-18.json -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.sweep_results_not_a_run fail "results.sqlite: is a SQLite file, not a crowdrecon run file"
+                    export results/sweeps/madrid-arena/hallway-gamma/results.sqlite -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.damaged_run fail "fps-not-a-number.sqlite: table metadata, row key fps, column value: found"
+                    export fuzz/regressions/fuzz_run_file/fps-not-a-number.sqlite -o @TMP@/x.sqlite)
+crowdrecon_cli_test(export.output_folder_missing fail "no-such-folder/x.sqlite: .*no-such-folder does not exist. expected an existing folder"
+                    export ${render_data}/run.sqlite -o @TMP@/no-such-folder/x.sqlite)
+crowdrecon_cli_test(export.output_is_input fail "-o .*run.sqlite: is the run file .*an input is never overwritten, not even with --force"
+                    export ${render_data}/run.sqlite -o ${render_data}/run.sqlite --force)
+set_tests_properties(cli.export.periodic_run cli.export.empty_run cli.export.output_folder_missing
+                     cli.export.output_is_input PROPERTIES FIXTURES_REQUIRED render_data)

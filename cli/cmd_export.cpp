@@ -1,0 +1,75 @@
+// `crowdrecon export`: a run's trajectories as a plain JuPedSim trajectory file
+// for tools unaware of periodic boxes, each trajectory cut at the seams of the
+// box (runfile/trajectory_export.hpp, docs/scenarios.md "Periodic runs in
+// other tools").
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/runfile/trajectory_export.hpp"
+
+namespace crowdrecon::cli {
+
+namespace {
+
+struct ExportArgs {
+  std::string run_file;
+  std::string output;
+  bool force = false;
+};
+
+// "x in [0, 12) m" for the periodic axes of `box`.
+std::string DescribeSeams(const PeriodicBox& box) {
+  std::string text;
+  if (box.x) text += "x in [" + FormatNumber(box.min_m.x) + ", " + FormatNumber(box.max_m.x) + ") m";
+  if (box.y) text += std::string(text.empty() ? "" : ", ") + "y in [" + FormatNumber(box.min_m.y) + ", " +
+                     FormatNumber(box.max_m.y) + ") m";
+  return text;
+}
+
+void RunExport(const ExportArgs& args) {
+  CheckOutputs({{"-o", args.output, runfile::TrajectoryExportOutput()}}, {{"the run file", args.run_file}},
+               args.force);
+  // Said here rather than as SQLite's "file is not a database".
+  std::error_code ec;
+  if (!std::filesystem::exists(args.run_file, ec))
+    throw InputError(args.run_file + ": no such file; expected a run file (.sqlite) written by `crowdrecon simulate`");
+  if (!runfile::IsRunFile(args.run_file))
+    throw InputError(args.run_file + ": is " + DescribeExisting(args.run_file) +
+                     ", not a crowdrecon run file; expected a run file (.sqlite) written by `crowdrecon simulate`");
+  const runfile::RunFileReader run(args.run_file);
+  const runfile::ExportSummary s = runfile::ExportTrajectories(run, args.output);
+  std::printf("export: %lld rows in %lld frames, %lld people\n", static_cast<long long>(s.rows),
+              static_cast<long long>(s.frames), static_cast<long long>(s.people));
+  if (s.box.any())
+    std::printf("periodic box %s: %lld split(s) at its seams, %lld ids (table crowdrecon_track maps them to people)\n",
+                DescribeSeams(s.box).c_str(), static_cast<long long>(s.splits), static_cast<long long>(s.tracks));
+  else
+    std::printf("not periodic: ids kept, no splits\n");
+  std::printf("wrote %s\n", args.output.c_str());
+}
+
+}  // namespace
+
+void RegisterExportCommand(CLI::App& app) {
+  auto args = std::make_shared<ExportArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "export", "Write a run's trajectories as a plain JuPedSim trajectory file (version 2) for PedPy and other "
+                "tools; a periodic run's trajectories are cut where they cross a seam of the box, each piece "
+                "with an id of its own (docs/scenarios.md, \"Periodic runs in other tools\")");
+  cmd->add_option("RUN", args->run_file, "run file (.sqlite) written by `crowdrecon simulate`")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "the trajectory file to write (.sqlite; an existing one must be a previous export)")
+      ->required();
+  AddForceFlag(cmd, &args->force);
+  cmd->callback([args] { RunExport(*args); });
+}
+
+}  // namespace crowdrecon::cli
