@@ -57,7 +57,18 @@ struct Sample {
   std::size_t region;
   cv::Point pixel;
   std::array<double, 4> jacobian;  // floor per image pixel
+  int ix, iy;                      // place in the region's floor grid
 };
+
+// A region's floor grid, for step 4's averaging over a body's size.
+struct Grid {
+  int nx = 0, ny = 0;
+  std::vector<int> sample;  // index into the samples, -1 where none
+};
+
+// Step 4's averaging window (m): about a body's depth and half its breadth
+// (the paper's thorax: 0.24 m x 0.5 m).
+constexpr double kBodyWindow_m = 0.5;
 
 // Step 4: an image displacement (px) carried to the floor (m).
 Vec2 FloorDisplacement(const Sample& s, cv::Point2f u_px) {
@@ -160,6 +171,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
 
   // The floor grid of every region, seen in the picture.
   std::vector<Sample> samples;
+  std::vector<Grid> grids;
   std::vector<std::vector<cv::Point>> outlines;
   cv::Mat mask = cv::Mat::zeros(s.height, s.width, CV_8U);
   for (std::size_t r = 0; r < spec.regions.size(); ++r) {
@@ -167,8 +179,13 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     Vec2 lo = region.polygon_m.front(), hi = lo;
     for (Vec2 p : region.polygon_m) lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)}, hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
     std::size_t inside = 0, seen = 0;
-    for (double y = lo.y + options.grid_spacing_m / 2; y < hi.y; y += options.grid_spacing_m)
-      for (double x = lo.x + options.grid_spacing_m / 2; x < hi.x; x += options.grid_spacing_m) {
+    Grid grid;
+    grid.nx = static_cast<int>(std::ceil((hi.x - lo.x) / options.grid_spacing_m));
+    grid.ny = static_cast<int>(std::ceil((hi.y - lo.y) / options.grid_spacing_m));
+    grid.sample.assign(static_cast<std::size_t>(grid.nx) * grid.ny, -1);
+    for (int iy = 0; iy < grid.ny; ++iy)
+      for (int ix = 0; ix < grid.nx; ++ix) {
+        const double x = lo.x + (ix + 0.5) * options.grid_spacing_m, y = lo.y + (iy + 0.5) * options.grid_spacing_m;
         if (!region.Contains({x, y})) continue;
         ++inside;
         if (!homography.InFront({x, y})) continue;
@@ -176,8 +193,10 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
         const cv::Point px(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
         if (px.x < 0 || px.y < 0 || px.x >= s.width || px.y >= s.height) continue;
         ++seen;
-        samples.push_back({r, px, homography.FloorJacobianAt({static_cast<double>(px.x), static_cast<double>(px.y)})});
+        grid.sample[static_cast<std::size_t>(iy) * grid.nx + ix] = static_cast<int>(samples.size());
+        samples.push_back({r, px, homography.FloorJacobianAt({static_cast<double>(px.x), static_cast<double>(px.y)}), ix, iy});
       }
+    grids.push_back(std::move(grid));
     if (seen == 0)
       throw InputError("region " + region.name + ": none of its floor lies in the picture (" + std::to_string(s.width) + "x" +
                        std::to_string(s.height) + ") through this homography; expected regions the camera sees");
@@ -193,6 +212,9 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{outline}, cv::Scalar(255));
   }
   s.grid_points = samples.size();
+  std::vector<char> moved(samples.size(), 0);
+  std::vector<double> along(samples.size(), 0.0);
+  const int reach = std::max(0, static_cast<int>(std::lround(0.5 * kBodyWindow_m / options.grid_spacing_m - 0.5)));
 
   Observation obs;
   obs.source_file = video.string();
@@ -269,23 +291,45 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     if (dis) dis->calc(held.front().grey, held.back().grey, flow);
     else cv::calcOpticalFlowFarneback(held.front().grey, held.back().grey, flow, 0.5, 3, 15, 3, 5, 1.2, 0);
     ++s.flows;
-    // 4. Where the picture changed over the span: the flow of a textured
-    // floor next to a moving body is smeared from the body (the flow field
-    // is smooth), but the floor itself does not change; a pixel whose grey
-    // level changed by less than the noise allows is still (velocity 0).
+    // 4. Floor velocities where the picture changed over the span: the
+    // flow of a textured floor next to a moving body is smeared from the
+    // body (the flow field is smooth), but the floor itself does not change;
+    // a pixel whose grey level changed by less than the noise allows is
+    // still (velocity 0). The velocity of a changed point is the mean over
+    // the changed points within a body's size around it (a square of
+    // kBodyWindow_m on the floor): a body turning in place moves its two
+    // shoulders opposite ways, which cancel, as they do in the trajectory of
+    // its centre; occlusion errors at its edges are averaged with its inside.
     ChangeMask(held.front().raw, held.back().raw, mask, &change);
-    // 5. Floor velocities into the series.
+    const double per_second = s.fps / span;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      moved[i] = change.at<unsigned char>(samples[i].pixel) != 0;
+      along[i] = moved[i] ? Dot(FloorDisplacement(samples[i], flow.at<cv::Point2f>(samples[i].pixel)), axis) * per_second : 0.0;
+    }
+    // 5. Into the series.
     const std::size_t b = builder.Bin(t_mid);
     if (b == detail::SeriesBuilder::kNoBin) continue;
     builder.AddFrame(b, nullptr);
-    const double per_second = s.fps / span;
     for (const Sample& sample : samples) {
-      if (change.at<unsigned char>(sample.pixel) == 0) {
-        builder.AddSample(sample.region, b, 0.0);
-        continue;
+      double v = 0.0;
+      if (moved[&sample - samples.data()]) {
+        const Grid& g = grids[sample.region];
+        double sum = 0.0;
+        int n = 0;
+        for (int dy = -reach; dy <= reach; ++dy)
+          for (int dx = -reach; dx <= reach; ++dx) {
+            const int x = sample.ix + dx, y = sample.iy + dy;
+            if (x < 0 || y < 0 || x >= g.nx || y >= g.ny) continue;
+            const int j = g.sample[static_cast<std::size_t>(y) * g.nx + x];
+            if (j >= 0 && moved[static_cast<std::size_t>(j)]) sum += along[static_cast<std::size_t>(j)], ++n;
+          }
+        // The window's mean tells which way (and whether) the body moves;
+        // the point's own velocity, the speed (the mean is lowered by a
+        // body's slower edges), where it agrees in sign.
+        const double local = sum / n, own = along[&sample - samples.data()];
+        v = (std::abs(local) > spec.still_speed_m_per_s && own * local > 0) ? own : local;
       }
-      const cv::Point2f u = flow.at<cv::Point2f>(sample.pixel);
-      builder.AddSample(sample.region, b, Dot(FloorDisplacement(sample, u), axis) * per_second);
+      builder.AddSample(sample.region, b, v);
     }
     while (!pictures_left.empty() && pictures_left.front() <= t_mid + 0.5 / s.fps) {
       char name[64];
