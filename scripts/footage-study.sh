@@ -58,8 +58,8 @@ for c in "${conditions[@]}"; do
   "$crowdrecon" observe footage "$video" --homography "$work/$name.h.json" --spec "$spec" -o "$work/$name-$flow.json" \
     --flow "$flow" "${extra[@]}" > "$work/$name-$flow.txt"
   if [ -d "$work/pictures-$name" ]; then cp "$work/pictures-$name"/flow_*.png "$out/flow-$name.png"; rm -rf "$work/pictures-$name"; fi
-  "$crowdrecon" observe compare "$work/truth.json" "$work/$name-$flow.json" --csv "$work/$name-$flow.csv" > "$work/$name-$flow.compare.txt"
-  python3 - "$work/$name-$flow.csv" "$work/$name-$flow.txt" "$name" "$flow" "$opts" >> "$work/errors.csv" <<'PY'
+  "$crowdrecon" observe compare "$work/truth.json" "$work/$name-$flow.json" --csv "$work/$name-$flow.compare.csv" > "$work/$name-$flow.compare.txt"
+  python3 - "$work/$name-$flow.compare.csv" "$work/$name-$flow.txt" "$name" "$flow" "$opts" >> "$work/errors.csv" <<'PY'
 import csv, re, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 text = open(sys.argv[2]).read()

@@ -190,3 +190,30 @@ crowdrecon_cli_test(export.output_is_input fail "-o .*run.sqlite: is the run fil
                     export ${render_data}/run.sqlite -o ${render_data}/run.sqlite --force)
 set_tests_properties(cli.export.periodic_run cli.export.empty_run cli.export.output_folder_missing
                      cli.export.output_is_input PROPERTIES FIXTURES_REQUIRED render_data)
+
+# Observations (issue 22): bad inputs named with what was expected.
+set(observe_data ${PROJECT_SOURCE_DIR}/tests/data/observe)
+set(hallway_spec ${PROJECT_SOURCE_DIR}/venues/madrid-arena/observations/hallway.json)
+set(bi_spec ${PROJECT_SOURCE_DIR}/venues/juelich/bidirectional-corridor.json)
+crowdrecon_cli_test(observe.spec_without_regions fail "spec-no-regions.json: /regions: expected a list of at least one region"
+                    observe trajectories ${observe_data}/not-petrack.txt --spec ${observe_data}/spec-no-regions.json -o @TMP@/o.json)
+crowdrecon_cli_test(observe.not_petrack fail "not-petrack.txt:2: .*3 fields. expected id frame x y \\[z\\]"
+                    observe trajectories ${observe_data}/not-petrack.txt --spec ${bi_spec} -o @TMP@/o.json)
+crowdrecon_cli_test(observe.output_not_json fail "-o .*o.txt: expected a file name ending in .json"
+                    observe trajectories ${observe_data}/not-petrack.txt --spec ${bi_spec} -o @TMP@/o.txt)
+crowdrecon_cli_test(observe.output_is_input fail "is the trajectories .*an input is never overwritten"
+                    observe trajectories ${bi_spec} --spec ${bi_spec} -o ${bi_spec} --force)
+crowdrecon_cli_test(observe.not_a_video fail "README.md: cannot be read as a video"
+                    observe footage README.md --homography ${observe_data}/far-away.json --spec ${hallway_spec} -o @TMP@/o.json)
+crowdrecon_cli_test(observe.three_pairs fail "three-pairs.json: 3 point pairs. expected at least 4 image <-> floor pairs"
+                    observe footage README.md --homography ${observe_data}/three-pairs.json --spec ${hallway_spec} -o @TMP@/o.json)
+crowdrecon_cli_test(observe.collinear_pairs fail "collinear.json: the floor points lie on one line"
+                    observe footage README.md --homography ${observe_data}/collinear.json --spec ${hallway_spec} -o @TMP@/o.json)
+crowdrecon_cli_test(observe.singular_matrix fail "singular.json: the homography matrix is singular"
+                    observe footage README.md --homography ${observe_data}/singular.json --spec ${hallway_spec} -o @TMP@/o.json)
+crowdrecon_cli_test(observe.fd_spec_count fail "--spec: 2 given for 3 files. expected one for all or one per file"
+                    observe fd a.txt b.txt c.txt --spec ${bi_spec} --spec ${bi_spec} -o @TMP@/fd.png)
+crowdrecon_cli_test(observe.synthesize_not_a_run fail "README.md: .*not a crowdrecon run file"
+                    observe synthesize README.md -o @TMP@/v.avi --homography-out @TMP@/h.json)
+crowdrecon_cli_test(observe.compare_not_an_observation fail "hallway.json: /format: .*expected \"crowdrecon-observation\""
+                    observe compare ${hallway_spec} ${hallway_spec})
