@@ -76,35 +76,55 @@ Vec2 FloorDisplacement(const Sample& s, cv::Point2f u_px) {
   return {s.jacobian[0] * ux + s.jacobian[1] * uy, s.jacobian[2] * ux + s.jacobian[3] * uy};
 }
 
+// The standard deviation of a frame's noise, by J. Immerkaer's estimator
+// ("Fast noise variance estimation", Comput. Vis. Image Underst. 64:300,
+// 1996): the mean absolute response to the Laplacian difference mask
+// [1 -2 1; -2 4 -2; 1 -2 1], which cancels smooth image content, times
+// sqrt(pi/2)/6. From one frame, so it does not depend on how much of the
+// picture moves (a packed crowd walking changes nearly every pixel).
+double NoiseSigma(const cv::Mat& grey, const cv::Mat& mask) {
+  static const cv::Mat kernel = (cv::Mat_<float>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::Mat response;
+  cv::filter2D(grey, response, CV_32F, kernel);
+  response = cv::abs(response);
+  return std::sqrt(M_PI / 2.0) / 6.0 * cv::mean(response, mask)[0];
+}
+
 // Pixels (in `mask`) whose grey level changed between two frames by more
-// than the noise: the frames are smoothed (sigma 1 px), the noise's scale
-// estimated from the median absolute change over the mask (most of a
-// picture does not move: floor, walls, people standing), and a pixel counts
-// as changed beyond four such scales, and never below 3 grey levels. The
-// changed pixels are dilated by 2 px: a moving body's interior may be
-// uniform, its spots and edges are not.
+// than the noise allows: both frames smoothed (sigma 1 px, which leaves
+// about 0.28 of the noise), their difference (sqrt 2 of one frame's) against
+// four times its noise, never below 3 grey levels; the changed pixels
+// dilated by 2 px (a moving body's interior may be uniform, its spots and
+// edges are not).
 void ChangeMask(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask, cv::Mat* changed) {
   cv::Mat sa, sb, diff;
   cv::GaussianBlur(a, sa, cv::Size(0, 0), 1.0);
   cv::GaussianBlur(b, sb, cv::Size(0, 0), 1.0);
   cv::absdiff(sa, sb, diff);
-  cv::Mat hist;
-  const int channels[] = {0};
-  const int size[] = {256};
-  const float range[] = {0, 256};
-  const float* ranges[] = {range};
-  cv::calcHist(&diff, 1, channels, mask, hist, 1, size, ranges);
-  const double total = cv::sum(hist)[0];
-  double seen = 0.0;
-  int median = 0;
-  for (; median < 255; ++median) {
-    seen += static_cast<double>(hist.at<float>(median));
-    if (seen >= 0.5 * total) break;
-  }
-  // |difference of two Gaussians| has median 0.954 sigma_diff.
-  const double scale = std::max(0.5, median / 0.954);
-  cv::threshold(diff, *changed, std::max(3.0, 4.0 * scale), 255, cv::THRESH_BINARY);
+  const double sigma = 0.5 * (NoiseSigma(a, mask) + NoiseSigma(b, mask));
+  const double diff_sigma = std::sqrt(2.0) * 0.28 * sigma;
+  cv::threshold(diff, *changed, std::max(3.0, 4.0 * diff_sigma), 255, cv::THRESH_BINARY);
   cv::dilate(*changed, *changed, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+}
+
+// Normalised cross-correlation of two frames in the mask, at an eighth of
+// their size: consecutive frames of one scene stay correlated however the
+// crowd moves at that scale; another scene (a cut) is not. 0 when either is
+// uniform.
+double FrameCorrelation(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  const cv::Size small(std::max(1, a.cols / 8), std::max(1, a.rows / 8));
+  cv::Mat sa, sb, sm;
+  cv::resize(a, sa, small, 0, 0, cv::INTER_AREA);
+  cv::resize(b, sb, small, 0, 0, cv::INTER_AREA);
+  cv::resize(mask, sm, small, 0, 0, cv::INTER_NEAREST);
+  cv::Scalar ma, da, mb, db;
+  cv::meanStdDev(sa, ma, da, sm);
+  cv::meanStdDev(sb, mb, db, sm);
+  if (da[0] < 1e-6 || db[0] < 1e-6) return 0.0;
+  cv::Mat fa, fb;
+  sa.convertTo(fa, CV_64F, 1.0, -ma[0]);
+  sb.convertTo(fb, CV_64F, 1.0, -mb[0]);
+  return cv::mean(fa.mul(fb), sm)[0] / (da[0] * db[0]);
 }
 
 // What step 1 found in one frame.
@@ -113,7 +133,6 @@ enum Flag : unsigned { kDark = 1, kFlat = 2, kCut = 4, kFrozen = 8 };
 struct Held {
   cv::Mat grey;      // enhanced, for the flow
   cv::Mat raw;       // as decoded (grey), for the frozen check
-  cv::Mat hist;
   unsigned flags = 0;
   std::size_t index = 0;
 };
@@ -246,10 +265,6 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   std::sort(pictures_left.begin(), pictures_left.end());
   if (!pictures_left.empty()) std::filesystem::create_directories(options.picture_dir);
   cv::Mat frame, flow, change;
-  const int channels[] = {0};
-  const int hist_size[] = {32};
-  const float range[] = {0, 256};
-  const float* ranges[] = {range};
   std::size_t index = 0;
   for (;; ++index) {
     if (!capture.read(frame) || frame.empty()) break;
@@ -264,11 +279,10 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     else h.raw = frame.clone();
     cv::Scalar mean, sd;
     cv::meanStdDev(h.raw, mean, sd, mask);
-    cv::calcHist(&h.raw, 1, channels, mask, h.hist, 1, hist_size, ranges);
     if (mean[0] < options.min_brightness) h.flags |= kDark;
     if (sd[0] < options.min_contrast) h.flags |= kFlat;
     if (!held.empty() && held.back().index + 1 == index) {
-      if (cv::compareHist(held.back().hist, h.hist, cv::HISTCMP_CORREL) < options.min_correlation) h.flags |= kCut;
+      if (FrameCorrelation(held.back().raw, h.raw, mask) < options.min_correlation) h.flags |= kCut;
       if (cv::norm(held.back().raw, h.raw, cv::NORM_L1) == 0.0) h.flags |= kFrozen;
     }
     s.dark += (h.flags & kDark) != 0;

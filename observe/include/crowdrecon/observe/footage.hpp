@@ -57,8 +57,8 @@ struct FootageOptions {
   bool enhance = true;               // CLAHE before the flow (step 2)
   // Step 1's thresholds, on 8-bit grey levels in the regions: a mean below
   // min_brightness is too dark; a standard deviation below min_contrast is
-  // too flat; a histogram correlation with the previous frame below
-  // min_correlation is a cut.
+  // too flat; a correlation with the previous frame (at an eighth of the
+  // size, in the regions) below min_correlation is a cut.
   double min_brightness = 8.0;
   double min_contrast = 3.0;
   double min_correlation = 0.5;
