@@ -271,6 +271,7 @@ void DrawObservationFigure(const observe::Observation& obs, const observe::Obser
 struct FootageArgs {
   std::string video, homography, spec, output, picture_dir, picture_at, figure, reference, flow = "dis-medium";
   double grid_m = 0.1, from_s = 0.0, to_s = -1.0;
+  observe::FootageOptions defaults;
   bool no_enhance = false, quiet = false, force = false;
 };
 
@@ -282,6 +283,9 @@ void RunFootage(const FootageArgs& args) {
   observe::FootageOptions options;
   options.flow = args.flow;
   options.grid_spacing_m = args.grid_m;
+  options.min_brightness = args.defaults.min_brightness;
+  options.min_contrast = args.defaults.min_contrast;
+  options.min_correlation = args.defaults.min_correlation;
   options.enhance = !args.no_enhance;
   options.from_s = args.from_s;
   if (args.to_s >= 0) options.to_s = args.to_s;
@@ -482,6 +486,16 @@ void RegisterObserveCommands(CLI::App& app) {
   footage->add_option("--picture-at", vargs->picture_at, "times (s) of the flow-field pictures, e.g. 2,10.5");
   footage->add_option("--figure", vargs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   footage->add_option("--reference", vargs->reference, "an observation to draw beside it in --figure (e.g. the trajectories')");
+  footage->add_option("--min-brightness", vargs->defaults.min_brightness,
+                      "a frame darker than this mean grey level (of 255) in the regions is flagged dark (default 8)")
+      ->check(CLI::Range(0.0, 255.0));
+  footage->add_option("--min-contrast", vargs->defaults.min_contrast,
+                      "a frame whose grey levels in the regions vary less than this (standard deviation) is flagged flat "
+                      "(default 3; 0 lets every frame through)")
+      ->check(CLI::Range(0.0, 128.0));
+  footage->add_option("--min-correlation", vargs->defaults.min_correlation,
+                      "a frame correlated less than this with the previous one is flagged as a cut (default 0.5)")
+      ->check(CLI::Range(-1.0, 1.0));
   footage->add_flag("--no-enhance", vargs->no_enhance, "no contrast enhancement (CLAHE) before the flow");
   footage->add_flag("-q,--quiet", vargs->quiet, "no progress, print only the output's name");
   AddForceFlag(footage, &vargs->force);

@@ -28,6 +28,7 @@ conditions=(
   "dark-0.5|--darkness 0.5|dis-medium"
   "dark-0.75|--darkness 0.75|dis-medium"
   "dark-0.9|--darkness 0.9|dis-medium"
+  "dark-0.9-unflagged|--darkness 0.9|dis-medium --min-contrast 0"
   "blur-1.5|--blur 1.5|dis-medium"
   "blur-3|--blur 3|dis-medium"
   "noise-5|--noise 5|dis-medium"
@@ -44,20 +45,24 @@ conditions=(
   "clean||farneback"
   "semi-dark|--darkness 0.75 --noise 6 --blur 1 --quality 50|farneback"
 )
-pictures=" clean dark-0.9 noise-20 jpeg-5 semi-dark "
+pictures=" clean dark-0.9-unflagged noise-20 jpeg-5 semi-dark "
 echo "condition,flow,options,speed_forward_error_pct,speed_backward_error_pct,counterflow_share_error,onsets_matched,onsets_expected,max_onset_error_s,unmatched_events,flagged_frames,processing_fps" > "$work/errors.csv"
 for c in "${conditions[@]}"; do
-  IFS='|' read -r name opts flow <<< "$c"
-  video="$work/$name.avi"
+  IFS='|' read -r name opts flowopts <<< "$c"
+  flow=${flowopts%% *}
+  video="$work/${name%-unflagged}.avi"
   # shellcheck disable=SC2086
-  [ -f "$video" ] || "$crowdrecon" observe synthesize "$work/run.sqlite" -o "$video" --homography-out "$work/$name.h.json" $opts > /dev/null
+  [ -f "$video" ] || "$crowdrecon" observe synthesize "$work/run.sqlite" -o "$video" --homography-out "${video%.avi}.h.json" $opts > /dev/null
   extra=()
   if [ "$flow" = dis-medium ] && [[ "$pictures" == *" $name "* ]]; then
     extra=(--pictures "$work/pictures-$name" --picture-at 10.5 --figure "$out/figure-$name.png" --reference "$work/truth.json")
   fi
-  "$crowdrecon" observe footage "$video" --homography "$work/$name.h.json" --spec "$spec" -o "$work/$name-$flow.json" \
-    --flow "$flow" "${extra[@]}" > "$work/$name-$flow.txt"
-  if [ -d "$work/pictures-$name" ]; then cp "$work/pictures-$name"/flow_*.png "$out/flow-$name.png"; rm -rf "$work/pictures-$name"; fi
+  # shellcheck disable=SC2086
+  "$crowdrecon" observe footage "$video" --homography "${video%.avi}.h.json" --spec "$spec" -o "$work/$name-$flow.json" \
+    --flow $flowopts "${extra[@]}" > "$work/$name-$flow.txt"
+  # (no picture when every frame near its time was flagged)
+  for p in "$work/pictures-$name"/flow_*.png; do [ -f "$p" ] && cp "$p" "$out/flow-$name.png"; done
+  rm -rf "$work/pictures-$name"
   "$crowdrecon" observe compare "$work/truth.json" "$work/$name-$flow.json" --csv "$work/$name-$flow.compare.csv" > "$work/$name-$flow.compare.txt"
   python3 - "$work/$name-$flow.compare.csv" "$work/$name-$flow.txt" "$name" "$flow" "$opts" >> "$work/errors.csv" <<'PY'
 import csv, re, sys
@@ -87,10 +92,12 @@ import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 print("| condition | flow | speed forward | speed backward | counter-flow share | onsets within 1 s | worst onset | extra events | frames flagged | frames/s |")
 print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+def f(value, form):
+    return format(float(value), form) if value not in ("", "nan") else "n/a"
 for r in rows:
-    print(f"| {r['condition']} | {r['flow']} | {float(r['speed_forward_error_pct']):+.1f} % | {float(r['speed_backward_error_pct']):+.1f} % | "
-          f"{float(r['counterflow_share_error']):+.3f} | {r['onsets_matched']}/{r['onsets_expected']} | {r['max_onset_error_s']} s | "
-          f"{r['unmatched_events']} | {r['flagged_frames']} | {r['processing_fps']} |")
+    print(f"| {r['condition']} | {r['flow']} | {f(r['speed_forward_error_pct'], '+.1f')} % | {f(r['speed_backward_error_pct'], '+.1f')} % | "
+          f"{f(r['counterflow_share_error'], '+.3f')} | {r['onsets_matched']}/{r['onsets_expected']} | {r['max_onset_error_s']} s | "
+          f"{r['unmatched_events'] or 'n/a'} | {r['flagged_frames']} | {r['processing_fps']} |")
 PY
 cat "$out/table.md"
 
