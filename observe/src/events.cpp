@@ -71,26 +71,19 @@ std::vector<Event> DetectEvents(const std::vector<double>& time_s, const std::ve
   for (std::size_t k = 0; k < kept.size(); ++k) {
     const double onset = time_s[kept[k].bin];
     const double next = k + 1 < kept.size() ? time_s[kept[k + 1].bin] : nan;
-    if (!kept[k].moving) {
-      Event e;
-      e.kind = "stop";
-      e.where = where;
-      e.direction = direction;
-      e.time_s = onset;
-      e.uncertainty_s = time_uncertainty_s;
-      e.end_s = next;
-      e.censored = k == 0;
-      events.push_back(e);
-      continue;
-    }
-    if (k == 0) continue;  // motion from the start: no onset seen
     Event e;
-    e.kind = "surge";
+    e.kind = kept[k].moving ? "surge" : "stop";
     e.where = where;
     e.direction = direction;
     e.time_s = onset;
     e.uncertainty_s = time_uncertainty_s;
     e.end_s = next;
+    if (!kept[k].moving) {
+      e.censored = k == 0;
+      events.push_back(e);
+      continue;
+    }
+    if (k == 0) continue;  // motion from the start: no onset seen
     const std::size_t last = k + 1 < kept.size() ? kept[k + 1].bin : speed.size();
     double peak = 0.0;
     for (std::size_t i = kept[k].bin; i < last; ++i)

@@ -16,6 +16,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "jupedsim_tables.hpp"
 
 namespace crowdrecon::runfile {
 
@@ -24,17 +25,8 @@ namespace {
 using sqlite::Database;
 using sqlite::Statement;
 
-std::string NumberText(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
-}
-
-// 64-bit FNV-1a of the WKT, as the geometry hash (JuPedSim uses Python's hash;
-// any integer identifying the geometry will do for readers).
-std::int64_t GeometryHash(const std::string& wkt) {
-  return static_cast<std::int64_t>(Fnv1a(wkt.data(), wkt.size()) >> 1);
-}
+using detail::GeometryHash;
+using detail::NumberText;
 
 std::string PointsJson(const std::vector<Vec2>& points) {
   nlohmann::json j = nlohmann::json::array();
@@ -90,12 +82,8 @@ constexpr int kWriterMutexMode = SQLITE_OPEN_NOMUTEX;
 // in when the file is next opened.
 constexpr const char* kJournal = "PRAGMA journal_mode=WAL";
 
+// crowdrecon's own tables, after the JuPedSim ones (jupedsim_tables.hpp).
 constexpr const char* kSchema = R"SQL(
-CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL,
-  pos_y REAL NOT NULL, ori_x REAL NOT NULL, ori_y REAL NOT NULL);
-CREATE TABLE metadata(key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE geometry(hash INTEGER NOT NULL, wkt TEXT NOT NULL);
-CREATE TABLE frame_data(frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL);
 CREATE INDEX frame_id_idx ON trajectory_data(frame, id);
 CREATE TABLE run(key TEXT NOT NULL PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE shape(id INTEGER PRIMARY KEY, radius_m REAL NOT NULL, vertices TEXT NOT NULL);
@@ -160,6 +148,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
   db.Exec(kJournal);
   db.Exec("PRAGMA synchronous=NORMAL");
   db.Exec("BEGIN");
+  db.Exec(detail::kJuPedSimSchema);
   db.Exec(kSchema);
   w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
   {

@@ -12,6 +12,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "jupedsim_tables.hpp"
 
 namespace crowdrecon::runfile {
 
@@ -21,14 +22,9 @@ namespace fs = std::filesystem;
 using sqlite::Database;
 using sqlite::Statement;
 
-// The JuPedSim tables as the run file has them (run_file.cpp), and the map
-// from the export's ids to the run's people.
-constexpr const char* kExportSchema = R"SQL(
-CREATE TABLE trajectory_data(frame INTEGER NOT NULL, id INTEGER NOT NULL, pos_x REAL NOT NULL,
-  pos_y REAL NOT NULL, ori_x REAL NOT NULL, ori_y REAL NOT NULL);
-CREATE TABLE metadata(key TEXT NOT NULL UNIQUE PRIMARY KEY, value TEXT NOT NULL);
-CREATE TABLE geometry(hash INTEGER NOT NULL, wkt TEXT NOT NULL);
-CREATE TABLE frame_data(frame INTEGER NOT NULL, geometry_hash INTEGER NOT NULL);
+// After the JuPedSim tables (jupedsim_tables.hpp): the map from the
+// export's ids to the run's people.
+constexpr const char* kTrackSchema = R"SQL(
 CREATE TABLE crowdrecon_track(id INTEGER PRIMARY KEY, person INTEGER NOT NULL, part INTEGER NOT NULL,
   first_frame INTEGER NOT NULL, last_frame INTEGER NOT NULL);
 )SQL";
@@ -38,16 +34,8 @@ CREATE TABLE crowdrecon_track(id INTEGER PRIMARY KEY, person INTEGER NOT NULL, p
 // cache, whatever the run's length.
 constexpr std::int64_t kRowsPerTransaction = 200000;
 
-std::string NumberText(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", v);
-  return buffer;
-}
-
-// The run file's rule (run_file.cpp): any integer naming the geometry will do.
-std::int64_t GeometryHash(const std::string& wkt) {
-  return static_cast<std::int64_t>(Fnv1a(wkt.data(), wkt.size()) >> 1);
-}
+using detail::GeometryHash;
+using detail::NumberText;
 
 std::string BoxJson(const PeriodicBox& box) {
   const nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
@@ -111,7 +99,8 @@ ExportSummary WriteExport(const RunFileReader& run, Database& db) {
   db.Exec("PRAGMA journal_mode=OFF");
   db.Exec("PRAGMA synchronous=OFF");
   db.Exec("BEGIN");
-  db.Exec(kExportSchema);
+  db.Exec(detail::kJuPedSimSchema);
+  db.Exec(kTrackSchema);
   {
     Statement geo(db, "INSERT INTO geometry VALUES(?, ?)");
     geo.Bind(1, geometry_hash).Bind(2, wkt).Run();
