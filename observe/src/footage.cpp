@@ -137,9 +137,13 @@ struct Held {
   std::size_t index = 0;
 };
 
+// The flow field as measured: at every second floor point, an arrow along
+// the image motion over the span (three times longer) coloured by the
+// velocity that went into the series (step 4: blue forward, red backward),
+// or a grey dot where the point was still.
 void DrawFlowPicture(const cv::Mat& frame, const cv::Mat& flow, const std::vector<Sample>& samples,
-                     const std::vector<std::vector<cv::Point>>& outlines, const Homography& h, Vec2 axis, double fps,
-                     int span, double still, const std::filesystem::path& file) {
+                     const std::vector<double>& used_velocity, const std::vector<std::vector<cv::Point>>& outlines,
+                     double still, const std::filesystem::path& file) {
   cv::Mat out;
   if (frame.channels() == 1) cv::cvtColor(frame, out, cv::COLOR_GRAY2BGR);
   else out = frame.clone();
@@ -147,14 +151,13 @@ void DrawFlowPicture(const cv::Mat& frame, const cv::Mat& flow, const std::vecto
   for (std::size_t i = 0; i < samples.size(); i += 2) {
     const Sample& s = samples[i];
     const cv::Point2f u = flow.at<cv::Point2f>(s.pixel);
-    const double v = Dot(FloorDisplacement(s, u), axis) * fps / span;
+    const double v = used_velocity[i];
     const cv::Scalar colour = v > still ? cv::Scalar(200, 90, 30) : v < -still ? cv::Scalar(40, 40, 220) : cv::Scalar(150, 150, 150);
     // Arrows show the image motion over the span, drawn three times longer.
     const cv::Point tip(static_cast<int>(std::lround(s.pixel.x + 3.0 * static_cast<double>(u.x))), static_cast<int>(std::lround(s.pixel.y + 3.0 * static_cast<double>(u.y))));
     if (std::abs(v) > still) cv::arrowedLine(out, s.pixel, tip, colour, 1, cv::LINE_AA, 0, 0.3);
     else cv::circle(out, s.pixel, 1, colour, -1);
   }
-  (void)h;
   if (!cv::imwrite(file.string(), out)) throw InputError(file.string() + ": cannot write the flow picture");
 }
 
@@ -232,7 +235,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   }
   s.grid_points = samples.size();
   std::vector<char> moved(samples.size(), 0);
-  std::vector<double> along(samples.size(), 0.0);
+  std::vector<double> along(samples.size(), 0.0), used(samples.size(), 0.0);
   const int reach = std::max(0, static_cast<int>(std::lround(0.5 * kBodyWindow_m / options.grid_spacing_m - 0.5)));
 
   Observation obs;
@@ -325,7 +328,8 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     if (b == detail::SeriesBuilder::kNoBin) continue;
     builder.AddFrame(b, nullptr);
     for (const Sample& sample : samples) {
-      double v = 0.0;
+      double& v = used[&sample - samples.data()];
+      v = 0.0;
       if (moved[&sample - samples.data()]) {
         const Grid& g = grids[sample.region];
         double sum = 0.0;
@@ -349,7 +353,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
       char name[64];
       std::snprintf(name, sizeof name, "flow_%08.2fs.png", t_mid);
       const std::filesystem::path file = options.picture_dir / name;
-      DrawFlowPicture(frame, flow, samples, outlines, homography, axis, s.fps, span, spec.still_speed_m_per_s, file);
+      DrawFlowPicture(frame, flow, samples, used, outlines, spec.still_speed_m_per_s, file);
       s.pictures.push_back(file);
       pictures_left.erase(pictures_left.begin());
     }
