@@ -90,7 +90,7 @@ cp "$work/errors.csv" "$out/errors.csv"
 python3 - "$out/errors.csv" > "$out/table.md" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-print("| condition | flow | speed forward | speed backward | counter-flow share | onsets within 1 s | worst onset | extra events | frames flagged | frames/s |")
+print("| condition | flow | speed forward | speed backward | counter-flow share | onsets found (of 4, within 3 s) | largest onset error | events not in the trajectories | frames flagged | frames/s |")
 print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
 def f(value, form):
     return format(float(value), form) if value not in ("", "nan") else "n/a"
