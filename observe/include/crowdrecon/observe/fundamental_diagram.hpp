@@ -4,7 +4,8 @@
 // position lies in the area, and the mean of their speeds |v| (velocities as
 // in observations: a centred difference over the spec's velocity span).
 // Compared with Weidmann's speed-density relation (U. Weidmann,
-// "Transporttechnik der Fussgänger", 1993; ERRATA facts).
+// "Transporttechnik der Fussgänger", 1993; docs/decisions.md, "Facts from
+// other sources").
 #pragma once
 
 #include <string>
