@@ -72,7 +72,7 @@ constexpr double kBodyWindow_m = 0.5;
 
 // Step 4: an image displacement (px) carried to the floor (m).
 Vec2 FloorDisplacement(const Sample& s, cv::Point2f u_px) {
-  const double ux = u_px.x, uy = u_px.y;
+  const double ux = static_cast<double>(u_px.x), uy = static_cast<double>(u_px.y);
   return {s.jacobian[0] * ux + s.jacobian[1] * uy, s.jacobian[2] * ux + s.jacobian[3] * uy};
 }
 
