@@ -203,21 +203,6 @@ void RunFundamentalDiagram(const FdArgs& args) {
   }
 }
 
-// "1,2.5,7" -> {1, 2.5, 7}.
-std::vector<double> ParseTimes(const std::string& text, const std::string& option) {
-  std::vector<double> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v) || v < 0)
-      throw InputError(option + " \"" + text + "\": expected times in seconds separated by commas, e.g. 2,10.5");
-    out.push_back(v);
-  }
-  return out;
-}
-
 // The figure of an observation: per region, the speed of each direction with
 // its uncertainty and the shares moving, with the detected events; a second
 // observation (the reference, e.g. a run's own trajectories) drawn beside it.
@@ -269,7 +254,8 @@ void DrawObservationFigure(const observe::Observation& obs, const observe::Obser
 }
 
 struct FootageArgs {
-  std::string video, homography, spec, output, picture_dir, picture_at, figure, reference, flow = "dis-medium";
+  std::string video, homography, spec, output, picture_dir, figure, reference, flow = "dis-medium";
+  std::vector<double> picture_at;
   double grid_m = 0.1, from_s = 0.0, to_s = -1.0;
   observe::FootageOptions defaults;
   bool no_enhance = false, quiet = false, force = false;
@@ -291,7 +277,7 @@ void RunFootage(const FootageArgs& args) {
   if (args.to_s >= 0) options.to_s = args.to_s;
   if (!args.picture_at.empty()) {
     if (args.picture_dir.empty()) throw InputError("--picture-at needs --pictures FOLDER");
-    options.picture_times_s = ParseTimes(args.picture_at, "--picture-at");
+    options.picture_times_s = args.picture_at;
     options.picture_dir = args.picture_dir;
   }
   if (!args.quiet && isatty(fileno(stderr)) != 0)
@@ -483,7 +469,9 @@ void RegisterObserveCommands(CLI::App& app) {
   footage->add_option("--from", vargs->from_s, "start at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
   footage->add_option("--to", vargs->to_s, "stop at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
   footage->add_option("--pictures", vargs->picture_dir, "folder for the flow-field pictures (with --picture-at)");
-  footage->add_option("--picture-at", vargs->picture_at, "times (s) of the flow-field pictures, e.g. 2,10.5");
+  footage->add_option("--picture-at", vargs->picture_at, "times (s) of the flow-field pictures, e.g. 2,10.5")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1e7));
   footage->add_option("--figure", vargs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   footage->add_option("--reference", vargs->reference, "an observation to draw beside it in --figure (e.g. the trajectories')");
   footage->add_option("--min-brightness", vargs->defaults.min_brightness,

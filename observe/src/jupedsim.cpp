@@ -19,12 +19,6 @@ namespace crowdrecon::observe {
 
 namespace {
 
-bool HasTable(const sqlite::Database& db, const std::string& name) {
-  sqlite::Statement s(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?");
-  s.Bind(1, name);
-  return s.Next();
-}
-
 std::set<std::string> Columns(const sqlite::Database& db, const std::string& table) {
   std::set<std::string> out;
   sqlite::Statement s(db, "PRAGMA table_info(" + table + ")");
@@ -52,12 +46,12 @@ Trajectories ReadJuPedSim(const std::filesystem::path& file, double fps_override
     };
     // A file SQLite cannot read as a database fails on its first query.
     try {
-      if (!HasTable(db, "trajectory_data")) fail("no table trajectory_data");
+      if (!sqlite::HasTable(db, "trajectory_data")) fail("no table trajectory_data");
     } catch (const InputError& e) {
       if (std::string(e.what()).find("expected a JuPedSim") != std::string::npos) throw;
       fail("not a readable SQLite database");
     }
-    if (!HasTable(db, "metadata")) fail("no table metadata");
+    if (!sqlite::HasTable(db, "metadata")) fail("no table metadata");
     const std::set<std::string> columns = Columns(db, "trajectory_data");
     for (const char* c : {"frame", "id", "pos_x", "pos_y"})
       if (!columns.count(c)) fail(std::string("table trajectory_data has no column ") + c);
@@ -66,7 +60,7 @@ Trajectories ReadJuPedSim(const std::filesystem::path& file, double fps_override
     int version = 0;
     if (version_text == "1" || version_text == "2" || version_text == "3") version = version_text[0] - '0';
     else fail("metadata version \"" + ShortText(version_text, 20) + "\"");
-    const bool ours = HasTable(db, "run");
+    const bool ours = sqlite::HasTable(db, "run");
     t.format = ours ? "crowdrecon-run" : "jupedsim-v" + std::to_string(version);
 
     const std::string fps_text = Metadata(db, "fps");
@@ -80,7 +74,7 @@ Trajectories ReadJuPedSim(const std::filesystem::path& file, double fps_override
     t.fps = fps_override > 0.0 ? fps_override : file_fps;
     if (!(t.fps > 0.0)) throw InputError(name + ": metadata has no fps; give the frame rate with --fps");
 
-    if (HasTable(db, "geometry")) {
+    if (sqlite::HasTable(db, "geometry")) {
       sqlite::Statement g(db, "SELECT wkt FROM geometry");
       std::vector<std::string> wkts;
       while (g.Next()) wkts.push_back(g.Text(0));

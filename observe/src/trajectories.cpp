@@ -1,24 +1,18 @@
 #include "crowdrecon/observe/trajectories.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <map>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/observe/petrack.hpp"
 
 namespace crowdrecon::observe {
 
 Trajectories ReadTrajectories(const std::filesystem::path& file, double fps_override) {
-  // SQLite files begin with this 16-byte header string.
-  static constexpr char kSqliteMagic[] = "SQLite format 3";
-  char head[16] = {};
-  {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file.string() + ": cannot open the trajectory file");
-    in.read(head, sizeof head);
-  }
-  if (std::equal(kSqliteMagic, kSqliteMagic + sizeof kSqliteMagic, head)) return ReadJuPedSim(file, fps_override);
+  // SQLite files begin with "SQLite format 3" and a NUL. (A missing or
+  // unreadable file goes to the PeTrack reader, whose error names it.)
+  if (FileStartsWith(file, std::string("SQLite format 3", 16))) return ReadJuPedSim(file, fps_override);
   Trajectories t = ReadPeTrack(file, fps_override);
   t.format = "petrack";
   return t;

@@ -214,15 +214,9 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   const std::string after = std::to_string(last_frame);
   for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
     db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
-  {
-    Statement loads(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'person_load'");
-    w.impl_->has_person_load = loads.Next() && loads.Int(0) > 0;
-    if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
-  }
-  {
-    Statement census(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'census'");
-    if (census.Next() && census.Int(0) > 0) db.Exec("DELETE FROM census WHERE frame > " + after);
-  }
+  w.impl_->has_person_load = sqlite::HasTable(db, "person_load");
+  if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
+  if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);
   {
     Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
     if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
@@ -723,10 +717,7 @@ bool PersonLoadStream::Next(std::int64_t* frame, std::vector<PersonLoad>* out) {
   return true;
 }
 
-bool RunFileReader::HasPersonLoads() const {
-  Statement s(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'person_load'");
-  return s.Next() && s.Int(0) > 0;
-}
+bool RunFileReader::HasPersonLoads() const { return sqlite::HasTable(*impl_->db, "person_load"); }
 
 PersonLoadStream RunFileReader::PersonLoads(std::int64_t last_frame) const {
   PersonLoadStream stream;
@@ -778,10 +769,7 @@ std::vector<Event> RunFileReader::Events() const {
 
 std::vector<CensusRow> RunFileReader::CensusRows() const {
   std::vector<CensusRow> rows;
-  {
-    Statement exists(*impl_->db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = 'census'");
-    if (!exists.Next() || exists.Int(0) == 0) return rows;
-  }
+  if (!sqlite::HasTable(*impl_->db, "census")) return rows;
   Statement s(*impl_->db,
               "SELECT frame, time_s, walking, fallen, removed, queued, entered FROM census ORDER BY frame");
   s.Describe("census", {0});

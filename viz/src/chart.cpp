@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ticks.hpp"
+
 namespace crowdrecon::viz {
 
 struct ChartPanel::Item {
@@ -62,12 +64,8 @@ namespace {
 constexpr double kLeft = 90, kRight = 40, kTop = 76, kGap = 64;
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
 
-double NiceStep(double range) {
-  const double raw = range / 5.0, p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
-}
+// About five ticks per axis.
+double NiceStep(double range) { return detail::NiceStep(range, 5.0); }
 
 std::string Tick(double v, double step) {
   char text[32];

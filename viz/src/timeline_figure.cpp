@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "crowdrecon/viz/canvas.hpp"
+#include "ticks.hpp"
 
 namespace crowdrecon::viz {
 
@@ -32,12 +33,8 @@ struct Panel {
   double Y(double v) const { return bottom - (std::clamp(v, lo, hi) - lo) / (hi - lo) * (bottom - top); }
 };
 
-double NiceStep(double range) {
-  const double raw = range / 4.0, p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
-}
+// About four ticks per panel.
+double NiceStep(double range) { return detail::NiceStep(range, 4.0); }
 
 std::string Number(double v) {
   char text[32];

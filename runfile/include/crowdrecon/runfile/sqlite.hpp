@@ -153,6 +153,13 @@ class Statement {
   std::vector<int> key_columns_;
 };
 
+// Whether the database has a table of this name.
+inline bool HasTable(const Database& db, const std::string& name) {
+  Statement s(db, "SELECT COUNT(*) FROM sqlite_master WHERE type = 'table' AND name = ?");
+  s.Bind(1, name);
+  return s.Next() && s.Int(0) > 0;
+}
+
 // Inserts rows of numbers into one table, many rows per INSERT statement
 // ("INSERT INTO t VALUES (?, ...), (?, ...), ..."): per row, SQLite then
 // skips a statement's start, its cursors' opening and closing, and its reset,
