@@ -22,6 +22,7 @@ void RegisterTimelineCommand(CLI::App& app);  // timeline (the figure of an inci
 void RegisterReportCommand(CLI::App& app);  // report (injury risk of runs: HTML, PDF, CSV)
 void RegisterObserveCommands(CLI::App& app);  // observe trajectories / footage (observations)
 void RegisterExportCommand(CLI::App& app);  // export (a run's trajectories for tools unaware of periodic boxes)
+void RegisterCalibrateCommand(CLI::App& app);  // calibrate (scenario values fitted to observations)
 
 // The command line as given (for the records of reports), set by main.
 const std::string& CommandLine();

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterReportCommand(app);
   crowdrecon::cli::RegisterObserveCommands(app);
   crowdrecon::cli::RegisterExportCommand(app);
+  crowdrecon::cli::RegisterCalibrateCommand(app);
   crowdrecon::cli::SetCommandLine(argc, argv);
   try {
     app.parse(argc, argv);

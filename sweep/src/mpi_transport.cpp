@@ -25,19 +25,33 @@ struct MpiTransport::Impl {
   int size = 1;
 };
 
+// MPI is initialised once per process and finalised at its exit: a
+// calibration runs many sweeps in one process, and MPI cannot be initialised
+// again once finalised.
+extern "C" void FinalizeMpiAtExit() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (!finalized) MPI_Finalize();
+}
+
 MpiTransport::MpiTransport() : impl_(std::make_unique<Impl>()) {
-  int provided = 0;
-  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-  if (provided < MPI_THREAD_FUNNELED) {
-    MPI_Finalize();
-    throw InputError("MPI: the MPI library does not allow threads (MPI_THREAD_FUNNELED); run with --jobs 1 under "
-                     "a thread-capable MPI");
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (!initialized) {
+    int provided = 0;
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+    if (provided < MPI_THREAD_FUNNELED) {
+      MPI_Finalize();
+      throw InputError("MPI: the MPI library does not allow threads (MPI_THREAD_FUNNELED); run with --jobs 1 under "
+                       "a thread-capable MPI");
+    }
+    std::atexit(FinalizeMpiAtExit);
   }
   MPI_Comm_rank(MPI_COMM_WORLD, &impl_->rank);
   MPI_Comm_size(MPI_COMM_WORLD, &impl_->size);
 }
 
-MpiTransport::~MpiTransport() { MPI_Finalize(); }
+MpiTransport::~MpiTransport() = default;
 
 int MpiTransport::rank() const { return impl_->rank; }
 int MpiTransport::size() const { return impl_->size; }

@@ -21,9 +21,10 @@ bool LaunchedAsMpiRank();
 
 class MpiTransport {
  public:
-  // MPI_Init_thread; throws InputError if this crowdrecon was built without MPI.
+  // MPI_Init_thread the first time in a process (MPI_Finalize at its exit);
+  // throws InputError if this crowdrecon was built without MPI.
   MpiTransport();
-  ~MpiTransport();  // MPI_Finalize
+  ~MpiTransport();
   MpiTransport(const MpiTransport&) = delete;
   MpiTransport& operator=(const MpiTransport&) = delete;
 

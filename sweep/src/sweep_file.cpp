@@ -252,7 +252,8 @@ SweepSpec ParseSweep(const std::string& json_text, const std::string& origin, co
     root.At("format").Fail("\"" + format + "\" is not a sweep; expected \"crowdrecon-sweep\"");
   root.Integer("version", 1, 1, 1);
   s.name = root.String("name", fs::path(origin).stem().string());
-  const fs::path sweep_dir = fs::absolute(base_dir).lexically_normal();
+  // A file in the working folder has an empty parent path, which fs::absolute refuses.
+  const fs::path sweep_dir = fs::absolute(base_dir.empty() ? fs::path(".") : base_dir).lexically_normal();
 
   {
     const JsonReader scenario = root.At("scenario");

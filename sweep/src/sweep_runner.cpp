@@ -157,6 +157,7 @@ struct Context {
   fs::path dir;
   fs::path runs_dir;
   analysis::AnalysisOptions analysis;
+  const std::function<void(const RunPlan&, const fs::path&, const std::string&)>* after_run = nullptr;
 };
 
 // Each metric's position in ResultRow::metrics, by name.
@@ -253,6 +254,9 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
     row.status = "failed: " + ReplaceAll(e.what(), ctx.runs_dir.string(), "runs");
     row.metrics.assign(MetricColumns().size(), std::numeric_limits<double>::quiet_NaN());
   }
+  // The caller's own measurement of the run (outside the try: its errors are
+  // not the run's result but the sweep's).
+  if (ctx.after_run && *ctx.after_run) (*ctx.after_run)(run, file, failed ? row.status : std::string("complete"));
   // A failed run keeps its file (and saved state) for inspection.
   if (!ctx.spec.keep_runs && !failed) RemoveRunFiles(file);
   row.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
@@ -586,7 +590,7 @@ SweepSummary RunSweep(const SweepOptions& options) {
   if (mpi && !AgreeOnSetUp(*transport, rank, setup.error, &s)) return s;
   if (setup.error) std::rethrow_exception(setup.error);
 
-  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}};
+  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}, &options.after_run};
   const Work work = [&ctx](std::size_t index) {
     Outcome o;
     o.index = index;
@@ -598,12 +602,22 @@ SweepSummary RunSweep(const SweepOptions& options) {
     return o;
   };
   const SweepSignals signals;
+  // Under MPI every rank returns only when every run's row has reached rank
+  // 0, so that what the runs left behind (their after_run files) is complete
+  // on every rank when RunSweep returns there (a calibration reads it next).
   if (rank != 0) {
     RunWorkerRank(*transport, rank, jobs, work);
+    if (!transport->RootOk(true)) s.exit_code = 2;
     s.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
     return s;
   }
-  Coordinator(options, setup, transport.get(), ranks, jobs, start, &s).Run(work);
+  try {
+    Coordinator(options, setup, transport.get(), ranks, jobs, start, &s).Run(work);
+  } catch (...) {
+    if (mpi) transport->RootOk(false);
+    throw;
+  }
+  if (mpi) transport->RootOk(true);
   return s;
 }
 

@@ -70,6 +70,18 @@ TEST(SweepFile, GridOrderIdsAndValues) {
   for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(again[i].id, runs[i].id);
 }
 
+// A sweep file named without a folder ("sweep.json", in the working folder)
+// has an empty parent path: its scenario resolves against the working folder
+// (this used to stop with an internal error from fs::absolute("")).
+TEST(SweepFile, AFileInTheWorkingFolderResolvesItsScenarioThere) {
+  const std::filesystem::path here = std::filesystem::current_path();
+  std::filesystem::current_path(kSweepDir);
+  SweepSpec s;
+  EXPECT_NO_THROW(s = ParseSweep("{" + kHead + "}", "test.json", ""));
+  std::filesystem::current_path(here);
+  EXPECT_EQ(s.scenario_file, (kSweepDir / "../scenarios/sweep-tiny.json").lexically_normal());
+}
+
 TEST(SweepFile, DefaultsWithoutAxesVariantsOrSeeds) {
   const SweepSpec s = Parse("{" + kHead + "}");
   EXPECT_EQ(s.variants.size(), 1u);

@@ -32,8 +32,11 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
+
+#include "crowdrecon/sweep/sweep_file.hpp"
 
 namespace crowdrecon::sweep {
 
@@ -47,6 +50,15 @@ struct SweepOptions {
   // For tests of resumption: stop as if interrupted once this many rows have
   // been written by this invocation (< 0: never).
   long long stop_after_runs = -1;
+  // Called for every run that got a row, on the worker (and MPI rank) that
+  // ran it, after its analysis and before its run file is removed, with the
+  // row's status ("complete" or "failed: ..."): what a caller measures from
+  // the run file itself (the calibration observes it, calibrate/). It runs on
+  // worker threads at once, so it must be thread-safe; an exception from it
+  // stops the sweep as an error. Every rank must be given the same hook;
+  // under MPI, RunSweep returns on any rank only once every rank's calls
+  // have returned.
+  std::function<void(const RunPlan& run, const std::filesystem::path& run_file, const std::string& status)> after_run;
 };
 
 struct SweepSummary {

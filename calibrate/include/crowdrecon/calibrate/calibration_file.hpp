@@ -1,0 +1,134 @@
+// Calibration files: which scenario values to fit, to which observations, with
+// how many seeds and which approach (docs/calibration.md).
+//
+//   {
+//     "format": "crowdrecon-calibration", "version": 1,
+//     "name": "Madrid Arena hallway: Γ, λ and ε from the velocities",
+//     "scenario": "../scenarios/hallway-5pm2-30cf.json",        (relative to this file)
+//     "set": {"run.duration_s": 30, "run.contacts": false},     (every run, as in a sweep)
+//     "parameters": [
+//       {"path": "model.back_force_gamma", "min": 0.3, "max": 4.8, "start": 1.2},
+//       {"path": "model.torsion_stiffness_lambda"},             (bounds: the parameter table; start: the scenario)
+//       {"path": "population.desired_speed_m_per_s", "min": 0.6, "max": 1.8, "width": 0.4}   (a range's centre)
+//     ],
+//     "observations": [
+//       {"file": "recorded.observation.json", "time_offset_s": 0,
+//        "series": [{"quantity": "speed", "where": "hallway", "direction": "forward",
+//                    "from_s": 5, "to_s": 30, "window_s": 0, "relative_error": 0}],
+//        "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 30}]}
+//     ],
+//     "seeds": {"first": 1, "count": 8},
+//     "approach": "surrogate",                                   (or "gradient")
+//     "starts": [{"model.back_force_gamma": 3.0}],               (more starting points)
+//     "options": {"refinements": 2, "shrink": 0.5, "gradient_step": 0.1, "max_iterations": 8,
+//                 "bootstrap": 200, "profile_points": 7, "measure_noise": false}
+//   }
+//
+// "scenario", "set" and "seeds" mean what they mean in a sweep file (they are
+// read by the sweep's parser, so overrides and file paths behave alike). A
+// parameter's bounds default to the model parameter table's range for
+// "model.*" paths and must be given otherwise; its start defaults to the
+// base scenario's value (with "set" applied), else the table's default.
+// Errors name the file, the JSON path, the value and what was expected.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/observe/observation.hpp"
+#include "crowdrecon/sweep/sweep_file.hpp"
+
+namespace crowdrecon::calibrate {
+
+struct Parameter {
+  std::string path;  // dotted scenario path
+  std::string name;  // its last element, for tables ("back_force_gamma")
+  double min = 0.0, max = 1.0;
+  double start = 0.0;
+  // A range value ([low, high], e.g. population.desired_speed_m_per_s): the
+  // parameter is its centre and the range keeps this width (0: a number).
+  double width = 0.0;
+  bool is_range = false;
+  double Range() const { return max - min; }
+  // The JSON text written at `path` for a value.
+  std::string JsonOf(double value) const;
+};
+
+// A series of an observation compared over windows of time: the mean of its
+// bins whose centres lie in each window [from, from + window), ..., up to to.
+struct SeriesMatch {
+  std::string quantity, where, direction;
+  double from_s = 0.0, to_s = 0.0;  // on the observation's clock
+  double window_s = 0.0;            // 0: one window from..to
+  // The observation's systematic error as a fraction of its value (e.g. the
+  // footage study's 10 %), added to its statistical one.
+  double relative_error = 0.0;
+};
+
+// Events (observe/events.hpp) of one kind, place and direction, compared as
+// cumulative counts: after each observed onset and at the end of the window.
+struct EventMatch {
+  std::string kind;  // stop, surge
+  std::string where, direction;
+  double from_s = 0.0, to_s = 0.0;
+};
+
+struct ObservationMatch {
+  std::filesystem::path file;
+  observe::Observation observation;
+  // Simulated time = observed time + offset (an experiment's clock against
+  // the run's, which starts at 0).
+  double time_offset_s = 0.0;
+  std::vector<SeriesMatch> series;
+  std::vector<EventMatch> events;
+};
+
+enum class Approach { kSurrogate, kGradient };
+const char* ToString(Approach a);
+
+struct CalibrationOptions {
+  // Surrogate: rounds of refinement after the design over the whole box, each
+  // in a box `shrink` times the previous one around the optimum found.
+  int refinements = 2;
+  double shrink = 0.5;
+  // Gradient: the central-difference step, as a fraction of each range, and
+  // Ceres' iterations per start.
+  double gradient_step = 0.1;
+  int max_iterations = 8;
+  // Replicates of the seed-and-observation bootstrap (0: none).
+  int bootstrap = 200;
+  // Simulated points along each parameter's whole range through the best
+  // fit (0: no profiles).
+  int profile_points = 7;
+  // Measure the objective's noise along each parameter at small steps first.
+  bool measure_noise = false;
+  double noise_step = 0.01;  // fraction of the range
+};
+
+struct CalibrationSpec {
+  std::filesystem::path file;
+  std::string origin;  // names the file in messages
+  std::string name;
+  // The sweep that every evaluation is: scenario, "set", seeds (no axes, no
+  // variants: each parameter set becomes a variant of a batch).
+  sweep::SweepSpec base;
+  std::vector<Parameter> parameters;
+  std::vector<ObservationMatch> observations;
+  Approach approach = Approach::kSurrogate;
+  // Starting points, each one value per parameter: the parameters' starts
+  // first, then the file's "starts".
+  std::vector<std::vector<double>> starts;
+  CalibrationOptions options;
+  // Everything a run's statistics depend on besides the parameter values:
+  // the base scenario, "set", the seeds, the observations' specs and
+  // matches. Cached evaluations are keyed by it and by the values.
+  std::string fingerprint;
+};
+
+CalibrationSpec LoadCalibration(const std::filesystem::path& file);
+CalibrationSpec ParseCalibration(const std::string& json_text, const std::string& origin,
+                                 const std::filesystem::path& base_dir);
+
+}  // namespace crowdrecon::calibrate

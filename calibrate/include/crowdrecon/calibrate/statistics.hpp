@@ -1,0 +1,42 @@
+// The statistics a calibration compares: numbers computed alike from an
+// observation file and from every simulated run's observation (the same
+// observe::ObserveTrajectories with the observation's own spec), one per
+// window of a matched series and one per checkpoint of matched events
+// (docs/calibration.md, "Statistics").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "crowdrecon/calibrate/calibration_file.hpp"
+#include "crowdrecon/observe/observation.hpp"
+
+namespace crowdrecon::calibrate {
+
+struct Statistic {
+  std::string name;        // "obs0 speed hallway forward [5, 30) s", "obs0 stop hallway forward count at 12.4 s"
+  std::string unit;
+  std::size_t observation = 0;  // index into CalibrationSpec::observations
+  bool is_count = false;        // an event count (else a series' window mean)
+  std::string quantity;         // the series' quantity, or the events' kind
+  std::string where, direction;
+  double from_s = 0.0, to_s = 0.0;  // window (series) or [from, checkpoint] (counts), observed clock
+  double observed = 0.0;
+  // The observed value's own uncertainty: the standard error of the window's
+  // mean from its bins' (independent bins assumed), plus the match's
+  // relative error, in quadrature; for counts, half an event.
+  double observed_sigma = 0.0;
+};
+
+// Every statistic of the calibration, observed values included. Throws
+// InputError naming the calibration file, the match and the series when a
+// matched series is missing from the observation or a window holds no value.
+std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec);
+
+// The values of `statistics` (of observation `index` only; others NaN) in a
+// simulated run's observation: the same windows shifted by the match's time
+// offset. NaN where a window holds no value.
+void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
+                         const std::vector<Statistic>& statistics, std::vector<double>* values);
+
+}  // namespace crowdrecon::calibrate

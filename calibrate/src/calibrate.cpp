@@ -1,0 +1,548 @@
+#include "crowdrecon/calibrate/calibrate.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "evaluator.hpp"
+#include "fit.hpp"
+#include "outputs.hpp"
+
+namespace crowdrecon::calibrate {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kChi2At95 = 3.841458820694124;  // chi-square, one degree of freedom, 95 %
+
+// An evaluation was interrupted (Ctrl-C, SIGTERM): the calibration stops
+// and resumes from its cache when run again.
+struct Interrupted {};
+
+using Point = std::vector<double>;  // unit coordinates
+
+// The face-centred central composite design in the box centre +- half (each
+// coordinate clamped to [0, 1]): corners, face centres, centre; for more than
+// four parameters a Halton design of twice the quadratic's terms instead.
+std::vector<Point> Design(const Point& centre, double half) {
+  const std::size_t p = centre.size();
+  std::vector<Point> d;
+  const auto add = [&](Point u) {
+    for (double& x : u) x = std::clamp(x, 0.0, 1.0);
+    for (const Point& q : d)
+      if (q == u) return;
+    d.push_back(std::move(u));
+  };
+  add(centre);
+  if (p <= 4) {
+    for (std::size_t mask = 0; mask < (std::size_t{1} << p); ++mask) {
+      Point u = centre;
+      for (std::size_t i = 0; i < p; ++i) u[i] += (mask >> i & 1) ? half : -half;
+      add(u);
+    }
+    for (std::size_t i = 0; i < p; ++i)
+      for (double s : {-1.0, 1.0}) {
+        Point u = centre;
+        u[i] += s * half;
+        add(u);
+      }
+  } else {
+    static const int primes[] = {2, 3, 5, 7, 11, 13, 17, 19};
+    const std::size_t n = 2 * (1 + p + p * (p + 1) / 2);
+    for (std::size_t k = 1; k <= n; ++k) {
+      Point u(p);
+      for (std::size_t i = 0; i < p; ++i) {
+        double f = 1.0, r = 0.0;
+        for (std::size_t x = k; x > 0; x /= static_cast<std::size_t>(primes[i])) {
+          f /= primes[i];
+          r += f * static_cast<double>(x % static_cast<std::size_t>(primes[i]));
+        }
+        u[i] = centre[i] - half + 2.0 * half * r;
+      }
+      add(u);
+    }
+  }
+  return d;
+}
+
+double Distance(const Point& a, const Point& b) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+
+class Calibration {
+ public:
+  Calibration(const CalibrationSpec& spec, Evaluator& evaluator, CalibrationResult& r, bool progress)
+      : spec_(spec), ev_(evaluator), r_(r), progress_(progress) {}
+
+  void Run() {
+    r_.spec = &spec_;
+    r_.objective.statistics = ObservedStatistics(spec_);
+    if (spec_.options.measure_noise) MeasureNoise();
+    if (spec_.approach == Approach::kSurrogate) SearchWithSurrogates();
+    else SearchWithGradients();
+    Uncertainty();
+    Profiles();
+  }
+
+ private:
+  // Runs `sets` (values) and returns their results; throws Interrupted.
+  std::vector<SetResult> Eval(const std::vector<Point>& units, const std::string& stage) {
+    std::vector<std::vector<double>> sets;
+    for (const Point& u : units) sets.push_back(ev_.FromUnit(u));
+    std::vector<SetResult> out;
+    if (!ev_.Evaluate(sets, stage, &out)) throw Interrupted{};
+    return out;
+  }
+
+  void Say(const std::string& line) const {
+    if (progress_ && ev_.coordinator()) std::fprintf(stderr, "calibrate: %s\n", line.c_str());
+  }
+
+  // The seed-to-seed spread of each statistic, pooled over `sets`, fixes the
+  // objective's sigmas (docs/calibration.md, "The objective").
+  void FixSigmas(const std::vector<SetResult>& sets) {
+    if (!r_.objective.sigma.empty()) return;
+    const std::size_t n = r_.objective.statistics.size();
+    const double k = static_cast<double>(spec_.base.seeds.size());
+    r_.seed_sd.assign(n, kNaN);
+    r_.objective.sigma.assign(n, kNaN);
+    for (std::size_t j = 0; j < n; ++j) {
+      double sum = 0.0, count = 0.0;
+      for (const SetResult& s : sets)
+        if (std::isfinite(s.sd[j])) {
+          sum += s.sd[j] * s.sd[j];
+          count += 1.0;
+        }
+      if (count > 0) r_.seed_sd[j] = std::sqrt(sum / count);
+      const double seed = std::isfinite(r_.seed_sd[j]) ? r_.seed_sd[j] : 0.0;
+      const double obs = r_.objective.statistics[j].observed_sigma;
+      const double sigma = std::sqrt(obs * obs + seed * seed * (1.0 + 1.0 / k));
+      // A statistic that neither the runs nor the observation vary is left
+      // out: its residual would have no scale.
+      r_.objective.sigma[j] = sigma > 0 ? sigma : kNaN;
+    }
+  }
+
+  std::vector<std::vector<double>> Means(const std::vector<SetResult>& sets) const {
+    std::vector<std::vector<double>> m;
+    for (const SetResult& s : sets) m.push_back(s.mean);
+    return m;
+  }
+
+  // 2. The objective's noise: sets a small step apart along each parameter.
+  void MeasureNoise() {
+    const std::size_t p = spec_.parameters.size();
+    const Point start = ev_.ToUnit(spec_.starts[0]);
+    const double d = spec_.options.noise_step;
+    for (std::size_t i = 0; i < p; ++i) {
+      std::vector<Point> line;
+      for (int k = -3; k <= 3; ++k) {
+        Point u = start;
+        u[i] = std::clamp(u[i] + d * k, 0.0, 1.0);
+        line.push_back(u);
+      }
+      const std::vector<SetResult> sets = Eval(line, "noise of the objective along " + spec_.parameters[i].name);
+      FixSigmas(sets);
+      NoiseResult nr;
+      nr.parameter = spec_.parameters[i].path;
+      nr.step = d * spec_.parameters[i].Range();
+      // chi2 against a quadratic in k, residuals against lines in k.
+      std::vector<double> x, chi2;
+      std::vector<std::vector<double>> res;
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        x.push_back((line[s][i] - start[i]) / d);
+        chi2.push_back(r_.objective.Chi2(sets[s].mean));
+        res.push_back(r_.objective.Residuals(sets[s].mean));
+      }
+      const auto scatter = [&](const std::vector<double>& y, int degree, double* slope) {
+        std::vector<Point> pts;
+        std::vector<std::vector<double>> vals;
+        for (std::size_t s = 0; s < y.size(); ++s)
+          if (std::isfinite(y[s])) {
+            pts.push_back({x[s]});
+            vals.push_back({y[s]});
+          }
+        Quadratic q;
+        if (pts.size() < 4 || !q.Fit(pts, vals, {0.0}, 1.0)) return kNaN;
+        (void)degree;
+        if (slope) *slope = q.Gradient(0, {0.0})[0];
+        return q.rms[0] * std::sqrt(static_cast<double>(pts.size()) / static_cast<double>(pts.size() - 3));
+      };
+      nr.chi2_noise_sd = scatter(chi2, 2, nullptr);
+      double pooled = 0.0, count = 0.0;
+      std::vector<double> signal;
+      for (std::size_t j = 0; j < r_.objective.statistics.size(); ++j) {
+        std::vector<double> y;
+        for (const auto& rr : res) y.push_back(rr[j]);
+        double slope = kNaN;
+        const double sd = scatter(y, 1, &slope);
+        if (!std::isfinite(sd)) continue;
+        pooled += sd * sd;
+        count += 1.0;
+        if (std::isfinite(slope) && sd > 0) signal.push_back(std::abs(slope) * 2.0 * spec_.options.gradient_step / d / sd);
+      }
+      nr.residual_noise_sd = count > 0 ? std::sqrt(pooled / count) : kNaN;
+      if (!signal.empty()) {
+        std::nth_element(signal.begin(), signal.begin() + static_cast<long>(signal.size() / 2), signal.end());
+        nr.slope_signal = signal[signal.size() / 2];
+      }
+      r_.noise.push_back(nr);
+      Say("noise along " + spec_.parameters[i].name + ": chi2 scatter " + FormatNumber(nr.chi2_noise_sd) +
+          ", residual scatter " + FormatNumber(nr.residual_noise_sd));
+    }
+  }
+
+  // 3a. Surrogates: a design over the whole box, then boxes shrinking
+  //     around each start's optimum.
+  void SearchWithSurrogates() {
+    const std::size_t p = spec_.parameters.size();
+    const Point centre(p, 0.5);
+    const std::vector<Point> design = Design(centre, 0.5);
+    const std::vector<SetResult> sets = Eval(design, "design over the whole box");
+    FixSigmas(sets);
+    Quadratic global;
+    if (!global.Fit(design, Means(sets), centre, 0.5)) throw InputError(spec_.origin + ": too few design points");
+    std::vector<Point> optima;
+    for (std::size_t s = 0; s < spec_.starts.size(); ++s) {
+      const Point start = ev_.ToUnit(spec_.starts[s]);
+      Minimum m = MinimiseSurrogate(global, r_.objective, start);
+      for (int round = 1; round <= spec_.options.refinements; ++round) {
+        const double half = 0.5 * std::pow(spec_.options.shrink, round);
+        Point c = m.u;
+        for (double& x : c) x = std::clamp(x, half, 1.0 - half);
+        Quadratic local = FitLocal(c, half, "refinement " + std::to_string(round) + " from start " + std::to_string(s + 1));
+        m = MinimiseSurrogate(local, r_.objective, m.u);
+      }
+      StartResult sr;
+      sr.start = spec_.starts[s];
+      sr.found = ev_.FromUnit(m.u);
+      sr.surrogate_chi2 = m.chi2;
+      sr.termination = m.termination;
+      sr.simulated_chi2 = r_.objective.Chi2(Eval({m.u}, "optimum of start " + std::to_string(s + 1))[0].mean);
+      r_.starts.push_back(sr);
+      optima.push_back(m.u);
+      Say("start " + std::to_string(s + 1) + ": chi2 " + FormatNumber(sr.simulated_chi2));
+    }
+  }
+
+  // Evaluates a design in the box and fits a quadratic to every set
+  // evaluated inside it.
+  Quadratic FitLocal(const Point& c, double half, const std::string& stage) {
+    Eval(Design(c, half), stage);
+    std::vector<Point> pts;
+    std::vector<std::vector<double>> vals;
+    for (const SetResult* s : ev_.All()) {
+      const Point u = ev_.ToUnit(s->values);
+      if (Distance(u, c) <= half * (1.0 + 1e-9)) {
+        pts.push_back(u);
+        vals.push_back(s->mean);
+      }
+    }
+    Quadratic q;
+    if (!q.Fit(pts, vals, c, half)) throw InputError(spec_.origin + ": too few design points in " + stage);
+    return q;
+  }
+
+  // 3b. Ceres with central differences of the simulated statistics.
+  void SearchWithGradients() {
+    const std::size_t p = spec_.parameters.size();
+    const std::size_t n = r_.objective.statistics.size();
+    const double h = spec_.options.gradient_step;
+    for (std::size_t s = 0; s < spec_.starts.size(); ++s) {
+      const Point start = ev_.ToUnit(spec_.starts[s]);
+      const std::string stage = "gradient search from start " + std::to_string(s + 1);
+      const ResidualFunction f = [&](const Point& u, std::vector<double>* res, std::vector<double>* jac) {
+        std::vector<Point> pts{u};
+        if (jac)
+          for (std::size_t i = 0; i < p; ++i)
+            for (double sign : {1.0, -1.0}) {
+              Point v = u;
+              v[i] = std::clamp(u[i] + sign * h, 0.0, 1.0);
+              pts.push_back(v);
+            }
+        const std::vector<SetResult> sets = Eval(pts, stage);
+        FixSigmas(sets);
+        *res = r_.objective.Residuals(sets[0].mean);
+        for (double& x : *res)
+          if (!std::isfinite(x)) x = 0.0;  // statistics left out (no scale) or undefined here count nothing
+        if (jac) {
+          jac->assign(n * p, 0.0);
+          for (std::size_t i = 0; i < p; ++i) {
+            const std::vector<double> up = r_.objective.Residuals(sets[1 + 2 * i].mean);
+            const std::vector<double> down = r_.objective.Residuals(sets[2 + 2 * i].mean);
+            const double span = pts[1 + 2 * i][i] - pts[2 + 2 * i][i];
+            for (std::size_t j = 0; j < n; ++j) {
+              const double d = (up[j] - down[j]) / span;
+              (*jac)[j * p + i] = std::isfinite(d) ? d : 0.0;
+            }
+          }
+        }
+        return true;
+      };
+      Minimum m = MinimiseFunction(f, n, start, spec_.options.max_iterations);
+      StartResult sr;
+      sr.start = spec_.starts[s];
+      sr.found = ev_.FromUnit(m.u);
+      sr.surrogate_chi2 = kNaN;
+      sr.termination = m.termination;
+      sr.simulated_chi2 = r_.objective.Chi2(Eval({m.u}, stage)[0].mean);
+      r_.starts.push_back(sr);
+      Say("start " + std::to_string(s + 1) + ": chi2 " + FormatNumber(sr.simulated_chi2));
+    }
+  }
+
+  // 4. At the best start's optimum: a local design and quadratic, Ceres'
+  //    covariance, the bootstrap.
+  void Uncertainty() {
+    const std::size_t p = spec_.parameters.size();
+    std::size_t b = 0;
+    for (std::size_t s = 1; s < r_.starts.size(); ++s)
+      if (r_.starts[s].simulated_chi2 < r_.starts[b].simulated_chi2) b = s;
+    Point best = ev_.ToUnit(r_.starts[b].found);
+    const double half = spec_.approach == Approach::kSurrogate
+                            ? 0.5 * std::pow(spec_.options.shrink, std::max(1, spec_.options.refinements))
+                            : spec_.options.gradient_step;
+    Point c = best;
+    for (double& x : c) x = std::clamp(x, half, 1.0 - half);
+    const std::vector<Point> design = Design(c, half);
+    const std::vector<SetResult> sets = Eval(design, "uncertainty: the design around the best fit");
+    FixSigmas(sets);
+    Quadratic local;
+    {
+      std::vector<std::vector<double>> means = Means(sets);
+      if (!local.Fit(design, means, c, half)) throw InputError(spec_.origin + ": too few points around the best fit");
+    }
+    const Minimum m = MinimiseSurrogate(local, r_.objective, best);
+    best = m.u;
+    r_.best = ev_.FromUnit(best);
+    r_.surrogate_form = local.form;
+    r_.surrogate_rms = local.rms;
+    r_.best_set = Eval({best}, "the best fit")[0];
+    r_.best_simulated_chi2 = r_.objective.Chi2(r_.best_set.mean);
+
+    std::vector<double> cov_u;
+    r_.covariance_ok = SurrogateCovariance(local, r_.objective, best, &cov_u, &r_.covariance_reason);
+    if (r_.covariance_ok) {
+      r_.covariance.assign(p * p, 0.0);
+      for (std::size_t i = 0; i < p; ++i)
+        for (std::size_t k = 0; k < p; ++k)
+          r_.covariance[i * p + k] = cov_u[i * p + k] * spec_.parameters[i].Range() * spec_.parameters[k].Range();
+    }
+
+    // The bootstrap: the seeds drawn again with replacement (the same draw at
+    // every set: common random numbers), and the observation drawn again
+    // from its own uncertainty and the crowd's seed-to-seed spread (it is
+    // one realisation); refit, re-minimise.
+    std::mt19937_64 rng(20121101);
+    const std::size_t k = spec_.base.seeds.size();
+    std::uniform_int_distribution<std::size_t> pick(0, k - 1);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const double kd = static_cast<double>(k);
+    for (int rep = 0; rep < spec_.options.bootstrap; ++rep) {
+      std::vector<std::size_t> draw(k);
+      for (std::size_t& d : draw) d = pick(rng);
+      Objective o = r_.objective;
+      for (std::size_t j = 0; j < o.statistics.size(); ++j) {
+        const double seed = std::isfinite(r_.seed_sd[j]) ? r_.seed_sd[j] : 0.0;
+        const double obs = o.statistics[j].observed_sigma;
+        o.statistics[j].observed += normal(rng) * std::sqrt(obs * obs + seed * seed);
+      }
+      std::vector<std::vector<double>> means;
+      for (const SetResult& s : sets) {
+        std::vector<double> mean(o.statistics.size(), 0.0), count(o.statistics.size(), 0.0);
+        for (std::size_t d : draw)
+          for (std::size_t j = 0; j < mean.size(); ++j)
+            if (std::isfinite(s.per_seed[d][j])) {
+              mean[j] += s.per_seed[d][j];
+              count[j] += 1.0;
+            }
+        for (std::size_t j = 0; j < mean.size(); ++j) mean[j] = count[j] > 0 ? mean[j] / count[j] : kNaN;
+        means.push_back(mean);
+      }
+      (void)kd;
+      Quadratic q;
+      if (!q.Fit(design, means, c, half)) continue;
+      r_.bootstrap.push_back(ev_.FromUnit(MinimiseSurrogate(q, o, best).u));
+    }
+  }
+
+  // 5. Profiles: the simulated chi2 along each parameter's whole range
+  //    through the best fit, and the local surrogate re-minimised over the others.
+  void Profiles() {
+    const std::size_t p = spec_.parameters.size();
+    const int n = spec_.options.profile_points;
+    r_.profiles.assign(p, {});
+    if (n < 2) return;
+    const Point best = ev_.ToUnit(r_.best);
+    std::vector<Point> pts;
+    for (std::size_t i = 0; i < p; ++i)
+      for (int k = 0; k < n; ++k) {
+        Point u = best;
+        u[i] = static_cast<double>(k) / (n - 1);
+        pts.push_back(u);
+      }
+    const std::vector<SetResult> sets = Eval(pts, "profiles");
+    for (std::size_t i = 0; i < p; ++i)
+      for (int k = 0; k < n; ++k) {
+        const SetResult& s = sets[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)];
+        r_.profiles[i].push_back({s.values[i], r_.objective.Chi2(s.mean)});
+      }
+  }
+
+  const CalibrationSpec& spec_;
+  Evaluator& ev_;
+  CalibrationResult& r_;
+  bool progress_;
+};
+
+// Fills the summary's parameters: values, intervals, determination.
+void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
+  const std::size_t p = spec.parameters.size();
+  Summary& s = r.summary;
+  s.chi2 = r.best_simulated_chi2;
+  std::size_t used = 0;
+  for (double sigma : r.objective.sigma) used += std::isfinite(sigma) ? 1 : 0;
+  s.degrees_of_freedom = static_cast<int>(used) - static_cast<int>(p);
+  s.parameters.clear();
+  for (std::size_t i = 0; i < p; ++i) {
+    const Parameter& par = spec.parameters[i];
+    ParameterResult pr;
+    pr.path = par.path;
+    pr.value = r.best[i];
+    pr.min = par.min;
+    pr.max = par.max;
+    pr.sigma = r.covariance_ok ? std::sqrt(std::max(0.0, r.covariance[i * p + i])) : kNaN;
+    pr.lo95 = pr.value - 1.96 * pr.sigma;
+    pr.hi95 = pr.value + 1.96 * pr.sigma;
+    std::vector<double> v;
+    for (const auto& rep : r.bootstrap) v.push_back(rep[i]);
+    if (v.size() >= 2) {
+      std::sort(v.begin(), v.end());
+      double mean = 0.0, ss = 0.0;
+      for (double x : v) mean += x / static_cast<double>(v.size());
+      for (double x : v) ss += (x - mean) * (x - mean);
+      pr.bootstrap_sigma = std::sqrt(ss / static_cast<double>(v.size() - 1));
+      pr.bootstrap_lo95 = v[static_cast<std::size_t>(std::floor(0.025 * static_cast<double>(v.size() - 1)))];
+      pr.bootstrap_hi95 = v[static_cast<std::size_t>(std::ceil(0.975 * static_cast<double>(v.size() - 1)))];
+    } else {
+      pr.bootstrap_sigma = pr.bootstrap_lo95 = pr.bootstrap_hi95 = kNaN;
+    }
+    // Determination: the covariance, the bootstrap and the profile each may
+    // say that the observations leave the parameter free.
+    const double range = par.Range();
+    bool low_excluded = true, high_excluded = true;
+    if (!r.profiles.empty() && r.profiles[i].size() >= 2) {
+      double lowest = r.best_simulated_chi2;
+      for (const ProfilePoint& q : r.profiles[i]) lowest = std::min(lowest, q.chi2);
+      low_excluded = r.profiles[i].front().chi2 - lowest > kChi2At95;
+      high_excluded = r.profiles[i].back().chi2 - lowest > kChi2At95;
+    }
+    if (!r.covariance_ok) {
+      pr.determination = "undetermined";
+      pr.reason = r.covariance_reason;
+    } else if (pr.hi95 - pr.lo95 >= range) {
+      pr.determination = "undetermined";
+      pr.reason = "the 95 % interval from the covariance (" + FormatNumber(pr.lo95) + " to " + FormatNumber(pr.hi95) +
+                  ") is wider than the whole range";
+    } else if (std::isfinite(pr.bootstrap_sigma) && pr.bootstrap_hi95 - pr.bootstrap_lo95 >= 0.9 * range) {
+      pr.determination = "undetermined";
+      pr.reason = "the bootstrap's 95 % interval spans most of the range";
+    } else if (!low_excluded && !high_excluded) {
+      pr.determination = "undetermined";
+      pr.reason = "the profile is flat: both ends of the range fit within chi2 + 3.84 of the best";
+    } else if (!low_excluded || !high_excluded) {
+      pr.determination = "bounded on one side";
+      pr.reason = std::string("the profile excludes only the ") + (low_excluded ? "low" : "high") + " end of the range";
+    } else {
+      pr.determination = "determined";
+    }
+    s.parameters.push_back(pr);
+  }
+  s.correlation.assign(p, std::vector<double>(p, kNaN));
+  if (r.covariance_ok)
+    for (std::size_t i = 0; i < p; ++i)
+      for (std::size_t k = 0; k < p; ++k)
+        s.correlation[i][k] = r.covariance[i * p + k] / std::sqrt(r.covariance[i * p + i] * r.covariance[k * p + k]);
+  s.starts = r.starts.size();
+  s.starts_agree = true;
+  for (const StartResult& a : r.starts)
+    for (std::size_t i = 0; i < p; ++i) {
+      const double tol = std::max(0.02 * spec.parameters[i].Range(),
+                                  std::isfinite(s.parameters[i].sigma) ? 1.96 * s.parameters[i].sigma : 0.0);
+      if (std::abs(a.found[i] - r.best[i]) > tol) s.starts_agree = false;
+    }
+}
+
+}  // namespace
+
+OutputKind CalibrationFolderOutput() {
+  return {"a calibration folder (.crowdrecon-calibration, cache/, batches/, calibration.json, ...)", true,
+          [](const fs::path& dir) {
+            std::error_code ec;
+            return fs::is_regular_file(dir / ".crowdrecon-calibration", ec);
+          }};
+}
+
+bool Options::IsValid(std::string* error) const {
+  if (calibration_file.empty()) return *error = "no calibration file", false;
+  if (output_dir.empty()) return *error = "no output folder", false;
+  if (jobs < 0) return *error = "jobs must be 0 (all cores) or more", false;
+  return true;
+}
+
+std::string Summary::BriefReport() const {
+  std::string s = "calibration: " + name + " (" + approach + ")\n";
+  if (interrupted) return s + "interrupted: run the same command again to continue (the runs done are cached)\n";
+  for (const ParameterResult& p : parameters) {
+    s += "  " + p.path + " = " + FormatNumber(p.value);
+    if (std::isfinite(p.sigma)) s += " +- " + FormatNumber(p.sigma) + " (95 %: " + FormatNumber(p.lo95) + " to " + FormatNumber(p.hi95) + ")";
+    s += ": " + p.determination + (p.reason.empty() ? "" : " (" + p.reason + ")") + "\n";
+  }
+  s += "  chi2 " + FormatNumber(chi2) + " for " + std::to_string(degrees_of_freedom) + " degrees of freedom; " +
+       std::to_string(starts) + " start(s), " + (starts_agree ? "agreeing" : "NOT agreeing") + "\n";
+  s += "  " + std::to_string(sets_evaluated) + " parameter sets, " + std::to_string(runs) + " runs simulated now; wall time " +
+       FormatNumber(std::round(wall_s)) + " s\n";
+  s += "  outputs: " + json_file.string() + ", " + report_file.string() + "\n";
+  return s;
+}
+
+Summary Calibrate(const Options& options) {
+  const auto t0 = Clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError("calibrate: " + error);
+  const CalibrationSpec spec = LoadCalibration(options.calibration_file);
+  fs::create_directories(options.output_dir);
+  WriteFileAtomically(options.output_dir / ".crowdrecon-calibration", spec.file.string() + "\n");
+  CalibrationResult r;
+  r.summary.name = spec.name;
+  r.summary.approach = ToString(spec.approach);
+  const std::vector<Statistic> statistics = ObservedStatistics(spec);
+  Evaluator evaluator(spec, statistics, options.output_dir, options.jobs, options.show_progress);
+  try {
+    Calibration(spec, evaluator, r, options.show_progress).Run();
+  } catch (const Interrupted&) {
+    r.summary.interrupted = true;
+    r.summary.coordinator = evaluator.coordinator();
+    r.summary.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    return r.summary;
+  }
+  r.summary.coordinator = evaluator.coordinator();
+  r.summary.sets_evaluated = evaluator.All().size();
+  r.summary.runs = evaluator.runs_simulated();
+  Summarise(spec, r);
+  r.summary.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (r.summary.coordinator) WriteOutputs(options.output_dir, evaluator, &r);
+  return r.summary;
+}
+
+}  // namespace crowdrecon::calibrate

@@ -1,0 +1,283 @@
+#include "fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+#include <ceres/manifold.h>
+
+namespace crowdrecon::calibrate {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+// --- Objective --------------------------------------------------------------
+
+std::vector<double> Objective::Residuals(const std::vector<double>& mean) const {
+  std::vector<double> r(statistics.size());
+  for (std::size_t j = 0; j < r.size(); ++j) r[j] = (mean[j] - statistics[j].observed) / sigma[j];
+  return r;
+}
+
+double Objective::Chi2(const std::vector<double>& mean) const {
+  double chi2 = 0.0;
+  const std::vector<double> r = Residuals(mean);
+  for (std::size_t j = 0; j < r.size(); ++j) {
+    if (!std::isfinite(sigma[j])) continue;  // left out: no scale
+    if (!std::isfinite(r[j])) return std::numeric_limits<double>::infinity();
+    chi2 += r[j] * r[j];
+  }
+  return chi2;
+}
+
+// --- Quadratic --------------------------------------------------------------
+
+std::vector<double> Quadratic::Basis(const std::vector<double>& u) const {
+  std::vector<double> z(dims_);
+  for (std::size_t i = 0; i < dims_; ++i) z[i] = (u[i] - centre[i]) / half_width;
+  std::vector<double> b{1.0};
+  for (double zi : z) b.push_back(zi);
+  if (terms_ >= 1)
+    for (std::size_t i = 0; i < dims_; ++i)
+      for (std::size_t k = i; k < dims_; ++k)
+        if (k == i || terms_ == 2) b.push_back(z[i] * z[k]);
+  return b;
+}
+
+std::vector<std::vector<double>> Quadratic::BasisGradient(const std::vector<double>& u) const {
+  std::vector<double> z(dims_);
+  for (std::size_t i = 0; i < dims_; ++i) z[i] = (u[i] - centre[i]) / half_width;
+  std::vector<std::vector<double>> g;  // [basis][coordinate]
+  g.push_back(std::vector<double>(dims_, 0.0));
+  for (std::size_t i = 0; i < dims_; ++i) {
+    std::vector<double> row(dims_, 0.0);
+    row[i] = 1.0 / half_width;
+    g.push_back(row);
+  }
+  if (terms_ >= 1)
+    for (std::size_t i = 0; i < dims_; ++i)
+      for (std::size_t k = i; k < dims_; ++k)
+        if (k == i || terms_ == 2) {
+          std::vector<double> row(dims_, 0.0);
+          row[i] += z[k] / half_width;
+          row[k] += z[i] / half_width;
+          g.push_back(row);
+        }
+  return g;
+}
+
+bool Quadratic::Fit(const std::vector<std::vector<double>>& points, const std::vector<std::vector<double>>& values,
+                    const std::vector<double>& centre_u, double half) {
+  centre = centre_u;
+  half_width = half;
+  dims_ = centre.size();
+  const std::size_t p = dims_;
+  const std::size_t full = 1 + p + p * (p + 1) / 2, squares = 1 + 2 * p, linear = 1 + p;
+  const std::size_t n = points.size();
+  terms_ = n >= full + 1 ? 2 : n >= squares + 1 ? 1 : 0;
+  if (n < linear) return false;
+  form = terms_ == 2 ? "full quadratic" : terms_ == 1 ? "quadratic without cross terms" : "linear";
+  const std::size_t statistics = values.empty() ? 0 : values[0].size();
+  coefficients_.assign(statistics, {});
+  rms.assign(statistics, kNaN);
+  const std::size_t m = Basis(points[0]).size();
+  for (std::size_t j = 0; j < statistics; ++j) {
+    std::vector<std::size_t> rows;
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::isfinite(values[i][j])) rows.push_back(i);
+    if (rows.size() < m) {
+      coefficients_[j].assign(m, kNaN);
+      continue;
+    }
+    Eigen::MatrixXd a(rows.size(), m);
+    Eigen::VectorXd y(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const std::vector<double> b = Basis(points[rows[r]]);
+      for (std::size_t c = 0; c < m; ++c) a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = b[c];
+      y(static_cast<Eigen::Index>(r)) = values[rows[r]][j];
+    }
+    const Eigen::VectorXd x = a.colPivHouseholderQr().solve(y);
+    coefficients_[j].assign(x.data(), x.data() + x.size());
+    const Eigen::VectorXd e = a * x - y;
+    rms[j] = std::sqrt(e.squaredNorm() / static_cast<double>(rows.size()));
+  }
+  return true;
+}
+
+double Quadratic::Value(std::size_t statistic, const std::vector<double>& u) const {
+  const std::vector<double> b = Basis(u);
+  double v = 0.0;
+  for (std::size_t c = 0; c < b.size(); ++c) v += coefficients_[statistic][c] * b[c];
+  return v;
+}
+
+std::vector<double> Quadratic::Gradient(std::size_t statistic, const std::vector<double>& u) const {
+  const auto g = BasisGradient(u);
+  std::vector<double> out(dims_, 0.0);
+  for (std::size_t c = 0; c < g.size(); ++c)
+    for (std::size_t i = 0; i < dims_; ++i) out[i] += coefficients_[statistic][c] * g[c][i];
+  return out;
+}
+
+std::vector<double> Quadratic::Values(const std::vector<double>& u) const {
+  std::vector<double> v(coefficients_.size());
+  for (std::size_t j = 0; j < v.size(); ++j) v[j] = Value(j, u);
+  return v;
+}
+
+// --- Ceres ------------------------------------------------------------------
+
+namespace {
+
+// The surrogate's residuals (only statistics it could fit).
+class SurrogateCost final : public ceres::CostFunction {
+ public:
+  SurrogateCost(const Quadratic& q, const Objective& o, std::vector<std::size_t> rows) : q_(q), o_(o), rows_(std::move(rows)) {
+    set_num_residuals(static_cast<int>(rows_.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(q.centre.size()));
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const std::size_t p = q_.centre.size();
+    const std::vector<double> u(parameters[0], parameters[0] + p);
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      const std::size_t j = rows_[r];
+      residuals[r] = (q_.Value(j, u) - o_.statistics[j].observed) / o_.sigma[j];
+      if (jacobians && jacobians[0]) {
+        const std::vector<double> g = q_.Gradient(j, u);
+        for (std::size_t i = 0; i < p; ++i) jacobians[0][r * p + i] = g[i] / o_.sigma[j];
+      }
+    }
+    return true;
+  }
+
+ private:
+  const Quadratic& q_;
+  const Objective& o_;
+  std::vector<std::size_t> rows_;
+};
+
+std::vector<std::size_t> FittedRows(const Quadratic& q, const Objective& o) {
+  std::vector<std::size_t> rows;
+  const std::vector<double> probe = q.Values(q.centre);
+  for (std::size_t j = 0; j < o.statistics.size(); ++j)
+    if (std::isfinite(probe[j]) && std::isfinite(o.sigma[j]) && o.sigma[j] > 0) rows.push_back(j);
+  return rows;
+}
+
+ceres::Solver::Options SolverOptions(int max_iterations) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.minimizer_type = ceres::TRUST_REGION;
+  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  options.max_num_iterations = max_iterations;
+  options.num_threads = 1;  // deterministic
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+void Bound(ceres::Problem* problem, double* u, std::size_t p) {
+  for (std::size_t i = 0; i < p; ++i) {
+    problem->SetParameterLowerBound(u, static_cast<int>(i), 0.0);
+    problem->SetParameterUpperBound(u, static_cast<int>(i), 1.0);
+  }
+}
+
+// The gradient approach's residuals: the caller's function, evaluated at
+// the point Ceres asks for (its Jacobian by the caller's central differences).
+class FunctionCost final : public ceres::CostFunction {
+ public:
+  FunctionCost(const ResidualFunction& f, std::size_t residuals, std::size_t p) : f_(f), p_(p) {
+    set_num_residuals(static_cast<int>(residuals));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(p));
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const std::vector<double> u(parameters[0], parameters[0] + p_);
+    std::vector<double> r, j;
+    const bool want = jacobians && jacobians[0];
+    if (!f_(u, &r, want ? &j : nullptr)) return false;
+    std::copy(r.begin(), r.end(), residuals);
+    if (want) std::copy(j.begin(), j.end(), jacobians[0]);
+    return true;
+  }
+
+ private:
+  const ResidualFunction& f_;
+  std::size_t p_;
+};
+
+}  // namespace
+
+Minimum MinimiseSurrogate(const Quadratic& q, const Objective& objective, const std::vector<double>& start, int fixed) {
+  const std::size_t p = start.size();
+  Minimum m;
+  m.u = start;
+  const std::vector<std::size_t> rows = FittedRows(q, objective);
+  if (rows.empty() || (p == 1 && fixed == 0)) {
+    m.chi2 = objective.Chi2(q.Values(m.u));
+    m.termination = rows.empty() ? "no statistic could be fitted" : "nothing to vary";
+    return m;
+  }
+  ceres::Problem problem;
+  problem.AddResidualBlock(new SurrogateCost(q, objective, rows), nullptr, m.u.data());
+  Bound(&problem, m.u.data(), p);
+  if (fixed >= 0) problem.SetManifold(m.u.data(), new ceres::SubsetManifold(static_cast<int>(p), {fixed}));
+  ceres::Solver::Summary summary;
+  ceres::Solve(SolverOptions(100), &problem, &summary);
+  m.iterations = static_cast<int>(summary.iterations.size());
+  m.termination = summary.BriefReport();
+  m.chi2 = 2.0 * summary.final_cost;
+  return m;
+}
+
+Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const std::vector<double>& start,
+                         int max_iterations) {
+  Minimum m;
+  m.u = start;
+  ceres::Problem problem;
+  problem.AddResidualBlock(new FunctionCost(f, residuals, start.size()), nullptr, m.u.data());
+  Bound(&problem, m.u.data(), start.size());
+  ceres::Solver::Options options = SolverOptions(max_iterations);
+  // Each evaluation is K runs: no line search, no extra evaluations.
+  options.max_num_consecutive_invalid_steps = 3;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  m.iterations = static_cast<int>(summary.iterations.size());
+  m.termination = summary.BriefReport();
+  m.chi2 = 2.0 * summary.final_cost;
+  return m;
+}
+
+bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
+                         std::vector<double>* covariance, std::string* reason) {
+  const std::size_t p = u.size();
+  std::vector<double> x = u;
+  const std::vector<std::size_t> rows = FittedRows(q, objective);
+  if (rows.empty()) {
+    *reason = "no statistic could be fitted";
+    return false;
+  }
+  ceres::Problem problem;
+  problem.AddResidualBlock(new SurrogateCost(q, objective, rows), nullptr, x.data());
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.null_space_rank = 0;  // a direction the data do not constrain is an error, not dropped
+  options.min_reciprocal_condition_number = 1e-12;
+  options.num_threads = 1;
+  ceres::Covariance cov(options);
+  std::vector<std::pair<const double*, const double*>> blocks{{x.data(), x.data()}};
+  if (!cov.Compute(blocks, &problem)) {
+    *reason = "the Jacobian at the optimum is rank deficient (some combination of the parameters leaves every "
+              "statistic unchanged)";
+    return false;
+  }
+  covariance->assign(p * p, 0.0);
+  cov.GetCovarianceBlock(x.data(), x.data(), covariance->data());
+  return true;
+}
+
+}  // namespace crowdrecon::calibrate

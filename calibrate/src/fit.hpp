@@ -1,0 +1,76 @@
+// The least-squares problems of a calibration, in the unit box of the
+// parameters' bounds (internal to calibrate/): the residuals, the quadratic
+// surrogate of every statistic, and Ceres minimising it, with its covariance.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/calibrate/statistics.hpp"
+
+namespace crowdrecon::calibrate {
+
+// Residual j = (simulated mean_j - observed_j) / sigma_j, where sigma_j^2 =
+// observed_sigma_j^2 + seed_sd_j^2 (1 + 1/K): the observation is one
+// realisation of the crowd (its own seed-to-seed spread) measured with its
+// uncertainty, against the mean of K seeds (docs/calibration.md, "The
+// objective"). NaN where the simulated mean is.
+struct Objective {
+  std::vector<Statistic> statistics;
+  std::vector<double> sigma;  // per statistic, fixed once the seed spread is estimated
+  std::vector<double> Residuals(const std::vector<double>& mean) const;
+  double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
+};
+
+// Each statistic's mean as a quadratic in the unit coordinates around
+// `centre`, scaled by `half_width` (full quadratic where the points allow,
+// else squares without cross terms, else linear), fitted by least squares.
+class Quadratic {
+ public:
+  // points: unit coordinates; values[point][statistic] (NaN: left out).
+  bool Fit(const std::vector<std::vector<double>>& points, const std::vector<std::vector<double>>& values,
+           const std::vector<double>& centre, double half_width);
+  double Value(std::size_t statistic, const std::vector<double>& u) const;
+  // d value / d u.
+  std::vector<double> Gradient(std::size_t statistic, const std::vector<double>& u) const;
+  std::vector<double> Values(const std::vector<double>& u) const;
+  // Root mean square of the fit's residuals per statistic, and the terms used.
+  std::vector<double> rms;
+  std::string form;  // "full quadratic", "quadratic without cross terms", "linear"
+  std::vector<double> centre;
+  double half_width = 1.0;
+
+ private:
+  std::vector<double> Basis(const std::vector<double>& u) const;
+  std::vector<std::vector<double>> BasisGradient(const std::vector<double>& u) const;
+  std::size_t dims_ = 0;
+  int terms_ = 2;  // 0 linear, 1 squares, 2 full
+  std::vector<std::vector<double>> coefficients_;  // [statistic][basis]
+};
+
+struct Minimum {
+  std::vector<double> u;
+  double chi2 = 0.0;
+  int iterations = 0;
+  std::string termination;  // Ceres' summary line
+};
+
+// Ceres (trust region, Levenberg-Marquardt, bounds [0, 1]) on the surrogate's
+// residuals from `start`; `fixed` >= 0 holds that coordinate at start's value.
+Minimum MinimiseSurrogate(const Quadratic& q, const Objective& objective, const std::vector<double>& start, int fixed = -1);
+
+// Residuals and (when jacobian is not null) their Jacobian, row-major
+// [residual][coordinate], at u; false when they cannot be had (interrupted,
+// a statistic undefined). The gradient approach's function.
+using ResidualFunction = std::function<bool(const std::vector<double>& u, std::vector<double>* residuals,
+                                            std::vector<double>* jacobian)>;
+Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const std::vector<double>& start,
+                         int max_iterations);
+
+// Ceres' covariance of the unit coordinates at u for the surrogate problem
+// (row-major p x p); false with the reason when the Jacobian is rank deficient.
+bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
+                         std::vector<double>* covariance, std::string* reason);
+
+}  // namespace crowdrecon::calibrate

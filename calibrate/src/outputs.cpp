@@ -1,0 +1,284 @@
+#include "outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/sweep/sweep_file.hpp"
+#include "crowdrecon/viz/chart.hpp"
+
+namespace crowdrecon::calibrate {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json Values(const CalibrationSpec& spec, const std::vector<double>& v) {
+  json o = json::object();
+  for (std::size_t i = 0; i < v.size(); ++i) o[spec.parameters[i].path] = Num(v[i]);
+  return o;
+}
+
+std::string Fixed(double v, int digits = 3) {
+  if (!std::isfinite(v)) return "-";
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+json ToJson(const Evaluator& ev, const CalibrationResult& r) {
+  const CalibrationSpec& spec = *r.spec;
+  const Summary& s = r.summary;
+  json j;
+  j["format"] = "crowdrecon-calibration-result";
+  j["version"] = 1;
+  j["name"] = spec.name;
+  j["calibration_file"] = spec.file.string();
+  j["approach"] = s.approach;
+  j["seeds"] = spec.base.seeds;
+  json params = json::array();
+  for (std::size_t i = 0; i < s.parameters.size(); ++i) {
+    const ParameterResult& p = s.parameters[i];
+    params.push_back({{"path", p.path}, {"value", Num(p.value)}, {"min", p.min}, {"max", p.max},
+                      {"start", spec.parameters[i].start}, {"sigma", Num(p.sigma)},
+                      {"ci95", {Num(p.lo95), Num(p.hi95)}}, {"bootstrap_sigma", Num(p.bootstrap_sigma)},
+                      {"bootstrap_ci95", {Num(p.bootstrap_lo95), Num(p.bootstrap_hi95)}},
+                      {"determination", p.determination}, {"reason", p.reason}});
+  }
+  j["parameters"] = params;
+  json corr = json::array();
+  for (const auto& row : s.correlation) {
+    json jr = json::array();
+    for (double v : row) jr.push_back(Num(v));
+    corr.push_back(jr);
+  }
+  j["correlation"] = corr;
+  j["covariance"] = r.covariance_ok ? json(r.covariance) : json(nullptr);
+  j["covariance_note"] = r.covariance_ok ? "" : r.covariance_reason;
+  j["chi2"] = Num(s.chi2);
+  j["degrees_of_freedom"] = s.degrees_of_freedom;
+  j["surrogate"] = {{"form", r.surrogate_form}};
+  json starts = json::array();
+  for (const StartResult& st : r.starts)
+    starts.push_back({{"start", Values(spec, st.start)}, {"found", Values(spec, st.found)},
+                      {"surrogate_chi2", Num(st.surrogate_chi2)}, {"simulated_chi2", Num(st.simulated_chi2)},
+                      {"ceres", st.termination}});
+  j["starts"] = starts;
+  j["starts_agree"] = s.starts_agree;
+  json noise = json::array();
+  for (const NoiseResult& n : r.noise)
+    noise.push_back({{"parameter", n.parameter}, {"step", n.step}, {"chi2_scatter", Num(n.chi2_noise_sd)},
+                     {"residual_scatter", Num(n.residual_noise_sd)}, {"gradient_step_signal_to_noise", Num(n.slope_signal)}});
+  j["noise"] = noise;
+  json stats = json::array();
+  for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
+    const Statistic& st = r.objective.statistics[k];
+    stats.push_back({{"name", st.name}, {"unit", st.unit}, {"observed", Num(st.observed)},
+                     {"observed_sigma", Num(st.observed_sigma)}, {"seed_sd", Num(r.seed_sd[k])},
+                     {"sigma", Num(r.objective.sigma[k])}, {"simulated_at_best", Num(r.best_set.mean[k])},
+                     {"simulated_sd_at_best", Num(r.best_set.sd[k])},
+                     {"residual_at_best", Num((r.best_set.mean[k] - st.observed) / r.objective.sigma[k])},
+                     {"surrogate_rms", k < r.surrogate_rms.size() ? Num(r.surrogate_rms[k]) : json(nullptr)}});
+  }
+  j["statistics"] = stats;
+  json profiles = json::object();
+  for (std::size_t i = 0; i < r.profiles.size(); ++i) {
+    json pts = json::array();
+    for (const ProfilePoint& q : r.profiles[i]) pts.push_back({Num(q.value), Num(q.chi2)});
+    profiles[spec.parameters[i].path] = pts;
+  }
+  j["profiles"] = profiles;
+  json evals = json::array();
+  for (const SetResult* e : ev.All())
+    evals.push_back({{"key", e->key}, {"stage", e->stage}, {"values", Values(spec, e->values)},
+                     {"chi2", Num(r.objective.Chi2(e->mean))}, {"failed_seeds", e->failures}});
+  j["evaluations"] = evals;
+  j["sets_evaluated"] = s.sets_evaluated;
+  j["runs_simulated_now"] = s.runs;
+  j["wall_s"] = s.wall_s;
+  return j;
+}
+
+std::string Report(const CalibrationResult& r) {
+  const CalibrationSpec& spec = *r.spec;
+  const Summary& s = r.summary;
+  std::ostringstream o;
+  o << "Calibration: " << spec.name << "\n";
+  o << "Approach: " << s.approach << "; " << spec.base.seeds.size() << " seeds per parameter set (the same at every set); "
+    << r.objective.statistics.size() << " statistics from " << spec.observations.size() << " observation file(s)\n\n";
+  o << "Best fit (95 % intervals: Ceres' covariance at the optimum | the seed-and-observation bootstrap):\n";
+  for (const ParameterResult& p : s.parameters) {
+    o << "  " << p.path << " = " << Fixed(p.value, 4) << "   [" << Fixed(p.lo95) << ", " << Fixed(p.hi95) << "] | ["
+      << Fixed(p.bootstrap_lo95) << ", " << Fixed(p.bootstrap_hi95) << "]   range [" << FormatNumber(p.min) << ", "
+      << FormatNumber(p.max) << "]: " << p.determination;
+    if (!p.reason.empty()) o << " (" << p.reason << ")";
+    o << "\n";
+  }
+  if (s.parameters.size() > 1 && r.covariance_ok) {
+    o << "\nCorrelations:\n";
+    for (std::size_t i = 0; i < s.parameters.size(); ++i) {
+      o << "  ";
+      for (double c : s.correlation[i]) o << Fixed(c, 2) << "\t";
+      o << spec.parameters[i].name << "\n";
+    }
+  }
+  o << "\nchi2 at the best fit (simulated): " << Fixed(s.chi2, 4) << " for " << s.degrees_of_freedom
+    << " degrees of freedom\n";
+  o << "\nStarts (" << (s.starts_agree ? "they agree" : "they do NOT agree") << "):\n";
+  for (const StartResult& st : r.starts) {
+    o << "  from";
+    for (double v : st.start) o << " " << FormatNumber(v);
+    o << " -> ";
+    for (double v : st.found) o << " " << Fixed(v, 4);
+    o << "   chi2 " << Fixed(st.simulated_chi2, 4) << "\n";
+  }
+  if (!r.noise.empty()) {
+    o << "\nNoise of the objective (sets " << FormatNumber(spec.options.noise_step) << " of the range apart):\n";
+    for (const NoiseResult& n : r.noise)
+      o << "  " << n.parameter << ": chi2 scatters by " << Fixed(n.chi2_noise_sd) << ", residuals by "
+        << Fixed(n.residual_noise_sd) << "; a central difference over the gradient step sees "
+        << Fixed(n.slope_signal) << " times the residuals' scatter (median over statistics)\n";
+  }
+  o << "\nStatistics at the best fit (observed +- its sigma | simulated mean +- seed sd | residual):\n";
+  for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
+    const Statistic& st = r.objective.statistics[k];
+    o << "  " << st.name << ": " << Fixed(st.observed) << " +- " << Fixed(st.observed_sigma) << " | "
+      << Fixed(r.best_set.mean[k]) << " +- " << Fixed(r.best_set.sd[k]) << " | "
+      << Fixed((r.best_set.mean[k] - st.observed) / r.objective.sigma[k], 2) << "\n";
+  }
+  o << "\n" << s.sets_evaluated << " parameter sets evaluated (" << s.runs << " runs simulated by this invocation); wall time "
+    << Fixed(s.wall_s, 4) << " s\n";
+  return o.str();
+}
+
+// chi2 along each parameter: the simulated profile, the best and its intervals.
+void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
+  const CalibrationSpec& spec = *r.spec;
+  viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
+                        "chi2 along each parameter through the best fit (others held); dashed: chi2 min + 3.84 (95 %)");
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+    const Parameter& p = spec.parameters[i];
+    const ParameterResult& pr = r.summary.parameters[i];
+    std::vector<double> x, y;
+    double lo = r.best_simulated_chi2, hi = r.best_simulated_chi2;
+    for (const ProfilePoint& q : r.profiles[i])
+      if (std::isfinite(q.chi2)) {
+        x.push_back(q.value);
+        y.push_back(q.chi2);
+        lo = std::min(lo, q.chi2);
+        hi = std::max(hi, q.chi2);
+      }
+    if (!(hi > lo)) hi = lo + 1.0;
+    viz::ChartPanel& panel = sheet.AddPanel(p.path + " (" + pr.determination + ")", "chi2", p.min, p.max,
+                                            std::max(0.0, lo - 0.1 * (hi - lo)), hi + 0.1 * (hi - lo), 260);
+    if (!x.empty()) panel.Line(x, y, viz::ChartColor(0), 2.0, "simulated");
+    panel.Points(x, y, viz::ChartColor(0), 3.0);
+    panel.Line({p.min, p.max}, {lo + 3.841, lo + 3.841}, viz::Color::Black(), 1.0, "min + 3.84", true);
+    panel.Points({pr.value}, {r.best_simulated_chi2}, viz::ChartColor(1), 5.0, "best fit");
+    if (std::isfinite(pr.lo95)) {
+      panel.Mark(std::max(p.min, pr.lo95), viz::ChartColor(1), "95 % (covariance)");
+      panel.Mark(std::min(p.max, pr.hi95), viz::ChartColor(1));
+    }
+    if (std::isfinite(pr.bootstrap_lo95)) {
+      panel.Mark(pr.bootstrap_lo95, viz::ChartColor(2), "95 % (bootstrap)");
+      panel.Mark(pr.bootstrap_hi95, viz::ChartColor(2));
+    }
+  }
+  sheet.Finish();
+}
+
+// Observed statistics against the simulated ones at the best fit: one panel
+// per matched series (window means over time) and per matched events
+// (cumulative counts), with the observation's error bars and the seeds' band.
+void DrawFit(const fs::path& file, const CalibrationResult& r) {
+  const CalibrationSpec& spec = *r.spec;
+  viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
+                        "observed (points, +- sigma) against simulated at the best fit (line: mean of the seeds; band: +- their sd)");
+  std::map<std::string, std::vector<std::size_t>> groups;
+  std::vector<std::string> order;
+  for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
+    const Statistic& st = r.objective.statistics[k];
+    const std::string g = "obs" + std::to_string(st.observation) + " " + (st.is_count ? st.quantity + "s" : st.quantity) +
+                          " " + st.where + " " + st.direction + " (" + st.unit + ")";
+    if (!groups.contains(g)) order.push_back(g);
+    groups[g].push_back(k);
+  }
+  std::size_t panels = 0;
+  for (const std::string& g : order) {
+    if (++panels > 12) break;
+    std::vector<double> x, obs, err, sim, lo, hi;
+    double y0 = 1e300, y1 = -1e300, x0 = 1e300, x1 = -1e300;
+    for (std::size_t k : groups[g]) {
+      const Statistic& st = r.objective.statistics[k];
+      const double t = st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s);
+      x.push_back(t);
+      obs.push_back(st.observed);
+      err.push_back(st.observed_sigma);
+      const double m = r.best_set.mean[k], sd = std::isfinite(r.best_set.sd[k]) ? r.best_set.sd[k] : 0.0;
+      sim.push_back(m);
+      lo.push_back(m - sd);
+      hi.push_back(m + sd);
+      for (double v : {st.observed - st.observed_sigma, st.observed + st.observed_sigma, m - sd, m + sd})
+        if (std::isfinite(v)) {
+          y0 = std::min(y0, v);
+          y1 = std::max(y1, v);
+        }
+      x0 = std::min(x0, st.from_s);
+      x1 = std::max(x1, st.to_s);
+    }
+    if (!(y1 > y0)) {
+      y0 -= 0.5;
+      y1 += 0.5;
+    }
+    const double pad = 0.15 * (y1 - y0);
+    viz::ChartPanel& panel = sheet.AddPanel("time, s (observation's clock)", g, x0, x1, y0 - pad, y1 + pad, 220);
+    if (x.size() > 1) {
+      panel.Band(x, lo, hi, viz::ChartColor(1));
+      panel.Line(x, sim, viz::ChartColor(1), 2.0, "simulated");
+    } else {
+      panel.Points(x, sim, viz::ChartColor(1), 5.0, "simulated", nullptr);
+      std::vector<double> sd{hi[0] - sim[0]};
+      panel.Points(x, sim, viz::ChartColor(1), 5.0, "", &sd);
+    }
+    panel.Points(x, obs, viz::Color::Black(), 4.0, "observed", &err);
+  }
+  sheet.Finish();
+}
+
+}  // namespace
+
+void WriteOutputs(const fs::path& dir, const Evaluator& ev, CalibrationResult* r) {
+  r->summary.json_file = dir / "calibration.json";
+  r->summary.report_file = dir / "report.txt";
+  WriteFileAtomically(r->summary.json_file, ToJson(ev, *r).dump(1) + "\n");
+  // Every evaluation, one row each.
+  std::ostringstream csv;
+  csv << "order,stage,key";
+  for (const Parameter& p : r->spec->parameters) csv << "," << p.path;
+  csv << ",chi2,failed_seeds\n";
+  for (const SetResult* e : ev.All()) {
+    csv << e->order << ",\"" << e->stage << "\"," << e->key;
+    for (double v : e->values) csv << "," << sweep::ExactNumber(v);
+    csv << "," << sweep::ExactNumber(r->objective.Chi2(e->mean)) << "," << e->failures.size() << "\n";
+  }
+  WriteFileAtomically(dir / "evaluations.csv", csv.str());
+  WriteFileAtomically(r->summary.report_file, Report(*r));
+  for (const char* ext : {".png", ".svg"}) {
+    if (!r->profiles.empty() && !r->profiles[0].empty()) DrawProfiles(dir / (std::string("profiles") + ext), *r);
+    DrawFit(dir / (std::string("fit") + ext), *r);
+  }
+}
+
+}  // namespace crowdrecon::calibrate

@@ -1,0 +1,60 @@
+// What a calibration found, as its outputs need it, and the writers of
+// DIR/calibration.json, evaluations.csv, report.txt and the pictures
+// (internal to calibrate/).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/calibrate/calibrate.hpp"
+#include "evaluator.hpp"
+#include "fit.hpp"
+
+namespace crowdrecon::calibrate {
+
+struct StartResult {
+  std::vector<double> start;  // values
+  std::vector<double> found;  // values
+  double surrogate_chi2 = 0.0;
+  double simulated_chi2 = 0.0;
+  std::string termination;
+};
+
+struct NoiseResult {
+  std::string parameter;
+  double step = 0.0;              // in the parameter's units
+  double chi2_noise_sd = 0.0;     // scatter of chi2 around a quadratic along the line
+  double residual_noise_sd = 0.0; // pooled scatter of the residuals around lines
+  double slope_signal = 0.0;      // median |d residual| over the gradient step, in units of that scatter
+};
+
+struct ProfilePoint {
+  double value = 0.0;
+  double chi2 = 0.0;
+};
+
+struct CalibrationResult {
+  const CalibrationSpec* spec = nullptr;
+  Objective objective;
+  std::vector<double> seed_sd;  // pooled seed-to-seed spread per statistic
+  std::vector<NoiseResult> noise;
+  std::vector<StartResult> starts;
+  std::vector<double> best;  // values
+  double best_simulated_chi2 = 0.0;
+  SetResult best_set;        // the best set's runs
+  std::string surrogate_form;
+  std::vector<double> surrogate_rms;  // per statistic, the local surrogate's fit
+  bool covariance_ok = false;
+  std::string covariance_reason;
+  std::vector<double> covariance;  // values' units, row-major
+  std::vector<std::vector<double>> bootstrap;  // replicates' values
+  std::vector<std::vector<ProfilePoint>> profiles;
+  std::vector<std::vector<ProfilePoint>> surrogate_profiles;  // the local surrogate's, re-minimised
+  Summary summary;
+};
+
+// Writes every output into `dir` and fills summary.json_file / report_file.
+void WriteOutputs(const std::filesystem::path& dir, const Evaluator& evaluator, CalibrationResult* result);
+
+}  // namespace crowdrecon::calibrate

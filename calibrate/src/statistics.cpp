@@ -1,0 +1,132 @@
+#include "crowdrecon/calibrate/statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "crowdrecon/common/error.hpp"
+
+namespace crowdrecon::calibrate {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct WindowMean {
+  double mean = kNaN;
+  double standard_error = kNaN;
+};
+
+// Mean of the bins of `series` whose centres lie in [from, to) (observation
+// clock shifted by `shift`: a bin at t counts where t - shift is inside).
+WindowMean MeanOver(const observe::Observation& obs, const observe::Series& series, double from, double to, double shift) {
+  double sum = 0.0, sum_u2 = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < series.points.size(); ++k) {
+    const double t = obs.t0_s + (static_cast<double>(k) + 0.5) * obs.bin_s - shift;
+    if (t < from || t >= to) continue;
+    const observe::SeriesPoint& p = series.points[k];
+    if (!std::isfinite(p.value)) continue;
+    sum += p.value;
+    sum_u2 += std::isfinite(p.uncertainty) ? p.uncertainty * p.uncertainty : 0.0;
+    ++n;
+  }
+  WindowMean w;
+  if (n == 0) return w;
+  w.mean = sum / static_cast<double>(n);
+  w.standard_error = std::sqrt(sum_u2) / static_cast<double>(n);
+  return w;
+}
+
+// Onsets of the events of a kind, region and direction, sorted (a censored
+// stop, under way when the series began, has no observed onset).
+std::vector<double> Onsets(const observe::Observation& obs, const std::string& kind, const std::string& where,
+                           const std::string& direction) {
+  std::vector<double> t;
+  for (const observe::Event& e : obs.events)
+    if (e.kind == kind && e.where == where && e.direction == direction && !e.censored) t.push_back(e.time_s);
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+std::string Window(double a, double b) { return "[" + FormatNumber(a) + ", " + FormatNumber(b) + ") s"; }
+
+}  // namespace
+
+std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
+  std::vector<Statistic> out;
+  for (std::size_t i = 0; i < spec.observations.size(); ++i) {
+    const ObservationMatch& m = spec.observations[i];
+    const std::string tag = "obs" + std::to_string(i) + " ";
+    for (const SeriesMatch& s : m.series) {
+      const observe::Series* series = m.observation.Find(s.quantity, s.where, s.direction);
+      const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;
+      for (double a = s.from_s; a < s.to_s - 1e-9; a += width) {
+        const double b = std::min(a + width, s.to_s);
+        const WindowMean w = MeanOver(m.observation, *series, a, b, 0.0);
+        if (!std::isfinite(w.mean))
+          throw InputError(spec.origin + ": " + m.file.string() + ": series " + s.quantity + " " + s.where + " " +
+                           s.direction + " has no value in the window " + Window(a, b) +
+                           "; expected a window where the observation has data (see its CSV)");
+        Statistic st;
+        st.name = tag + s.quantity + " " + s.where + " " + s.direction + " " + Window(a, b);
+        st.unit = series->unit;
+        st.observation = i;
+        st.quantity = s.quantity;
+        st.where = s.where;
+        st.direction = s.direction;
+        st.from_s = a;
+        st.to_s = b;
+        st.observed = w.mean;
+        const double systematic = s.relative_error * std::abs(w.mean);
+        st.observed_sigma = std::sqrt(w.standard_error * w.standard_error + systematic * systematic);
+        out.push_back(st);
+      }
+    }
+    for (const EventMatch& e : m.events) {
+      const std::vector<double> all = Onsets(m.observation, e.kind, e.where, e.direction);
+      std::vector<double> checkpoints;
+      for (double t : all)
+        if (t >= e.from_s && t < e.to_s) checkpoints.push_back(t);
+      checkpoints.push_back(e.to_s);
+      for (std::size_t k = 0; k < checkpoints.size(); ++k) {
+        Statistic st;
+        st.is_count = true;
+        st.name = tag + e.kind + "s " + e.where + " " + e.direction + " by " + FormatNumber(checkpoints[k]) + " s";
+        st.unit = "events";
+        st.observation = i;
+        st.quantity = e.kind;
+        st.where = e.where;
+        st.direction = e.direction;
+        st.from_s = e.from_s;
+        st.to_s = checkpoints[k];
+        // Onsets at the checkpoint count (a count just after the event).
+        st.observed = static_cast<double>(std::min(k + 1, checkpoints.size() - 1));
+        st.observed_sigma = 0.5;
+        out.push_back(st);
+      }
+    }
+  }
+  return out;
+}
+
+void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
+                         const std::vector<Statistic>& statistics, std::vector<double>* values) {
+  values->assign(statistics.size(), kNaN);
+  const double shift = spec.observations[index].time_offset_s;
+  for (std::size_t j = 0; j < statistics.size(); ++j) {
+    const Statistic& st = statistics[j];
+    if (st.observation != index) continue;
+    if (st.is_count) {
+      double n = 0;
+      for (double t : Onsets(simulated, st.quantity, st.where, st.direction))
+        if (t - shift >= st.from_s && t - shift <= st.to_s) ++n;
+      (*values)[j] = n;
+    } else {
+      const observe::Series* series = simulated.Find(st.quantity, st.where, st.direction);
+      if (series) (*values)[j] = MeanOver(simulated, *series, st.from_s, st.to_s, shift).mean;
+    }
+  }
+}
+
+}  // namespace crowdrecon::calibrate
