@@ -11,6 +11,7 @@
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
+#include "crowdrecon/sweep/results.hpp"
 
 namespace crowdrecon::calibrate {
 
@@ -77,6 +78,9 @@ Parameter ReadParameter(const JsonReader& item, const json& base_scenario, const
 
   const json* v = AtPath(base_scenario, p.path);
   const bool range = v && v->is_array() && v->size() == 2 && (*v)[0].is_number() && (*v)[1].is_number();
+  if (entry && item.Has("width"))
+    item.At("width").Fail("\"" + p.path + "\" is a number; \"width\" is for ranges [low, high] such as "
+                          "population.desired_speed_m_per_s");
   if (item.Has("width") || range) {
     p.is_range = true;
     p.width = item.Number("width", range ? (*v)[1].get<double>() - (*v)[0].get<double>() : 0.0, 0.0, 1e300);
@@ -84,7 +88,8 @@ Parameter ReadParameter(const JsonReader& item, const json& base_scenario, const
       item.At("width").Fail("\"" + p.path + "\" is not a range [low, high] in the scenario; \"width\" is for ranges");
     }
     if (p.min - p.width / 2 < lo_allowed || p.max + p.width / 2 > hi_allowed)
-      item.Fail("the range's ends would leave the allowed values");
+      item.Fail("the range's ends would leave the allowed values: [" + FormatNumber(p.min - p.width / 2) + ", " +
+                FormatNumber(p.max + p.width / 2) + "]");
   }
   if (item.Has("start")) {
     p.start = item.Number("start", p.min, p.max);
@@ -276,7 +281,8 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
 
   // The fingerprint: what a run's outputs depend on besides the values and
   // the seed (the observation specs key the cache's files themselves).
-  std::string f = c.base.scenario_canonical_json + "\n";
+  // The build counts too: runs of different builds are never mixed (as in sweeps).
+  std::string f = "crowdrecon " + sweep::BuildVersion() + "\n" + c.base.scenario_canonical_json + "\n";
   for (const sweep::Override& o : c.base.set) f += o.path + "=" + o.json + "\n";
   for (const Parameter& p : c.parameters)
     f += "param " + p.path + (p.is_range ? " range of width " + FormatNumber(p.width) : std::string()) + "\n";

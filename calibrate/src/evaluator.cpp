@@ -169,7 +169,7 @@ SetResult Evaluator::Load(const std::vector<double>& values, const std::string& 
 }
 
 bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys) {
-  std::string joined;
+  std::string joined = spec_.fingerprint;  // the build's version among it: a batch folder is one build's
   for (const std::string& k : keys) joined += k;
   const std::string batch = Sha256Hex(joined).substr(0, 16);
   const fs::path batches = dir_ / "batches";

@@ -336,6 +336,8 @@ ResultsTable ReadResults(const fs::path& dir_or_file) {
   return t;
 }
 
+std::string BuildVersion() { return CROWDRECON_GIT_VERSION; }
+
 OutputKind SweepFolderOutput() {
   return {"a sweep folder (results.sqlite of a crowdrecon sweep)", true, [](const fs::path& dir) {
     const fs::path file = dir / "results.sqlite";

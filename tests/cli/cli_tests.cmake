@@ -217,3 +217,15 @@ crowdrecon_cli_test(observe.synthesize_not_a_run fail "README.md: .*not a crowdr
                     observe synthesize README.md -o @TMP@/v.avi --homography-out @TMP@/h.json)
 crowdrecon_cli_test(observe.compare_not_an_observation fail "hallway.json: /format: .*expected \"crowdrecon-observation\""
                     observe compare ${hallway_spec} ${hallway_spec})
+
+# Calibration files (issue 23): refused with the file, the JSON path, the
+# value and what was expected; an output folder that is not a calibration's.
+set(calibration_data ${PROJECT_SOURCE_DIR}/tests/data/calibration)
+crowdrecon_cli_test(calibrate.not_json fail "README.md:1:1: .*JSON"
+                    calibrate README.md -o @TMP@/c)
+crowdrecon_cli_test(calibrate.unknown_parameter fail "bad-parameter.json: /parameters/0/path: \"model.back_force_gama\" is not a model parameter"
+                    calibrate ${calibration_data}/bad-parameter.json -o @TMP@/c)
+crowdrecon_cli_test(calibrate.missing_observation fail "bad-observation.json: /observations/0/file: cannot use the observation: .*nowhere.observation.json"
+                    calibrate ${calibration_data}/bad-observation.json -o @TMP@/c)
+crowdrecon_cli_test(calibrate.output_is_a_foreign_folder fail "-o .*calibration: exists and is a folder .*not a calibration folder"
+                    calibrate ${calibration_data}/bad-parameter.json -o ${calibration_data})

@@ -121,9 +121,10 @@ struct CalibrationSpec {
   // first, then the file's "starts".
   std::vector<std::vector<double>> starts;
   CalibrationOptions options;
-  // Everything a run's statistics depend on besides the parameter values:
-  // the base scenario, "set", the seeds, the observations' specs and
-  // matches. Cached evaluations are keyed by it and by the values.
+  // What a run depends on besides the parameter values and its seed: the
+  // build (runs of different builds are never mixed, as in sweeps), the base
+  // scenario, "set" and the parameters' paths. Cached runs are keyed by it
+  // and by the values (the seed and the observation spec name the files).
   std::string fingerprint;
 };
 

@@ -111,6 +111,10 @@ struct ResultsTable {
 // Throws InputError if it is missing or not a sweep's results.
 ResultsTable ReadResults(const std::filesystem::path& dir_or_file);
 
+// The build's version as stored with results (`git describe` at build time):
+// results of different builds are never mixed.
+std::string BuildVersion();
+
 // A previous sweep folder: its results.sqlite holds a crowdrecon sweep's
 // results (or is still empty, a sweep killed while starting); `sweep -o`
 // continues it (common/output_path.hpp).

@@ -1,0 +1,75 @@
+#!/bin/bash
+# A calibration small enough for the sanitizer build: one parameter (Γ) of a
+# sparse 1-s hallway, two seeds, fitted to an observation of a run made with
+# another Γ. Checks that every output is written (the JSON's fields, the
+# report, the pictures, one row per evaluation) and, with MODE mpi, that
+# `mpirun -np 2` gives the same calibration.json as the local run (exit 77:
+# skipped where mpirun is absent).
+#
+#   smoke_test.sh CROWDRECON SOURCE_DIR [local|mpi]
+set -euo pipefail
+crowdrecon=$1
+src=$(cd "$2" && pwd)
+mode=${3:-local}
+d=$(mktemp -d)
+trap 'rm -rf "$d"' EXIT
+if [ "$mode" = mpi ]; then
+  command -v mpirun > /dev/null || { echo "mpirun not found: skipped"; exit 77; }
+fi
+
+python3 - "$src" "$d" <<'PY'
+import json, sys
+src, d = sys.argv[1:3]
+s = json.load(open(src + "/tests/data/scenarios/sweep-tiny.json"))
+s["venue"] = src + "/venues/madrid-arena/hallway-periodic.json"
+s["population"]["body"]["reference"] = src + "/venues/bodies/thorax-18.json"
+s["population"]["density_per_m2"] = 2.0
+s["run"]["duration_s"] = 2.0
+json.dump(s, open(d + "/scenario.json", "w"))
+s["model"] = {"back_force_gamma": 2.5}
+s["population"]["seed"] = 9
+json.dump(s, open(d + "/truth.json", "w"))
+c = {"format": "crowdrecon-calibration", "version": 1, "name": "smoke", "scenario": "scenario.json",
+     "parameters": [{"path": "model.back_force_gamma", "min": 0.5, "max": 4.5}],
+     "observations": [{"file": "truth.observation.json", "series": [
+         {"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0.4, "to_s": 2, "window_s": 0.8},
+         {"quantity": "share_still", "where": "hallway", "direction": "all", "from_s": 0.4, "to_s": 2}]}],
+     "seeds": {"first": 1, "count": 2}, "starts": [{"model.back_force_gamma": 4}],
+     "options": {"refinements": 1, "bootstrap": 20, "profile_points": 3}}
+json.dump(c, open(d + "/calibration.json", "w"))
+PY
+"$crowdrecon" simulate "$d/truth.json" -o "$d/truth.sqlite" -q > /dev/null
+"$crowdrecon" observe trajectories "$d/truth.sqlite" --spec "$src/venues/madrid-arena/observations/hallway.json" \
+  -o "$d/truth.observation.json" -q > /dev/null
+
+"$crowdrecon" calibrate "$d/calibration.json" -o "$d/local" -q --jobs 2 | tee "$d/local.txt"
+grep -q "model.back_force_gamma = " "$d/local.txt"
+for f in calibration.json report.txt evaluations.csv profiles.png profiles.svg fit.png fit.svg; do
+  test -s "$d/local/$f" || { echo "FAIL: no $f"; exit 1; }
+done
+python3 - "$d/local/calibration.json" "$d/local/evaluations.csv" <<'PY'
+import csv, json, sys
+c = json.load(open(sys.argv[1]))
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert c["format"] == "crowdrecon-calibration-result", c["format"]
+assert len(c["parameters"]) == 1 and c["parameters"][0]["determination"] in ("determined", "bounded on one side", "undetermined")
+assert len(c["starts"]) == 2 and len(c["profiles"]["model.back_force_gamma"]) == 3
+assert len(rows) == len(c["evaluations"]) == c["sets_evaluated"], (len(rows), len(c["evaluations"]))
+assert all(s["sigma"] is None or s["sigma"] > 0 for s in c["statistics"])
+print("outputs: OK,", len(rows), "parameter sets")
+PY
+
+if [ "$mode" = mpi ]; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader OMPI_MCA_rmaps_base_oversubscribe=1
+  mpirun -np 2 --oversubscribe "$crowdrecon" calibrate "$d/calibration.json" -o "$d/mpi" -q > "$d/mpi.txt" 2>&1 ||
+    { echo "FAIL: mpirun exited $?"; cat "$d/mpi.txt"; exit 1; }
+  cat "$d/mpi.txt"
+  python3 - "$d/local/calibration.json" "$d/mpi/calibration.json" <<'PY'
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+for k in ("wall_s", "runs_simulated_now"):
+    a.pop(k); b.pop(k)
+assert a == b, "mpirun -np 2 and the local calibration differ"
+print("MPI: the same calibration.json")
+PY
+fi

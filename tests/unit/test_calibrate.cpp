@@ -1,0 +1,271 @@
+// Calibration (issue 23): the quadratic surrogate fitted exactly to a known
+// quadratic; Ceres finding a known minimum, inside the box and on its edge;
+// Ceres' covariance equal to (JᵀJ)⁻¹ of a linear model, and a parameter no
+// statistic depends on reported rank deficient; statistics of an observation
+// made in memory (window means, their standard errors, event counts, a time
+// offset); calibration files read with their defaults and refused with the
+// JSON path, the value and what was expected.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "crowdrecon/calibrate/calibration_file.hpp"
+#include "crowdrecon/calibrate/statistics.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "fit.hpp"
+#include "scratch.hpp"
+
+namespace crowdrecon::calibrate {
+namespace {
+
+using crowdrecon::testing::ScratchFile;
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Two statistics of two unit coordinates, known quadratics.
+double F0(const std::vector<double>& u) { return 1.0 + 2.0 * u[0] - u[1] + 3.0 * u[0] * u[0] + 0.5 * u[0] * u[1]; }
+double F1(const std::vector<double>& u) { return -0.5 + u[1] + 2.0 * u[1] * u[1] - u[0] * u[1]; }
+
+TEST(Surrogate, AQuadraticIsFittedExactlyWithItsGradient) {
+  std::vector<std::vector<double>> pts, vals;
+  for (double a : {0.0, 0.5, 1.0})
+    for (double b : {0.0, 0.5, 1.0}) {
+      pts.push_back({a, b});
+      vals.push_back({F0({a, b}), F1({a, b})});
+    }
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  EXPECT_EQ(q.form, "full quadratic");
+  const std::vector<double> u{0.3, 0.8};
+  EXPECT_NEAR(q.Value(0, u), F0(u), 1e-12);
+  EXPECT_NEAR(q.Value(1, u), F1(u), 1e-12);
+  const std::vector<double> g = q.Gradient(0, u);
+  EXPECT_NEAR(g[0], 2.0 + 6.0 * u[0] + 0.5 * u[1], 1e-10);
+  EXPECT_NEAR(g[1], -1.0 + 0.5 * u[0], 1e-10);
+  EXPECT_LT(q.rms[0], 1e-12);
+  // Fewer points: squares without cross terms, then linear.
+  Quadratic few;
+  ASSERT_TRUE(few.Fit({pts[0], pts[1], pts[2], pts[3], pts[4], pts[5]}, {vals[0], vals[1], vals[2], vals[3], vals[4], vals[5]},
+                      {0.5, 0.5}, 0.5));
+  EXPECT_EQ(few.form, "quadratic without cross terms");
+  Quadratic line;
+  ASSERT_TRUE(line.Fit({pts[0], pts[1], pts[3]}, {vals[0], vals[1], vals[3]}, {0.5, 0.5}, 0.5));
+  EXPECT_EQ(line.form, "linear");
+  EXPECT_FALSE(Quadratic().Fit({pts[0], pts[1]}, {vals[0], vals[1]}, {0.5, 0.5}, 0.5));
+}
+
+Objective ObjectiveObserving(const std::vector<double>& observed, const std::vector<double>& sigma) {
+  Objective o;
+  for (std::size_t j = 0; j < observed.size(); ++j) {
+    Statistic s;
+    s.name = "s" + std::to_string(j);
+    s.observed = observed[j];
+    o.statistics.push_back(s);
+  }
+  o.sigma = sigma;
+  return o;
+}
+
+TEST(Surrogate, CeresFindsTheParametersThatReproduceTheObservation) {
+  std::vector<std::vector<double>> pts, vals;
+  for (double a : {0.0, 0.5, 1.0})
+    for (double b : {0.0, 0.5, 1.0}) {
+      pts.push_back({a, b});
+      vals.push_back({F0({a, b}), F1({a, b})});
+    }
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  const std::vector<double> truth{0.35, 0.7};
+  const Objective o = ObjectiveObserving({F0(truth), F1(truth)}, {0.1, 0.1});
+  for (const std::vector<double>& start : {std::vector<double>{0.9, 0.1}, std::vector<double>{0.1, 0.95}}) {
+    const Minimum m = MinimiseSurrogate(q, o, start);
+    EXPECT_NEAR(m.u[0], truth[0], 1e-6);
+    EXPECT_NEAR(m.u[1], truth[1], 1e-6);
+    EXPECT_LT(m.chi2, 1e-10);
+  }
+  // An observation the box cannot reach: the optimum lies on its edge.
+  const Objective beyond = ObjectiveObserving({F0({1.0, 0.7}) + 5.0, F1({1.0, 0.7})}, {0.1, 0.1});
+  EXPECT_NEAR(MinimiseSurrogate(q, beyond, {0.5, 0.5}).u[0], 1.0, 1e-9);
+  // A coordinate held: the other is minimised alone.
+  const Minimum held = MinimiseSurrogate(q, o, {0.6, 0.2}, 0);
+  EXPECT_EQ(held.u[0], 0.6);
+  EXPECT_GT(held.chi2, 0.0);
+}
+
+TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
+  // Linear statistics m = A u + b with sigma 0.5: covariance (JᵀJ)⁻¹, J = A / 0.5.
+  const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
+  std::vector<std::vector<double>> pts, vals;
+  for (double x : {0.0, 1.0})
+    for (double y : {0.0, 1.0}) {
+      pts.push_back({x, y});
+      vals.push_back({a[0][0] * x + a[0][1] * y, a[1][0] * x + a[1][1] * y, a[2][0] * x + a[2][1] * y});
+    }
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  const Objective o = ObjectiveObserving({0.5, 0.5, 0.5}, {0.5, 0.5, 0.5});
+  std::vector<double> cov;
+  std::string reason;
+  ASSERT_TRUE(SurrogateCovariance(q, o, {0.4, 0.6}, &cov, &reason)) << reason;
+  double jtj[2][2] = {{0, 0}, {0, 0}};
+  for (const auto& row : a)
+    for (int i = 0; i < 2; ++i)
+      for (int k = 0; k < 2; ++k) jtj[i][k] += row[i] * row[k] / 0.25;
+  const double det = jtj[0][0] * jtj[1][1] - jtj[0][1] * jtj[1][0];
+  EXPECT_NEAR(cov[0], jtj[1][1] / det, 1e-9);
+  EXPECT_NEAR(cov[1], -jtj[0][1] / det, 1e-9);
+  EXPECT_NEAR(cov[3], jtj[0][0] / det, 1e-9);
+
+  // Statistics that depend on u[0] only: u[1] is free, and said so.
+  std::vector<std::vector<double>> flat;
+  for (const auto& p : pts) flat.push_back({2.0 * p[0], -p[0]});
+  Quadratic f;
+  ASSERT_TRUE(f.Fit(pts, flat, {0.5, 0.5}, 0.5));
+  EXPECT_FALSE(SurrogateCovariance(f, ObjectiveObserving({1.0, -0.5}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason));
+  EXPECT_NE(reason.find("rank deficient"), std::string::npos) << reason;
+}
+
+// An observation of 10 s in 0.2-s bins: speed forward 1.0 for t < 5 s and
+// 0.5 after (uncertainty 0.1 per bin), and three stops.
+observe::Observation MadeObservation() {
+  observe::Observation o;
+  o.spec.regions.push_back({"hallway", {{0, 0}, {8, 0}, {8, 3}, {0, 3}}});
+  o.method = "trajectories";
+  o.source_format = "crowdrecon-run";
+  o.source_file = "made";
+  o.t0_s = 0.0;
+  o.bin_s = 0.2;
+  o.bins = 50;
+  observe::Series s{"speed", "hallway", "forward", "m/s", {}};
+  for (std::size_t k = 0; k < o.bins; ++k) s.points.push_back({k < 25 ? 1.0 : 0.5, 0.1, 10.0});
+  o.series.push_back(s);
+  for (double t : {1.0, 4.0, 8.0}) {
+    observe::Event e;
+    e.kind = "stop";
+    e.where = "hallway";
+    e.direction = "forward";
+    e.time_s = t;
+    e.end_s = t + 0.5;
+    o.events.push_back(e);
+  }
+  return o;
+}
+
+const std::string kScenario = std::string(CROWDRECON_SOURCE_DIR) + "/tests/data/scenarios/sweep-tiny.json";
+
+std::string Calibration(const std::string& observation_file, const std::string& parameters, const std::string& more = "") {
+  return R"({"format": "crowdrecon-calibration", "version": 1, "scenario": ")" + kScenario + R"(",
+    "parameters": )" + parameters + R"(,
+    "observations": [{"file": ")" + observation_file + R"(",
+      "series": [{"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 10, "window_s": 5}],
+      "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 2, "to_s": 10}]}],
+    "seeds": {"first": 1, "count": 3})" + more + "}";
+}
+
+TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
+  const auto file = ScratchFile("made.observation.json");
+  observe::WriteObservation(MadeObservation(), file);
+  const CalibrationSpec spec =
+      ParseCalibration(Calibration(file.string(), R"([{"path": "model.back_force_gamma"}])"), "cal.json", "");
+  const std::vector<Statistic> st = ObservedStatistics(spec);
+  // Two windows of the series, then the counts after each stop from 2 s on (4 s, 8 s) and at the end.
+  ASSERT_EQ(st.size(), 5u);
+  EXPECT_DOUBLE_EQ(st[0].observed, 1.0);
+  EXPECT_DOUBLE_EQ(st[1].observed, 0.5);
+  EXPECT_NEAR(st[0].observed_sigma, 0.1 / std::sqrt(25.0), 1e-12);  // 25 bins of 0.1 each
+  EXPECT_EQ(st[2].to_s, 4.0);
+  EXPECT_EQ(st[2].observed, 1.0);
+  EXPECT_EQ(st[3].observed, 2.0);
+  EXPECT_EQ(st[4].to_s, 10.0);
+  EXPECT_EQ(st[4].observed, 2.0);
+  // A simulated observation equal to the observed one reads the same values ...
+  std::vector<double> values;
+  SimulatedStatistics(spec, 0, MadeObservation(), st, &values);
+  for (std::size_t j = 0; j < st.size(); ++j) EXPECT_DOUBLE_EQ(values[j], st[j].observed) << st[j].name;
+  // ... and one whose clock runs 1 s later, with the offset, too.
+  observe::Observation later = MadeObservation();
+  later.t0_s = 1.0;
+  for (observe::Event& e : later.events) e.time_s += 1.0;
+  CalibrationSpec shifted = spec;
+  shifted.observations[0].time_offset_s = 1.0;
+  SimulatedStatistics(shifted, 0, later, st, &values);
+  for (std::size_t j = 0; j < st.size(); ++j) EXPECT_DOUBLE_EQ(values[j], st[j].observed) << st[j].name;
+}
+
+TEST(CalibrationFile, DefaultsFromTheParameterTableAndTheScenario) {
+  const auto file = ScratchFile("made.observation.json");
+  observe::WriteObservation(MadeObservation(), file);
+  const CalibrationSpec spec = ParseCalibration(
+      Calibration(file.string(),
+                  R"([{"path": "model.back_force_gamma"}, {"path": "model.restitution", "min": 0.1, "max": 0.8, "start": 0.3},
+                      {"path": "population.desired_speed_m_per_s", "min": 0.6, "max": 1.8, "width": 0.4, "start": 1.0}])",
+                  R"(, "starts": [{"model.restitution": 0.7}])"),
+      "cal.json", "");
+  ASSERT_EQ(spec.parameters.size(), 3u);
+  EXPECT_EQ(spec.parameters[0].min, 0.0);    // the table's range
+  EXPECT_EQ(spec.parameters[0].max, 100.0);
+  EXPECT_EQ(spec.parameters[0].start, 1.2);  // the table's default (the scenario has no model block)
+  EXPECT_EQ(spec.parameters[1].start, 0.3);
+  // A range: its centre is the parameter, its width kept.
+  EXPECT_TRUE(spec.parameters[2].is_range);
+  EXPECT_DOUBLE_EQ(spec.parameters[2].start, 1.0);
+  EXPECT_DOUBLE_EQ(spec.parameters[2].width, 0.4);
+  EXPECT_EQ(spec.parameters[2].JsonOf(1.5), "[1.3,1.7]");
+  ASSERT_EQ(spec.starts.size(), 2u);
+  EXPECT_EQ(spec.starts[1][1], 0.7);
+  EXPECT_EQ(spec.starts[1][0], 1.2);
+  EXPECT_EQ(spec.base.seeds.size(), 3u);
+}
+
+TEST(CalibrationFile, BadFilesAreRefusedWithThePathAndTheValue) {
+  const auto file = ScratchFile("made.observation.json");
+  observe::WriteObservation(MadeObservation(), file);
+  const std::string obs = file.string();
+  const auto error = [&](const std::string& text) { return ErrorOf([&] { ParseCalibration(text, "cal.json", ""); }); };
+  const auto expect = [&](const std::string& text, const std::string& part) {
+    const std::string e = error(text);
+    EXPECT_NE(e.find(part), std::string::npos) << "error: " << e << "\nexpected: " << part;
+  };
+  expect(Calibration(obs, R"([{"path": "model.back_force_gama"}])"),
+         "cal.json: /parameters/0/path: \"model.back_force_gama\" is not a model parameter");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma", "max": 200}])"), "/parameters/0/max");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma", "min": 2, "max": 1}])"), "are empty; expected min < max");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma", "min": 2, "max": 3}])"),
+         "the start 1.2 (from the scenario) lies outside the bounds [2, 3]");
+  expect(Calibration(obs, R"([{"path": "population.density_per_m2"}])"),
+         "\"min\" is required for \"population.density_per_m2\"");
+  expect(Calibration(obs, R"([{"path": "model.integrator"}])"), "is not a number");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}, {"path": "model.back_force_gamma"}])"), "given twice");
+  expect(Calibration(obs, R"([{"path": "population.seed", "min": 1, "max": 9}])"), "the seed is not a parameter");
+  expect(Calibration(obs, R"([])"), "/parameters: expected at least one parameter");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "approach": "newton")"),
+         "/approach");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "starts": [{"model.restitution": 0.3}])"),
+         "/starts/0/model.restitution: \"model.restitution\" is not one of the parameters to fit");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "options": {"profile_points": 1})"),
+         "/options/profile_points");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "extra": 1)"), "unknown key");
+  expect(Calibration("/nonexistent/obs.json", R"([{"path": "model.back_force_gamma"}])"),
+         "/observations/0/file: cannot use the observation");
+  // A series the observation does not have: the ones it has are listed.
+  std::string text = Calibration(obs, R"([{"path": "model.back_force_gamma"}])");
+  text.replace(text.find("\"direction\": \"forward\", \"from_s\": 0"), 22, "\"direction\": \"backward\"");
+  expect(text, "the observation has no series speed hallway backward; expected one of: speed hallway forward");
+  // An override that makes the scenario invalid at a bound: refused before any run.
+  expect(Calibration(obs, R"([{"path": "population.density_per_m2", "min": 0.5, "max": 400, "start": 1}])"),
+         "(variant max-density_per_m2, seed 1): the scenario with this run's overrides is not valid");
+  // "width" for a value that is not a range.
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma", "width": 0.2}])"), "\"width\" is for ranges");
+}
+
+}  // namespace
+}  // namespace crowdrecon::calibrate
