@@ -36,6 +36,9 @@ if [ "${CALIBRATION_APPROACH:-surrogate}" = gradient ]; then
 import json, sys
 c = json.load(open(sys.argv[1]))
 c["approach"] = "gradient"
+# The gradient approach also measures the objective's noise first, which
+# says whether its central differences see the slope.
+c["options"].update({"measure_noise": True, "max_iterations": 4})
 c["scenario"] = sys.argv[3] + "/" + c["scenario"]
 for o in c["observations"]:
     o["file"] = sys.argv[3] + "/" + o["file"]
