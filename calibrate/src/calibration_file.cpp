@@ -139,6 +139,15 @@ SeriesMatch ReadSeriesMatch(const JsonReader& item, const observe::Observation& 
   if (m.window_s > 0 && (m.to_s - m.from_s) / m.window_s > 10000)
     item.At("window_s").Fail("more than 10,000 windows; expected a longer window");
   m.relative_error = item.Number("relative_error", 0.0, 0.0, 10.0);
+  if (item.Has("simulated_from_s") || item.Has("simulated_to_s")) {
+    m.simulated_from_s = item.Number("simulated_from_s", -1e9, 1e9);
+    m.simulated_to_s = item.Number("simulated_to_s", -1e9, 1e9);
+    if (!(m.simulated_to_s > m.simulated_from_s))
+      item.Fail("the simulated window [" + FormatNumber(m.simulated_from_s) + ", " + FormatNumber(m.simulated_to_s) +
+                "] s is empty; expected simulated_from_s < simulated_to_s");
+    if (m.window_s > 0 && m.window_s < m.to_s - m.from_s)
+      item.At("window_s").Fail("a simulated window of its own goes with one observed window; expected window_s 0");
+  }
   item.Finish();
   return m;
 }

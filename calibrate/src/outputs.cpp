@@ -167,13 +167,17 @@ std::string Report(const CalibrationResult& r) {
 void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
   const CalibrationSpec& spec = *r.spec;
   viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
-                        "chi2 along each parameter through the best fit (others held); dashed: chi2 min + 3.84 (95 %)");
+                        "chi2 along each parameter through the best fit (others held); shaded: the covariance's 95 % interval; "
+                        "green dashes: the bootstrap's");
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const Parameter& p = spec.parameters[i];
     const ParameterResult& pr = r.summary.parameters[i];
+    std::vector<ProfilePoint> points = r.profiles[i];
+    points.push_back({pr.value, r.best_simulated_chi2});  // the best fit lies on every profile
+    std::sort(points.begin(), points.end(), [](const ProfilePoint& a, const ProfilePoint& b) { return a.value < b.value; });
     std::vector<double> x, y;
     double lo = r.best_simulated_chi2, hi = r.best_simulated_chi2;
-    for (const ProfilePoint& q : r.profiles[i])
+    for (const ProfilePoint& q : points)
       if (std::isfinite(q.chi2)) {
         x.push_back(q.value);
         y.push_back(q.chi2);
@@ -183,53 +187,47 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
     if (!(hi > lo)) hi = lo + 1.0;
     viz::ChartPanel& panel = sheet.AddPanel(p.path + " (" + pr.determination + ")", "chi2", p.min, p.max,
                                             std::max(0.0, lo - 0.1 * (hi - lo)), hi + 0.1 * (hi - lo), 260);
-    if (!x.empty()) panel.Line(x, y, viz::ChartColor(0), 2.0, "simulated");
-    panel.Points(x, y, viz::ChartColor(0), 3.0);
-    panel.Line({p.min, p.max}, {lo + 3.841, lo + 3.841}, viz::Color::Black(), 1.0, "min + 3.84", true);
-    panel.Points({pr.value}, {r.best_simulated_chi2}, viz::ChartColor(1), 5.0, "best fit");
-    if (std::isfinite(pr.lo95)) {
-      panel.Mark(std::max(p.min, pr.lo95), viz::ChartColor(1), "95 % (covariance)");
-      panel.Mark(std::min(p.max, pr.hi95), viz::ChartColor(1));
-    }
+
+    const double y0 = std::max(0.0, lo - 0.1 * (hi - lo)), y1 = hi + 0.1 * (hi - lo);
+    if (std::isfinite(pr.lo95))
+      panel.Band({std::max(p.min, pr.lo95), std::min(p.max, pr.hi95)}, {y0, y0}, {y1, y1}, viz::ChartColor(1));
     if (std::isfinite(pr.bootstrap_lo95)) {
-      panel.Mark(pr.bootstrap_lo95, viz::ChartColor(2), "95 % (bootstrap)");
-      panel.Mark(pr.bootstrap_hi95, viz::ChartColor(2));
+      panel.Mark(pr.bootstrap_lo95, viz::ChartColor(2), "", true);
+      panel.Mark(pr.bootstrap_hi95, viz::ChartColor(2), "", true);
     }
+    if (!x.empty()) panel.Line(x, y, viz::ChartColor(0), 2.0, "simulated (profile)");
+    panel.Points(x, y, viz::ChartColor(0), 3.0);
+    panel.Line({p.min, p.max}, {lo + 3.841, lo + 3.841}, viz::Color::Black(), 1.0, "chi2 min + 3.84", true);
+    panel.Points({pr.value}, {r.best_simulated_chi2}, viz::ChartColor(1), 5.0, "best fit");
   }
   sheet.Finish();
 }
 
 // Observed statistics against the simulated ones at the best fit: one panel
 // per matched series (window means over time) and per matched events
-// (cumulative counts), with the observation's error bars and the seeds' band.
+// (cumulative counts), every observation's points (each its colour, with its
+// error bars) against the seeds' mean and band.
 void DrawFit(const fs::path& file, const CalibrationResult& r) {
   const CalibrationSpec& spec = *r.spec;
   viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
-                        "observed (points, +- sigma) against simulated at the best fit (line: mean of the seeds; band: +- their sd)");
+                        "observed (points, +- sigma; one colour per observation file) against simulated at the best fit "
+                        "(line: mean of the seeds; band: +- their sd)");
   std::map<std::string, std::vector<std::size_t>> groups;
   std::vector<std::string> order;
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
-    const std::string g = "obs" + std::to_string(st.observation) + " " + (st.is_count ? st.quantity + "s" : st.quantity) +
-                          " " + st.where + " " + st.direction + " (" + st.unit + ")";
+    const std::string g = (st.is_count ? st.quantity + "s" : st.quantity) + " " + st.where + " " + st.direction + " (" +
+                          st.unit + ")";
     if (!groups.contains(g)) order.push_back(g);
     groups[g].push_back(k);
   }
-  std::size_t panels = 0;
-  for (const std::string& g : order) {
-    if (++panels > 12) break;
-    std::vector<double> x, obs, err, sim, lo, hi;
+  const std::size_t observations = spec.observations.size();
+  for (std::size_t panel_index = 0; panel_index < order.size() && panel_index < 16; ++panel_index) {
+    const std::vector<std::size_t>& members = groups[order[panel_index]];
     double y0 = 1e300, y1 = -1e300, x0 = 1e300, x1 = -1e300;
-    for (std::size_t k : groups[g]) {
+    for (std::size_t k : members) {
       const Statistic& st = r.objective.statistics[k];
-      const double t = st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s);
-      x.push_back(t);
-      obs.push_back(st.observed);
-      err.push_back(st.observed_sigma);
       const double m = r.best_set.mean[k], sd = std::isfinite(r.best_set.sd[k]) ? r.best_set.sd[k] : 0.0;
-      sim.push_back(m);
-      lo.push_back(m - sd);
-      hi.push_back(m + sd);
       for (double v : {st.observed - st.observed_sigma, st.observed + st.observed_sigma, m - sd, m + sd})
         if (std::isfinite(v)) {
           y0 = std::min(y0, v);
@@ -242,17 +240,44 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
       y0 -= 0.5;
       y1 += 0.5;
     }
+    // Room above the data for the legend.
     const double pad = 0.15 * (y1 - y0);
-    viz::ChartPanel& panel = sheet.AddPanel("time, s (observation's clock)", g, x0, x1, y0 - pad, y1 + pad, 220);
-    if (x.size() > 1) {
-      panel.Band(x, lo, hi, viz::ChartColor(1));
-      panel.Line(x, sim, viz::ChartColor(1), 2.0, "simulated");
-    } else {
-      panel.Points(x, sim, viz::ChartColor(1), 5.0, "simulated", nullptr);
-      std::vector<double> sd{hi[0] - sim[0]};
-      panel.Points(x, sim, viz::ChartColor(1), 5.0, "", &sd);
+    viz::ChartPanel& panel = sheet.AddPanel("time, s (observation's clock)", order[panel_index], x0, x1, y0 - pad,
+                                            y1 + 4 * pad, 240);
+    // The simulated statistics of the first observation that has this series
+    // (the others compare the same runs, over their own windows).
+    const std::size_t first = r.objective.statistics[members.front()].observation;
+    std::vector<double> x, sim, lo, hi;
+    for (std::size_t k : members) {
+      const Statistic& st = r.objective.statistics[k];
+      if (st.observation != first) continue;
+      x.push_back(st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s));
+      const double m = r.best_set.mean[k], sd = std::isfinite(r.best_set.sd[k]) ? r.best_set.sd[k] : 0.0;
+      sim.push_back(m);
+      lo.push_back(m - sd);
+      hi.push_back(m + sd);
     }
-    panel.Points(x, obs, viz::Color::Black(), 4.0, "observed", &err);
+    if (x.size() > 1) {
+      panel.Band(x, lo, hi, viz::Color::Black());
+      panel.Line(x, sim, viz::Color::Black(), 2.0, "simulated");
+    } else {
+      std::vector<double> sd{hi[0] - sim[0]};
+      panel.Points(x, sim, viz::Color::Black(), 6.0, "simulated", &sd);
+    }
+    for (std::size_t o = 0; o < observations; ++o) {
+      std::vector<double> ox, oy, oe;
+      const double shift = (x1 - x0) * 0.006 * (static_cast<double>(o) - 0.5 * static_cast<double>(observations - 1));
+      for (std::size_t k : members) {
+        const Statistic& st = r.objective.statistics[k];
+        if (st.observation != o) continue;
+        ox.push_back((st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s)) + shift);
+        oy.push_back(st.observed);
+        oe.push_back(st.observed_sigma);
+      }
+      if (!ox.empty())
+        panel.Points(ox, oy, viz::ChartColor(static_cast<int>(o)), 4.0,
+                     observations > 1 ? spec.observations[o].file.filename().string() : std::string("observed"), &oe);
+    }
   }
   sheet.Finish();
 }

@@ -77,6 +77,8 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         st.direction = s.direction;
         st.from_s = a;
         st.to_s = b;
+        st.sim_from_s = std::isnan(s.simulated_from_s) ? a + m.time_offset_s : s.simulated_from_s;
+        st.sim_to_s = std::isnan(s.simulated_to_s) ? b + m.time_offset_s : s.simulated_to_s;
         st.observed = w.mean;
         const double systematic = s.relative_error * std::abs(w.mean);
         st.observed_sigma = std::sqrt(w.standard_error * w.standard_error + systematic * systematic);
@@ -100,6 +102,8 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         st.direction = e.direction;
         st.from_s = e.from_s;
         st.to_s = checkpoints[k];
+        st.sim_from_s = e.from_s + m.time_offset_s;
+        st.sim_to_s = checkpoints[k] + m.time_offset_s;
         // Onsets at the checkpoint count (a count just after the event).
         st.observed = static_cast<double>(std::min(k + 1, checkpoints.size() - 1));
         st.observed_sigma = 0.5;
@@ -112,19 +116,19 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
 
 void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
                          const std::vector<Statistic>& statistics, std::vector<double>* values) {
+  (void)spec;
   values->assign(statistics.size(), kNaN);
-  const double shift = spec.observations[index].time_offset_s;
   for (std::size_t j = 0; j < statistics.size(); ++j) {
     const Statistic& st = statistics[j];
     if (st.observation != index) continue;
     if (st.is_count) {
       double n = 0;
       for (double t : Onsets(simulated, st.quantity, st.where, st.direction))
-        if (t - shift >= st.from_s && t - shift <= st.to_s) ++n;
+        if (t >= st.sim_from_s && t <= st.sim_to_s) ++n;
       (*values)[j] = n;
     } else {
       const observe::Series* series = simulated.Find(st.quantity, st.where, st.direction);
-      if (series) (*values)[j] = MeanOver(simulated, *series, st.from_s, st.to_s, shift).mean;
+      if (series) (*values)[j] = MeanOver(simulated, *series, st.sim_from_s, st.sim_to_s, 0.0).mean;
     }
   }
 }

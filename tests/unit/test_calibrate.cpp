@@ -197,8 +197,18 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   for (observe::Event& e : later.events) e.time_s += 1.0;
   CalibrationSpec shifted = spec;
   shifted.observations[0].time_offset_s = 1.0;
-  SimulatedStatistics(shifted, 0, later, st, &values);
+  SimulatedStatistics(shifted, 0, later, ObservedStatistics(shifted), &values);
   for (std::size_t j = 0; j < st.size(); ++j) EXPECT_DOUBLE_EQ(values[j], st[j].observed) << st[j].name;
+  // A simulated window of its own: the observed [5, 10) against the run's [0, 5).
+  std::string text = Calibration(file.string(), R"([{"path": "model.back_force_gamma"}])");
+  const std::string windows = "\"from_s\": 0, \"to_s\": 10, \"window_s\": 5";
+  text.replace(text.find(windows), windows.size(),
+               "\"from_s\": 5, \"to_s\": 10, \"simulated_from_s\": 0, \"simulated_to_s\": 5");
+  const CalibrationSpec own = ParseCalibration(text, "cal.json", "");
+  const std::vector<Statistic> ost = ObservedStatistics(own);
+  EXPECT_DOUBLE_EQ(ost[0].observed, 0.5);
+  SimulatedStatistics(own, 0, MadeObservation(), ost, &values);
+  EXPECT_DOUBLE_EQ(values[0], 1.0);
 }
 
 TEST(CalibrationFile, DefaultsFromTheParameterTableAndTheScenario) {

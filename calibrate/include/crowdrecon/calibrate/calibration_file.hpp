@@ -14,7 +14,8 @@
 //     "observations": [
 //       {"file": "recorded.observation.json", "time_offset_s": 0,
 //        "series": [{"quantity": "speed", "where": "hallway", "direction": "forward",
-//                    "from_s": 5, "to_s": 30, "window_s": 0, "relative_error": 0}],
+//                    "from_s": 5, "to_s": 30, "window_s": 0, "relative_error": 0,
+//                    "simulated_from_s": 5, "simulated_to_s": 30}],     (default: the same window + offset)
 //        "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 30}]}
 //     ],
 //     "seeds": {"first": 1, "count": 8},
@@ -34,6 +35,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,6 +67,11 @@ struct SeriesMatch {
   // The observation's systematic error as a fraction of its value (e.g. the
   // footage study's 10 %), added to its statistical one.
   double relative_error = 0.0;
+  // The simulated window, when it is not the observed one shifted by the
+  // observation's time offset (NaN): the steady state of an experiment
+  // against the steady state of a periodic run. One window only.
+  double simulated_from_s = std::numeric_limits<double>::quiet_NaN();
+  double simulated_to_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Events (observe/events.hpp) of one kind, place and direction, compared as

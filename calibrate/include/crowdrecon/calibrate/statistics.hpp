@@ -21,6 +21,7 @@ struct Statistic {
   std::string quantity;         // the series' quantity, or the events' kind
   std::string where, direction;
   double from_s = 0.0, to_s = 0.0;  // window (series) or [from, checkpoint] (counts), observed clock
+  double sim_from_s = 0.0, sim_to_s = 0.0;  // the same on the run's clock
   double observed = 0.0;
   // The observed value's own uncertainty: the standard error of the window's
   // mean from its bins' (independent bins assumed), plus the match's
@@ -34,8 +35,9 @@ struct Statistic {
 std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec);
 
 // The values of `statistics` (of observation `index` only; others NaN) in a
-// simulated run's observation: the same windows shifted by the match's time
-// offset. NaN where a window holds no value.
+// simulated run's observation, over their simulated windows (the observed
+// ones shifted by the observation's time offset, or the match's own). NaN
+// where a window holds no value.
 void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
                          const std::vector<Statistic>& statistics, std::vector<double>* values);
 
