@@ -19,9 +19,10 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 echo "1. the synthetic recordings (known values; seeds 1001-1004)"
-"$crowdrecon" sweep "$dir/hallway-recovery-truth.json" -o "$work/truth" -q
+# (the recordings' runs are kept in OUT-truth/, the path their observations name)
+"$crowdrecon" sweep "$dir/hallway-recovery-truth.json" -o "$out-truth" -q
 mkdir -p "$dir/recovery"
-for run in "$work"/truth/runs/*.sqlite; do
+for run in "$out-truth"/runs/*.sqlite; do
   seed=${run##*-seed}
   seed=${seed%.sqlite}
   "$crowdrecon" observe trajectories "$run" --spec venues/madrid-arena/observations/hallway.json \
