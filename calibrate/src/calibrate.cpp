@@ -331,7 +331,7 @@ class Calibration {
     r_.best_simulated_chi2 = r_.objective.Chi2(r_.best_set.mean);
 
     std::vector<double> cov_u;
-    r_.covariance_ok = SurrogateCovariance(local, r_.objective, best, &cov_u, &r_.covariance_reason);
+    r_.covariance_ok = SurrogateCovariance(local, r_.objective, best, &cov_u, &r_.covariance_reason, &r_.without_effect);
     if (r_.covariance_ok) {
       r_.covariance.assign(p * p, 0.0);
       for (std::size_t i = 0; i < p; ++i)
@@ -447,7 +447,16 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
       low_excluded = r.profiles[i].front().chi2 - lowest > kChi2At95;
       high_excluded = r.profiles[i].back().chi2 - lowest > kChi2At95;
     }
-    if (!r.covariance_ok) {
+    const bool no_effect = std::find(r.without_effect.begin(), r.without_effect.end(), static_cast<int>(i)) !=
+                           r.without_effect.end();
+    if (no_effect) {
+      // The bootstrap cannot move it either: its spread would look precise.
+      pr.sigma = pr.lo95 = pr.hi95 = kNaN;
+      pr.bootstrap_sigma = pr.bootstrap_lo95 = pr.bootstrap_hi95 = kNaN;
+      pr.determination = "undetermined";
+      pr.reason = "no statistic depends on it at the best fit (the surrogate's slope along it is zero): any value in "
+                  "the range fits as well";
+    } else if (!r.covariance_ok) {
       pr.determination = "undetermined";
       pr.reason = r.covariance_reason;
     } else if (pr.hi95 - pr.lo95 >= range) {
@@ -472,11 +481,15 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
   if (r.covariance_ok)
     for (std::size_t i = 0; i < p; ++i)
       for (std::size_t k = 0; k < p; ++k)
-        s.correlation[i][k] = r.covariance[i * p + k] / std::sqrt(r.covariance[i * p + i] * r.covariance[k * p + k]);
+        if (r.covariance[i * p + i] > 0 && r.covariance[k * p + k] > 0)
+          s.correlation[i][k] = r.covariance[i * p + k] / std::sqrt(r.covariance[i * p + i] * r.covariance[k * p + k]);
   s.starts = r.starts.size();
   s.starts_agree = true;
+  // Agreement on what the observations determine (an undetermined
+  // parameter lies anywhere, and says so).
   for (const StartResult& a : r.starts)
     for (std::size_t i = 0; i < p; ++i) {
+      if (s.parameters[i].determination == "undetermined") continue;
       const double tol = std::max(0.02 * spec.parameters[i].Range(),
                                   std::isfinite(s.parameters[i].sigma) ? 1.96 * s.parameters[i].sigma : 0.0);
       if (std::abs(a.found[i] - r.best[i]) > tol) s.starts_agree = false;

@@ -11,6 +11,8 @@
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
+#include "crowdrecon/scenario/scenario.hpp"
+#include "crowdrecon/scenario/timeline.hpp"
 #include "crowdrecon/sweep/results.hpp"
 
 namespace crowdrecon::calibrate {
@@ -214,6 +216,43 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
     const JsonReader item = observations.Element(i);
     if (!item.IsObject()) item.Fail("expected {\"file\": ..., \"series\": [...]}, found " + item.ValueText());
     ObservationMatch m;
+    if (auto recorded = item.Find("recorded")) {
+      // Events recorded of the incident: observed times from the scenario's
+      // timeline.recorded marks, simulated ones from the run's event table.
+      m.recorded_kind = recorded->Choice("kind", {"avalanche"});
+      EventMatch e;
+      e.kind = m.recorded_kind;
+      e.where = "run";
+      e.direction = recorded->String("direction", "crowd");
+      const scenario::Scenario sc = sweep::RunScenarioOf(c.base, sweep::RunPlan{0, "base", 0, {}, c.base.seeds[0], ""});
+      double last = 0.0;
+      for (const scenario::RecordedMark& mark : sc.timeline.recorded)
+        if (mark.kind == m.recorded_kind) {
+          observe::Event ev;
+          ev.kind = e.kind;
+          ev.where = e.where;
+          ev.direction = e.direction;
+          ev.time_s = mark.time_s;
+          m.observation.events.push_back(ev);
+          last = std::max(last, mark.time_s);
+        }
+      if (m.observation.events.empty())
+        recorded->Fail("the scenario records no \"" + m.recorded_kind + "\" in timeline.recorded; expected the times of "
+                       "the incident's events there (docs/scenarios.md)");
+      const double duration = sc.run.duration_s;
+      e.from_s = recorded->Number("from_s", 0.0, -1e9, 1e9);
+      e.to_s = recorded->Number("to_s", std::max(duration, last), -1e9, 1e9);
+      if (!(e.to_s > e.from_s)) recorded->Fail("the window is empty; expected from_s < to_s");
+      m.observation.method = "recorded";
+      m.observation.source_file = c.base.scenario_file.string();
+      m.events.push_back(e);
+      recorded->Finish();
+      if (item.Has("file") || item.Has("series") || item.Has("events"))
+        item.Fail("\"recorded\" stands alone: an observation is either a file or the scenario's recorded events");
+      item.Finish();
+      c.observations.push_back(std::move(m));
+      continue;
+    }
     const JsonReader file = item.At("file");
     m.file = fs::path(file.AsString());
     if (m.file.is_relative()) m.file = (dir / m.file).lexically_normal();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -15,6 +16,7 @@
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/observe/trajectories.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
 
 namespace crowdrecon::calibrate {
@@ -25,6 +27,26 @@ using nlohmann::json;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+const std::string kRunEvents = "run events";
+
+// The run's own events of the kinds a calibration can match (avalanches,
+// detected during the run: docs/scenarios.md), as an observation's events:
+// where "run", direction the group's name or "crowd".
+observe::Observation RunEvents(const fs::path& run_file) {
+  observe::Observation o;
+  o.bin_s = 1.0;
+  for (const runfile::Event& e : runfile::RunFileReader(run_file).Events()) {
+    if (e.kind != "avalanche") continue;
+    observe::Event ev;
+    ev.kind = e.kind;
+    ev.where = "run";
+    const std::string who = e.detail.substr(0, e.detail.find(':'));
+    ev.direction = who.rfind("direction ", 0) == 0 ? who.substr(10) : who;
+    ev.time_s = e.time_s;
+    o.events.push_back(ev);
+  }
+  return o;
+}
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -84,12 +106,14 @@ Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& 
                      bool show_progress)
     : spec_(spec), statistics_(statistics), dir_(std::move(dir)), jobs_(jobs), show_progress_(show_progress) {
   for (const ObservationMatch& m : spec_.observations) {
-    const std::string j = observe::SpecToJson(m.observation.spec);
+    // The scenario's recorded events compare with the run's event table: one
+    // file per run of that table's events, whatever the spec.
+    const std::string j = m.recorded_kind.empty() ? observe::SpecToJson(m.observation.spec) : kRunEvents;
     std::size_t k = 0;
     while (k < spec_json_.size() && spec_json_[k] != j) ++k;
     if (k == spec_json_.size()) {
       spec_json_.push_back(j);
-      spec_tag_.push_back(Sha256Hex(j).substr(0, 12));
+      spec_tag_.push_back(j == kRunEvents ? std::string("events") : Sha256Hex(j).substr(0, 12));
     }
     spec_of_observation_.push_back(k);
   }
@@ -209,10 +233,16 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
       WriteFileAtomically(d / (stem + ".failed"), status);
       return;
     }
-    const observe::Trajectories t = observe::ReadTrajectories(run_file);
+    std::optional<observe::Trajectories> t;
     for (std::size_t k = 0; k < spec_json_.size(); ++k) {
-      const observe::ObservationSpec spec = observe::ParseObservationSpec(spec_json_[k], "observation spec");
-      WriteFileAtomically(d / (stem + "-" + spec_tag_[k] + ".json"), CompactObservation(observe::ObserveTrajectories(t, spec)).dump());
+      observe::Observation o;
+      if (spec_json_[k] == kRunEvents) {
+        o = RunEvents(run_file);
+      } else {
+        if (!t) t = observe::ReadTrajectories(run_file);
+        o = observe::ObserveTrajectories(*t, observe::ParseObservationSpec(spec_json_[k], "observation spec"));
+      }
+      WriteFileAtomically(d / (stem + "-" + spec_tag_[k] + ".json"), CompactObservation(o).dump());
     }
   };
   const sweep::SweepSummary s = sweep::RunSweep(options);

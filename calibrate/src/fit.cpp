@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
 #include <ceres/manifold.h>
+#include <glog/logging.h>
 
 namespace crowdrecon::calibrate {
 
@@ -169,7 +170,18 @@ std::vector<std::size_t> FittedRows(const Quadratic& q, const Objective& o) {
   return rows;
 }
 
+// Ceres logs through glog, which writes to stderr unless told otherwise; a
+// calibration says what happened in its own outputs.
+void QuietGlog() {
+  static const bool once = [] {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    return true;
+  }();
+  (void)once;
+}
+
 ceres::Solver::Options SolverOptions(int max_iterations) {
+  QuietGlog();
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
   options.minimizer_type = ceres::TRUST_REGION;
@@ -253,16 +265,32 @@ Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const
 }
 
 bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
-                         std::vector<double>* covariance, std::string* reason) {
+                         std::vector<double>* covariance, std::string* reason, std::vector<int>* without_effect) {
   const std::size_t p = u.size();
   std::vector<double> x = u;
+  without_effect->clear();
   const std::vector<std::size_t> rows = FittedRows(q, objective);
   if (rows.empty()) {
     *reason = "no statistic could be fitted";
     return false;
   }
+  // Which coordinates move any statistic at all.
+  std::vector<double> norm(p, 0.0);
+  for (std::size_t j : rows) {
+    const std::vector<double> g = q.Gradient(j, u);
+    for (std::size_t i = 0; i < p; ++i) norm[i] += (g[i] / objective.sigma[j]) * (g[i] / objective.sigma[j]);
+  }
+  const double largest = *std::max_element(norm.begin(), norm.end());
+  for (std::size_t i = 0; i < p; ++i)
+    if (!(norm[i] > 1e-12 * largest) || largest == 0.0) without_effect->push_back(static_cast<int>(i));
+  if (without_effect->size() == p) {
+    *reason = "no statistic depends on any parameter at the optimum";
+    return false;
+  }
   ceres::Problem problem;
   problem.AddResidualBlock(new SurrogateCost(q, objective, rows), nullptr, x.data());
+  if (!without_effect->empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(static_cast<int>(p), *without_effect));
+  QuietGlog();
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::DENSE_SVD;
   options.null_space_rank = 0;  // a direction the data do not constrain is an error, not dropped

@@ -69,8 +69,12 @@ Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const
                          int max_iterations);
 
 // Ceres' covariance of the unit coordinates at u for the surrogate problem
-// (row-major p x p); false with the reason when the Jacobian is rank deficient.
+// (row-major p x p). A coordinate no statistic depends on (its Jacobian
+// column below 1e-6 of the largest) is listed in `without_effect`, held
+// constant, and gets zero rows and columns: the others' covariance is then
+// given whatever its value. False with the reason when what remains is still
+// rank deficient (a combination of parameters leaves every statistic unchanged).
 bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
-                         std::vector<double>* covariance, std::string* reason);
+                         std::vector<double>* covariance, std::string* reason, std::vector<int>* without_effect);
 
 }  // namespace crowdrecon::calibrate

@@ -276,7 +276,10 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
       }
       if (!ox.empty())
         panel.Points(ox, oy, viz::ChartColor(static_cast<int>(o)), 4.0,
-                     observations > 1 ? spec.observations[o].file.filename().string() : std::string("observed"), &oe);
+                     !spec.observations[o].recorded_kind.empty() ? "recorded (the scenario's timeline)"
+                     : observations > 1                           ? spec.observations[o].file.filename().string()
+                                                                  : std::string("observed"),
+                     &oe);
     }
   }
   sheet.Finish();

@@ -48,6 +48,7 @@ struct CalibrationResult {
   bool covariance_ok = false;
   std::string covariance_reason;
   std::vector<double> covariance;  // values' units, row-major
+  std::vector<int> without_effect;  // parameters no statistic depends on at the best fit
   std::vector<std::vector<double>> bootstrap;  // replicates' values
   std::vector<std::vector<ProfilePoint>> profiles;
   std::vector<std::vector<ProfilePoint>> surrogate_profiles;  // the local surrogate's, re-minimised

@@ -115,7 +115,9 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   const Objective o = ObjectiveObserving({0.5, 0.5, 0.5}, {0.5, 0.5, 0.5});
   std::vector<double> cov;
   std::string reason;
-  ASSERT_TRUE(SurrogateCovariance(q, o, {0.4, 0.6}, &cov, &reason)) << reason;
+  std::vector<int> without_effect;
+  ASSERT_TRUE(SurrogateCovariance(q, o, {0.4, 0.6}, &cov, &reason, &without_effect)) << reason;
+  EXPECT_TRUE(without_effect.empty());
   double jtj[2][2] = {{0, 0}, {0, 0}};
   for (const auto& row : a)
     for (int i = 0; i < 2; ++i)
@@ -125,12 +127,22 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   EXPECT_NEAR(cov[1], -jtj[0][1] / det, 1e-9);
   EXPECT_NEAR(cov[3], jtj[0][0] / det, 1e-9);
 
-  // Statistics that depend on u[0] only: u[1] is free, and said so.
+  // Statistics that depend on u[0] only: u[1] is listed as without effect,
+  // and u[0]'s variance is that of the problem without it.
   std::vector<std::vector<double>> flat;
   for (const auto& p : pts) flat.push_back({2.0 * p[0], -p[0]});
   Quadratic f;
   ASSERT_TRUE(f.Fit(pts, flat, {0.5, 0.5}, 0.5));
-  EXPECT_FALSE(SurrogateCovariance(f, ObjectiveObserving({1.0, -0.5}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason));
+  ASSERT_TRUE(SurrogateCovariance(f, ObjectiveObserving({1.0, -0.5}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason, &without_effect));
+  ASSERT_EQ(without_effect, std::vector<int>{1});
+  EXPECT_NEAR(cov[0], 1.0 / (4.0 / 0.01 + 1.0 / 0.01), 1e-12);
+  EXPECT_EQ(cov[3], 0.0);
+  // Statistics that depend on u[0] + u[1] only: a combination is free, said so.
+  std::vector<std::vector<double>> sum;
+  for (const auto& p : pts) sum.push_back({p[0] + p[1], 2.0 * (p[0] + p[1])});
+  Quadratic g;
+  ASSERT_TRUE(g.Fit(pts, sum, {0.5, 0.5}, 0.5));
+  EXPECT_FALSE(SurrogateCovariance(g, ObjectiveObserving({1.0, 2.0}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason, &without_effect));
   EXPECT_NE(reason.find("rank deficient"), std::string::npos) << reason;
 }
 

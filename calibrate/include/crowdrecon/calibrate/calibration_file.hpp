@@ -16,8 +16,9 @@
 //        "series": [{"quantity": "speed", "where": "hallway", "direction": "forward",
 //                    "from_s": 5, "to_s": 30, "window_s": 0, "relative_error": 0,
 //                    "simulated_from_s": 5, "simulated_to_s": 30}],     (default: the same window + offset)
-//        "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 30}]}
-//     ],
+//        "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 30}]},
+//       {"recorded": {"kind": "avalanche", "direction": "crowd", "from_s": 0, "to_s": 5700}}
+//     ],                                                          (the scenario's timeline.recorded against the run's events)
 //     "seeds": {"first": 1, "count": 8},
 //     "approach": "surrogate",                                   (or "gradient")
 //     "starts": [{"model.back_force_gamma": 3.0}],               (more starting points)
@@ -83,7 +84,12 @@ struct EventMatch {
 };
 
 struct ObservationMatch {
-  std::filesystem::path file;
+  std::filesystem::path file;  // empty for events recorded in the scenario
+  // Events recorded of the real incident in the base scenario's
+  // timeline.recorded (e.g. the five avalanches of the Madrid Arena),
+  // against the run's own events of that kind (its event table): the kind,
+  // and "" for an observation file.
+  std::string recorded_kind;
   observe::Observation observation;
   // Simulated time = observed time + offset (an experiment's clock against
   // the run's, which starts at 0).
