@@ -139,6 +139,7 @@ void Simulation::LoadBodies() {
   if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
   in_->sin_angle.assign(n, 0.0);
   in_->travel_m.assign(n, 0.0);
+  in_->field_cache.assign(n, {});
   in_->travel_position = bodies_.position_m;
   in_->travel_angle = bodies_.angle_rad;
 }
