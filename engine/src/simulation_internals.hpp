@@ -278,6 +278,12 @@ struct Simulation::Internals {
   // per step, after the integrator; empty otherwise).
   std::vector<double> averaged_along;
 
+  // Per body, the navigation field's cell it last sampled (Drive,
+  // AverageBackForceTrigger): the grid is read only when someone enters a
+  // new cell. A cache names its field and cell, so it is never stale (the
+  // fields do not change); nothing about it is saved in checkpoints.
+  std::vector<geometry::NavigationField::CellCache> field_cache;
+
   // Parallel Collide: each thread's contacts, in the order of the chunks it
   // took (buffers apart in memory), where each chunk's contacts lie in them,
   // and where each chunk's contacts start in the contact list.

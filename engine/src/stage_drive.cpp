@@ -18,6 +18,7 @@ using namespace detail;  // the stages' shared helpers (simulation_internals.hpp
 void Simulation::Drive() {
   ScopedTimer timer(profile_.stage_s[Index(Stage::kDrive)]);
   const Internals& in = *in_;
+  std::vector<geometry::NavigationField::CellCache>& field_cache = in_->field_cache;
   const ModelParameters& mp = def_.parameters;
   // Loop invariants, so that the loop below divides only where it must.
   const double inverse_tau = 1.0 / mp.relaxation_time_s;
@@ -55,7 +56,7 @@ void Simulation::Drive() {
       gain[k] = 0.0;
       if (!driven[k]) continue;
       const Vec2 v = bodies_.velocity_m_per_s[i];
-      direction[k] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i]);
+      direction[k] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
       const double speed = Length(v);
       // Only the direction of `facing` matters to the angle (atan2 of two
       // products with it), so the velocity needs no normalising.
@@ -116,7 +117,7 @@ void Simulation::AverageBackForceTrigger() {
   const double a = -std::expm1(-dt_s_ / mp.back_force_reaction_time_s);
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_.state[i] != PersonState::kWalking) continue;
-    const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i]);
+    const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], in_->field_cache[i]);
     u[i] += a * (Dot(e, bodies_.velocity_m_per_s[i]) - u[i]);
   }
 }

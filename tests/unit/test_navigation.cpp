@@ -241,5 +241,29 @@ TEST(Navigation, MadridArenaGroundFloor) {
   EXPECT_NEAR(f.Distance({54.9, 34.9}), exact, 0.02 * exact);
 }
 
+TEST(Navigation, CachedDirectionIsDirectionBitForBit) {
+  // Walks that stay in a cell, cross cells, pass beside the pillar (cells
+  // with unreachable nodes), leave the grid and switch between two fields
+  // with one cache: the cached direction is the direction, bit for bit.
+  const Venue v = LoadVenue(kNavigationData / "room.json");
+  NavigationOptions coarse;
+  coarse.grid_spacing_m = 0.15;
+  const NavigationField fields[2] = {NavigationField::ToExit(v, "door"), NavigationField::ToExit(v, "door", coarse)};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> start(-0.5, 10.5), step(-0.03, 0.03);
+  NavigationField::CellCache cache;
+  for (int walk = 0; walk < 200; ++walk) {
+    Vec2 p{start(rng), start(rng) * 0.5};
+    for (int k = 0; k < 50; ++k) {
+      const NavigationField& f = fields[(walk + k / 25) % 2];
+      const Vec2 plain = f.Direction(p), cached = f.Direction(p, cache);
+      ASSERT_EQ(plain.x, cached.x) << p.x << ", " << p.y;
+      ASSERT_EQ(plain.y, cached.y) << p.x << ", " << p.y;
+      p += Vec2{step(rng), step(rng)};
+    }
+  }
+  EXPECT_TRUE(cache.field == &fields[0] || cache.field == &fields[1]);
+}
+
 }  // namespace
 }  // namespace crowdrecon::geometry

@@ -75,6 +75,21 @@ class NavigationField {
   // reached (a disconnected part of the venue) or p is far outside the area.
   // (Inline for the constant field: the engine asks once per person and step.)
   Vec2 Direction(Vec2 p) const { return constant_ ? constant_direction_ : FieldDirection(p); }
+
+  // The nodes of the grid cell a caller last sampled, as Direction reads them.
+  // A walking person stays in one cell (0.1 m) for a hundred steps or more,
+  // while the grid of a large venue is megabytes (the 55 m x 35 m ground
+  // floor: 4.6 MB), so reading it afresh for every person at every step
+  // missed the caches on most reads. The engine keeps one per person.
+  struct CellCache {
+    const NavigationField* field = nullptr;  // whose cell this is (none yet)
+    std::size_t cell = 0;                    // j * nx + i of its lower-left node
+    Vec2 direction[4];                       // of nodes (i, j), (i+1, j), (i, j+1), (i+1, j+1)
+    unsigned valid = 0;                      // bit c: node c reachable (finite distance)
+  };
+  // Direction(p), bit for bit, reading the grid only when p's cell is not the
+  // one in `cache` (which it then holds).
+  Vec2 Direction(Vec2 p, CellCache& cache) const { return constant_ ? constant_direction_ : CachedDirection(p, cache); }
   // Geodesic distance to the exit at p (m), bilinearly interpolated;
   // +infinity where unreachable. For a constant field: 0.
   double Distance(Vec2 p) const;
@@ -92,6 +107,8 @@ class NavigationField {
 
  private:
   Vec2 FieldDirection(Vec2 p) const;
+  Vec2 CachedDirection(Vec2 p, CellCache& cache) const;
+  Vec2 NearestNodeDirection(Vec2 p) const;
 
   bool constant_ = true;
   Vec2 constant_direction_;
