@@ -184,7 +184,7 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
         lo = std::min(lo, q.chi2);
         hi = std::max(hi, q.chi2);
       }
-    if (!(hi > lo)) hi = lo + 1.0;
+    hi = std::max(hi, lo + 1.25 * 3.841);  // the 95 % line always shows
     viz::ChartPanel& panel = sheet.AddPanel(p.path + " (" + pr.determination + ")", "chi2", p.min, p.max,
                                             std::max(0.0, lo - 0.1 * (hi - lo)), hi + 0.1 * (hi - lo), 260);
 

@@ -38,15 +38,24 @@ WindowMean MeanOver(const observe::Observation& obs, const observe::Series& seri
   return w;
 }
 
-// Onsets of the events of a kind, region and direction, sorted (a censored
-// stop, under way when the series began, has no observed onset).
+// Onsets of the events of a kind, region and direction ("any": every
+// direction, merged), sorted (a censored stop, under way when the series
+// began, has no observed onset).
 std::vector<double> Onsets(const observe::Observation& obs, const std::string& kind, const std::string& where,
                            const std::string& direction) {
   std::vector<double> t;
+  const bool any = direction == "any";
   for (const observe::Event& e : obs.events)
-    if (e.kind == kind && e.where == where && e.direction == direction && !e.censored) t.push_back(e.time_s);
+    if (e.kind == kind && e.where == where && (any || e.direction == direction) && !e.censored) t.push_back(e.time_s);
   std::sort(t.begin(), t.end());
-  return t;
+  if (!any) return t;
+  // Any direction: one surge seen in several directions (each group's and the
+  // crowd's detector) within kSameEventS of the first counts once.
+  constexpr double kSameEventS = 2.0;
+  std::vector<double> merged;
+  for (double x : t)
+    if (merged.empty() || x - merged.back() > kSameEventS) merged.push_back(x);
+  return merged;
 }
 
 std::string Window(double a, double b) { return "[" + FormatNumber(a) + ", " + FormatNumber(b) + ") s"; }

@@ -223,6 +223,35 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   EXPECT_DOUBLE_EQ(values[0], 1.0);
 }
 
+// The run's avalanches in "any" direction: one surge seen by two detectors
+// within 2 s counts once.
+TEST(CalibrationStatistics, AvalanchesOfAnyDirectionCountOnce) {
+  observe::Observation run;
+  for (const auto& [t, who] : std::vector<std::pair<double, std::string>>{{10.0, "counter"}, {11.5, "crowd"}, {30.0, "leaving"}}) {
+    observe::Event e;
+    e.kind = "avalanche";
+    e.where = "run";
+    e.direction = who;
+    e.time_s = t;
+    run.events.push_back(e);
+  }
+  Statistic st;
+  st.is_count = true;
+  st.quantity = "avalanche";
+  st.where = "run";
+  st.direction = "any";
+  st.sim_from_s = 0.0;
+  st.sim_to_s = 100.0;
+  CalibrationSpec spec;
+  spec.observations.resize(1);
+  std::vector<double> values;
+  SimulatedStatistics(spec, 0, run, {st}, &values);
+  EXPECT_EQ(values[0], 2.0);
+  st.direction = "crowd";
+  SimulatedStatistics(spec, 0, run, {st}, &values);
+  EXPECT_EQ(values[0], 1.0);
+}
+
 TEST(CalibrationFile, DefaultsFromTheParameterTableAndTheScenario) {
   const auto file = ScratchFile("made.observation.json");
   observe::WriteObservation(MadeObservation(), file);
