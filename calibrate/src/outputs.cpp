@@ -55,6 +55,7 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                       {"start", spec.parameters[i].start}, {"sigma", Num(p.sigma)},
                       {"ci95", {Num(p.lo95), Num(p.hi95)}}, {"bootstrap_sigma", Num(p.bootstrap_sigma)},
                       {"bootstrap_ci95", {Num(p.bootstrap_lo95), Num(p.bootstrap_hi95)}},
+                      {"relative_half_width_95", Num(p.value != 0 ? 1.96 * p.sigma / std::abs(p.value) : kNaN)},
                       {"determination", p.determination}, {"reason", p.reason}});
   }
   j["parameters"] = params;
@@ -123,6 +124,8 @@ std::string Report(const CalibrationResult& r) {
     o << "  " << p.path << " = " << Fixed(p.value, 4) << "   [" << Fixed(p.lo95) << ", " << Fixed(p.hi95) << "] | ["
       << Fixed(p.bootstrap_lo95) << ", " << Fixed(p.bootstrap_hi95) << "]   range [" << FormatNumber(p.min) << ", "
       << FormatNumber(p.max) << "]: " << p.determination;
+    if (p.determination != "undetermined" && std::isfinite(p.sigma) && p.value != 0)
+      o << " to +-" << Fixed(100.0 * 1.96 * p.sigma / std::abs(p.value), 2) << " % (95 %)";
     if (!p.reason.empty()) o << " (" << p.reason << ")";
     o << "\n";
   }
