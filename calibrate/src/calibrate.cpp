@@ -164,7 +164,7 @@ class Calibration {
         chi2.push_back(r_.objective.Chi2(sets[s].mean));
         res.push_back(r_.objective.Residuals(sets[s].mean));
       }
-      const auto scatter = [&](const std::vector<double>& y, int degree, double* slope) {
+      const auto scatter = [&](const std::vector<double>& y, double* slope) {
         std::vector<Point> pts;
         std::vector<std::vector<double>> vals;
         for (std::size_t s = 0; s < y.size(); ++s)
@@ -174,18 +174,17 @@ class Calibration {
           }
         Quadratic q;
         if (pts.size() < 4 || !q.Fit(pts, vals, {0.0}, 1.0)) return kNaN;
-        (void)degree;
         if (slope) *slope = q.Gradient(0, {0.0})[0];
         return q.rms[0] * std::sqrt(static_cast<double>(pts.size()) / static_cast<double>(pts.size() - 3));
       };
-      nr.chi2_noise_sd = scatter(chi2, 2, nullptr);
+      nr.chi2_noise_sd = scatter(chi2, nullptr);
       double pooled = 0.0, count = 0.0;
       std::vector<double> signal;
       for (std::size_t j = 0; j < r_.objective.statistics.size(); ++j) {
         std::vector<double> y;
         for (const auto& rr : res) y.push_back(rr[j]);
         double slope = kNaN;
-        const double sd = scatter(y, 1, &slope);
+        const double sd = scatter(y, &slope);
         if (!std::isfinite(sd)) continue;
         pooled += sd * sd;
         count += 1.0;
@@ -347,7 +346,6 @@ class Calibration {
     const std::size_t k = spec_.base.seeds.size();
     std::uniform_int_distribution<std::size_t> pick(0, k - 1);
     std::normal_distribution<double> normal(0.0, 1.0);
-    const double kd = static_cast<double>(k);
     for (int rep = 0; rep < spec_.options.bootstrap; ++rep) {
       std::vector<std::size_t> draw(k);
       for (std::size_t& d : draw) d = pick(rng);
@@ -369,7 +367,6 @@ class Calibration {
         for (std::size_t j = 0; j < mean.size(); ++j) mean[j] = count[j] > 0 ? mean[j] / count[j] : kNaN;
         means.push_back(mean);
       }
-      (void)kd;
       Quadratic q;
       if (!q.Fit(design, means, c, half)) continue;
       r_.bootstrap.push_back(ev_.FromUnit(MinimiseSurrogate(q, o, best).u));

@@ -113,6 +113,7 @@ Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& 
     while (k < spec_json_.size() && spec_json_[k] != j) ++k;
     if (k == spec_json_.size()) {
       spec_json_.push_back(j);
+      specs_.push_back(j == kRunEvents ? observe::ObservationSpec{} : m.observation.spec);
       spec_tag_.push_back(j == kRunEvents ? std::string("events") : Sha256Hex(j).substr(0, 12));
     }
     spec_of_observation_.push_back(k);
@@ -167,7 +168,7 @@ SetResult Evaluator::Load(const std::vector<double>& values, const std::string& 
       for (const std::string& tag : spec_tag_) simulated.push_back(ReadCompact(d / (stem + "-" + tag + ".json")));
       for (std::size_t i = 0; i < spec_.observations.size(); ++i) {
         std::vector<double> part;
-        SimulatedStatistics(spec_, i, simulated[spec_of_observation_[i]], statistics_, &part);
+        SimulatedStatistics(i, simulated[spec_of_observation_[i]], statistics_, &part);
         for (std::size_t j = 0; j < n; ++j)
           if (statistics_[j].observation == i) row[j] = part[j];
       }
@@ -240,7 +241,7 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
         o = RunEvents(run_file);
       } else {
         if (!t) t = observe::ReadTrajectories(run_file);
-        o = observe::ObserveTrajectories(*t, observe::ParseObservationSpec(spec_json_[k], "observation spec"));
+        o = observe::ObserveTrajectories(*t, specs_[k]);
       }
       WriteFileAtomically(d / (stem + "-" + spec_tag_[k] + ".json"), CompactObservation(o).dump());
     }

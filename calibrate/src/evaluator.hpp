@@ -66,6 +66,7 @@ class Evaluator {
   std::size_t runs_simulated_ = 0;
   // Distinct observation specs (JSON) and, per observation, its spec's index.
   std::vector<std::string> spec_json_, spec_tag_;
+  std::vector<observe::ObservationSpec> specs_;  // parsed once, used by every run's hook
   std::vector<std::size_t> spec_of_observation_;
   std::map<std::string, SetResult> known_;
 };

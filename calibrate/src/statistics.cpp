@@ -17,13 +17,12 @@ struct WindowMean {
   double standard_error = kNaN;
 };
 
-// Mean of the bins of `series` whose centres lie in [from, to) (observation
-// clock shifted by `shift`: a bin at t counts where t - shift is inside).
-WindowMean MeanOver(const observe::Observation& obs, const observe::Series& series, double from, double to, double shift) {
+// Mean of the bins of `series` whose centres lie in [from, to).
+WindowMean MeanOver(const observe::Observation& obs, const observe::Series& series, double from, double to) {
   double sum = 0.0, sum_u2 = 0.0;
   std::size_t n = 0;
   for (std::size_t k = 0; k < series.points.size(); ++k) {
-    const double t = obs.t0_s + (static_cast<double>(k) + 0.5) * obs.bin_s - shift;
+    const double t = obs.t0_s + (static_cast<double>(k) + 0.5) * obs.bin_s;
     if (t < from || t >= to) continue;
     const observe::SeriesPoint& p = series.points[k];
     if (!std::isfinite(p.value)) continue;
@@ -72,7 +71,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
       const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;
       for (double a = s.from_s; a < s.to_s - 1e-9; a += width) {
         const double b = std::min(a + width, s.to_s);
-        const WindowMean w = MeanOver(m.observation, *series, a, b, 0.0);
+        const WindowMean w = MeanOver(m.observation, *series, a, b);
         if (!std::isfinite(w.mean))
           throw InputError(spec.origin + ": " + m.file.string() + ": series " + s.quantity + " " + s.where + " " +
                            s.direction + " has no value in the window " + Window(a, b) +
@@ -123,9 +122,8 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
   return out;
 }
 
-void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
+void SimulatedStatistics(std::size_t index, const observe::Observation& simulated,
                          const std::vector<Statistic>& statistics, std::vector<double>* values) {
-  (void)spec;
   values->assign(statistics.size(), kNaN);
   for (std::size_t j = 0; j < statistics.size(); ++j) {
     const Statistic& st = statistics[j];
@@ -137,7 +135,7 @@ void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const o
       (*values)[j] = n;
     } else {
       const observe::Series* series = simulated.Find(st.quantity, st.where, st.direction);
-      if (series) (*values)[j] = MeanOver(simulated, *series, st.sim_from_s, st.sim_to_s, 0.0).mean;
+      if (series) (*values)[j] = MeanOver(simulated, *series, st.sim_from_s, st.sim_to_s).mean;
     }
   }
 }

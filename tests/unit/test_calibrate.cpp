@@ -201,7 +201,7 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   EXPECT_EQ(st[4].observed, 2.0);
   // A simulated observation equal to the observed one reads the same values ...
   std::vector<double> values;
-  SimulatedStatistics(spec, 0, MadeObservation(), st, &values);
+  SimulatedStatistics(0, MadeObservation(), st, &values);
   for (std::size_t j = 0; j < st.size(); ++j) EXPECT_DOUBLE_EQ(values[j], st[j].observed) << st[j].name;
   // ... and one whose clock runs 1 s later, with the offset, too.
   observe::Observation later = MadeObservation();
@@ -209,7 +209,7 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   for (observe::Event& e : later.events) e.time_s += 1.0;
   CalibrationSpec shifted = spec;
   shifted.observations[0].time_offset_s = 1.0;
-  SimulatedStatistics(shifted, 0, later, ObservedStatistics(shifted), &values);
+  SimulatedStatistics(0, later, ObservedStatistics(shifted), &values);
   for (std::size_t j = 0; j < st.size(); ++j) EXPECT_DOUBLE_EQ(values[j], st[j].observed) << st[j].name;
   // A simulated window of its own: the observed [5, 10) against the run's [0, 5).
   std::string text = Calibration(file.string(), R"([{"path": "model.back_force_gamma"}])");
@@ -219,7 +219,7 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   const CalibrationSpec own = ParseCalibration(text, "cal.json", "");
   const std::vector<Statistic> ost = ObservedStatistics(own);
   EXPECT_DOUBLE_EQ(ost[0].observed, 0.5);
-  SimulatedStatistics(own, 0, MadeObservation(), ost, &values);
+  SimulatedStatistics(0, MadeObservation(), ost, &values);
   EXPECT_DOUBLE_EQ(values[0], 1.0);
 }
 
@@ -242,13 +242,11 @@ TEST(CalibrationStatistics, AvalanchesOfAnyDirectionCountOnce) {
   st.direction = "any";
   st.sim_from_s = 0.0;
   st.sim_to_s = 100.0;
-  CalibrationSpec spec;
-  spec.observations.resize(1);
   std::vector<double> values;
-  SimulatedStatistics(spec, 0, run, {st}, &values);
+  SimulatedStatistics(0, run, {st}, &values);
   EXPECT_EQ(values[0], 2.0);
   st.direction = "crowd";
-  SimulatedStatistics(spec, 0, run, {st}, &values);
+  SimulatedStatistics(0, run, {st}, &values);
   EXPECT_EQ(values[0], 1.0);
 }
 

@@ -38,7 +38,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec);
 // simulated run's observation, over their simulated windows (the observed
 // ones shifted by the observation's time offset, or the match's own). NaN
 // where a window holds no value.
-void SimulatedStatistics(const CalibrationSpec& spec, std::size_t index, const observe::Observation& simulated,
+void SimulatedStatistics(std::size_t index, const observe::Observation& simulated,
                          const std::vector<Statistic>& statistics, std::vector<double>* values);
 
 }  // namespace crowdrecon::calibrate
