@@ -79,7 +79,8 @@ class TimelineEventSystem : public RunSystem {
         for (const auto& [name, value] : e.parameters) {
           detail += (detail.empty() ? "" : ", ") + name + " = " + FormatNumber(value);
           if (name == "desired_speed_m_per_s") {
-            ForGroup(sim, e.group, [&](std::uint32_t i) { sim.SetDesiredSpeed(i, value); });
+            const double speed = value;  // (a structured binding is not captured before clang 16)
+            ForGroup(sim, e.group, [&](std::uint32_t i) { sim.SetDesiredSpeed(i, speed); });
             for (std::size_t g = 0; g < s_.group_speed.size(); ++g)
               if (e.group.empty() || g == GroupIndex(s_.spec, e.group)) s_.group_speed[g] = value;
           } else if (!e.group.empty()) {

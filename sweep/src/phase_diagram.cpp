@@ -324,8 +324,9 @@ void DrawPath(Page& page, const Layout& L, const PathOverlay& path) {
   std::vector<std::pair<double, double>> labelled;  // a label per place: clamped points pile up at the edges
   for (const auto& [index, text] : path.labels) {
     if (index >= pts.size()) continue;
+    const std::pair<double, double> spot = pts[index];  // (a structured binding is not captured before clang 16)
     const bool crowded = std::any_of(labelled.begin(), labelled.end(), [&](const std::pair<double, double>& q) {
-      return std::abs(q.first - pts[index].first) < 40.0 && std::abs(q.second - pts[index].second) < 14.0;
+      return std::abs(q.first - spot.first) < 40.0 && std::abs(q.second - spot.second) < 14.0;
     });
     if (crowded) continue;
     labelled.push_back(pts[index]);
