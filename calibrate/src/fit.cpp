@@ -199,8 +199,15 @@ void Bound(ceres::Problem* problem, double* u, std::size_t p) {
   }
 }
 
-// The gradient approach's residuals: the caller's function, evaluated at
-// the point Ceres asks for (its Jacobian by the caller's central differences).
+// The gradient approach's residuals: the caller's function of the point
+// Ceres asks for clamped into the box [0, 1]^p (its Jacobian by the caller's
+// central differences). The clamp replaces Ceres' bounds: on a bounded
+// problem Ceres evaluates a Jacobian at every trial point (its projection
+// onto the bounds searches along a gradient), 14 Jacobians instead of 2 in
+// 5 iterations of a small test, and here each Jacobian is a stencil of
+// 2p + 1 parameter sets. Clamped, a trial point costs one set and a
+// Jacobian is asked for only where a step was accepted. Outside the box the
+// clamped function does not depend on that coordinate: its column is zero.
 class FunctionCost final : public ceres::CostFunction {
  public:
   FunctionCost(const ResidualFunction& f, std::size_t residuals, std::size_t p) : f_(f), p_(p) {
@@ -208,12 +215,18 @@ class FunctionCost final : public ceres::CostFunction {
     mutable_parameter_block_sizes()->push_back(static_cast<int>(p));
   }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const std::vector<double> u(parameters[0], parameters[0] + p_);
+    std::vector<double> u(parameters[0], parameters[0] + p_);
+    for (double& x : u) x = std::clamp(x, 0.0, 1.0);
     std::vector<double> r, j;
     const bool want = jacobians && jacobians[0];
     if (!f_(u, &r, want ? &j : nullptr)) return false;
     std::copy(r.begin(), r.end(), residuals);
-    if (want) std::copy(j.begin(), j.end(), jacobians[0]);
+    if (want) {
+      for (std::size_t i = 0; i < p_; ++i)
+        if (parameters[0][i] != u[i])
+          for (std::size_t k = 0; k < r.size(); ++k) j[k * p_ + i] = 0.0;
+      std::copy(j.begin(), j.end(), jacobians[0]);
+    }
     return true;
   }
 
@@ -252,12 +265,11 @@ Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const
   m.u = start;
   ceres::Problem problem;
   problem.AddResidualBlock(new FunctionCost(f, residuals, start.size()), nullptr, m.u.data());
-  Bound(&problem, m.u.data(), start.size());
   ceres::Solver::Options options = SolverOptions(max_iterations);
-  // Each evaluation is K runs: no line search, no extra evaluations.
   options.max_num_consecutive_invalid_steps = 3;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
+  for (double& x : m.u) x = std::clamp(x, 0.0, 1.0);
   m.iterations = static_cast<int>(summary.iterations.size());
   m.termination = summary.BriefReport();
   m.chi2 = 2.0 * summary.final_cost;

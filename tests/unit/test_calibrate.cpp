@@ -101,6 +101,46 @@ TEST(Surrogate, CeresFindsTheParametersThatReproduceTheObservation) {
   EXPECT_GT(held.chi2, 0.0);
 }
 
+// The gradient approach's minimiser: residuals r = A (u - target) with
+// Jacobians by the function itself. It finds a minimum inside the box and
+// one beyond its edge (clamped onto the edge), and asks for a Jacobian only
+// at the start and where a step was accepted, never at every trial point
+// (each Jacobian is a stencil of 2p + 1 parameter sets).
+TEST(GradientSearch, FindsMinimaInsideAndOnTheEdgeWithFewJacobians) {
+  for (const std::vector<double>& target : {std::vector<double>{0.3, 0.7}, std::vector<double>{1.4, 0.2}}) {
+    int jacobians = 0, evaluations = 0;
+    const ResidualFunction f = [&](const std::vector<double>& u, std::vector<double>* r, std::vector<double>* j) {
+      EXPECT_GE(u[0], 0.0);
+      EXPECT_LE(u[0], 1.0);
+      ++evaluations;
+      const double a[3][2] = {{2.0, 0.5}, {0.0, 1.5}, {1.0, -1.0}};
+      r->assign(3, 0.0);
+      for (int k = 0; k < 3; ++k) (*r)[k] = a[k][0] * (u[0] - target[0]) + a[k][1] * (u[1] - target[1]);
+      if (j) {
+        ++jacobians;
+        j->assign(6, 0.0);
+        for (int k = 0; k < 3; ++k)
+          for (int i = 0; i < 2; ++i) (*j)[static_cast<std::size_t>(k * 2 + i)] = a[k][i];
+      }
+      return true;
+    };
+    const Minimum m = MinimiseFunction(f, 3, {0.9, 0.1}, 20);
+    const double expected0 = std::min(target[0], 1.0);
+    EXPECT_NEAR(m.u[0], expected0, 1e-6) << m.termination;
+    if (target[0] <= 1.0) {
+      EXPECT_NEAR(m.u[1], target[1], 1e-6) << m.termination;
+    } else {
+      // u0 held at the edge: the best u1 minimises |A (u - target)| with u0 = 1.
+      // d/du1: sum_k a_k1 (a_k0 (1 - t0) + a_k1 (u1 - t1)) = 0.
+      const double d0 = 1.0 - target[0];
+      const double num = -(2.0 * 0.5 * d0 + 0.0 + 1.0 * -1.0 * d0);
+      const double den = 0.5 * 0.5 + 1.5 * 1.5 + 1.0;
+      EXPECT_NEAR(m.u[1], target[1] + num / den, 1e-4) << m.termination;  // Ceres' function tolerance
+    }
+    EXPECT_LE(jacobians, m.iterations + 1) << evaluations << " evaluations";
+  }
+}
+
 TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   // Linear statistics m = A u + b with sigma 0.5: covariance (JᵀJ)⁻¹, J = A / 0.5.
   const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
