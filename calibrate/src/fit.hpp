@@ -63,11 +63,11 @@ Minimum MinimiseSurrogate(const Quadratic& q, const Objective& objective, const 
 // Residuals and (when jacobian is not null) their Jacobian, row-major
 // [residual][coordinate], at u; false when they cannot be had (interrupted,
 // a statistic undefined). The gradient approach's function.
-// MinimiseFunction: Ceres (Levenberg-Marquardt) from `start`, f evaluated at
-// the point clamped into [0, 1]^p (rather than Ceres' bounds, which ask for a
-// Jacobian at every trial point); the minimum returned inside the box.
 using ResidualFunction = std::function<bool(const std::vector<double>& u, std::vector<double>* residuals,
                                             std::vector<double>* jacobian)>;
+// Ceres (Levenberg-Marquardt) from `start`, f evaluated at the point clamped
+// into [0, 1]^p (rather than under Ceres' bounds, which ask for a Jacobian at
+// every trial point); the minimum returned inside the box.
 Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const std::vector<double>& start,
                          int max_iterations);
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <sstream>
 
@@ -20,7 +19,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -55,7 +53,7 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                       {"start", spec.parameters[i].start}, {"sigma", Num(p.sigma)},
                       {"ci95", {Num(p.lo95), Num(p.hi95)}}, {"bootstrap_sigma", Num(p.bootstrap_sigma)},
                       {"bootstrap_ci95", {Num(p.bootstrap_lo95), Num(p.bootstrap_hi95)}},
-                      {"relative_half_width_95", Num(p.value != 0 ? 1.96 * p.sigma / std::abs(p.value) : kNaN)},
+                      {"relative_half_width_95", Num(p.RelativeHalfWidth95())},
                       {"determination", p.determination}, {"reason", p.reason}});
   }
   j["parameters"] = params;
@@ -124,8 +122,8 @@ std::string Report(const CalibrationResult& r) {
     o << "  " << p.path << " = " << Fixed(p.value, 4) << "   [" << Fixed(p.lo95) << ", " << Fixed(p.hi95) << "] | ["
       << Fixed(p.bootstrap_lo95) << ", " << Fixed(p.bootstrap_hi95) << "]   range [" << FormatNumber(p.min) << ", "
       << FormatNumber(p.max) << "]: " << p.determination;
-    if (p.determination != "undetermined" && std::isfinite(p.sigma) && p.value != 0)
-      o << " to +-" << Fixed(100.0 * 1.96 * p.sigma / std::abs(p.value), 2) << " % (95 %)";
+    if (p.determination != "undetermined" && std::isfinite(p.RelativeHalfWidth95()))
+      o << " to +-" << Fixed(100.0 * p.RelativeHalfWidth95(), 2) << " % (95 %)";
     if (!p.reason.empty()) o << " (" << p.reason << ")";
     o << "\n";
   }

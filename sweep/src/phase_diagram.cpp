@@ -329,9 +329,9 @@ void DrawPath(Page& page, const Layout& L, const PathOverlay& path) {
       return std::abs(q.first - spot.first) < 40.0 && std::abs(q.second - spot.second) < 14.0;
     });
     if (crowded) continue;
-    labelled.push_back(pts[index]);
-    page.canvas.Dot(page.P(pts[index].first, pts[index].second), 4.5, ink);
-    page.canvas.TextPxAligned(pts[index].first + 7, pts[index].second - 7, text, 12, 0.0, 1.0, ink, 0.0, true);
+    labelled.push_back(spot);
+    page.canvas.Dot(page.P(spot.first, spot.second), 4.5, ink);
+    page.canvas.TextPxAligned(spot.first + 7, spot.second - 7, text, 12, 0.0, 1.0, ink, 0.0, true);
   }
   if (!path.caption.empty())
     page.canvas.TextPxAligned(L.left, L.height - 32, path.caption, 12, 0.0, 0.0, ink);

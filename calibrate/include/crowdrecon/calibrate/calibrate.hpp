@@ -18,7 +18,9 @@
 // interrupted calibration resumes where it stopped and repeats nothing.
 #pragma once
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,6 +45,9 @@ struct ParameterResult {
   // covariance could not be computed) and the bootstrap's percentiles.
   double sigma = 0.0, lo95 = 0.0, hi95 = 0.0;
   double bootstrap_sigma = 0.0, bootstrap_lo95 = 0.0, bootstrap_hi95 = 0.0;
+  // The covariance's 95 % half-width as a fraction of the value (NaN where
+  // either is unknown or the value is 0): how precisely "determined".
+  double RelativeHalfWidth95() const { return value != 0.0 ? 1.96 * sigma / std::abs(value) : std::numeric_limits<double>::quiet_NaN(); }
   // "determined", "bounded on one side" or "undetermined", with the reason.
   std::string determination;
   std::string reason;
