@@ -141,6 +141,7 @@ SeriesMatch ReadSeriesMatch(const JsonReader& item, const observe::Observation& 
   if (m.window_s > 0 && (m.to_s - m.from_s) / m.window_s > 10000)
     item.At("window_s").Fail("more than 10,000 windows; expected a longer window");
   m.relative_error = item.Number("relative_error", 0.0, 0.0, 10.0);
+  m.take_max = item.Choice("reduce", "mean", {"mean", "max"}) == "max";
   if (item.Has("simulated_from_s") || item.Has("simulated_to_s")) {
     m.simulated_from_s = item.Number("simulated_from_s", -1e9, 1e9);
     m.simulated_to_s = item.Number("simulated_to_s", -1e9, 1e9);
@@ -170,6 +171,106 @@ EventMatch ReadEventMatch(const JsonReader& item, const observe::Observation& ob
     item.Fail("the window [" + FormatNumber(m.from_s) + ", " + FormatNumber(m.to_s) + "] s is empty; expected from_s < to_s");
   item.Finish();
   return m;
+}
+
+// {"recorded": {"kind": "avalanche", "direction", "from_s", "to_s"}}: events
+// recorded of the incident, observed times from the scenario's
+// timeline.recorded marks, simulated ones from the run's event table.
+void ReadRecordedAvalanches(const JsonReader& recorded, const scenario::Scenario& sc, ObservationMatch* m) {
+  EventMatch e;
+  e.kind = m->recorded_kind;
+  e.where = "run";
+  e.direction = recorded.String("direction", "crowd");
+  double last = 0.0;
+  for (const scenario::RecordedMark& mark : sc.timeline.recorded)
+    if (mark.kind == m->recorded_kind) {
+      observe::Event ev;
+      ev.kind = e.kind;
+      ev.where = e.where;
+      ev.direction = e.direction;
+      ev.time_s = mark.time_s;
+      m->observation.events.push_back(ev);
+      last = std::max(last, mark.time_s);
+    }
+  if (m->observation.events.empty())
+    recorded.Fail("the scenario records no \"" + m->recorded_kind + "\" in timeline.recorded; expected the times of "
+                  "the incident's events there (docs/scenarios.md)");
+  e.from_s = recorded.Number("from_s", 0.0, -1e9, 1e9);
+  e.to_s = recorded.Number("to_s", std::max(sc.run.duration_s, last), -1e9, 1e9);
+  if (!(e.to_s > e.from_s)) recorded.Fail("the window is empty; expected from_s < to_s");
+  m->events.push_back(e);
+}
+
+// The regions of a spec, listed for a message.
+std::string RegionNames(const observe::ObservationSpec& spec) {
+  std::string list;
+  for (const observe::Region& r : spec.regions) list += (list.empty() ? "\"" : ", \"") + r.name + "\"";
+  return list;
+}
+
+// {"recorded": {"kind": "max_speed", "spec": FILE, "where": REGION, "from_s", "to_s"}}:
+// each speed the scenario's timeline.recorded reads from the footage becomes
+// a statistic: the largest bin of the run's max_speed series in REGION
+// (observed with the spec) within a window around its mark -- by default
+// from the mark before it to the mark after it (the part of the incident the
+// footage of that moment belongs to: the simulated night need not place its
+// avalanches at the recorded times, and the avalanche times are matched
+// separately), else the given one.
+void ReadRecordedMaxSpeed(const JsonReader& recorded, const scenario::Scenario& sc, const fs::path& dir,
+                          ObservationMatch* m) {
+  const JsonReader spec_file = recorded.At("spec");
+  fs::path file = fs::path(spec_file.AsString());
+  if (file.is_relative()) file = (dir / file).lexically_normal();
+  try {
+    m->observation.spec = observe::ReadObservationSpec(file);
+  } catch (const InputError& e) {
+    spec_file.Fail(std::string("cannot use the observation spec: ") + e.what());
+  }
+  const std::string where = recorded.String("where");
+  const auto& regions = m->observation.spec.regions;
+  if (std::none_of(regions.begin(), regions.end(), [&](const observe::Region& r) { return r.name == where; }))
+    recorded.At("where").Fail("the spec has no region \"" + where + "\"; expected one of " + RegionNames(m->observation.spec));
+  m->observation.t0_s = 0.0;
+  m->observation.bin_s = m->observation.spec.bin_s;
+  std::vector<scenario::RecordedMark> marks = sc.timeline.recorded;
+  std::stable_sort(marks.begin(), marks.end(), [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
+  const bool has_from = recorded.Has("from_s"), has_to = recorded.Has("to_s");
+  const double from = recorded.Number("from_s", 0.0, -1e9, 1e9);
+  const double to = recorded.Number("to_s", 0.0, -1e9, 1e9);
+  for (std::size_t k = 0; k < marks.size(); ++k) {
+    if (!marks[k].HasMaxSpeed()) continue;
+    SeriesMatch s;
+    s.quantity = "max_speed";
+    s.where = where;
+    s.direction = "all";
+    s.take_max = true;
+    s.from_s = has_from ? from : (k > 0 ? marks[k - 1].time_s : 0.0);
+    s.to_s = has_to ? to : (k + 1 < marks.size() ? marks[k + 1].time_s : std::max(sc.run.duration_s, marks[k].time_s));
+    if (!(s.to_s > s.from_s))
+      recorded.Fail("the window [" + FormatNumber(s.from_s) + ", " + FormatNumber(s.to_s) + "] s around the mark \"" +
+                    marks[k].label + "\" is empty; expected from_s < to_s");
+    if (marks[k].time_s < s.from_s || marks[k].time_s > s.to_s)
+      recorded.Fail("the window [" + FormatNumber(s.from_s) + ", " + FormatNumber(s.to_s) + "] s leaves out the mark \"" +
+                    marks[k].label + "\" at " + FormatNumber(marks[k].time_s) + " s; expected a window around it");
+    s.recorded_value = marks[k].max_speed_m_per_s;
+    s.recorded_sigma = marks[k].max_speed_uncertainty_m_per_s;
+    m->series.push_back(s);
+  }
+  if (m->series.empty())
+    recorded.Fail("the scenario records no speed in timeline.recorded; expected a mark with \"max_speed_m_per_s\" "
+                  "and \"max_speed_uncertainty_m_per_s\" (docs/scenarios.md)");
+}
+
+// Velocities over the spec's span need frames that close: a run written at
+// too few frames per second would measure them over a longer span (slower
+// peaks, smoother speeds) than the observation did.
+void CheckFramesForVelocities(const JsonReader& item, const observe::ObservationSpec& spec, double output_fps) {
+  const int half_span = std::max(1, static_cast<int>(std::lround(spec.velocity_span_s * output_fps / 2.0)));
+  const double span = 2.0 * half_span / output_fps;
+  if (span > 1.5 * spec.velocity_span_s)
+    item.Fail("the runs write " + FormatNumber(output_fps) + " frames/s, so their velocities would span " +
+              FormatNumber(span) + " s against the observation's " + FormatNumber(spec.velocity_span_s) +
+              " s; expected run.output_fps of at least " + FormatNumber(2.0 / spec.velocity_span_s) + " (in \"set\")");
 }
 
 }  // namespace
@@ -212,40 +313,21 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
   // 3. The observations and what to match in each.
   const JsonReader observations = root.At("observations");
   if (observations.Size() == 0) observations.Fail("expected at least one observation file");
+  const scenario::Scenario sc = sweep::RunScenarioOf(c.base, sweep::RunPlan{0, "base", 0, {}, c.base.seeds[0], ""});
   for (std::size_t i = 0; i < observations.Size(); ++i) {
     const JsonReader item = observations.Element(i);
     if (!item.IsObject()) item.Fail("expected {\"file\": ..., \"series\": [...]}, found " + item.ValueText());
     ObservationMatch m;
     if (auto recorded = item.Find("recorded")) {
-      // Events recorded of the incident: observed times from the scenario's
-      // timeline.recorded marks, simulated ones from the run's event table.
-      m.recorded_kind = recorded->Choice("kind", {"avalanche"});
-      EventMatch e;
-      e.kind = m.recorded_kind;
-      e.where = "run";
-      e.direction = recorded->String("direction", "crowd");
-      const scenario::Scenario sc = sweep::RunScenarioOf(c.base, sweep::RunPlan{0, "base", 0, {}, c.base.seeds[0], ""});
-      double last = 0.0;
-      for (const scenario::RecordedMark& mark : sc.timeline.recorded)
-        if (mark.kind == m.recorded_kind) {
-          observe::Event ev;
-          ev.kind = e.kind;
-          ev.where = e.where;
-          ev.direction = e.direction;
-          ev.time_s = mark.time_s;
-          m.observation.events.push_back(ev);
-          last = std::max(last, mark.time_s);
-        }
-      if (m.observation.events.empty())
-        recorded->Fail("the scenario records no \"" + m.recorded_kind + "\" in timeline.recorded; expected the times of "
-                       "the incident's events there (docs/scenarios.md)");
-      const double duration = sc.run.duration_s;
-      e.from_s = recorded->Number("from_s", 0.0, -1e9, 1e9);
-      e.to_s = recorded->Number("to_s", std::max(duration, last), -1e9, 1e9);
-      if (!(e.to_s > e.from_s)) recorded->Fail("the window is empty; expected from_s < to_s");
+      m.recorded_kind = recorded->Choice("kind", {"avalanche", "max_speed"});
       m.observation.method = "recorded";
       m.observation.source_file = c.base.scenario_file.string();
-      m.events.push_back(e);
+      if (m.recorded_kind == "max_speed") {
+        ReadRecordedMaxSpeed(*recorded, sc, dir, &m);
+        CheckFramesForVelocities(*recorded, m.observation.spec, sc.run.output_fps);
+      } else {
+        ReadRecordedAvalanches(*recorded, sc, &m);
+      }
       recorded->Finish();
       if (item.Has("file") || item.Has("series") || item.Has("events"))
         item.Fail("\"recorded\" stands alone: an observation is either a file or the scenario's recorded events");
@@ -261,6 +343,7 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
     } catch (const InputError& e) {
       file.Fail(std::string("cannot use the observation: ") + e.what());
     }
+    CheckFramesForVelocities(item, m.observation.spec, sc.run.output_fps);
     m.time_offset_s = item.Number("time_offset_s", 0.0, -1e9, 1e9);
     if (auto series = item.Find("series"))
       for (std::size_t k = 0; k < series->Size(); ++k) m.series.push_back(ReadSeriesMatch(series->Element(k), m.observation));

@@ -108,7 +108,7 @@ Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& 
   for (const ObservationMatch& m : spec_.observations) {
     // The scenario's recorded events compare with the run's event table: one
     // file per run of that table's events, whatever the spec.
-    const std::string j = m.recorded_kind.empty() ? observe::SpecToJson(m.observation.spec) : kRunEvents;
+    const std::string j = m.UsesRunEvents() ? kRunEvents : observe::SpecToJson(m.observation.spec);
     std::size_t k = 0;
     while (k < spec_json_.size() && spec_json_[k] != j) ++k;
     if (k == spec_json_.size()) {

@@ -37,6 +37,26 @@ WindowMean MeanOver(const observe::Observation& obs, const observe::Series& seri
   return w;
 }
 
+// The largest bin of `series` whose centre lies in [from, to), with that
+// bin's uncertainty.
+WindowMean MaxOver(const observe::Observation& obs, const observe::Series& series, double from, double to) {
+  WindowMean w;
+  for (std::size_t k = 0; k < series.points.size(); ++k) {
+    const double t = obs.t0_s + (static_cast<double>(k) + 0.5) * obs.bin_s;
+    const observe::SeriesPoint& p = series.points[k];
+    if (t < from || t >= to || !std::isfinite(p.value)) continue;
+    if (std::isnan(w.mean) || p.value > w.mean) {
+      w.mean = p.value;
+      w.standard_error = std::isfinite(p.uncertainty) ? p.uncertainty : 0.0;
+    }
+  }
+  return w;
+}
+
+WindowMean Reduce(bool take_max, const observe::Observation& obs, const observe::Series& series, double from, double to) {
+  return take_max ? MaxOver(obs, series, from, to) : MeanOver(obs, series, from, to);
+}
+
 // Onsets of the events of a kind, region and direction ("any": every
 // direction, merged), sorted (a censored stop, under way when the series
 // began, has no observed onset).
@@ -71,14 +91,18 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
       const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;
       for (double a = s.from_s; a < s.to_s - 1e-9; a += width) {
         const double b = std::min(a + width, s.to_s);
-        const WindowMean w = MeanOver(m.observation, *series, a, b);
+        // A value recorded of the incident stands for the observation's series.
+        const bool recorded = std::isfinite(s.recorded_value);
+        const WindowMean w = recorded ? WindowMean{s.recorded_value, s.recorded_sigma}
+                                      : Reduce(s.take_max, m.observation, *series, a, b);
         if (!std::isfinite(w.mean))
           throw InputError(spec.origin + ": " + m.file.string() + ": series " + s.quantity + " " + s.where + " " +
                            s.direction + " has no value in the window " + Window(a, b) +
                            "; expected a window where the observation has data (see its CSV)");
         Statistic st;
-        st.name = tag + s.quantity + " " + s.where + " " + s.direction + " " + Window(a, b);
-        st.unit = series->unit;
+        st.name = tag + s.quantity + " " + s.where + " " + s.direction + (s.take_max ? " max " : " ") + Window(a, b);
+        st.unit = recorded ? "m/s" : series->unit;
+        st.is_max = s.take_max;
         st.observation = i;
         st.quantity = s.quantity;
         st.where = s.where;
@@ -135,7 +159,7 @@ void SimulatedStatistics(std::size_t index, const observe::Observation& simulate
       (*values)[j] = n;
     } else {
       const observe::Series* series = simulated.Find(st.quantity, st.where, st.direction);
-      if (series) (*values)[j] = MeanOver(simulated, *series, st.sim_from_s, st.sim_to_s).mean;
+      if (series) (*values)[j] = Reduce(st.is_max, simulated, *series, st.sim_from_s, st.sim_to_s).mean;
     }
   }
 }

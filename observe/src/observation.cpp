@@ -212,6 +212,7 @@ void SeriesBuilder::AddSample(std::size_t r, std::size_t b, double v) {
   c.n += 1;
   c.s_all += v;
   c.ss_all += v * v;
+  c.top = std::max(c.top, std::abs(v));
   if (v > spec_.still_speed_m_per_s) {
     c.n_fwd += 1;
     c.s_fwd += v;
@@ -263,13 +264,14 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
         speed_a{"speed", where, "all", "m/s", {}}, share_f{"share_moving", where, "forward", "1", {}},
         share_b{"share_moving", where, "backward", "1", {}}, still{"share_still", where, "all", "1", {}},
         counter{"counterflow_share", where, "all", "1", {}}, mean_v{"mean_velocity", where, "all", "m/s", {}},
-        density{"density", where, "all", "1/m2", {}};
+        density{"density", where, "all", "1/m2", {}}, fastest{"max_speed", where, "all", "m/s", {}};
     for (std::size_t b = 0; b < bins_; ++b) {
       const Cell& c = cells_[r][b];
       const double per = std::max(1.0, frames_[b]) * correlated_;  // samples per independent sample
       if (c.n == 0) {
         const SeriesPoint none{kNaN, kNaN, 0.0};
-        for (Series* s : {&speed_f, &speed_b, &speed_a, &share_f, &share_b, &still, &counter, &mean_v}) s->points.push_back(none);
+        for (Series* s : {&speed_f, &speed_b, &speed_a, &share_f, &share_b, &still, &counter, &mean_v, &fastest})
+          s->points.push_back(none);
       } else {
         const auto speed_of = [&](double n_d, double s_d, double ss_d) {
           const double moving_area = n_d / std::max(1.0, frames_[b]) * sample_area_m2_;
@@ -294,6 +296,10 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
         }
         const auto [m, se] = mean_se(c.n, c.s_all, c.ss_all, n_eff);
         mean_v.points.push_back({m, se, c.n});
+        // The fastest sample. A maximum has no standard error; its
+        // uncertainty is the spec's speed resolution, the still speed (a
+        // calibration adds the seeds' spread).
+        fastest.points.push_back({c.top, spec_.still_speed_m_per_s, c.n});
       }
       if (with_density) {
         if (frames_[b] == 0) {
@@ -309,7 +315,7 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
         }
       }
     }
-    std::vector<Series*> list = {&speed_f, &speed_b, &speed_a, &share_f, &share_b, &still, &counter, &mean_v};
+    std::vector<Series*> list = {&speed_f, &speed_b, &speed_a, &share_f, &share_b, &still, &counter, &mean_v, &fastest};
     if (with_density) list.push_back(&density);
     for (Series* s : list) obs->series.push_back(std::move(*s));
   }

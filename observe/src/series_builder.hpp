@@ -42,6 +42,7 @@ class SeriesBuilder {
     double s_bwd = 0, ss_bwd = 0;
     double s_all = 0, ss_all = 0;      // v.axis over every sample
     double count = 0, count_sq = 0;    // people in the region, summed over frames
+    double top = 0;                    // the largest |v.axis| of the bin's samples
   };
   void Grow(std::size_t b);
   const ObservationSpec& spec_;

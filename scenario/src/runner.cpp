@@ -307,8 +307,13 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     // What the figure marks (timeline.hpp: RecordedMark), as JSON.
     if (!scenario.timeline.clock_start.empty()) writer.SetRunValue("timeline_clock_start", scenario.timeline.clock_start);
     nlohmann::json marks = nlohmann::json::array();
-    for (const RecordedMark& m : scenario.timeline.recorded)
+    for (const RecordedMark& m : scenario.timeline.recorded) {
       marks.push_back({{"time_s", m.time_s}, {"label", m.label}, {"kind", m.kind}});
+      if (m.HasMaxSpeed()) {
+        marks.back()["max_speed_m_per_s"] = m.max_speed_m_per_s;
+        marks.back()["max_speed_uncertainty_m_per_s"] = m.max_speed_uncertainty_m_per_s;
+      }
+    }
     writer.SetRunValue("timeline_recorded", marks.dump());
   }
   writer.SetRunValue("max_initial_overlap_m", FormatNumber(built.max_initial_overlap_m));

@@ -341,6 +341,11 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
       m.label = item.String("label", "");
       if (m.label.size() > 200) item.At("label").Fail("a label of at most 200 characters");
       m.kind = item.Choice("kind", "avalanche", {"avalanche", "fatal", "other"});
+      if (item.Has("max_speed_m_per_s") || item.Has("max_speed_uncertainty_m_per_s")) {
+        // A reading has its uncertainty: both or neither.
+        m.max_speed_m_per_s = item.Number("max_speed_m_per_s", 0.0, 20.0);
+        m.max_speed_uncertainty_m_per_s = item.Number("max_speed_uncertainty_m_per_s", 1e-3, 20.0);
+      }
       item.Finish();
       t.recorded.push_back(std::move(m));
     }

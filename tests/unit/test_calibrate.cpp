@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -288,6 +289,110 @@ TEST(CalibrationStatistics, AvalanchesOfAnyDirectionCountOnce) {
   st.direction = "crowd";
   SimulatedStatistics(0, run, {st}, &values);
   EXPECT_EQ(values[0], 1.0);
+}
+
+// "reduce": "max": the window's largest bin and that bin's uncertainty.
+TEST(CalibrationStatistics, AWindowsLargestBinWithItsUncertainty) {
+  const auto file = ScratchFile("made.observation.json");
+  observe::Observation made = MadeObservation();
+  made.series[0].points[30] = {1.7, 0.25, 10.0};
+  observe::WriteObservation(made, file);
+  std::string text = Calibration(file.string(), R"([{"path": "model.back_force_gamma"}])");
+  const std::string window = "\"window_s\": 5";
+  text.replace(text.find(window), window.size(), window + ", \"reduce\": \"max\"");
+  const std::vector<Statistic> st = ObservedStatistics(ParseCalibration(text, "cal.json", ""));
+  ASSERT_EQ(st.size(), 5u);
+  EXPECT_TRUE(st[0].is_max);
+  EXPECT_DOUBLE_EQ(st[0].observed, 1.0);  // [0, 5): every bin 1.0
+  EXPECT_DOUBLE_EQ(st[0].observed_sigma, 0.1);
+  EXPECT_DOUBLE_EQ(st[1].observed, 1.7);  // [5, 10): bin 30 (6.1 s)
+  EXPECT_DOUBLE_EQ(st[1].observed_sigma, 0.25);
+  EXPECT_NE(st[1].name.find("speed hallway forward max [5, 10) s"), std::string::npos) << st[1].name;
+  std::vector<double> values;
+  SimulatedStatistics(0, made, st, &values);
+  EXPECT_DOUBLE_EQ(values[1], 1.7);
+  EXPECT_DOUBLE_EQ(values[0], 1.0);
+  EXPECT_NE(ErrorOf([&] {
+              std::string bad = text;
+              bad.replace(bad.find("\"max\""), 5, "\"median\"");
+              ParseCalibration(bad, "cal.json", "");
+            }).find("/observations/0/series/0/reduce"),
+            std::string::npos);
+}
+
+// A speed read from the footage at a recorded mark (the Madrid night's
+// "up to 3 m/s" at the fifth avalanche), against the run's fastest person at
+// the exit end between the marks before and after it; refused with the path
+// where it cannot be matched.
+TEST(CalibrationFile, ASpeedRecordedOfTheIncident) {
+  const std::string src = CROWDRECON_SOURCE_DIR;
+  const auto calibration = [&](const std::string& scenario, const std::string& set, const std::string& recorded) {
+    return R"({"format": "crowdrecon-calibration", "version": 1, "scenario": ")" + src + scenario + R"(",
+      "set": )" + set + R"(, "parameters": [{"path": "model.back_force_gamma"}],
+      "observations": [{"recorded": {"kind": "max_speed", "spec": ")" + src +
+           R"(/venues/madrid-arena/observations/hallway-night.json", )" + recorded + R"(}}],
+      "seeds": {"first": 1, "count": 2}})";
+  };
+  const std::string night = "/venues/madrid-arena/scenarios/madrid-night-demo.json";
+  const std::string fast = R"({"run.output_fps": 10})";
+  const CalibrationSpec spec = ParseCalibration(calibration(night, fast, R"("where": "exit end")"), "cal.json", "");
+  const std::vector<Statistic> st = ObservedStatistics(spec);
+  ASSERT_EQ(st.size(), 1u);
+  EXPECT_TRUE(st[0].is_max);
+  EXPECT_EQ(st[0].quantity, "max_speed");
+  EXPECT_EQ(st[0].where, "exit end");
+  EXPECT_DOUBLE_EQ(st[0].observed, 3.0);
+  EXPECT_DOUBLE_EQ(st[0].observed_sigma, 0.5);
+  EXPECT_DOUBLE_EQ(st[0].sim_from_s, 177.0);  // the demo's marks (/20): 02:59 ...
+  EXPECT_DOUBLE_EQ(st[0].sim_to_s, 279.0);    // ... and the fatal clog, around 03:29 (267 s)
+  // The run's observation: the fastest bin inside the window counts, not one outside.
+  observe::Observation run;
+  run.bin_s = 0.2;
+  run.bins = 1500;
+  observe::Series m{"max_speed", "exit end", "all", "m/s", {}};
+  for (std::size_t k = 0; k < run.bins; ++k) m.points.push_back({k == 1000 ? 2.6 : (k == 1450 ? 4.0 : 1.0), 0.1, 5.0});
+  run.series.push_back(m);
+  std::vector<double> values;
+  SimulatedStatistics(0, run, st, &values);
+  EXPECT_DOUBLE_EQ(values[0], 2.6);  // bin 1000 (200.1 s); bin 1450 (290.1 s) lies after the window
+  // A window of one's own.
+  const std::vector<Statistic> own =
+      ObservedStatistics(ParseCalibration(calibration(night, fast, R"("where": "exit end", "from_s": 260, "to_s": 300)"), "cal.json", ""));
+  SimulatedStatistics(0, run, own, &values);
+  EXPECT_DOUBLE_EQ(values[0], 4.0);
+  const auto expect = [&](const std::string& text, const std::string& part) {
+    const std::string e = ErrorOf([&] { ParseCalibration(text, "cal.json", ""); });
+    EXPECT_NE(e.find(part), std::string::npos) << "error: " << e << "\nexpected: " << part;
+  };
+  expect(calibration(night, "{}", R"("where": "exit end")"),
+         "/observations/0/recorded: the runs write 5 frames/s, so their velocities would span 0.4 s against the "
+         "observation's 0.2 s; expected run.output_fps of at least 10");
+  expect(calibration(night, fast, R"("where": "exit")"),
+         "/observations/0/recorded/where: the spec has no region \"exit\"; expected one of \"hallway\", \"exit end\"");
+  expect(calibration(night, fast, R"("where": "exit end", "from_s": 0, "to_s": 100)"), "leaves out the mark");
+  expect(calibration("/tests/data/scenarios/sweep-tiny.json", fast, R"("where": "exit end")"),
+         "the scenario records no speed in timeline.recorded");
+}
+
+// Every calibration the repository ships is read and its observed statistics
+// computed (a change to the format or the checks that refused one would
+// show here first, not in a documented command an hour in).
+TEST(CalibrationFile, EveryShippedCalibrationIsValid) {
+  int files = 0;
+  for (const auto& venue : std::filesystem::directory_iterator(std::string(CROWDRECON_SOURCE_DIR) + "/venues")) {
+    const std::filesystem::path dir = venue.path() / "calibrations";
+    if (!std::filesystem::is_directory(dir)) continue;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      if (entry.path().extension() != ".json") continue;
+      std::ifstream in(entry.path());
+      const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (text.find("\"crowdrecon-calibration\"") == std::string::npos) continue;  // a sweep of recordings
+      SCOPED_TRACE(entry.path().string());
+      EXPECT_EQ(ErrorOf([&] { EXPECT_FALSE(ObservedStatistics(LoadCalibration(entry.path())).empty()); }), "");
+      ++files;
+    }
+  }
+  EXPECT_GE(files, 5);  // the Madrid Arena's three, the Jülich corridors' two
 }
 
 TEST(CalibrationFile, DefaultsFromTheParameterTableAndTheScenario) {

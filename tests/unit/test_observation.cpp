@@ -1,6 +1,6 @@
 // Observations (issue 22): the stop/surge detector on series with known
 // changes; observations of trajectories made in memory with known speeds,
-// shares, densities and crossings (two directions, a stalled direction, a
+// shares, densities, peak speeds and crossings (two directions, a stalled direction, a
 // periodic seam); JuPedSim files of versions 1-3 read and bad ones refused;
 // the file format written and read back, and a changed CSV refused; specs
 // refused with their JSON path; Weidmann's relation.
@@ -154,6 +154,22 @@ TEST(Observation, SpeedsSharesDensityAndFlowOfTwoKnownGroups) {
   EXPECT_NEAR(forward_crossings, expect_f, 1e-9);
   EXPECT_NEAR(backward_crossings, expect_b, 1e-9);
   EXPECT_TRUE(obs.events.empty());
+}
+
+// max_speed: the fastest sample of the bin, whichever way it moves; its
+// uncertainty, the spec's speed resolution (the still speed).
+TEST(Observation, MaxSpeedIsTheFastestSampleEitherWay) {
+  const Observation one = ObserveTrajectories(Corridor(8, 1, 3.0), CorridorSpec());
+  const Series* m = one.Find("max_speed", "all", "all");
+  ASSERT_TRUE(m);
+  EXPECT_EQ(m->unit, "m/s");
+  for (const SeriesPoint& p : m->points) {
+    EXPECT_NEAR(p.value, 3.0, 1e-9);  // the one backward runner
+    EXPECT_EQ(p.uncertainty, 0.1);
+  }
+  const Observation three = ObserveTrajectories(Corridor(8, 3, 0.8), CorridorSpec());
+  for (const SeriesPoint& p : three.Find("max_speed", "all", "all")->points)
+    EXPECT_NEAR(p.value, 1.2, 1e-9);  // now a forward walker is the fastest
 }
 
 TEST(Observation, AStalledDirectionReadsAsStoppedNotAsItsJitter) {

@@ -354,6 +354,11 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
   refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
   refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
+  // A speed read at a recorded mark comes with its uncertainty.
+  refuse(R"({"recorded": [{"time_s": 5, "label": "a", "max_speed_m_per_s": 3}]})",
+         "/timeline/recorded/0: missing required key \"max_speed_uncertainty_m_per_s\"");
+  refuse(R"({"recorded": [{"time_s": 5, "max_speed_m_per_s": -1, "max_speed_uncertainty_m_per_s": 0.5}]})",
+         "/timeline/recorded/0/max_speed_m_per_s");
 }
 
 }  // namespace timeline_tests

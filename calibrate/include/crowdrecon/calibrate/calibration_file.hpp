@@ -15,10 +15,13 @@
 //       {"file": "recorded.observation.json", "time_offset_s": 0,
 //        "series": [{"quantity": "speed", "where": "hallway", "direction": "forward",
 //                    "from_s": 5, "to_s": 30, "window_s": 0, "relative_error": 0,
-//                    "simulated_from_s": 5, "simulated_to_s": 30}],     (default: the same window + offset)
+//                    "simulated_from_s": 5, "simulated_to_s": 30,       (default: the same window + offset)
+//                    "reduce": "mean"}],                                (or "max": the window's largest bin)
 //        "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 30}]},
-//       {"recorded": {"kind": "avalanche", "direction": "crowd", "from_s": 0, "to_s": 5700}}
-//     ],                                                          (the scenario's timeline.recorded against the run's events)
+//       {"recorded": {"kind": "avalanche", "direction": "crowd", "from_s": 0, "to_s": 5700}},
+//                                                                 (the scenario's timeline.recorded against the run's events)
+//       {"recorded": {"kind": "max_speed", "spec": "../observations/hallway-night.json", "where": "exit end"}}
+//     ],                                                          (a speed read from footage against the run's max_speed)
 //     "seeds": {"first": 1, "count": 8},
 //     "approach": "surrogate",                                   (or "gradient")
 //     "starts": [{"model.back_force_gamma": 3.0}],               (more starting points)
@@ -73,6 +76,14 @@ struct SeriesMatch {
   // against the steady state of a periodic run. One window only.
   double simulated_from_s = std::numeric_limits<double>::quiet_NaN();
   double simulated_to_s = std::numeric_limits<double>::quiet_NaN();
+  // "reduce": "max": a window's largest bin instead of its mean (a peak,
+  // e.g. the fastest person during an avalanche; its uncertainty that bin's).
+  bool take_max = false;
+  // A value recorded of the incident instead of the observation's series
+  // (timeline.recorded's max_speed: the observation has no series): the
+  // observed value and its uncertainty (NaN: from the series).
+  double recorded_value = std::numeric_limits<double>::quiet_NaN();
+  double recorded_sigma = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Events (observe/events.hpp) of one kind, place and direction, compared as
@@ -84,12 +95,15 @@ struct EventMatch {
 };
 
 struct ObservationMatch {
-  std::filesystem::path file;  // empty for events recorded in the scenario
-  // Events recorded of the real incident in the base scenario's
-  // timeline.recorded (e.g. the five avalanches of the Madrid Arena),
-  // against the run's own events of that kind (its event table): the kind,
-  // and "" for an observation file.
+  std::filesystem::path file;  // empty for what the scenario records
+  // What was recorded of the real incident in the base scenario's
+  // timeline.recorded, and "" for an observation file: "avalanche" (e.g. the
+  // five avalanches of the Madrid Arena, against the run's own events of
+  // that kind, its event table) or "max_speed" (a speed read from the
+  // footage at a mark, against the max_speed series of the run observed
+  // with `observation.spec`, the largest in a window around the mark).
   std::string recorded_kind;
+  bool UsesRunEvents() const { return recorded_kind == "avalanche"; }
   observe::Observation observation;
   // Simulated time = observed time + offset (an experiment's clock against
   // the run's, which starts at 0).

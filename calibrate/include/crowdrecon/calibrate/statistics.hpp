@@ -17,7 +17,8 @@ struct Statistic {
   std::string name;        // "obs0 speed hallway forward [5, 30) s", "obs0 stop hallway forward count at 12.4 s"
   std::string unit;
   std::size_t observation = 0;  // index into CalibrationSpec::observations
-  bool is_count = false;        // an event count (else a series' window mean)
+  bool is_count = false;        // an event count (else a series' window mean, or largest bin)
+  bool is_max = false;          // a series' largest bin in the window (SeriesMatch::take_max)
   std::string quantity;         // the series' quantity, or the events' kind
   std::string where, direction;
   double from_s = 0.0, to_s = 0.0;  // window (series) or [from, checkpoint] (counts), observed clock

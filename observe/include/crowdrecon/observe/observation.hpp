@@ -91,7 +91,7 @@ struct SeriesPoint {
 // direction ("forward", "backward" or "all"), in `unit`, one point per bin;
 // bin k covers [t0 + k bin_s, t0 + (k+1) bin_s).
 struct Series {
-  std::string quantity;   // speed, share_moving, share_still, counterflow_share, mean_velocity, density, flow
+  std::string quantity;   // speed, share_moving, share_still, counterflow_share, mean_velocity, max_speed, density, flow
   std::string where;
   std::string direction;  // forward, backward, all
   std::string unit;
@@ -124,6 +124,7 @@ struct Observation {
 //     in the region (of the people in it);
 //   counterflow_share: backward movers / all movers;
 //   mean_velocity (all): mean v.axis over every sample;
+//   max_speed (all): the largest |v.axis| among the samples;
 //   density (all): classic density, people in the region / its area;
 //   flow (forward/backward) per line: crossings per second per metre.
 // Events from the speed series (events.hpp), per region and direction.

@@ -27,8 +27,10 @@
 // that act on it are in scenario/src/timeline_systems.hpp.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -123,6 +125,12 @@ struct RecordedMark {
   double time_s = 0.0;
   std::string label;  // "avalanche 02:18"
   std::string kind;   // "avalanche", "fatal" or "other"
+  // A speed read from the footage at this mark, with its uncertainty (NaN:
+  // none): the paper's "velocities up to 3 m/s" at the fifth avalanche,
+  // which a calibration matches with the observations' max_speed.
+  double max_speed_m_per_s = std::numeric_limits<double>::quiet_NaN();
+  double max_speed_uncertainty_m_per_s = std::numeric_limits<double>::quiet_NaN();
+  bool HasMaxSpeed() const { return std::isfinite(max_speed_m_per_s); }
 };
 
 struct TimelineSpec {
