@@ -8,41 +8,70 @@
 #
 #   scripts/calibration-recovery.sh [OUT]        (default out/calibration/hallway-recovery)
 #
+#
 # CROWDRECON names the program (default build/release/cli/crowdrecon);
-# CALIBRATION_APPROACH=gradient runs the other approach on the same problem.
+# CALIBRATION_APPROACH=gradient runs the other approach on the same problem;
+# RECOVERY_RECORDINGS=N (default 4) makes N recordings (seeds 1001 ...) and
+# matches each as the four are matched: more information, the same runs.
+# Their observation files then go to OUT-truth/observations/ (the default
+# four are the repository's).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 crowdrecon=${CROWDRECON:-build/release/cli/crowdrecon}
 out=${1:-out/calibration/hallway-recovery}
 dir=venues/madrid-arena/calibrations
+recordings=${RECOVERY_RECORDINGS:-4}
+approach=${CALIBRATION_APPROACH:-surrogate}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-echo "1. the synthetic recordings (known values; seeds 1001-1004)"
+truth="$dir/hallway-recovery-truth.json"
+observations="$dir/recovery"
+if [ "$recordings" != 4 ]; then
+  truth="$work/hallway-recovery-truth.json"
+  observations="$out-truth/observations"
+  python3 - "$dir/hallway-recovery-truth.json" "$truth" "$PWD/$dir" "$recordings" <<'PY'
+import json, sys
+t = json.load(open(sys.argv[1]))
+t["scenario"] = sys.argv[3] + "/" + t["scenario"]
+t["seeds"] = list(range(1001, 1001 + int(sys.argv[4])))
+json.dump(t, open(sys.argv[2], "w"), indent=1, ensure_ascii=False)
+PY
+fi
+
+echo "1. the synthetic recordings (known values; $recordings seeds from 1001)"
 # (the recordings' runs are kept in OUT-truth/, the path their observations name)
-"$crowdrecon" sweep "$dir/hallway-recovery-truth.json" -o "$out-truth" -q
-mkdir -p "$dir/recovery"
+"$crowdrecon" sweep "$truth" -o "$out-truth" -q
+mkdir -p "$observations"
 for run in "$out-truth"/runs/*.sqlite; do
   seed=${run##*-seed}
   seed=${seed%.sqlite}
   "$crowdrecon" observe trajectories "$run" --spec venues/madrid-arena/observations/hallway.json \
-    -o "$dir/recovery/truth-seed$seed.observation.json" -q --force
+    -o "$observations/truth-seed$seed.observation.json" -q --force
 done
 
 echo "2. the calibration"
 calibration="$dir/hallway-recovery.json"
-if [ "${CALIBRATION_APPROACH:-surrogate}" = gradient ]; then
-  calibration="$work/hallway-recovery-gradient.json"
-  python3 - "$dir/hallway-recovery.json" "$calibration" "$PWD/$dir" <<'PY'
-import json, sys
+if [ "$approach" = gradient ] || [ "$recordings" != 4 ]; then
+  calibration="$work/hallway-recovery-variant.json"
+  python3 - "$dir/hallway-recovery.json" "$calibration" "$PWD/$dir" "$approach" "$recordings" \
+    "$(cd "$observations" && pwd)" <<'PY'
+import copy, json, sys
 c = json.load(open(sys.argv[1]))
-c["approach"] = "gradient"
-# The gradient approach also measures the objective's noise first, which
-# says whether its central differences see the slope.
-c["options"].update({"measure_noise": True, "max_iterations": 4})
-c["scenario"] = sys.argv[3] + "/" + c["scenario"]
-for o in c["observations"]:
-    o["file"] = sys.argv[3] + "/" + o["file"]
+base, approach, recordings, observations = sys.argv[3], sys.argv[4], int(sys.argv[5]), sys.argv[6]
+c["scenario"] = base + "/" + c["scenario"]
+if approach == "gradient":
+    c["approach"] = "gradient"
+    # The gradient approach also measures the objective's noise first, which
+    # says whether its central differences see the slope.
+    c["options"].update({"measure_noise": True, "max_iterations": 4})
+# Every recording matched as the first one is.
+first = c["observations"][0]
+c["observations"] = []
+for seed in range(1001, 1001 + recordings):
+    o = copy.deepcopy(first)
+    o["file"] = "%s/truth-seed%d.observation.json" % (observations, seed)
+    c["observations"].append(o)
 json.dump(c, open(sys.argv[2], "w"), indent=1, ensure_ascii=False)
 PY
 fi

@@ -465,6 +465,14 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
     } else if (std::isfinite(pr.bootstrap_sigma) && pr.bootstrap_hi95 - pr.bootstrap_lo95 >= 0.9 * range) {
       pr.determination = "undetermined";
       pr.reason = "the bootstrap's 95 % interval spans most of the range";
+    } else if (pr.value <= par.min + 1e-9 * range || pr.value >= par.max - 1e-9 * range) {
+      // The best fit on a bound: the observations ask for a value beyond the
+      // box, and the covariance's interval, a local quadratic's, says nothing
+      // of that side.
+      const bool low = pr.value <= par.min + 1e-9 * range;
+      pr.determination = "bounded on one side";
+      pr.reason = std::string("the best fit lies on the ") + (low ? "lower" : "upper") + " bound of its range (" +
+                  FormatNumber(low ? par.min : par.max) + "): the observations ask for a value beyond it";
     } else if (!low_excluded && !high_excluded) {
       pr.determination = "undetermined";
       pr.reason = "the profile is flat: both ends of the range fit within chi2 + 3.84 of the best";

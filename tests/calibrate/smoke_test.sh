@@ -2,7 +2,8 @@
 # A calibration small enough for the sanitizer build: one parameter (Γ) of a
 # sparse 1-s hallway, two seeds, fitted to an observation of a run made with
 # another Γ. Checks that every output is written (the JSON's fields, the
-# report, the pictures, one row per evaluation) and, with MODE mpi, that
+# report, the pictures, one row per evaluation), that a fit on a bound of
+# its range is reported bounded on one side, and, with MODE mpi, that
 # `mpirun -np 2` gives the same calibration.json as the local run (exit 77:
 # skipped where mpirun is absent).
 #
@@ -58,6 +59,37 @@ assert len(rows) == len(c["evaluations"]) == c["sets_evaluated"], (len(rows), le
 assert all(s["sigma"] is None or s["sigma"] > 0 for s in c["statistics"])
 print("outputs: OK,", len(rows), "parameter sets")
 PY
+
+# A best fit on a bound of the range is not "determined": observations of a
+# crowd walking at 1.5-1.7 m/s against desired speeds of at most 1.0 m/s.
+if [ "$mode" = local ]; then
+  python3 - "$d" <<'PY'
+import json, sys
+d = sys.argv[1]
+s = json.load(open(d + "/scenario.json"))
+s["population"]["desired_speed_m_per_s"] = [1.5, 1.7]
+s["population"]["seed"] = 9
+json.dump(s, open(d + "/fast.json", "w"))
+c = json.load(open(d + "/calibration.json"))
+c["parameters"] = [{"path": "population.desired_speed_m_per_s", "min": 0.6, "max": 1.0, "width": 0.2, "start": 0.8}]
+c["observations"][0]["file"] = "fast.observation.json"
+c["starts"] = []
+c["options"]["profile_points"] = 0
+json.dump(c, open(d + "/bound.json", "w"))
+PY
+  "$crowdrecon" simulate "$d/fast.json" -o "$d/fast.sqlite" -q > /dev/null
+  "$crowdrecon" observe trajectories "$d/fast.sqlite" --spec "$src/venues/madrid-arena/observations/hallway.json" \
+    -o "$d/fast.observation.json" -q > /dev/null
+  "$crowdrecon" calibrate "$d/bound.json" -o "$d/bound" -q --jobs 2 > /dev/null
+  python3 - "$d/bound/calibration.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[1]))["parameters"][0]
+assert abs(p["value"] - 1.0) < 1e-6, p["value"]
+assert p["determination"] == "bounded on one side", p["determination"]
+assert "upper bound" in p["reason"], p["reason"]
+print("a fit on the bound: bounded on one side,", p["reason"])
+PY
+fi
 
 if [ "$mode" = mpi ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader OMPI_MCA_rmaps_base_oversubscribe=1
