@@ -113,9 +113,7 @@ class Calibration {
   void FixSigmas(const std::vector<SetResult>& sets) {
     if (!r_.objective.sigma.empty()) return;
     const std::size_t n = r_.objective.statistics.size();
-    const double k = static_cast<double>(spec_.base.seeds.size());
     r_.seed_sd.assign(n, kNaN);
-    r_.objective.sigma.assign(n, kNaN);
     for (std::size_t j = 0; j < n; ++j) {
       double sum = 0.0, count = 0.0;
       for (const SetResult& s : sets)
@@ -124,13 +122,8 @@ class Calibration {
           count += 1.0;
         }
       if (count > 0) r_.seed_sd[j] = std::sqrt(sum / count);
-      const double seed = std::isfinite(r_.seed_sd[j]) ? r_.seed_sd[j] : 0.0;
-      const double obs = r_.objective.statistics[j].observed_sigma;
-      const double sigma = std::sqrt(obs * obs + seed * seed * (1.0 + 1.0 / k));
-      // A statistic that neither the runs nor the observation vary is left
-      // out: its residual would have no scale.
-      r_.objective.sigma[j] = sigma > 0 ? sigma : kNaN;
     }
+    r_.objective.Weigh(r_.seed_sd, static_cast<double>(spec_.base.seeds.size()));
   }
 
   std::vector<std::vector<double>> Means(const std::vector<SetResult>& sets) const {
@@ -357,6 +350,7 @@ class Calibration {
         const double obs = o.statistics[j].observed_sigma;
         o.statistics[j].observed += normal(rng) * std::sqrt(obs * obs + seed * seed);
       }
+      o.Weigh(o.seed_sd, o.seeds);  // the whitened residuals of the new observed values
       std::vector<std::vector<double>> means;
       for (const SetResult& s : sets) {
         std::vector<double> mean(o.statistics.size(), 0.0), count(o.statistics.size(), 0.0);

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
+#include <tuple>
 
 #include <Eigen/Dense>
 #include <ceres/ceres.h>
@@ -19,9 +21,72 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // --- Objective --------------------------------------------------------------
 
+void Objective::Weigh(const std::vector<double>& sd, double k) {
+  seed_sd = sd;
+  seeds = k;
+  const std::size_t n = statistics.size();
+  sigma.assign(n, kNaN);
+  lead.resize(n);
+  alpha.assign(n, kNaN);
+  beta.assign(n, kNaN);
+  const auto spread = [&](std::size_t j) { return j < sd.size() && std::isfinite(sd[j]) ? sd[j] : 0.0; };
+  for (std::size_t j = 0; j < n; ++j) {
+    const double obs = statistics[j].observed_sigma, seed = spread(j);
+    const double s = std::sqrt(obs * obs + seed * seed * (1.0 + 1.0 / k));
+    // A statistic that neither the runs nor the observation vary is left
+    // out: its residual would have no scale.
+    sigma[j] = s > 0 ? s : kNaN;
+  }
+  // Groups: the statistics (left-out ones aside) that read one simulated
+  // value, in the order of their first statistic.
+  using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool>;
+  const auto key_of = [](const Statistic& st) {
+    return Key{st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s, st.is_count, st.is_max};
+  };
+  const auto alone = [&](std::size_t j) { return statistics[j].simulated_from.empty() || !std::isfinite(sigma[j]); };
+  std::map<Key, std::vector<std::size_t>> groups;
+  for (std::size_t j = 0; j < n; ++j)
+    if (!alone(j)) groups[key_of(statistics[j])].push_back(j);
+  std::vector<std::vector<std::size_t>> order;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (alone(j)) {
+      order.push_back({j});
+    } else {
+      const std::vector<std::size_t>& g = groups.at(key_of(statistics[j]));
+      if (g.front() == j) order.push_back(g);
+    }
+  }
+  for (const std::vector<std::size_t>& g : order) {
+    const std::size_t m = g.size();
+    for (std::size_t j : g) lead[j] = g.front();
+    if (m == 1 || !std::isfinite(sigma[g.front()])) {
+      for (std::size_t j : g) {
+        alpha[j] = 1.0 / sigma[j];
+        beta[j] = statistics[j].observed / sigma[j];
+      }
+      continue;
+    }
+    const double shared = spread(g.front()) * spread(g.front()) / k;
+    Eigen::MatrixXd c = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m), shared);
+    Eigen::VectorXd o(static_cast<Eigen::Index>(m));
+    for (std::size_t i = 0; i < m; ++i) {
+      const double obs = statistics[g[i]].observed_sigma, seed = spread(g[i]);
+      c(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) += obs * obs + seed * seed;
+      o(static_cast<Eigen::Index>(i)) = statistics[g[i]].observed;
+    }
+    const Eigen::LLT<Eigen::MatrixXd> llt(c);
+    const Eigen::VectorXd a = llt.matrixL().solve(Eigen::VectorXd::Ones(static_cast<Eigen::Index>(m)));
+    const Eigen::VectorXd b = llt.matrixL().solve(o);
+    for (std::size_t i = 0; i < m; ++i) {
+      alpha[g[i]] = a(static_cast<Eigen::Index>(i));
+      beta[g[i]] = b(static_cast<Eigen::Index>(i));
+    }
+  }
+}
+
 std::vector<double> Objective::Residuals(const std::vector<double>& mean) const {
   std::vector<double> r(statistics.size());
-  for (std::size_t j = 0; j < r.size(); ++j) r[j] = (mean[j] - statistics[j].observed) / sigma[j];
+  for (std::size_t j = 0; j < r.size(); ++j) r[j] = alpha[j] * mean[lead[j]] - beta[j];
   return r;
 }
 
@@ -146,11 +211,11 @@ class SurrogateCost final : public ceres::CostFunction {
     const std::size_t p = q_.centre.size();
     const std::vector<double> u(parameters[0], parameters[0] + p);
     for (std::size_t r = 0; r < rows_.size(); ++r) {
-      const std::size_t j = rows_[r];
-      residuals[r] = (q_.Value(j, u) - o_.statistics[j].observed) / o_.sigma[j];
+      const std::size_t j = rows_[r], lead = o_.lead[j];
+      residuals[r] = o_.alpha[j] * q_.Value(lead, u) - o_.beta[j];
       if (jacobians && jacobians[0]) {
-        const std::vector<double> g = q_.Gradient(j, u);
-        for (std::size_t i = 0; i < p; ++i) jacobians[0][r * p + i] = g[i] / o_.sigma[j];
+        const std::vector<double> g = q_.Gradient(lead, u);
+        for (std::size_t i = 0; i < p; ++i) jacobians[0][r * p + i] = o_.alpha[j] * g[i];
       }
     }
     return true;
@@ -166,7 +231,7 @@ std::vector<std::size_t> FittedRows(const Quadratic& q, const Objective& o) {
   std::vector<std::size_t> rows;
   const std::vector<double> probe = q.Values(q.centre);
   for (std::size_t j = 0; j < o.statistics.size(); ++j)
-    if (std::isfinite(probe[j]) && std::isfinite(o.sigma[j]) && o.sigma[j] > 0) rows.push_back(j);
+    if (std::isfinite(probe[o.lead[j]]) && std::isfinite(o.sigma[j]) && o.sigma[j] > 0) rows.push_back(j);
   return rows;
 }
 
@@ -289,8 +354,8 @@ bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const s
   // Which coordinates move any statistic at all.
   std::vector<double> norm(p, 0.0);
   for (std::size_t j : rows) {
-    const std::vector<double> g = q.Gradient(j, u);
-    for (std::size_t i = 0; i < p; ++i) norm[i] += (g[i] / objective.sigma[j]) * (g[i] / objective.sigma[j]);
+    const std::vector<double> g = q.Gradient(objective.lead[j], u);
+    for (std::size_t i = 0; i < p; ++i) norm[i] += (objective.alpha[j] * g[i]) * (objective.alpha[j] * g[i]);
   }
   const double largest = *std::max_element(norm.begin(), norm.end());
   for (std::size_t i = 0; i < p; ++i)

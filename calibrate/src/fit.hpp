@@ -11,16 +11,34 @@
 
 namespace crowdrecon::calibrate {
 
-// Residual j = (simulated mean_j - observed_j) / sigma_j, where sigma_j^2 =
-// observed_sigma_j^2 + seed_sd_j^2 (1 + 1/K): the observation is one
-// realisation of the crowd (its own seed-to-seed spread) measured with its
-// uncertainty, against the mean of K seeds (docs/calibration.md, "The
-// objective"). NaN where the simulated mean is.
+// The weighted residuals of the statistics (docs/calibration.md, "The
+// objective"). Statistic j alone: (simulated mean_j - observed_j) / sigma_j,
+// sigma_j^2 = observed_sigma_j^2 + seed_sd_j^2 (1 + 1/K): the observation
+// is one realisation of the crowd (its own seed-to-seed spread) measured
+// with its uncertainty, against the mean of K seeds. Statistics of several
+// recordings that read the same simulated value (Statistic::simulated_from,
+// the same series, window and reduction) share that mean's error, of
+// variance seed_sd^2 / K: their residuals are correlated, with covariance
+// C = diag(observed_sigma_i^2 + seed_sd^2) + seed_sd^2 / K, and are whitened
+// by C's Cholesky factor L (residuals L^-1 (m 1 - o)), so that the sum of
+// squares is the generalised chi2 r^T C^-1 r. (Counted as independent,
+// N recordings would shrink the simulated mean's error N times: intervals
+// too narrow by up to sqrt(1 + N/K) at N >> K.) NaN where the simulated
+// mean is.
 struct Objective {
   std::vector<Statistic> statistics;
-  std::vector<double> sigma;  // per statistic, fixed once the seed spread is estimated
+  std::vector<double> sigma;  // per statistic, alone (display, and NaN: left out)
+  // Residual j = alpha_j * mean[lead_j] - beta_j; lead_j is the first
+  // statistic of j's group (j itself when alone).
+  std::vector<std::size_t> lead;
+  std::vector<double> alpha, beta;
+  // Sets sigma, the groups and their whitening from each statistic's seed
+  // spread (NaN: none measured) and K; again after an observed value changes.
+  void Weigh(const std::vector<double>& seed_sd, double seeds);
   std::vector<double> Residuals(const std::vector<double>& mean) const;
   double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
+  std::vector<double> seed_sd;
+  double seeds = 1.0;
 };
 
 // Each statistic's mean as a quadratic in the unit coordinates around

@@ -217,8 +217,8 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
   std::vector<std::string> order;
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
-    const std::string g = (st.is_count ? st.quantity + "s" : st.quantity) + " " + st.where + " " + st.direction + " (" +
-                          st.unit + ")";
+    const std::string g = (st.is_count ? st.quantity + "s" : st.quantity) + " " + st.where + " " + st.direction +
+                          (st.is_max ? ", largest in the window" : "") + " (" + st.unit + ")";
     if (!groups.contains(g)) order.push_back(g);
     groups[g].push_back(k);
   }
@@ -274,6 +274,14 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
         ox.push_back((st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s)) + shift);
         oy.push_back(st.observed);
         oe.push_back(st.observed_sigma);
+      }
+      // A window's largest bin: the window drawn through the point (the
+      // peak may lie anywhere in it).
+      for (std::size_t k : members) {
+        const Statistic& st = r.objective.statistics[k];
+        if (st.observation == o && st.is_max)
+          panel.Line({st.from_s, st.to_s}, {st.observed, st.observed}, viz::ChartColor(static_cast<int>(o)), 1.0, "",
+                     true);
       }
       if (!ox.empty())
         panel.Points(ox, oy, viz::ChartColor(static_cast<int>(o)), 4.0,

@@ -86,6 +86,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
   for (std::size_t i = 0; i < spec.observations.size(); ++i) {
     const ObservationMatch& m = spec.observations[i];
     const std::string tag = "obs" + std::to_string(i) + " ";
+    const std::string simulated_from = m.UsesRunEvents() ? "run events" : observe::SpecToJson(m.observation.spec);
     for (const SeriesMatch& s : m.series) {
       const observe::Series* series = m.observation.Find(s.quantity, s.where, s.direction);
       const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;
@@ -103,6 +104,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         st.name = tag + s.quantity + " " + s.where + " " + s.direction + (s.take_max ? " max " : " ") + Window(a, b);
         st.unit = recorded ? "m/s" : series->unit;
         st.is_max = s.take_max;
+        st.simulated_from = simulated_from;
         st.observation = i;
         st.quantity = s.quantity;
         st.where = s.where;
@@ -126,6 +128,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
       for (std::size_t k = 0; k < checkpoints.size(); ++k) {
         Statistic st;
         st.is_count = true;
+        st.simulated_from = simulated_from;
         st.name = tag + e.kind + "s " + e.where + " " + e.direction + " by " + FormatNumber(checkpoints[k]) + " s";
         st.unit = "events";
         st.observation = i;

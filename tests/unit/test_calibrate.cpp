@@ -70,9 +70,10 @@ Objective ObjectiveObserving(const std::vector<double>& observed, const std::vec
     Statistic s;
     s.name = "s" + std::to_string(j);
     s.observed = observed[j];
+    s.observed_sigma = sigma[j];
     o.statistics.push_back(s);
   }
-  o.sigma = sigma;
+  o.Weigh({}, 1.0);  // no seed spread: sigma is the observed one
   return o;
 }
 
@@ -185,6 +186,55 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   ASSERT_TRUE(g.Fit(pts, sum, {0.5, 0.5}, 0.5));
   EXPECT_FALSE(SurrogateCovariance(g, ObjectiveObserving({1.0, 2.0}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason, &without_effect));
   EXPECT_NE(reason.find("rank deficient"), std::string::npos) << reason;
+}
+
+// Recordings of one simulated value share its error (seed_sd^2 / K): their
+// residuals are whitened so that chi2 is the generalised one, within-group
+// scatter plus (m - weighted mean)^2 / (1/W + seed_sd^2/K), and the
+// parameter's variance stops shrinking at (seed_sd^2 / K) / slope^2 however
+// many recordings there are.
+TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
+  const auto statistic = [](double observed, double from) {
+    Statistic s;
+    s.simulated_from = "spec";
+    s.quantity = "speed";
+    s.sim_from_s = from;
+    s.sim_to_s = from + 5.0;
+    s.observed = observed;
+    s.observed_sigma = 0.1;
+    return s;
+  };
+  Objective o;
+  o.statistics = {statistic(1.0, 0.0), statistic(2.0, 0.0), statistic(3.0, 5.0)};
+  o.Weigh({0.5, 0.5, 0.5}, 4.0);
+  EXPECT_EQ(o.lead, (std::vector<std::size_t>{0, 0, 2}));
+  const double d = 0.01 + 0.25, w = 2.0 / d, a = 0.25 / 4.0;
+  const double grouped = 2 * 0.25 / d + (1.7 - 1.5) * (1.7 - 1.5) / (1.0 / w + a);
+  const double alone = (2.6 - 3.0) * (2.6 - 3.0) / (0.01 + 0.25 * (1.0 + 1.0 / 4.0));
+  EXPECT_NEAR(o.Chi2({1.7, 1.7, 2.6}), grouped + alone, 1e-12);
+  EXPECT_NEAR(o.sigma[1], std::sqrt(0.01 + 0.25 * 1.25), 1e-12);  // shown per statistic, alone
+
+  // A linear statistic m(u) = 2u observed N times: var(u) = (s^2/N + s^2/K) / 4.
+  std::vector<std::vector<double>> pts, vals;
+  for (double u : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    pts.push_back({u});
+    vals.push_back(std::vector<double>(16, 2.0 * u));
+  }
+  for (std::size_t n : {1u, 16u}) {
+    Objective many;
+    for (std::size_t i = 0; i < n; ++i) many.statistics.push_back(statistic(1.0, 0.0));
+    for (Statistic& st : many.statistics) st.observed_sigma = 0.0;
+    many.Weigh(std::vector<double>(n, 0.4), 8.0);
+    std::vector<std::vector<double>> v;
+    for (const auto& row : vals) v.push_back(std::vector<double>(row.begin(), row.begin() + static_cast<long>(n)));
+    Quadratic q;
+    ASSERT_TRUE(q.Fit(pts, v, {0.5}, 0.5));
+    std::vector<double> cov;
+    std::string reason;
+    std::vector<int> without;
+    ASSERT_TRUE(SurrogateCovariance(q, many, {0.5}, &cov, &reason, &without)) << reason;
+    EXPECT_NEAR(cov[0], (0.16 / static_cast<double>(n) + 0.16 / 8.0) / 4.0, 1e-9) << n << " recordings";
+  }
 }
 
 // An observation of 10 s in 0.2-s bins: speed forward 1.0 for t < 5 s and

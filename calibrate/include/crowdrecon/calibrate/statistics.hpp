@@ -23,6 +23,11 @@ struct Statistic {
   std::string where, direction;
   double from_s = 0.0, to_s = 0.0;  // window (series) or [from, checkpoint] (counts), observed clock
   double sim_from_s = 0.0, sim_to_s = 0.0;  // the same on the run's clock
+  // What the simulated value is computed from: the observation spec the runs
+  // are observed with ("" for statistics built by hand). Statistics of
+  // several recordings with the same spec, quantity, place, direction,
+  // reduction and simulated window read one simulated value (fit.hpp).
+  std::string simulated_from;
   double observed = 0.0;
   // The observed value's own uncertainty: the standard error of the window's
   // mean from its bins' (independent bins assumed), plus the match's
