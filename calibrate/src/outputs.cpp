@@ -210,9 +210,15 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
 // error bars) against the seeds' mean and band.
 void DrawFit(const fs::path& file, const CalibrationResult& r) {
   const CalibrationSpec& spec = *r.spec;
+  // Many recordings of one kind (a recovery's): one colour and one legend
+  // entry for all, which would otherwise cover the panels.
+  const std::size_t observations = spec.observations.size();
+  const bool many = observations > 6;
   viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
-                        "observed (points, +- sigma; one colour per observation file) against simulated at the best fit "
-                        "(line: mean of the seeds; band: +- their sd)");
+                        std::string("observed (points, +- sigma; ") +
+                            (many ? "every observation file in one colour" : "one colour per observation file") +
+                            "; a window's largest value: the window dashed) against simulated at the best fit "
+                            "(line: mean of the seeds; band: +- their sd)");
   std::map<std::string, std::vector<std::size_t>> groups;
   std::vector<std::string> order;
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
@@ -222,7 +228,6 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
     if (!groups.contains(g)) order.push_back(g);
     groups[g].push_back(k);
   }
-  const std::size_t observations = spec.observations.size();
   for (std::size_t panel_index = 0; panel_index < order.size() && panel_index < 16; ++panel_index) {
     const std::vector<std::size_t>& members = groups[order[panel_index]];
     double y0 = 1e300, y1 = -1e300, x0 = 1e300, x1 = -1e300;
@@ -267,6 +272,7 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
     }
     for (std::size_t o = 0; o < observations; ++o) {
       std::vector<double> ox, oy, oe;
+      const viz::Color colour = viz::ChartColor(many ? 0 : static_cast<int>(o));
       const double shift = (x1 - x0) * 0.006 * (static_cast<double>(o) - 0.5 * static_cast<double>(observations - 1));
       for (std::size_t k : members) {
         const Statistic& st = r.objective.statistics[k];
@@ -280,15 +286,13 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
       for (std::size_t k : members) {
         const Statistic& st = r.objective.statistics[k];
         if (st.observation == o && st.is_max)
-          panel.Line({st.from_s, st.to_s}, {st.observed, st.observed}, viz::ChartColor(static_cast<int>(o)), 1.0, "",
-                     true);
+          panel.Line({st.from_s, st.to_s}, {st.observed, st.observed}, colour, 1.0, "", true);
       }
-      if (!ox.empty())
-        panel.Points(ox, oy, viz::ChartColor(static_cast<int>(o)), 4.0,
-                     !spec.observations[o].recorded_kind.empty() ? "recorded (the scenario's timeline)"
-                     : observations > 1                           ? spec.observations[o].file.filename().string()
-                                                                  : std::string("observed"),
-                     &oe);
+      std::string legend = !spec.observations[o].recorded_kind.empty() ? "recorded (the scenario's timeline)"
+                           : observations > 1 ? spec.observations[o].file.filename().string()
+                                              : std::string("observed");
+      if (many) legend = o == 0 ? "observed (" + std::to_string(observations) + " files)" : "";
+      if (!ox.empty()) panel.Points(ox, oy, colour, 4.0, legend, &oe);
     }
   }
   sheet.Finish();
