@@ -65,6 +65,7 @@ if approach == "gradient":
     # The gradient approach also measures the objective's noise first, which
     # says whether its central differences see the slope.
     c["options"].update({"measure_noise": True, "max_iterations": 4})
+c["name"] = c["name"].replace("four synthetic recordings", "%d synthetic recordings" % recordings)
 # Every recording matched as the first one is.
 first = c["observations"][0]
 c["observations"] = []
