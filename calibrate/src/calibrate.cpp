@@ -113,7 +113,7 @@ class Calibration {
   void FixSigmas(const std::vector<SetResult>& sets) {
     if (!r_.objective.sigma.empty()) return;
     const std::size_t n = r_.objective.statistics.size();
-    r_.seed_sd.assign(n, kNaN);
+    std::vector<double> spread(n, kNaN);
     for (std::size_t j = 0; j < n; ++j) {
       double sum = 0.0, count = 0.0;
       for (const SetResult& s : sets)
@@ -121,9 +121,9 @@ class Calibration {
           sum += s.sd[j] * s.sd[j];
           count += 1.0;
         }
-      if (count > 0) r_.seed_sd[j] = std::sqrt(sum / count);
+      if (count > 0) spread[j] = std::sqrt(sum / count);
     }
-    r_.objective.Weigh(r_.seed_sd, static_cast<double>(spec_.base.seeds.size()));
+    r_.objective.Weigh(spread, static_cast<double>(spec_.base.seeds.size()));
   }
 
   std::vector<std::vector<double>> Means(const std::vector<SetResult>& sets) const {
@@ -346,7 +346,7 @@ class Calibration {
       for (std::size_t& d : draw) d = pick(rng);
       Objective o = r_.objective;
       for (std::size_t j = 0; j < o.statistics.size(); ++j) {
-        const double seed = std::isfinite(r_.seed_sd[j]) ? r_.seed_sd[j] : 0.0;
+        const double seed = std::isfinite(o.seed_sd[j]) ? o.seed_sd[j] : 0.0;
         const double obs = o.statistics[j].observed_sigma;
         o.statistics[j].observed += normal(rng) * std::sqrt(obs * obs + seed * seed);
       }

@@ -27,8 +27,8 @@ void Objective::Weigh(const std::vector<double>& sd, double k) {
   const std::size_t n = statistics.size();
   sigma.assign(n, kNaN);
   lead.resize(n);
-  alpha.assign(n, kNaN);
-  beta.assign(n, kNaN);
+  alpha.resize(n);
+  beta.resize(n);
   const auto spread = [&](std::size_t j) { return j < sd.size() && std::isfinite(sd[j]) ? sd[j] : 0.0; };
   for (std::size_t j = 0; j < n; ++j) {
     const double obs = statistics[j].observed_sigma, seed = spread(j);
@@ -38,34 +38,23 @@ void Objective::Weigh(const std::vector<double>& sd, double k) {
     sigma[j] = s > 0 ? s : kNaN;
   }
   // Groups: the statistics (left-out ones aside) that read one simulated
-  // value, in the order of their first statistic.
+  // value; a statistic alone is its own.
   using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool>;
-  const auto key_of = [](const Statistic& st) {
-    return Key{st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s, st.is_count, st.is_max};
-  };
-  const auto alone = [&](std::size_t j) { return statistics[j].simulated_from.empty() || !std::isfinite(sigma[j]); };
   std::map<Key, std::vector<std::size_t>> groups;
-  for (std::size_t j = 0; j < n; ++j)
-    if (!alone(j)) groups[key_of(statistics[j])].push_back(j);
-  std::vector<std::vector<std::size_t>> order;
   for (std::size_t j = 0; j < n; ++j) {
-    if (alone(j)) {
-      order.push_back({j});
-    } else {
-      const std::vector<std::size_t>& g = groups.at(key_of(statistics[j]));
-      if (g.front() == j) order.push_back(g);
-    }
+    const Statistic& st = statistics[j];
+    lead[j] = j;
+    alpha[j] = 1.0 / sigma[j];
+    beta[j] = st.observed / sigma[j];
+    if (!st.simulated_from.empty() && std::isfinite(sigma[j]))
+      groups[{st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s, st.is_count,
+              st.is_max}]
+          .push_back(j);
   }
-  for (const std::vector<std::size_t>& g : order) {
+  for (const auto& entry : groups) {
+    const std::vector<std::size_t>& g = entry.second;
     const std::size_t m = g.size();
-    for (std::size_t j : g) lead[j] = g.front();
-    if (m == 1 || !std::isfinite(sigma[g.front()])) {
-      for (std::size_t j : g) {
-        alpha[j] = 1.0 / sigma[j];
-        beta[j] = statistics[j].observed / sigma[j];
-      }
-      continue;
-    }
+    if (m == 1) continue;
     const double shared = spread(g.front()) * spread(g.front()) / k;
     Eigen::MatrixXd c = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m), shared);
     Eigen::VectorXd o(static_cast<Eigen::Index>(m));
@@ -78,6 +67,7 @@ void Objective::Weigh(const std::vector<double>& sd, double k) {
     const Eigen::VectorXd a = llt.matrixL().solve(Eigen::VectorXd::Ones(static_cast<Eigen::Index>(m)));
     const Eigen::VectorXd b = llt.matrixL().solve(o);
     for (std::size_t i = 0; i < m; ++i) {
+      lead[g[i]] = g.front();
       alpha[g[i]] = a(static_cast<Eigen::Index>(i));
       beta[g[i]] = b(static_cast<Eigen::Index>(i));
     }

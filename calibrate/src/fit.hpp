@@ -32,13 +32,14 @@ struct Objective {
   // statistic of j's group (j itself when alone).
   std::vector<std::size_t> lead;
   std::vector<double> alpha, beta;
-  // Sets sigma, the groups and their whitening from each statistic's seed
-  // spread (NaN: none measured) and K; again after an observed value changes.
-  void Weigh(const std::vector<double>& seed_sd, double seeds);
-  std::vector<double> Residuals(const std::vector<double>& mean) const;
-  double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
+  // The pooled seed-to-seed spread per statistic (NaN: none measured) and K.
   std::vector<double> seed_sd;
   double seeds = 1.0;
+  // Sets seed_sd, seeds, sigma, the groups and their whitening; again (with
+  // the same spread) after an observed value changes.
+  void Weigh(const std::vector<double>& spread, double k);
+  std::vector<double> Residuals(const std::vector<double>& mean) const;
+  double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
 };
 
 // Each statistic's mean as a quadratic in the unit coordinates around

@@ -85,7 +85,7 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
     stats.push_back({{"name", st.name}, {"unit", st.unit}, {"observed", Num(st.observed)},
-                     {"observed_sigma", Num(st.observed_sigma)}, {"seed_sd", Num(r.seed_sd[k])},
+                     {"observed_sigma", Num(st.observed_sigma)}, {"seed_sd", Num(r.objective.seed_sd[k])},
                      {"sigma", Num(r.objective.sigma[k])}, {"simulated_at_best", Num(r.best_set.mean[k])},
                      {"simulated_sd_at_best", Num(r.best_set.sd[k])},
                      {"residual_at_best", Num((r.best_set.mean[k] - st.observed) / r.objective.sigma[k])},

@@ -37,7 +37,6 @@ struct ProfilePoint {
 struct CalibrationResult {
   const CalibrationSpec* spec = nullptr;
   Objective objective;
-  std::vector<double> seed_sd;  // pooled seed-to-seed spread per statistic
   std::vector<NoiseResult> noise;
   std::vector<StartResult> starts;
   std::vector<double> best;  // values
