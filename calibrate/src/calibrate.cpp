@@ -352,44 +352,70 @@ class Calibration {
       }
       o.Weigh(o.seed_sd, o.seeds);  // the whitened residuals of the new observed values
       std::vector<std::vector<double>> means;
-      for (const SetResult& s : sets) {
-        std::vector<double> mean(o.statistics.size(), 0.0), count(o.statistics.size(), 0.0);
-        for (std::size_t d : draw)
-          for (std::size_t j = 0; j < mean.size(); ++j)
-            if (std::isfinite(s.per_seed[d][j])) {
-              mean[j] += s.per_seed[d][j];
-              count[j] += 1.0;
-            }
-        for (std::size_t j = 0; j < mean.size(); ++j) mean[j] = count[j] > 0 ? mean[j] / count[j] : kNaN;
-        means.push_back(mean);
-      }
+      for (const SetResult& s : sets) means.push_back(RedrawnMean(s.per_seed, draw));
       Quadratic q;
       if (!q.Fit(design, means, c, half)) continue;
       r_.bootstrap.push_back(ev_.FromUnit(MinimiseSurrogate(q, o, best).u));
     }
   }
 
-  // 5. Profiles: the simulated chi2 along each parameter's whole range
-  //    through the best fit, and the local surrogate re-minimised over the others.
+  // 5. Profiles: along each parameter's whole range, the others re-fitted
+  //    (on a quadratic of every set evaluated so far, over the whole box),
+  //    simulated there; each chi2 difference with the seeds' noise in it.
   void Profiles() {
     const std::size_t p = spec_.parameters.size();
     const int n = spec_.options.profile_points;
     r_.profiles.assign(p, {});
     if (n < 2) return;
     const Point best = ev_.ToUnit(r_.best);
+    std::vector<Point> all_units;
+    std::vector<std::vector<double>> all_means;
+    for (const SetResult* s : ev_.All()) {
+      all_units.push_back(ev_.ToUnit(s->values));
+      all_means.push_back(s->mean);
+    }
+    Quadratic whole;
+    const bool refit = whole.Fit(all_units, all_means, Point(p, 0.5), 0.5);
     std::vector<Point> pts;
+    std::vector<double> surrogate_chi2;
     for (std::size_t i = 0; i < p; ++i)
       for (int k = 0; k < n; ++k) {
         Point u = best;
         u[i] = static_cast<double>(k) / (n - 1);
+        double predicted = kNaN;
+        if (refit && p > 1) {
+          const Minimum m = MinimiseSurrogate(whole, r_.objective, u, static_cast<int>(i));
+          u = m.u;
+          u[i] = static_cast<double>(k) / (n - 1);
+          predicted = m.chi2;
+        } else if (refit) {
+          predicted = r_.objective.Chi2(whole.Values(u));
+        }
         pts.push_back(u);
+        surrogate_chi2.push_back(predicted);
       }
+    r_.profiles_refitted = refit && p > 1;
     const std::vector<SetResult> sets = Eval(pts, "profiles");
-    for (std::size_t i = 0; i < p; ++i)
+    for (std::size_t i = 0; i < p; ++i) {
+      std::vector<const std::vector<std::vector<double>>*> along;
+      for (int k = 0; k < n; ++k)
+        along.push_back(&sets[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)].per_seed);
+      const ProfileNoise noise =
+          ProfileDifferences(r_.objective, along, r_.best_set.per_seed, spec_.options.bootstrap, 20121103 + i);
       for (int k = 0; k < n; ++k) {
-        const SetResult& s = sets[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)];
-        r_.profiles[i].push_back({s.values[i], r_.objective.Chi2(s.mean)});
+        const std::size_t at = i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k);
+        const auto kk = static_cast<std::size_t>(k);
+        ProfilePoint q;
+        q.value = sets[at].values[i];
+        q.values = sets[at].values;
+        q.chi2 = r_.objective.Chi2(sets[at].mean);
+        q.surrogate_chi2 = surrogate_chi2[at];
+        q.delta_chi2 = noise.delta[kk];
+        q.delta_lo95 = noise.lo95[kk];
+        q.delta_hi95 = noise.hi95[kk];
+        r_.profiles[i].push_back(q);
       }
+    }
   }
 
   const CalibrationSpec& spec_;
@@ -433,12 +459,26 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
     // Determination: the covariance, the bootstrap and the profile each may
     // say that the observations leave the parameter free.
     const double range = par.Range();
+    // An end of the range is excluded when its chi2 lies more than 3.84
+    // above the profile's lowest in 97.5 % of the seeds' redraws (or, with
+    // no redraws, as simulated): a difference within the simulation's
+    // noise excludes nothing (docs/calibration.md, "Profiles").
     bool low_excluded = true, high_excluded = true;
+    std::string low_end, high_end;  // each end's difference, for the reason
     if (!r.profiles.empty() && r.profiles[i].size() >= 2) {
-      double lowest = r.best_simulated_chi2;
-      for (const ProfilePoint& q : r.profiles[i]) lowest = std::min(lowest, q.chi2);
-      low_excluded = r.profiles[i].front().chi2 - lowest > kChi2At95;
-      high_excluded = r.profiles[i].back().chi2 - lowest > kChi2At95;
+      const auto excluded = [](const ProfilePoint& q) {
+        return (std::isnan(q.delta_lo95) ? q.delta_chi2 : q.delta_lo95) > kChi2At95;
+      };
+      const auto said = [](const ProfilePoint& q) {
+        std::string t = "delta chi2 " + Fixed(q.delta_chi2, 3);
+        if (!std::isnan(q.delta_lo95))
+          t += ", seeds redrawn " + Fixed(q.delta_lo95, 3) + " to " + Fixed(q.delta_hi95, 3);
+        return t;
+      };
+      low_excluded = excluded(r.profiles[i].front());
+      high_excluded = excluded(r.profiles[i].back());
+      low_end = said(r.profiles[i].front());
+      high_end = said(r.profiles[i].back());
     }
     const bool no_effect = std::find(r.without_effect.begin(), r.without_effect.end(), static_cast<int>(i)) !=
                            r.without_effect.end();
@@ -469,10 +509,13 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
                   FormatNumber(low ? par.min : par.max) + "): the observations ask for a value beyond it";
     } else if (!low_excluded && !high_excluded) {
       pr.determination = "undetermined";
-      pr.reason = "the profile is flat: both ends of the range fit within chi2 + 3.84 of the best";
+      pr.reason = "the profile is flat: neither end of the range lies beyond chi2_min + 3.84 beyond the seeds' noise "
+                  "(low end: " + low_end + "; high end: " + high_end + ")";
     } else if (!low_excluded || !high_excluded) {
       pr.determination = "bounded on one side";
-      pr.reason = std::string("the profile excludes only the ") + (low_excluded ? "low" : "high") + " end of the range";
+      pr.reason = std::string("the profile excludes only the ") + (low_excluded ? "low" : "high") +
+                  " end of the range (" + (low_excluded ? "high end: " + high_end : "low end: " + low_end) +
+                  ", within chi2_min + 3.84 or the seeds' noise)";
     } else {
       pr.determination = "determined";
     }

@@ -193,9 +193,11 @@ SetResult Evaluator::Load(const std::vector<double>& values, const std::string& 
   return r;
 }
 
-bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys) {
+bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys,
+                         int attempt) {
   std::string joined = spec_.fingerprint;  // the build's version among it: a batch folder is one build's
   for (const std::string& k : keys) joined += k;
+  if (attempt > 0) joined += "attempt " + std::to_string(attempt);
   const std::string batch = Sha256Hex(joined).substr(0, 16);
   const fs::path batches = dir_ / "batches";
   fs::create_directories(batches);
@@ -250,7 +252,19 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
   coordinator_ = s.coordinator;
   if (s.exit_code != 0) throw InputError("an MPI rank could not take part in the calibration's sweep");
   runs_simulated_ += s.completed;
-  return !s.interrupted;
+  if (s.interrupted) return false;
+  std::vector<std::vector<double>> stale;
+  std::vector<std::string> stale_keys;
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    if (!Cached(keys[k])) {
+      stale.push_back(sets[k]);
+      stale_keys.push_back(keys[k]);
+    }
+  if (stale.empty()) return true;
+  if (attempt == 0) return RunBatch(stale, stale_keys, 1);
+  throw InputError(sweep_file.string() + ": the runs of parameter set " + stale_keys.front() +
+                   " completed, but their observations are missing from " +
+                   (dir_ / "cache" / stale_keys.front()).string());
 }
 
 bool Evaluator::Evaluate(const std::vector<std::vector<double>>& sets, const std::string& stage,

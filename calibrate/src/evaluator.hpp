@@ -55,7 +55,11 @@ class Evaluator {
   std::string KeyOf(const std::vector<double>& values) const;
   bool Cached(const std::string& key) const;
   SetResult Load(const std::vector<double>& values, const std::string& key) const;
-  bool RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys);
+  // Runs the sets through one sweep (resumable: the same sets, the same
+  // folder). `attempt` > 0: again in a folder of its own, for sets whose
+  // runs that sweep had already recorded as done while their observations
+  // are gone from the cache (deleted by hand): its record would skip them.
+  bool RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys, int attempt = 0);
 
   const CalibrationSpec& spec_;
   const std::vector<Statistic>& statistics_;

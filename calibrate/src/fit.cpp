@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <tuple>
 
 #include <Eigen/Dense>
@@ -89,6 +90,63 @@ double Objective::Chi2(const std::vector<double>& mean) const {
     chi2 += r[j] * r[j];
   }
   return chi2;
+}
+
+std::vector<double> RedrawnMean(const std::vector<std::vector<double>>& per_seed,
+                                const std::vector<std::size_t>& draw) {
+  const std::size_t n = per_seed.empty() ? 0 : per_seed.front().size();
+  std::vector<double> mean(n, 0.0), count(n, 0.0);
+  for (std::size_t d : draw)
+    for (std::size_t j = 0; j < n; ++j)
+      if (std::isfinite(per_seed[d][j])) {
+        mean[j] += per_seed[d][j];
+        count[j] += 1.0;
+      }
+  for (std::size_t j = 0; j < n; ++j) mean[j] = count[j] > 0 ? mean[j] / count[j] : kNaN;
+  return mean;
+}
+
+ProfileNoise ProfileDifferences(const Objective& objective,
+                                const std::vector<const std::vector<std::vector<double>>*>& points,
+                                const std::vector<std::vector<double>>& best, int replicates, std::uint64_t seed) {
+  const std::size_t n = points.size(), k = best.size();
+  // chi2 - lowest of every point for one draw of the seeds (every point and
+  // the best fit with the same draw); the lowest is finite unless every set failed.
+  const auto differences = [&](const std::vector<std::size_t>& draw) {
+    std::vector<double> chi2(n);
+    double lowest = objective.Chi2(RedrawnMean(best, draw));
+    for (std::size_t i = 0; i < n; ++i) {
+      chi2[i] = objective.Chi2(RedrawnMean(*points[i], draw));
+      lowest = std::min(lowest, chi2[i]);
+    }
+    for (double& c : chi2) c = std::isfinite(lowest) ? c - lowest : kNaN;
+    return chi2;
+  };
+  std::vector<std::size_t> all(k);
+  for (std::size_t d = 0; d < k; ++d) all[d] = d;
+  ProfileNoise noise;
+  noise.delta = differences(all);
+  noise.lo95.assign(n, kNaN);
+  noise.hi95.assign(n, kNaN);
+  if (replicates < 2 || k == 0) return noise;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, k - 1);
+  std::vector<std::vector<double>> samples(n);
+  std::vector<std::size_t> draw(k);
+  for (int rep = 0; rep < replicates; ++rep) {
+    for (std::size_t& d : draw) d = pick(rng);
+    const std::vector<double> delta = differences(draw);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::isnan(delta[i])) samples[i].push_back(delta[i]);  // (+inf: that point's runs failed in this draw)
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<double>& v = samples[i];
+    if (v.size() < 2) continue;
+    std::sort(v.begin(), v.end());
+    noise.lo95[i] = v[static_cast<std::size_t>(std::floor(0.025 * static_cast<double>(v.size() - 1)))];
+    noise.hi95[i] = v[static_cast<std::size_t>(std::ceil(0.975 * static_cast<double>(v.size() - 1)))];
+  }
+  return noise;
 }
 
 // --- Quadratic --------------------------------------------------------------

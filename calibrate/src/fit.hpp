@@ -3,6 +3,7 @@
 // surrogate of every statistic, and Ceres minimising it, with its covariance.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -41,6 +42,28 @@ struct Objective {
   std::vector<double> Residuals(const std::vector<double>& mean) const;
   double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
 };
+
+// The mean of each statistic over the seeds `draw` (indices into per_seed,
+// [seed][statistic], repeats allowed: a bootstrap's redraw of the seeds);
+// NaN where none of them has a value.
+std::vector<double> RedrawnMean(const std::vector<std::vector<double>>& per_seed,
+                                const std::vector<std::size_t>& draw);
+
+// The chi2 differences along one parameter's profile, and the seeds' noise
+// in them (docs/calibration.md, "Profiles"). `points`: the profile's sets,
+// `best`: the best fit's, each as per-seed values [seed][statistic] of the
+// same K seeds. delta[k] = chi2(point k) - the lowest chi2 among the points
+// and the best fit. lo95/hi95: the 2.5 and 97.5 percentiles of that
+// difference over `replicates` redraws of the K seeds with replacement (the
+// same draw for every set: common random numbers), NaN when replicates < 2.
+// The simulated chi2 is noisy (each set is a mean of K chaotic runs): a
+// difference above 3.84 may be noise, and the redraws say how much.
+struct ProfileNoise {
+  std::vector<double> delta, lo95, hi95;
+};
+ProfileNoise ProfileDifferences(const Objective& objective,
+                                const std::vector<const std::vector<std::vector<double>>*>& points,
+                                const std::vector<std::vector<double>>& best, int replicates, std::uint64_t seed);
 
 // Each statistic's mean as a quadratic in the unit coordinates around
 // `centre`, scaled by `half_width` (full quadratic where the points allow,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -17,8 +18,15 @@ namespace crowdrecon::calibrate {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
+std::string Fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "-";
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
 
+namespace {
 
 json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -26,14 +34,6 @@ json Values(const CalibrationSpec& spec, const std::vector<double>& v) {
   json o = json::object();
   for (std::size_t i = 0; i < v.size(); ++i) o[spec.parameters[i].path] = Num(v[i]);
   return o;
-}
-
-std::string Fixed(double v, int digits = 3) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s.precision(digits);
-  s << v;
-  return s.str();
 }
 
 json ToJson(const Evaluator& ev, const CalibrationResult& r) {
@@ -95,10 +95,14 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   json profiles = json::object();
   for (std::size_t i = 0; i < r.profiles.size(); ++i) {
     json pts = json::array();
-    for (const ProfilePoint& q : r.profiles[i]) pts.push_back({Num(q.value), Num(q.chi2)});
+    for (const ProfilePoint& q : r.profiles[i])
+      pts.push_back({{"value", Num(q.value)}, {"values", Values(spec, q.values)}, {"chi2", Num(q.chi2)},
+                     {"surrogate_chi2", Num(q.surrogate_chi2)}, {"delta_chi2", Num(q.delta_chi2)},
+                     {"delta_chi2_seeds_95", {Num(q.delta_lo95), Num(q.delta_hi95)}}});
     profiles[spec.parameters[i].path] = pts;
   }
   j["profiles"] = profiles;
+  j["profiles_refitted"] = r.profiles_refitted;
   json evals = json::array();
   for (const SetResult* e : ev.All())
     evals.push_back({{"key", e->key}, {"stage", e->stage}, {"values", Values(spec, e->values)},
@@ -122,8 +126,10 @@ std::string Report(const CalibrationResult& r) {
     o << "  " << p.path << " = " << Fixed(p.value, 4) << "   [" << Fixed(p.lo95) << ", " << Fixed(p.hi95) << "] | ["
       << Fixed(p.bootstrap_lo95) << ", " << Fixed(p.bootstrap_hi95) << "]   range [" << FormatNumber(p.min) << ", "
       << FormatNumber(p.max) << "]: " << p.determination;
-    if (p.determination != "undetermined" && std::isfinite(p.RelativeHalfWidth95()))
-      o << " to +-" << Fixed(100.0 * p.RelativeHalfWidth95(), 2) << " % (95 %)";
+    if (p.determination != "undetermined" && std::isfinite(p.RelativeHalfWidth95())) {
+      const double percent = 100.0 * p.RelativeHalfWidth95();  // (whole percents from 10 on: not "1.3e+02")
+      o << " to +-" << (percent >= 10.0 ? std::to_string(std::lround(percent)) : Fixed(percent, 2)) << " % (95 %)";
+    }
     if (!p.reason.empty()) o << " (" << p.reason << ")";
     o << "\n";
   }
@@ -164,41 +170,63 @@ std::string Report(const CalibrationResult& r) {
   return o.str();
 }
 
-// chi2 along each parameter: the simulated profile, the best and its intervals.
+// chi2 along each parameter: the simulated profile with the seeds' noise in
+// its differences, the quadratic's prediction, the best and its intervals.
 void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
   const CalibrationSpec& spec = *r.spec;
   viz::ChartSheet sheet(file, 1000, "Calibration: " + spec.name,
-                        "chi2 along each parameter through the best fit (others held); shaded: the covariance's 95 % interval; "
-                        "green dashes: the bootstrap's");
+                        std::string("chi2 along each parameter, ") +
+                            (r.profiles_refitted ? "the others re-fitted at each point"
+                                                 : "the others held at the best fit") +
+                            "; grey band: 95 % of the seeds' redraws; shaded: the covariance's 95 % interval; "
+                            "green dashes: the bootstrap's");
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const Parameter& p = spec.parameters[i];
     const ParameterResult& pr = r.summary.parameters[i];
     std::vector<ProfilePoint> points = r.profiles[i];
-    points.push_back({pr.value, r.best_simulated_chi2});  // the best fit lies on every profile
+    double lowest = r.best_simulated_chi2;
+    for (const ProfilePoint& q : points) lowest = std::min(lowest, q.chi2);
+    ProfilePoint at_best;  // the best fit lies on every profile
+    at_best.value = pr.value;
+    at_best.chi2 = r.best_simulated_chi2;
+    at_best.surrogate_chi2 = std::numeric_limits<double>::quiet_NaN();
+    at_best.delta_lo95 = at_best.delta_hi95 = std::numeric_limits<double>::quiet_NaN();
+    points.push_back(at_best);
     std::sort(points.begin(), points.end(), [](const ProfilePoint& a, const ProfilePoint& b) { return a.value < b.value; });
-    std::vector<double> x, y;
+    std::vector<double> x, y, bx, blo, bhi, sx, sy;
     double lo = r.best_simulated_chi2, hi = r.best_simulated_chi2;
-    for (const ProfilePoint& q : points)
-      if (std::isfinite(q.chi2)) {
-        x.push_back(q.value);
-        y.push_back(q.chi2);
-        lo = std::min(lo, q.chi2);
-        hi = std::max(hi, q.chi2);
+    for (const ProfilePoint& q : points) {
+      if (!std::isfinite(q.chi2)) continue;
+      x.push_back(q.value);
+      y.push_back(q.chi2);
+      lo = std::min(lo, q.chi2);
+      hi = std::max(hi, q.chi2);
+      if (std::isfinite(q.delta_lo95) && std::isfinite(q.delta_hi95) && std::isfinite(lowest)) {
+        bx.push_back(q.value);
+        blo.push_back(lowest + q.delta_lo95);
+        bhi.push_back(lowest + q.delta_hi95);
+        lo = std::min(lo, blo.back());
+        hi = std::max(hi, bhi.back());
       }
+      if (std::isfinite(q.surrogate_chi2)) {
+        sx.push_back(q.value);
+        sy.push_back(q.surrogate_chi2);
+      }
+    }
     hi = std::max(hi, lo + 1.25 * 3.841);  // the 95 % line always shows
-    viz::ChartPanel& panel = sheet.AddPanel(p.path + " (" + pr.determination + ")", "chi2", p.min, p.max,
-                                            std::max(0.0, lo - 0.1 * (hi - lo)), hi + 0.1 * (hi - lo), 260);
-
     const double y0 = std::max(0.0, lo - 0.1 * (hi - lo)), y1 = hi + 0.1 * (hi - lo);
+    viz::ChartPanel& panel = sheet.AddPanel(p.path + " (" + pr.determination + ")", "chi2", p.min, p.max, y0, y1, 260);
     if (std::isfinite(pr.lo95))
       panel.Band({std::max(p.min, pr.lo95), std::min(p.max, pr.hi95)}, {y0, y0}, {y1, y1}, viz::ChartColor(1));
+    if (bx.size() >= 2) panel.Band(bx, blo, bhi, viz::Color::Hex(0x969696));
     if (std::isfinite(pr.bootstrap_lo95)) {
       panel.Mark(pr.bootstrap_lo95, viz::ChartColor(2), "", true);
       panel.Mark(pr.bootstrap_hi95, viz::ChartColor(2), "", true);
     }
     if (!x.empty()) panel.Line(x, y, viz::ChartColor(0), 2.0, "simulated (profile)");
     panel.Points(x, y, viz::ChartColor(0), 3.0);
-    panel.Line({p.min, p.max}, {lo + 3.841, lo + 3.841}, viz::Color::Black(), 1.0, "chi2 min + 3.84", true);
+    if (sx.size() >= 2) panel.Line(sx, sy, viz::ChartColor(3), 1.5, "the quadratic of every set", true);
+    panel.Line({p.min, p.max}, {lowest + 3.841, lowest + 3.841}, viz::Color::Black(), 1.0, "chi2 min + 3.84", true);
     panel.Points({pr.value}, {r.best_simulated_chi2}, viz::ChartColor(1), 5.0, "best fit");
   }
   sheet.Finish();

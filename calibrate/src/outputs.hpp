@@ -29,9 +29,15 @@ struct NoiseResult {
   double slope_signal = 0.0;      // median |d residual| over the gradient step, in units of that scatter
 };
 
+// One simulated point of a parameter's profile (calibrate.cpp, "5. Profiles").
 struct ProfilePoint {
-  double value = 0.0;
-  double chi2 = 0.0;
+  double value = 0.0;           // the parameter's
+  std::vector<double> values;   // every parameter's (the others re-fitted)
+  double chi2 = 0.0;            // simulated
+  double surrogate_chi2 = 0.0;  // what the quadratic of every set predicted there (NaN: none)
+  // chi2 less the lowest of the profile and the best fit, and the 2.5 and
+  // 97.5 percentiles of that difference over redraws of the seeds (NaN: no redraws).
+  double delta_chi2 = 0.0, delta_lo95 = 0.0, delta_hi95 = 0.0;
 };
 
 struct CalibrationResult {
@@ -50,9 +56,12 @@ struct CalibrationResult {
   std::vector<int> without_effect;  // parameters no statistic depends on at the best fit
   std::vector<std::vector<double>> bootstrap;  // replicates' values
   std::vector<std::vector<ProfilePoint>> profiles;
-  std::vector<std::vector<ProfilePoint>> surrogate_profiles;  // the local surrogate's, re-minimised
+  bool profiles_refitted = false;  // the others re-fitted at each point (else held at the best fit)
   Summary summary;
 };
+
+// v with `digits` significant digits ("-" when not finite), for reports.
+std::string Fixed(double v, int digits = 3);
 
 // Writes every output into `dir` and fills summary.json_file / report_file.
 void WriteOutputs(const std::filesystem::path& dir, const Evaluator& evaluator, CalibrationResult* result);

@@ -237,6 +237,49 @@ TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
   }
 }
 
+// A profile's chi2 differences and the seeds' noise in them: one statistic
+// observed 0 with sigma 1 (chi2 = mean^2), K = 8 seeds.
+TEST(Profile, AnEndIsExcludedOnlyBeyondTheSeedsNoise) {
+  Statistic st;
+  st.observed = 0.0;
+  st.observed_sigma = 1.0;
+  Objective o;
+  o.statistics = {st};
+  o.Weigh({0.0}, 8.0);
+  const auto seeds = [](std::vector<double> v) {
+    std::vector<std::vector<double>> per_seed;
+    for (double x : v) per_seed.push_back({x});
+    return per_seed;
+  };
+  const auto best = seeds({0.1, -0.1, 0.05, -0.05, 0.0, 0.1, -0.1, 0.0});
+  const auto steady = seeds({2.9, 3.1, 3.0, 3.0, 2.95, 3.05, 3.0, 3.0});     // chi2 9, little noise
+  const auto noisy = seeds({-2.0, 6.4, -2.0, 6.4, -2.0, 6.4, -2.0, 6.4});   // chi2 4.84 by its mean, mostly noise
+  const auto same = best;                                                  // the best's own runs
+  const ProfileNoise n = ProfileDifferences(o, {&steady, &noisy, &same}, best, 400, 7);
+  ASSERT_EQ(n.delta.size(), 3u);
+  EXPECT_NEAR(n.delta[0], 9.0, 1e-9);
+  EXPECT_NEAR(n.delta[1], 2.2 * 2.2, 1e-9);
+  EXPECT_NEAR(n.delta[2], 0.0, 1e-12);
+  // The steady end stays beyond 3.84 in 97.5 % of the redraws: excluded.
+  EXPECT_GT(n.lo95[0], 3.84);
+  EXPECT_LT(n.lo95[0], 9.0);
+  // The noisy one is beyond 3.84 by its mean only: the redraws reach 0.
+  EXPECT_GT(n.delta[1], 3.84);
+  EXPECT_LT(n.lo95[1], 3.84);
+  EXPECT_GT(n.hi95[1], 9.0);
+  // Common random numbers: a set with the best's own per-seed values
+  // differs from it by nothing in any redraw (independent redraws would not).
+  EXPECT_EQ(n.lo95[2], 0.0);
+  EXPECT_EQ(n.hi95[2], 0.0);
+  // No redraws: the point estimate only.
+  const ProfileNoise none = ProfileDifferences(o, {&steady}, best, 0, 7);
+  EXPECT_TRUE(std::isnan(none.lo95[0]));
+  EXPECT_NEAR(none.delta[0], 9.0, 1e-9);
+  // A redrawn mean with repeats, and NaN where no drawn seed has a value.
+  EXPECT_NEAR(RedrawnMean(seeds({1.0, 2.0, 4.0}), {2, 2, 0})[0], 3.0, 1e-12);
+  EXPECT_TRUE(std::isnan(RedrawnMean(seeds({std::nan(""), 2.0}), {0, 0})[0]));
+}
+
 // An observation of 10 s in 0.2-s bins: speed forward 1.0 for t < 5 s and
 // 0.5 after (uncertainty 0.1 per bin), and three stops.
 observe::Observation MadeObservation() {
