@@ -49,7 +49,10 @@ mkdir -p "$observations"
 for run in "$out-truth"/runs/*.sqlite; do
   seed=${run##*-seed}
   seed=${seed%.sqlite}
-  "$crowdrecon" observe trajectories "$run" --spec venues/madrid-arena/observations/hallway.json \
+  # (named relative to the repository, so that the shipped observation files
+  # do not record one machine's folders)
+  "$crowdrecon" observe trajectories "$(realpath --relative-to=. "$run")" \
+    --spec venues/madrid-arena/observations/hallway.json \
     -o "$observations/truth-seed$seed.observation.json" -q --force
 done
 
