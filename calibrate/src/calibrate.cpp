@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <tuple>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
@@ -451,8 +452,7 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
       for (double x : v) mean += x / static_cast<double>(v.size());
       for (double x : v) ss += (x - mean) * (x - mean);
       pr.bootstrap_sigma = std::sqrt(ss / static_cast<double>(v.size() - 1));
-      pr.bootstrap_lo95 = v[static_cast<std::size_t>(std::floor(0.025 * static_cast<double>(v.size() - 1)))];
-      pr.bootstrap_hi95 = v[static_cast<std::size_t>(std::ceil(0.975 * static_cast<double>(v.size() - 1)))];
+      std::tie(pr.bootstrap_lo95, pr.bootstrap_hi95) = Percentiles95(v);
     } else {
       pr.bootstrap_sigma = pr.bootstrap_lo95 = pr.bootstrap_hi95 = kNaN;
     }

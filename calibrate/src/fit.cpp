@@ -106,6 +106,12 @@ std::vector<double> RedrawnMean(const std::vector<std::vector<double>>& per_seed
   return mean;
 }
 
+std::pair<double, double> Percentiles95(const std::vector<double>& sorted) {
+  const double last = static_cast<double>(sorted.size() - 1);
+  return {sorted[static_cast<std::size_t>(std::floor(0.025 * last))],
+          sorted[static_cast<std::size_t>(std::ceil(0.975 * last))]};
+}
+
 ProfileNoise ProfileDifferences(const Objective& objective,
                                 const std::vector<const std::vector<std::vector<double>>*>& points,
                                 const std::vector<std::vector<double>>& best, int replicates, std::uint64_t seed) {
@@ -143,8 +149,7 @@ ProfileNoise ProfileDifferences(const Objective& objective,
     std::vector<double>& v = samples[i];
     if (v.size() < 2) continue;
     std::sort(v.begin(), v.end());
-    noise.lo95[i] = v[static_cast<std::size_t>(std::floor(0.025 * static_cast<double>(v.size() - 1)))];
-    noise.hi95[i] = v[static_cast<std::size_t>(std::ceil(0.975 * static_cast<double>(v.size() - 1)))];
+    std::tie(noise.lo95[i], noise.hi95[i]) = Percentiles95(v);
   }
   return noise;
 }

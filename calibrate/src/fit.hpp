@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowdrecon/calibrate/statistics.hpp"
@@ -48,6 +49,10 @@ struct Objective {
 // NaN where none of them has a value.
 std::vector<double> RedrawnMean(const std::vector<std::vector<double>>& per_seed,
                                 const std::vector<std::size_t>& draw);
+
+// The 2.5 and 97.5 percentiles of `sorted` (ascending, at least two values):
+// the bootstrap's 95 % interval, as the calibration reports it everywhere.
+std::pair<double, double> Percentiles95(const std::vector<double>& sorted);
 
 // The chi2 differences along one parameter's profile, and the seeds' noise
 // in them (docs/calibration.md, "Profiles"). `points`: the profile's sets,

@@ -186,11 +186,9 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
     std::vector<ProfilePoint> points = r.profiles[i];
     double lowest = r.best_simulated_chi2;
     for (const ProfilePoint& q : points) lowest = std::min(lowest, q.chi2);
-    ProfilePoint at_best;  // the best fit lies on every profile
+    ProfilePoint at_best;  // the best fit lies on every profile (no noise band, no prediction drawn there)
     at_best.value = pr.value;
     at_best.chi2 = r.best_simulated_chi2;
-    at_best.surrogate_chi2 = std::numeric_limits<double>::quiet_NaN();
-    at_best.delta_lo95 = at_best.delta_hi95 = std::numeric_limits<double>::quiet_NaN();
     points.push_back(at_best);
     std::sort(points.begin(), points.end(), [](const ProfilePoint& a, const ProfilePoint& b) { return a.value < b.value; });
     std::vector<double> x, y, bx, blo, bhi, sx, sy;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -34,10 +35,12 @@ struct ProfilePoint {
   double value = 0.0;           // the parameter's
   std::vector<double> values;   // every parameter's (the others re-fitted)
   double chi2 = 0.0;            // simulated
-  double surrogate_chi2 = 0.0;  // what the quadratic of every set predicted there (NaN: none)
+  // What the quadratic of every set predicted there (NaN: none).
+  double surrogate_chi2 = std::numeric_limits<double>::quiet_NaN();
   // chi2 less the lowest of the profile and the best fit, and the 2.5 and
   // 97.5 percentiles of that difference over redraws of the seeds (NaN: no redraws).
-  double delta_chi2 = 0.0, delta_lo95 = 0.0, delta_hi95 = 0.0;
+  double delta_chi2 = 0.0;
+  double delta_lo95 = std::numeric_limits<double>::quiet_NaN(), delta_hi95 = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CalibrationResult {

@@ -38,7 +38,16 @@ namespace {
 std::atomic<bool> g_stop{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
-extern "C" void OnSweepSignal(int) { g_stop.store(true); }
+// Set by SIGINT / SIGTERM alone: the sweep then reports itself interrupted
+// even when no run was left (the signal came as the last one finished, or
+// while there was nothing to run), so that the caller stops too instead of
+// losing the request (a calibration would go on to its next batch).
+std::atomic<bool> g_signalled{false};
+
+extern "C" void OnSweepSignal(int) {
+  g_signalled.store(true);
+  g_stop.store(true);
+}
 
 // Control codes from rank 0 besides run indices (>= 0).
 constexpr std::int64_t kStopSlot = -1;   // no more work for the slot that asked
@@ -494,7 +503,7 @@ class Coordinator {
     store_.WriteCsv();
     if (fatal_) std::rethrow_exception(fatal_);
     s_.remaining = s_.total - store_.done().size();
-    s_.interrupted = s_.remaining > 0;
+    s_.interrupted = s_.remaining > 0 || g_signalled.load();
     s_.wall_s = elapsed;
   }
 
@@ -572,6 +581,7 @@ class Coordinator {
 SweepSummary RunSweep(const SweepOptions& options) {
   const auto start = Clock::now();
   g_stop.store(false);
+  g_signalled.store(false);
   const bool mpi = LaunchedAsMpiRank();
   std::unique_ptr<MpiTransport> transport;
   if (mpi) transport = std::make_unique<MpiTransport>();

@@ -68,7 +68,7 @@ struct SweepSummary {
   std::size_t completed = 0;     // rows written now (failed runs included)
   std::size_t failed = 0;        // of those, runs whose status is "failed: ..."
   std::size_t remaining = 0;     // runs without a row at the end
-  bool interrupted = false;
+  bool interrupted = false;      // runs left by a stop, or SIGINT/SIGTERM received (even with none left)
   double wall_s = 0.0;
   int ranks = 1;   // MPI ranks (1 = local)
   int jobs = 1;    // runs at a time per rank
