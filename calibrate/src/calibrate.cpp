@@ -109,22 +109,19 @@ class Calibration {
     if (progress_ && ev_.coordinator()) std::fprintf(stderr, "calibrate: %s\n", line.c_str());
   }
 
-  // The seed-to-seed spread of each statistic, pooled over `sets`, fixes the
-  // objective's sigmas (docs/calibration.md, "The objective").
+  // The seeds' covariance of the statistics, pooled over `sets`, fixes the
+  // objective's weights (docs/calibration.md, "The objective").
   void FixSigmas(const std::vector<SetResult>& sets) {
     if (!r_.objective.sigma.empty()) return;
-    const std::size_t n = r_.objective.statistics.size();
-    std::vector<double> spread(n, kNaN);
-    for (std::size_t j = 0; j < n; ++j) {
-      double sum = 0.0, count = 0.0;
-      for (const SetResult& s : sets)
-        if (std::isfinite(s.sd[j])) {
-          sum += s.sd[j] * s.sd[j];
-          count += 1.0;
-        }
-      if (count > 0) spread[j] = std::sqrt(sum / count);
-    }
-    r_.objective.Weigh(spread, static_cast<double>(spec_.base.seeds.size()));
+    r_.objective.Group();
+    std::vector<const std::vector<std::vector<double>>*> per_seed;
+    for (const SetResult& s : sets) per_seed.push_back(&s.per_seed);
+    const SeedCovariance c = PooledSeedCovariance(per_seed, r_.objective.lead);
+    r_.objective.WeighCovariance(c.covariance, static_cast<double>(spec_.base.seeds.size()));
+    r_.seed_correlation = {c.shrinkage, c.effective_values, c.values, sets.size()};
+    Say("the seeds' covariance of " + std::to_string(c.values) + " simulated values from " +
+        std::to_string(sets.size()) + " sets: correlations shrunk by " + FormatNumber(c.shrinkage) +
+        ", as many as " + FormatNumber(c.effective_values) + " independent values");
   }
 
   std::vector<std::vector<double>> Means(const std::vector<SetResult>& sets) const {
@@ -346,12 +343,11 @@ class Calibration {
       std::vector<std::size_t> draw(k);
       for (std::size_t& d : draw) d = pick(rng);
       Objective o = r_.objective;
-      for (std::size_t j = 0; j < o.statistics.size(); ++j) {
-        const double seed = std::isfinite(o.seed_sd[j]) ? o.seed_sd[j] : 0.0;
-        const double obs = o.statistics[j].observed_sigma;
-        o.statistics[j].observed += normal(rng) * std::sqrt(obs * obs + seed * seed);
-      }
-      o.Weigh(o.seed_sd, o.seeds);  // the whitened residuals of the new observed values
+      std::vector<double> z(o.statistics.size());
+      for (double& x : z) x = normal(rng);
+      const std::vector<double> e = o.ObservationNoise(z);  // one recording's statistics scatter together
+      for (std::size_t j = 0; j < o.statistics.size(); ++j) o.statistics[j].observed += e[j];
+      o.Reobserve();
       std::vector<std::vector<double>> means;
       for (const SetResult& s : sets) means.push_back(RedrawnMean(s.per_seed, draw));
       Quadratic q;

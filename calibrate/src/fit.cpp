@@ -22,74 +22,256 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // --- Objective --------------------------------------------------------------
 
-void Objective::Weigh(const std::vector<double>& sd, double k) {
-  seed_sd = sd;
-  seeds = k;
-  const std::size_t n = statistics.size();
-  sigma.assign(n, kNaN);
-  lead.resize(n);
-  alpha.resize(n);
-  beta.resize(n);
-  const auto spread = [&](std::size_t j) { return j < sd.size() && std::isfinite(sd[j]) ? sd[j] : 0.0; };
-  for (std::size_t j = 0; j < n; ++j) {
-    const double obs = statistics[j].observed_sigma, seed = spread(j);
-    const double s = std::sqrt(obs * obs + seed * seed * (1.0 + 1.0 / k));
-    // A statistic that neither the runs nor the observation vary is left
-    // out: its residual would have no scale.
-    sigma[j] = s > 0 ? s : kNaN;
-  }
-  // Groups: the statistics (left-out ones aside) that read one simulated
-  // value; a statistic alone is its own.
-  using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool>;
-  std::map<Key, std::vector<std::size_t>> groups;
-  for (std::size_t j = 0; j < n; ++j) {
-    const Statistic& st = statistics[j];
-    lead[j] = j;
-    alpha[j] = 1.0 / sigma[j];
-    beta[j] = st.observed / sigma[j];
-    if (!st.simulated_from.empty() && std::isfinite(sigma[j]))
-      groups[{st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s, st.is_count,
-              st.is_max}]
-          .push_back(j);
-  }
-  for (const auto& entry : groups) {
-    const std::vector<std::size_t>& g = entry.second;
-    const std::size_t m = g.size();
-    if (m == 1) continue;
-    const double shared = spread(g.front()) * spread(g.front()) / k;
-    Eigen::MatrixXd c = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m), shared);
-    Eigen::VectorXd o(static_cast<Eigen::Index>(m));
-    for (std::size_t i = 0; i < m; ++i) {
-      const double obs = statistics[g[i]].observed_sigma, seed = spread(g[i]);
-      c(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) += obs * obs + seed * seed;
-      o(static_cast<Eigen::Index>(i)) = statistics[g[i]].observed;
-    }
-    const Eigen::LLT<Eigen::MatrixXd> llt(c);
-    const Eigen::VectorXd a = llt.matrixL().solve(Eigen::VectorXd::Ones(static_cast<Eigen::Index>(m)));
-    const Eigen::VectorXd b = llt.matrixL().solve(o);
-    for (std::size_t i = 0; i < m; ++i) {
-      lead[g[i]] = g.front();
-      alpha[g[i]] = a(static_cast<Eigen::Index>(i));
-      beta[g[i]] = b(static_cast<Eigen::Index>(i));
-    }
+namespace {
+
+using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// The lower Cholesky factor of c; a diagonal jitter (from 1e-12 of the
+// mean variance, growing) where c is only semi-definite, as it is when one
+// recording holds two statistics of one simulated value measured exactly.
+Matrix LowerCholesky(Matrix c) {
+  const Eigen::Index n = c.rows();
+  const double scale = n > 0 ? std::max(c.diagonal().mean(), 1e-300) : 1.0;
+  for (double jitter = 0.0;; jitter = jitter == 0.0 ? 1e-12 * scale : jitter * 100.0) {
+    Matrix t = c;
+    t.diagonal().array() += jitter;
+    const Eigen::LLT<Matrix> llt(t);
+    if (llt.info() == Eigen::Success) return llt.matrixL();
+    if (jitter > scale) throw std::logic_error("the statistics' covariance is not positive semi-definite");
   }
 }
 
+}  // namespace
+
+void Objective::Group() {
+  const std::size_t n = statistics.size();
+  lead.resize(n);
+  using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool>;
+  std::map<Key, std::size_t> first;
+  for (std::size_t j = 0; j < n; ++j) {
+    const Statistic& st = statistics[j];
+    lead[j] = j;
+    if (st.simulated_from.empty()) continue;
+    lead[j] = first.try_emplace({st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s,
+                                 st.is_count, st.is_max},
+                                j)
+                  .first->second;
+  }
+}
+
+void Objective::Weigh(const std::vector<double>& spread, double k) {
+  Group();
+  const std::size_t n = statistics.size();
+  const auto sd = [&](std::size_t j) { return j < spread.size() && std::isfinite(spread[j]) ? spread[j] : 0.0; };
+  std::vector<double> c(n * n, 0.0);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i)
+      if (lead[i] == lead[j]) c[j * n + i] = sd(j) * sd(i);
+  WeighCovariance(c, k);
+  for (std::size_t j = 0; j < n; ++j) seed_sd[j] = j < spread.size() ? spread[j] : kNaN;
+}
+
+void Objective::WeighCovariance(const std::vector<double>& covariance, double k) {
+  if (lead.size() != statistics.size()) Group();
+  const std::size_t n = statistics.size();
+  seed_covariance = covariance;
+  seeds = k;
+  seed_sd.assign(n, kNaN);
+  sigma.assign(n, kNaN);
+  used_.rows.clear();
+  for (std::size_t j = 0; j < n; ++j) {
+    const double var = covariance[j * n + j];
+    if (var > 0) seed_sd[j] = std::sqrt(var);
+    const double obs = statistics[j].observed_sigma;
+    const double s = std::sqrt(obs * obs + std::max(var, 0.0) * (1.0 + 1.0 / k));
+    // A statistic that neither the runs nor the observation vary is left
+    // out: its residual would have no scale.
+    sigma[j] = s > 0 ? s : kNaN;
+    if (std::isfinite(sigma[j])) used_.rows.push_back(j);
+  }
+  used_ = WhiteningOf(used_.rows);
+  const std::size_t m = used_.rows.size();
+  const std::vector<double> own = Covariance(used_.rows, false);
+  const Matrix l = LowerCholesky(Eigen::Map<const Matrix>(own.data(), static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m)));
+  realisation_.assign(l.data(), l.data() + l.size());
+}
+
+std::vector<double> Objective::Covariance(const std::vector<std::size_t>& rows, bool shared) const {
+  const std::size_t n = statistics.size(), m = rows.size();
+  std::vector<double> c(m * m, 0.0);
+  for (std::size_t a = 0; a < m; ++a)
+    for (std::size_t b = 0; b < m; ++b) {
+      const std::size_t j = rows[a], i = rows[b];
+      const double s = seed_covariance[j * n + i];
+      double v = statistics[j].observation == statistics[i].observation ? s : 0.0;
+      if (shared) v += s / seeds;
+      if (a == b) v += statistics[j].observed_sigma * statistics[j].observed_sigma;
+      c[a * m + b] = v;
+    }
+  return c;
+}
+
+Objective::Whitening Objective::WhiteningOf(const std::vector<std::size_t>& rows) const {
+  if (!used_.w.empty() && rows == used_.rows) return used_;
+  const std::size_t m = rows.size();
+  const std::vector<double> c = Covariance(rows, true);
+  const auto mi = static_cast<Eigen::Index>(m);
+  const Matrix l = LowerCholesky(Eigen::Map<const Matrix>(c.data(), mi, mi));
+  const Matrix w = l.triangularView<Eigen::Lower>().solve(Matrix::Identity(mi, mi));
+  Eigen::VectorXd o(mi);
+  for (std::size_t a = 0; a < m; ++a) o(static_cast<Eigen::Index>(a)) = statistics[rows[a]].observed;
+  const Eigen::VectorXd b = w * o;
+  Whitening out;
+  out.rows = rows;
+  out.w.assign(w.data(), w.data() + w.size());
+  out.b.assign(b.data(), b.data() + b.size());
+  return out;
+}
+
+void Objective::Reobserve() {
+  const std::vector<std::size_t> rows = used_.rows;
+  used_.w.clear();
+  used_ = WhiteningOf(rows);
+}
+
+std::vector<double> Objective::ObservationNoise(const std::vector<double>& normal) const {
+  std::vector<double> e(statistics.size(), 0.0);
+  const std::size_t m = used_.rows.size();
+  for (std::size_t a = 0; a < m; ++a) {
+    double v = 0.0;
+    for (std::size_t b = 0; b <= a; ++b) v += realisation_[a * m + b] * normal[used_.rows[b]];
+    e[used_.rows[a]] = v;
+  }
+  return e;
+}
+
 std::vector<double> Objective::Residuals(const std::vector<double>& mean) const {
-  std::vector<double> r(statistics.size());
-  for (std::size_t j = 0; j < r.size(); ++j) r[j] = alpha[j] * mean[lead[j]] - beta[j];
+  const std::size_t n = statistics.size();
+  std::vector<double> r(n, kNaN);
+  std::vector<std::size_t> rows;
+  for (std::size_t j : used_.rows)
+    if (std::isfinite(mean[lead[j]])) rows.push_back(j);
+  const Whitening& wh = rows == used_.rows ? used_ : WhiteningOf(rows);
+  const std::size_t m = rows.size();
+  for (std::size_t a = 0; a < m; ++a) {
+    double v = -wh.b[a];
+    for (std::size_t b = 0; b <= a; ++b) v += wh.w[a * m + b] * mean[lead[rows[b]]];
+    r[rows[a]] = v;
+  }
   return r;
 }
 
 double Objective::Chi2(const std::vector<double>& mean) const {
+  for (std::size_t j : used_.rows)
+    if (!std::isfinite(mean[lead[j]])) return std::numeric_limits<double>::infinity();
   double chi2 = 0.0;
-  const std::vector<double> r = Residuals(mean);
-  for (std::size_t j = 0; j < r.size(); ++j) {
-    if (!std::isfinite(sigma[j])) continue;  // left out: no scale
-    if (!std::isfinite(r[j])) return std::numeric_limits<double>::infinity();
-    chi2 += r[j] * r[j];
-  }
+  for (double x : Residuals(mean))
+    if (std::isfinite(x)) chi2 += x * x;
   return chi2;
+}
+
+SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vector<double>>*>& sets,
+                                    const std::vector<std::size_t>& lead) {
+  const std::size_t n = lead.size();
+  SeedCovariance out;
+  out.covariance.assign(n * n, 0.0);
+  out.sd.assign(n, kNaN);
+  // Each set's deviations from its own means, per simulated value.
+  std::vector<std::size_t> values;
+  for (std::size_t j = 0; j < n; ++j)
+    if (lead[j] == j) values.push_back(j);
+  const std::size_t g = values.size();
+  std::vector<std::vector<double>> dev;  // [row][value], NaN: none
+  std::vector<double> var_sum(g, 0.0), var_sets(g, 0.0);
+  std::vector<std::vector<double>> row_weight;  // n / (n - 1) of the row's set, per value
+  for (const auto* set : sets) {
+    const std::size_t k = set->size();
+    std::vector<double> mean(g, 0.0), count(g, 0.0);
+    for (const auto& seed : *set)
+      for (std::size_t a = 0; a < g; ++a)
+        if (std::isfinite(seed[values[a]])) {
+          mean[a] += seed[values[a]];
+          count[a] += 1.0;
+        }
+    for (std::size_t a = 0; a < g; ++a) mean[a] = count[a] > 0 ? mean[a] / count[a] : kNaN;
+    std::vector<double> ss(g, 0.0);
+    for (std::size_t s = 0; s < k; ++s) {
+      std::vector<double> d(g, kNaN), w(g, kNaN);
+      for (std::size_t a = 0; a < g; ++a)
+        if (std::isfinite((*set)[s][values[a]]) && count[a] >= 2) {
+          d[a] = (*set)[s][values[a]] - mean[a];
+          w[a] = count[a] / (count[a] - 1.0);
+          ss[a] += d[a] * d[a];
+        }
+      dev.push_back(d);
+      row_weight.push_back(w);
+    }
+    for (std::size_t a = 0; a < g; ++a)
+      if (count[a] >= 2) {
+        var_sum[a] += ss[a] / (count[a] - 1.0);
+        var_sets[a] += 1.0;
+      }
+  }
+  std::vector<double> sd(g, 0.0);
+  for (std::size_t a = 0; a < g; ++a)
+    if (var_sets[a] > 0) sd[a] = std::sqrt(var_sum[a] / var_sets[a]);
+  // Sample correlations (pairwise: rows where both have a value) and the
+  // variance of each, from the spread of the standardised products.
+  std::vector<std::size_t> live;
+  for (std::size_t a = 0; a < g; ++a)
+    if (sd[a] > 0) live.push_back(a);
+  const std::size_t h = live.size();
+  out.values = h;
+  Matrix r = Matrix::Identity(static_cast<Eigen::Index>(h), static_cast<Eigen::Index>(h));
+  double noise = 0.0, signal = 0.0;
+  for (std::size_t x = 0; x < h; ++x)
+    for (std::size_t y = x + 1; y < h; ++y) {
+      const std::size_t a = live[x], b = live[y];
+      std::vector<double> w;
+      for (std::size_t row = 0; row < dev.size(); ++row)
+        if (std::isfinite(dev[row][a]) && std::isfinite(dev[row][b]))
+          w.push_back(dev[row][a] * dev[row][b] / (sd[a] * sd[b]) * std::sqrt(row_weight[row][a] * row_weight[row][b]));
+      if (w.size() < 3) continue;  // unknown: taken as uncorrelated
+      double mean = 0.0;
+      for (double v : w) mean += v;
+      mean /= static_cast<double>(w.size());
+      double spread = 0.0;
+      for (double v : w) spread += (v - mean) * (v - mean);
+      const double nw = static_cast<double>(w.size());
+      const double rho = std::clamp(mean, -1.0, 1.0);
+      r(static_cast<Eigen::Index>(x), static_cast<Eigen::Index>(y)) = rho;
+      r(static_cast<Eigen::Index>(y), static_cast<Eigen::Index>(x)) = rho;
+      noise += spread / (nw * (nw - 1.0));
+      signal += rho * rho;
+    }
+  double lambda = signal > 0 ? std::clamp(noise / signal, 0.0, 1.0) : 1.0;
+  Matrix shrunk;
+  for (;; lambda = std::min(1.0, lambda + 0.02)) {
+    shrunk = (1.0 - lambda) * r;
+    shrunk.diagonal().setOnes();
+    const Eigen::SelfAdjointEigenSolver<Matrix> eig(shrunk);
+    if (h == 0 || eig.eigenvalues().minCoeff() > 1e-6 || lambda >= 1.0) {
+      const Eigen::VectorXd e = h ? Eigen::VectorXd(eig.eigenvalues()) : Eigen::VectorXd();
+      out.effective_values = h ? e.sum() * e.sum() / e.squaredNorm() : 0.0;
+      break;
+    }
+  }
+  out.shrinkage = lambda;
+  std::vector<long> row(g, -1);  // value -> row of `shrunk`
+  for (std::size_t x = 0; x < h; ++x) row[live[x]] = static_cast<long>(x);
+  std::vector<std::size_t> value_of(n, 0);  // statistic -> its value
+  for (std::size_t a = 0; a < g; ++a) value_of[values[a]] = a;
+  for (std::size_t j = 0; j < n; ++j) value_of[j] = value_of[lead[j]];
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::size_t a = value_of[j];
+    out.sd[j] = var_sets[a] > 0 ? sd[a] : kNaN;
+    if (row[a] < 0) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t b = value_of[i];
+      if (row[b] >= 0) out.covariance[j * n + i] = shrunk(row[a], row[b]) * sd[a] * sd[b];
+    }
+  }
+  return out;
 }
 
 std::vector<double> RedrawnMean(const std::vector<std::vector<double>>& per_seed,
@@ -253,23 +435,38 @@ std::vector<double> Quadratic::Values(const std::vector<double>& u) const {
 
 namespace {
 
-// The surrogate's residuals (only statistics it could fit).
+// The surrogate's residuals: the statistics it could fit, whitened among
+// themselves.
 class SurrogateCost final : public ceres::CostFunction {
  public:
-  SurrogateCost(const Quadratic& q, const Objective& o, std::vector<std::size_t> rows) : q_(q), o_(o), rows_(std::move(rows)) {
-    set_num_residuals(static_cast<int>(rows_.size()));
+  SurrogateCost(const Quadratic& q, const Objective& o, const std::vector<std::size_t>& rows)
+      : q_(q), o_(o), white_(o.WhiteningOf(rows)) {
+    set_num_residuals(static_cast<int>(rows.size()));
     mutable_parameter_block_sizes()->push_back(static_cast<int>(q.centre.size()));
   }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const std::size_t p = q_.centre.size();
+    const std::size_t p = q_.centre.size(), m = white_.rows.size();
     const std::vector<double> u(parameters[0], parameters[0] + p);
-    for (std::size_t r = 0; r < rows_.size(); ++r) {
-      const std::size_t j = rows_[r], lead = o_.lead[j];
-      residuals[r] = o_.alpha[j] * q_.Value(lead, u) - o_.beta[j];
-      if (jacobians && jacobians[0]) {
+    const bool want = jacobians && jacobians[0];
+    std::vector<double> value(m), gradient(want ? m * p : 0);
+    for (std::size_t r = 0; r < m; ++r) {
+      const std::size_t lead = o_.lead[white_.rows[r]];
+      value[r] = q_.Value(lead, u);
+      if (want) {
         const std::vector<double> g = q_.Gradient(lead, u);
-        for (std::size_t i = 0; i < p; ++i) jacobians[0][r * p + i] = o_.alpha[j] * g[i];
+        std::copy(g.begin(), g.end(), gradient.begin() + static_cast<long>(r * p));
       }
+    }
+    for (std::size_t r = 0; r < m; ++r) {
+      double v = -white_.b[r];
+      for (std::size_t c = 0; c <= r; ++c) v += white_.w[r * m + c] * value[c];
+      residuals[r] = v;
+      if (want)
+        for (std::size_t i = 0; i < p; ++i) {
+          double d = 0.0;
+          for (std::size_t c = 0; c <= r; ++c) d += white_.w[r * m + c] * gradient[c * p + i];
+          jacobians[0][r * p + i] = d;
+        }
     }
     return true;
   }
@@ -277,7 +474,7 @@ class SurrogateCost final : public ceres::CostFunction {
  private:
   const Quadratic& q_;
   const Objective& o_;
-  std::vector<std::size_t> rows_;
+  Objective::Whitening white_;
 };
 
 std::vector<std::size_t> FittedRows(const Quadratic& q, const Objective& o) {
@@ -404,11 +601,16 @@ bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const s
     *reason = "no statistic could be fitted";
     return false;
   }
-  // Which coordinates move any statistic at all.
+  // Which coordinates move any statistic at all (the whitened Jacobian's columns).
   std::vector<double> norm(p, 0.0);
-  for (std::size_t j : rows) {
-    const std::vector<double> g = q.Gradient(objective.lead[j], u);
-    for (std::size_t i = 0; i < p; ++i) norm[i] += (objective.alpha[j] * g[i]) * (objective.alpha[j] * g[i]);
+  {
+    const SurrogateCost cost(q, objective, rows);
+    std::vector<double> res(rows.size()), jac(rows.size() * p);
+    const double* params[] = {x.data()};
+    double* jacobians[] = {jac.data()};
+    cost.Evaluate(params, res.data(), jacobians);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (std::size_t i = 0; i < p; ++i) norm[i] += jac[r * p + i] * jac[r * p + i];
   }
   const double largest = *std::max_element(norm.begin(), norm.end());
   for (std::size_t i = 0; i < p; ++i)

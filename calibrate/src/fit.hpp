@@ -14,35 +14,84 @@
 namespace crowdrecon::calibrate {
 
 // The weighted residuals of the statistics (docs/calibration.md, "The
-// objective"). Statistic j alone: (simulated mean_j - observed_j) / sigma_j,
-// sigma_j^2 = observed_sigma_j^2 + seed_sd_j^2 (1 + 1/K): the observation
-// is one realisation of the crowd (its own seed-to-seed spread) measured
-// with its uncertainty, against the mean of K seeds. Statistics of several
-// recordings that read the same simulated value (Statistic::simulated_from,
-// the same series, window and reduction) share that mean's error, of
-// variance seed_sd^2 / K: their residuals are correlated, with covariance
-// C = diag(observed_sigma_i^2 + seed_sd^2) + seed_sd^2 / K, and are whitened
-// by C's Cholesky factor L (residuals L^-1 (m 1 - o)), so that the sum of
-// squares is the generalised chi2 r^T C^-1 r. (Counted as independent,
-// N recordings would shrink the simulated mean's error N times: intervals
-// too narrow by up to sqrt(1 + N/K) at N >> K.) NaN where the simulated
-// mean is.
+// objective"): the generalised chi2 (m - o)^T C^-1 (m - o), whitened by C's
+// Cholesky factor L (residuals L^-1 (m - o)), m the simulated means of K
+// seeds, o the observed values. The covariance of the statistics' errors,
+// with S the seeds' covariance of the statistics' values (one run's):
+//   C_jk = S_jk [j, k of one recording] + S_jk / K + [j = k] observed_sigma_j^2.
+// An observation is one realisation of the crowd (its statistics scatter
+// together as one run's do: S within a recording), measured with its own
+// uncertainty, against a mean of K seeds whose error S / K is shared by
+// every statistic and every recording (the same seeds: common random
+// numbers). Statistics of several recordings that read one simulated value
+// (Statistic::simulated_from, the same series, window and reduction) are one
+// value of the runs: lead_j, the first of them, is what j is compared with.
+// Alone (S diagonal, one recording) a residual is (m_j - o_j) / sigma_j,
+// sigma_j^2 = observed_sigma_j^2 + S_jj (1 + 1/K). Counted as independent,
+// correlated statistics (one window and the next, a share moving and a
+// share still) would each count as new evidence of the same seeds' offset,
+// and N recordings would shrink the simulated mean's error N times.
 struct Objective {
   std::vector<Statistic> statistics;
   std::vector<double> sigma;  // per statistic, alone (display, and NaN: left out)
-  // Residual j = alpha_j * mean[lead_j] - beta_j; lead_j is the first
-  // statistic of j's group (j itself when alone).
-  std::vector<std::size_t> lead;
-  std::vector<double> alpha, beta;
-  // The pooled seed-to-seed spread per statistic (NaN: none measured) and K.
+  std::vector<std::size_t> lead;  // per statistic: the first statistic of its simulated value
+  // The seeds' covariance of the statistics (n x n, row-major; zero rows
+  // where no spread was measured), its diagonal's square roots (NaN: none
+  // measured), and K.
+  std::vector<double> seed_covariance;
   std::vector<double> seed_sd;
   double seeds = 1.0;
-  // Sets seed_sd, seeds, sigma, the groups and their whitening; again (with
-  // the same spread) after an observed value changes.
+
+  // Sets lead from the statistics' simulated values.
+  void Group();
+  // Sets the weights from independent simulated values' spreads (sd per
+  // statistic, NaN or missing: none measured; statistics reading one
+  // simulated value share it).
   void Weigh(const std::vector<double>& spread, double k);
+  // Sets the weights from the seeds' covariance of the statistics.
+  void WeighCovariance(const std::vector<double>& covariance, double k);
+  // Again after observed values changed (the same covariance).
+  void Reobserve();
+  // Residuals, one per statistic: the whitened ones at the positions of the
+  // statistics used with a finite simulated mean (whitened among those
+  // alone), NaN elsewhere.
   std::vector<double> Residuals(const std::vector<double>& mean) const;
-  double Chi2(const std::vector<double>& mean) const;  // +inf where a residual is NaN
+  double Chi2(const std::vector<double>& mean) const;  // +inf where a statistic used has no simulated mean
+
+  // The whitening of `rows` (statistics used, ascending): residuals
+  // w * (simulated values of rows) - b.
+  struct Whitening {
+    std::vector<std::size_t> rows;
+    std::vector<double> w;  // rows x rows, row-major, lower triangular
+    std::vector<double> b;
+  };
+  Whitening WhiteningOf(const std::vector<std::size_t>& rows) const;
+  // One draw of the observed values' errors (C's part of one recording:
+  // S within recordings plus observed_sigma^2), from `normal` draws, one per
+  // statistic; zero for statistics left out.
+  std::vector<double> ObservationNoise(const std::vector<double>& normal) const;
+
+ private:
+  std::vector<double> Covariance(const std::vector<std::size_t>& rows, bool shared) const;
+  Whitening used_;                  // over every statistic used
+  std::vector<double> realisation_; // Cholesky factor of one recording's part, over used_.rows
 };
+
+// The seeds' covariance of the statistics pooled over sets: each set's
+// per-seed values ([seed][statistic], NaN: none) about that set's own mean,
+// every simulated value (lead) once; the correlations shrunk toward zero by
+// the Schafer-Strimmer intensity (the estimated variance of the sample
+// correlations over their squares), raised until the matrix is positive
+// definite. Variances: the mean of the sets' own, as `spread` gives them.
+struct SeedCovariance {
+  std::vector<double> covariance;  // n x n over the statistics, row-major
+  std::vector<double> sd;          // per statistic (NaN: none measured)
+  double shrinkage = 0.0;          // 0: the sample correlations, 1: none kept
+  double effective_values = 0.0;   // (sum eigenvalues)^2 / sum eigenvalues^2 of the correlation used
+  std::size_t values = 0;          // distinct simulated values with a spread
+};
+SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vector<double>>*>& sets,
+                                    const std::vector<std::size_t>& lead);
 
 // The mean of each statistic over the seeds `draw` (indices into per_seed,
 // [seed][statistic], repeats allowed: a bootstrap's redraw of the seeds);

@@ -81,6 +81,9 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
     noise.push_back({{"parameter", n.parameter}, {"step", n.step}, {"chi2_scatter", Num(n.chi2_noise_sd)},
                      {"residual_scatter", Num(n.residual_noise_sd)}, {"gradient_step_signal_to_noise", Num(n.slope_signal)}});
   j["noise"] = noise;
+  j["seed_correlation"] = {{"values", r.seed_correlation.values}, {"pooled_over_sets", r.seed_correlation.sets},
+                           {"shrinkage", Num(r.seed_correlation.shrinkage)},
+                           {"effective_independent_values", Num(r.seed_correlation.effective_values)}};
   json stats = json::array();
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
@@ -158,7 +161,12 @@ std::string Report(const CalibrationResult& r) {
         << Fixed(n.residual_noise_sd) << "; a central difference over the gradient step sees "
         << Fixed(n.slope_signal) << " times the residuals' scatter (median over statistics)\n";
   }
-  o << "\nStatistics at the best fit (observed +- its sigma | simulated mean +- seed sd | residual):\n";
+  if (r.seed_correlation.values > 0)
+    o << "\nThe seeds' covariance (pooled over " << r.seed_correlation.sets << " sets): "
+      << r.seed_correlation.values << " simulated values, their correlations shrunk by "
+      << Fixed(r.seed_correlation.shrinkage, 2) << ", as informative as "
+      << Fixed(r.seed_correlation.effective_values, 2) << " independent ones; chi2 is the generalised one\n";
+  o << "\nStatistics at the best fit (observed +- its sigma | simulated mean +- seed sd | residual alone):\n";
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
     o << "  " << st.name << ": " << Fixed(st.observed) << " +- " << Fixed(st.observed_sigma) << " | "

@@ -47,6 +47,13 @@ struct CalibrationResult {
   const CalibrationSpec* spec = nullptr;
   Objective objective;
   std::vector<NoiseResult> noise;
+  // The seeds' covariance behind the weights (fit.hpp, PooledSeedCovariance).
+  struct SeedCorrelation {
+    double shrinkage = 0.0;         // of the sample correlations toward zero
+    double effective_values = 0.0;  // independent simulated values they amount to
+    std::size_t values = 0;         // distinct simulated values with a spread
+    std::size_t sets = 0;           // pooled over
+  } seed_correlation;
   std::vector<StartResult> starts;
   std::vector<double> best;  // values
   double best_simulated_chi2 = 0.0;

@@ -5,8 +5,9 @@
 # defaults and from a second start. Checks:
 #   - the desired speed recovered within 10 % and reported determined, its
 #     95 % interval holding the truth;
-#   - the restitution within 10 %, or reported undetermined (never a
-#     confident wrong value);
+#   - the restitution within 10 % (determined), or reported undetermined,
+#     or bounded on one side with the truth inside its interval (never a
+#     confident wrong value, never a bound that excludes the truth);
 #   - a second invocation on the same folder runs nothing and gives the same result;
 #   - a folder with runs missing, interrupted (SIGINT) and continued, runs
 #     only what is missing and gives the same result.
@@ -84,8 +85,10 @@ for p in a["parameters"]:
     if p["path"] == "population.desired_speed_m_per_s":
         if not (err <= 0.10 and p["determination"] == "determined" and lo <= t <= hi):
             print("FAIL: the desired speed was not recovered within 10 % as determined with the truth in its interval"); ok = False
-    elif not (err <= 0.10 or p["determination"] == "undetermined"):
+    elif p["determination"] == "determined" and not (err <= 0.10 and lo <= t <= hi):
         print("FAIL: a confident wrong restitution"); ok = False
+    elif p["determination"] == "bounded on one side" and not lo <= t <= hi:
+        print("FAIL: a bound on the restitution that excludes the truth"); ok = False
 for key in ("wall_s", "runs_simulated_now", "calibration_file"):
     a.pop(key, None); b.pop(key, None)
 if a != b:

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <string>
 
 #include "crowdrecon/calibrate/calibration_file.hpp"
@@ -22,6 +24,8 @@ namespace crowdrecon::calibrate {
 namespace {
 
 using crowdrecon::testing::ScratchFile;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string ErrorOf(const std::function<void()>& f) {
   try {
@@ -194,8 +198,9 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
 // parameter's variance stops shrinking at (seed_sd^2 / K) / slope^2 however
 // many recordings there are.
 TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
-  const auto statistic = [](double observed, double from) {
+  const auto statistic = [](double observed, double from, std::size_t recording) {
     Statistic s;
+    s.observation = recording;
     s.simulated_from = "spec";
     s.quantity = "speed";
     s.sim_from_s = from;
@@ -205,7 +210,7 @@ TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
     return s;
   };
   Objective o;
-  o.statistics = {statistic(1.0, 0.0), statistic(2.0, 0.0), statistic(3.0, 5.0)};
+  o.statistics = {statistic(1.0, 0.0, 0), statistic(2.0, 0.0, 1), statistic(3.0, 5.0, 0)};
   o.Weigh({0.5, 0.5, 0.5}, 4.0);
   EXPECT_EQ(o.lead, (std::vector<std::size_t>{0, 0, 2}));
   const double d = 0.01 + 0.25, w = 2.0 / d, a = 0.25 / 4.0;
@@ -222,7 +227,7 @@ TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
   }
   for (std::size_t n : {1u, 16u}) {
     Objective many;
-    for (std::size_t i = 0; i < n; ++i) many.statistics.push_back(statistic(1.0, 0.0));
+    for (std::size_t i = 0; i < n; ++i) many.statistics.push_back(statistic(1.0, 0.0, i));
     for (Statistic& st : many.statistics) st.observed_sigma = 0.0;
     many.Weigh(std::vector<double>(n, 0.4), 8.0);
     std::vector<std::vector<double>> v;
@@ -235,6 +240,105 @@ TEST(Objective, RecordingsOfOneSimulatedValueShareItsError) {
     ASSERT_TRUE(SurrogateCovariance(q, many, {0.5}, &cov, &reason, &without)) << reason;
     EXPECT_NEAR(cov[0], (0.16 / static_cast<double>(n) + 0.16 / 8.0) / 4.0, 1e-9) << n << " recordings";
   }
+}
+
+// Statistics of one recording that the seeds move together (a share moving
+// and a share still: r = -1; one window and the next) are one piece of
+// evidence, not two: m1 = 2u and m2 = -2u with seed covariance
+// s^2 [[1, -1], [-1, 1]] give var(u) = s^2 (1 + 1/K) / 4, as m1 alone does
+// (weighted as independent, half of it), and the same statistics
+// uncorrelated do halve it.
+TEST(Objective, StatisticsTheSeedsMoveTogetherCountOnce) {
+  const double s2 = 0.16, k = 8.0;
+  std::vector<std::vector<double>> pts, vals;
+  for (double u : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    pts.push_back({u});
+    vals.push_back({2.0 * u, -2.0 * u});
+  }
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, vals, {0.5}, 0.5));
+  const auto variance = [&](double correlation) {
+    Objective o;
+    o.statistics.resize(2);
+    o.statistics[0].observed = 1.0;
+    o.statistics[1].observed = -1.0;
+    o.WeighCovariance({s2, correlation * s2, correlation * s2, s2}, k);
+    std::vector<double> cov;
+    std::string reason;
+    std::vector<int> without;
+    EXPECT_TRUE(SurrogateCovariance(q, o, {0.5}, &cov, &reason, &without)) << reason;
+    return cov.empty() ? kNaN : cov[0];
+  };
+  const double one = s2 * (1.0 + 1.0 / k) / 4.0;
+  EXPECT_NEAR(variance(-0.999999), one, 1e-6 * one);
+  EXPECT_NEAR(variance(0.0), one / 2.0, 1e-12);
+
+  // chi2 is the generalised one: (m - o)^T C^-1 (m - o).
+  Objective o;
+  o.statistics.resize(2);
+  o.statistics[0].observed = 1.0;
+  o.statistics[1].observed = 0.5;
+  o.statistics[1].observed_sigma = 0.3;
+  o.WeighCovariance({0.25, 0.1, 0.1, 0.2}, 4.0);
+  const double c00 = 0.25 * 1.25, c01 = 0.1 * 1.25, c11 = 0.2 * 1.25 + 0.09;
+  const double d0 = 1.4 - 1.0, d1 = 0.2 - 0.5, det = c00 * c11 - c01 * c01;
+  EXPECT_NEAR(o.Chi2({1.4, 0.2}), (c11 * d0 * d0 - 2.0 * c01 * d0 * d1 + c00 * d1 * d1) / det, 1e-12);
+  // Without a simulated value for one, the other is weighed alone.
+  EXPECT_TRUE(std::isinf(o.Chi2({1.4, kNaN})));
+  const std::vector<double> r = o.Residuals({1.4, kNaN});
+  EXPECT_NEAR(r[0], d0 / std::sqrt(c00), 1e-12);
+  EXPECT_TRUE(std::isnan(r[1]));
+  // The bootstrap's redraw of one recording: its statistics scatter with
+  // C's own part (S + observed sigma^2), correlated as the seeds are.
+  const std::vector<double> e = o.ObservationNoise({1.0, 0.0});
+  EXPECT_NEAR(e[0], 0.5, 1e-12);
+  EXPECT_NEAR(e[1], 0.1 / 0.5, 1e-12);
+}
+
+// The seeds' covariance pooled over sets: each set's seeds about their own
+// mean (a set's offset is not spread), the correlation recovered, the
+// correlations of noise shrunk away, a simulated value read by two
+// statistics expanded to both.
+TEST(Objective, TheSeedsCovarianceIsPooledAndShrunk) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<std::vector<std::vector<double>>> sets(40);
+  for (std::size_t s = 0; s < sets.size(); ++s)
+    for (int seed = 0; seed < 8; ++seed) {
+      const double a = normal(rng), b = 0.8 * a + 0.6 * normal(rng), c = normal(rng);
+      // values: a (sd 2, set offset s), b (sd 1), c (sd 0.5), and a again (another recording's statistic)
+      sets[s].push_back({10.0 * static_cast<double>(s) + 2.0 * a, b, 0.5 * c, 10.0 * static_cast<double>(s) + 2.0 * a});
+    }
+  std::vector<const std::vector<std::vector<double>>*> ptr;
+  for (const auto& s : sets) ptr.push_back(&s);
+  const SeedCovariance c = PooledSeedCovariance(ptr, {0, 1, 2, 0});
+  ASSERT_EQ(c.covariance.size(), 16u);
+  EXPECT_EQ(c.values, 3u);
+  EXPECT_NEAR(c.sd[0], 2.0, 0.2);
+  EXPECT_NEAR(c.sd[1], 1.0, 0.1);
+  EXPECT_NEAR(c.sd[2], 0.5, 0.05);
+  EXPECT_EQ(c.sd[3], c.sd[0]);
+  const auto corr = [&](std::size_t j, std::size_t i) {
+    return c.covariance[j * 4 + i] / std::sqrt(c.covariance[j * 4 + j] * c.covariance[i * 4 + i]);
+  };
+  EXPECT_NEAR(corr(0, 1), 0.8, 0.08);
+  EXPECT_LT(std::abs(corr(0, 2)), 0.1);
+  EXPECT_EQ(corr(0, 3), 1.0);
+  EXPECT_EQ(c.covariance[1 * 4 + 3], c.covariance[1 * 4 + 0]);
+  EXPECT_GT(c.shrinkage, 0.0);
+  EXPECT_LT(c.shrinkage, 0.2);
+  EXPECT_GT(c.effective_values, 1.5);
+  EXPECT_LT(c.effective_values, 3.0);
+  // Pure noise: the sample correlations are mostly shrunk away.
+  std::vector<std::vector<std::vector<double>>> few(2);
+  for (auto& s : few)
+    for (int seed = 0; seed < 4; ++seed) s.push_back({normal(rng), normal(rng), normal(rng), normal(rng), normal(rng)});
+  const SeedCovariance noise = PooledSeedCovariance({&few[0], &few[1]}, {0, 1, 2, 3, 4});
+  EXPECT_GT(noise.shrinkage, 0.5);
+  Objective o;
+  o.statistics.resize(5);
+  o.WeighCovariance(noise.covariance, 4.0);  // positive definite: whitened
+  EXPECT_TRUE(std::isfinite(o.Chi2({0.1, 0.2, 0.3, 0.4, 0.5})));
 }
 
 // A profile's chi2 differences and the seeds' noise in them: one statistic
