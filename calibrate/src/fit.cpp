@@ -89,6 +89,7 @@ void Objective::WeighCovariance(const std::vector<double>& covariance, double k)
     sigma[j] = s > 0 ? s : kNaN;
     if (std::isfinite(sigma[j])) used_.rows.push_back(j);
   }
+  used_.w.clear();  // (else WhiteningOf would return the last weights' whitening)
   used_ = WhiteningOf(used_.rows);
   const std::size_t m = used_.rows.size();
   const std::vector<double> own = Covariance(used_.rows, false);

@@ -293,6 +293,9 @@ TEST(Objective, StatisticsTheSeedsMoveTogetherCountOnce) {
   const std::vector<double> e = o.ObservationNoise({1.0, 0.0});
   EXPECT_NEAR(e[0], 0.5, 1e-12);
   EXPECT_NEAR(e[1], 0.1 / 0.5, 1e-12);
+  // Weighed again with other spreads: the new weights, not the last ones.
+  o.Weigh({0.5, 0.0}, 4.0);
+  EXPECT_NEAR(o.Chi2({1.4, 0.2}), d0 * d0 / (0.25 * 1.25) + d1 * d1 / 0.09, 1e-12);
 }
 
 // The seeds' covariance pooled over sets: each set's seeds about their own
