@@ -14,7 +14,7 @@
 # RECOVERY_RECORDINGS=N (default 4) makes N recordings (seeds 1001 ...) and
 # matches each as the four are matched: more information, the same runs.
 # Their observation files then go to OUT-truth/observations/ (the default
-# four are the repository's). RECOVERY_SEEDS=K (default 8) runs K seeds per
+# four, made into the default OUT, are the repository's). RECOVERY_SEEDS=K (default 8) runs K seeds per
 # parameter set instead: the simulated means' error falls with K as the
 # recordings' falls with N (docs/calibration.md, "The objective").
 set -euo pipefail
@@ -30,7 +30,9 @@ trap 'rm -rf "$work"' EXIT
 
 truth="$dir/hallway-recovery-truth.json"
 observations="$dir/recovery"
-if [ "$recordings" != 4 ]; then
+# The repository's four observation files are written only by the default
+# run (they name its runs); any other OUT or N writes its own.
+if [ "$recordings" != 4 ] || [ "$out" != out/calibration/hallway-recovery ]; then
   truth="$work/hallway-recovery-truth.json"
   observations="$out-truth/observations"
   python3 - "$dir/hallway-recovery-truth.json" "$truth" "$PWD/$dir" "$recordings" <<'PY'
@@ -58,7 +60,7 @@ done
 
 echo "2. the calibration"
 calibration="$dir/hallway-recovery.json"
-if [ "$approach" = gradient ] || [ "$recordings" != 4 ] || [ "$seeds" != 8 ]; then
+if [ "$approach" = gradient ] || [ "$observations" != "$dir/recovery" ] || [ "$seeds" != 8 ]; then
   calibration="$work/hallway-recovery-variant.json"
   python3 - "$dir/hallway-recovery.json" "$calibration" "$PWD/$dir" "$approach" "$recordings" \
     "$(cd "$observations" && pwd)" "$seeds" <<'PY'
@@ -72,7 +74,8 @@ if approach == "gradient":
     # The gradient approach also measures the objective's noise first, which
     # says whether its central differences see the slope.
     c["options"].update({"measure_noise": True, "max_iterations": 4})
-c["name"] = c["name"].replace("four synthetic recordings", "%d synthetic recordings" % recordings)
+if recordings != 4:
+    c["name"] = c["name"].replace("four synthetic recordings", "%d synthetic recordings" % recordings)
 # Every recording matched as the first one is.
 first = c["observations"][0]
 c["observations"] = []
