@@ -562,7 +562,7 @@ std::string Summary::BriefReport() const {
     s += ": " + p.determination + (p.reason.empty() ? "" : " (" + p.reason + ")") + "\n";
   }
   s += "  chi2 " + FormatNumber(chi2) + " for " + std::to_string(degrees_of_freedom) + " degrees of freedom; " +
-       std::to_string(starts) + " start(s), " + (starts_agree ? "agreeing" : "NOT agreeing") + "\n";
+       std::to_string(starts) + " start(s), " + (starts_agree ? "agreeing within the 95 % intervals" : "NOT agreeing within the 95 % intervals") + "\n";
   s += "  " + std::to_string(sets_evaluated) + " parameter sets, " + std::to_string(runs) + " runs simulated now; wall time " +
        FormatNumber(std::round(wall_s)) + " s\n";
   s += "  outputs: " + json_file.string() + ", " + report_file.string() + "\n";

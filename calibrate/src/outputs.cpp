@@ -146,7 +146,7 @@ std::string Report(const CalibrationResult& r) {
   }
   o << "\nchi2 at the best fit (simulated): " << Fixed(s.chi2, 4) << " for " << s.degrees_of_freedom
     << " degrees of freedom\n";
-  o << "\nStarts (" << (s.starts_agree ? "they agree" : "they do NOT agree") << "):\n";
+  o << "\nStarts (" << (s.starts_agree ? "they agree within the 95 % intervals (2 % of the range at least)" : "they do NOT agree within the 95 % intervals") << "; an undetermined parameter may lie anywhere):\n";
   for (const StartResult& st : r.starts) {
     o << "  from";
     for (double v : st.start) o << " " << FormatNumber(v);
