@@ -93,10 +93,11 @@ bool MpiTransport::AllOk(bool ok) {
   return all == 1;
 }
 
-bool MpiTransport::RootOk(bool ok) {
-  int value = ok ? 1 : 0;
-  MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  return value == 1;
+bool MpiTransport::RootOk(bool ok) { return RootStatus(ok ? 1 : 0) == 1; }
+
+int MpiTransport::RootStatus(int status) {
+  MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return status;
 }
 
 void MpiTransport::Abort(int code) {

@@ -44,6 +44,8 @@ class MpiTransport {
   bool AllOk(bool ok);
   // Every rank: rank 0's `ok` (collective).
   bool RootOk(bool ok);
+  // Every rank: rank 0's `status` (collective; a small non-negative code).
+  int RootStatus(int status);
   // Ends every rank at once, after a fatal error on one of them.
   [[noreturn]] void Abort(int code);
 

@@ -27,6 +27,7 @@ void MpiTransport::SendControl(int, std::int64_t) {}
 bool MpiTransport::PollControl(std::int64_t*) { return false; }
 bool MpiTransport::AllOk(bool ok) { return ok; }
 bool MpiTransport::RootOk(bool ok) { return ok; }
+int MpiTransport::RootStatus(int status) { return status; }
 void MpiTransport::Abort(int code) { std::exit(code); }
 
 }  // namespace crowdrecon::sweep

@@ -614,20 +614,25 @@ SweepSummary RunSweep(const SweepOptions& options) {
   const SweepSignals signals;
   // Under MPI every rank returns only when every run's row has reached rank
   // 0, so that what the runs left behind (their after_run files) is complete
-  // on every rank when RunSweep returns there (a calibration reads it next).
+  // on every rank when RunSweep returns there (a calibration reads it next),
+  // and knows what rank 0 knows: failed, done, or interrupted (a worker rank
+  // that went on as if its sweep were complete would look for runs never made).
+  enum RootStatus { kFailed = 0, kDone = 1, kInterrupted = 2 };
   if (rank != 0) {
     RunWorkerRank(*transport, rank, jobs, work);
-    if (!transport->RootOk(true)) s.exit_code = 2;
+    const int status = transport->RootStatus(kDone);
+    if (status == kFailed) s.exit_code = 2;
+    s.interrupted = status == kInterrupted;
     s.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
     return s;
   }
   try {
     Coordinator(options, setup, transport.get(), ranks, jobs, start, &s).Run(work);
   } catch (...) {
-    if (mpi) transport->RootOk(false);
+    if (mpi) transport->RootStatus(kFailed);
     throw;
   }
-  if (mpi) transport->RootOk(true);
+  if (mpi) transport->RootStatus(s.interrupted ? kInterrupted : kDone);
   return s;
 }
 
