@@ -89,8 +89,7 @@ void Objective::WeighCovariance(const std::vector<double>& covariance, double k)
     sigma[j] = s > 0 ? s : kNaN;
     if (std::isfinite(sigma[j])) used_.rows.push_back(j);
   }
-  used_.w.clear();  // (else WhiteningOf would return the last weights' whitening)
-  used_ = WhiteningOf(used_.rows);
+  used_ = Whiten(used_.rows);
   const std::size_t m = used_.rows.size();
   const std::vector<double> own = Covariance(used_.rows, false);
   const Matrix l = LowerCholesky(Eigen::Map<const Matrix>(own.data(), static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m)));
@@ -113,7 +112,19 @@ std::vector<double> Objective::Covariance(const std::vector<std::size_t>& rows, 
 }
 
 Objective::Whitening Objective::WhiteningOf(const std::vector<std::size_t>& rows) const {
-  if (!used_.w.empty() && rows == used_.rows) return used_;
+  return rows == used_.rows ? used_ : Whiten(rows);
+}
+
+void Objective::Whitening::Apply(const double* x, std::size_t stride, bool minus_b, double* out) const {
+  const std::size_t m = rows.size();
+  for (std::size_t a = 0; a < m; ++a) {
+    double v = minus_b ? -b[a] : 0.0;
+    for (std::size_t c = 0; c <= a; ++c) v += w[a * m + c] * x[c * stride];
+    out[a] = v;
+  }
+}
+
+Objective::Whitening Objective::Whiten(const std::vector<std::size_t>& rows) const {
   const std::size_t m = rows.size();
   const std::vector<double> c = Covariance(rows, true);
   const auto mi = static_cast<Eigen::Index>(m);
@@ -129,11 +140,7 @@ Objective::Whitening Objective::WhiteningOf(const std::vector<std::size_t>& rows
   return out;
 }
 
-void Objective::Reobserve() {
-  const std::vector<std::size_t> rows = used_.rows;
-  used_.w.clear();
-  used_ = WhiteningOf(rows);
-}
+void Objective::Reobserve() { used_ = Whiten(used_.rows); }
 
 std::vector<double> Objective::ObservationNoise(const std::vector<double>& normal) const {
   std::vector<double> e(statistics.size(), 0.0);
@@ -152,13 +159,14 @@ std::vector<double> Objective::Residuals(const std::vector<double>& mean) const 
   std::vector<std::size_t> rows;
   for (std::size_t j : used_.rows)
     if (std::isfinite(mean[lead[j]])) rows.push_back(j);
-  const Whitening& wh = rows == used_.rows ? used_ : WhiteningOf(rows);
+  Whitening subset;  // (only where some statistic has no simulated mean)
+  const Whitening* wh = &used_;
+  if (rows != used_.rows) wh = &(subset = Whiten(rows));
   const std::size_t m = rows.size();
-  for (std::size_t a = 0; a < m; ++a) {
-    double v = -wh.b[a];
-    for (std::size_t b = 0; b <= a; ++b) v += wh.w[a * m + b] * mean[lead[rows[b]]];
-    r[rows[a]] = v;
-  }
+  std::vector<double> value(m), white(m);
+  for (std::size_t a = 0; a < m; ++a) value[a] = mean[lead[rows[a]]];
+  wh->Apply(value.data(), 1, true, white.data());
+  for (std::size_t a = 0; a < m; ++a) r[rows[a]] = white[a];
   return r;
 }
 
@@ -458,16 +466,13 @@ class SurrogateCost final : public ceres::CostFunction {
         std::copy(g.begin(), g.end(), gradient.begin() + static_cast<long>(r * p));
       }
     }
-    for (std::size_t r = 0; r < m; ++r) {
-      double v = -white_.b[r];
-      for (std::size_t c = 0; c <= r; ++c) v += white_.w[r * m + c] * value[c];
-      residuals[r] = v;
-      if (want)
-        for (std::size_t i = 0; i < p; ++i) {
-          double d = 0.0;
-          for (std::size_t c = 0; c <= r; ++c) d += white_.w[r * m + c] * gradient[c * p + i];
-          jacobians[0][r * p + i] = d;
-        }
+    white_.Apply(value.data(), 1, true, residuals);
+    if (want) {
+      std::vector<double> column(m);
+      for (std::size_t i = 0; i < p; ++i) {
+        white_.Apply(gradient.data() + i, p, false, column.data());
+        for (std::size_t r = 0; r < m; ++r) jacobians[0][r * p + i] = column[r];
+      }
     }
     return true;
   }

@@ -64,6 +64,9 @@ struct Objective {
     std::vector<std::size_t> rows;
     std::vector<double> w;  // rows x rows, row-major, lower triangular
     std::vector<double> b;
+    // w * x - b (the residuals of simulated values x), or w * x without b
+    // (their derivatives); x: one value per row, `stride` apart.
+    void Apply(const double* x, std::size_t stride, bool minus_b, double* out) const;
   };
   Whitening WhiteningOf(const std::vector<std::size_t>& rows) const;
   // One draw of the observed values' errors (C's part of one recording:
@@ -73,6 +76,7 @@ struct Objective {
 
  private:
   std::vector<double> Covariance(const std::vector<std::size_t>& rows, bool shared) const;
+  Whitening Whiten(const std::vector<std::size_t>& rows) const;  // (WhiteningOf without the cache)
   Whitening used_;                  // over every statistic used
   std::vector<double> realisation_; // Cholesky factor of one recording's part, over used_.rows
 };
