@@ -25,6 +25,8 @@ packages=(
   chromium poppler-utils
   # tests and benchmarks (GNU time: peak memory in bench/run_benchmarks.py)
   libgtest-dev libgmock-dev libbenchmark-dev time
+  # the MPI interruption check finds rank 0 with pgrep
+  procps
 )
 
 source "$(dirname "${BASH_SOURCE[0]}")/apt-install.sh"
