@@ -14,6 +14,10 @@
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "host_device.hpp"
 
+#if defined(__SSE2__) && !defined(__CUDACC__)
+#include <emmintrin.h>
+#endif
+
 namespace crowdrecon::engine::detail {
 
 // Closest point of the core of `g` (in g's frame) to p, with the signed
@@ -22,6 +26,21 @@ struct Closest {
   Vec2 point;
   double distance = std::numeric_limits<double>::infinity();
 };
+
+// t clamped to [0, 1]: t > 1 gives 1, t < 0 gives 0, else t itself (-0.0
+// stays -0.0). On x86-64 by MINSD and MAXSD, whose operand order gives
+// exactly these comparisons, so that no branch is taken per edge (whether a
+// vertex projects before, on or beyond an edge varies from edge to edge and
+// defeats branch prediction; the compiler keeps branches for the plain
+// expressions, the device and other processors use them).
+CROWDRECON_HOST_DEVICE CROWDRECON_INLINE double ClampToUnit(double t) {
+#if defined(__SSE2__) && !defined(__CUDACC__)
+  return _mm_cvtsd_f64(_mm_max_sd(_mm_setzero_pd(), _mm_min_sd(_mm_set_sd(1.0), _mm_set_sd(t))));
+#else
+  t = t > 1.0 ? 1.0 : t;
+  return t < 0.0 ? 0.0 : t;
+#endif
+}
 
 // Searches the edges edge_index[0..m) (all edges when edge_index is null).
 // `Geometry`: ShapeGeometry, or the device's copy of it (cuda_collide.cu).
@@ -35,22 +54,28 @@ CROWDRECON_HOST_DEVICE CROWDRECON_INLINE Closest ClosestOnCore(Vec2 p, const Geo
     best.distance = std::sqrt(d.x * d.x + d.y * d.y);  // Length(d), which is not for the device
     return best;
   }
+  // The first candidate at the least squared distance, found without a
+  // branch per candidate (selects, not jumps: which edge is closest, and
+  // where along it, vary from vertex to vertex and defeat branch
+  // prediction); its closest point is then computed again by the same
+  // expressions, hence to the same bits.
   double best_d2 = std::numeric_limits<double>::infinity();
   std::size_t best_edge = 0;
-  double best_t = 0.0;
   for (std::size_t k = 0; k < m; ++k) {
     const std::size_t j = edge_index ? edge_index[k] : k;
     const CoreEdge& e = g.edges[j];
-    double t = Dot(p - e.start, e.direction) * e.inverse_length2;
-    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    const double t = ClampToUnit(Dot(p - e.start, e.direction) * e.inverse_length2);
     const Vec2 q = e.start + e.direction * t;
     const double d2 = LengthSquared(p - q);
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best.point = q;
-      best_edge = j;
-      best_t = t;
-    }
+    const bool closer = d2 < best_d2;
+    best_edge = closer ? j : best_edge;
+    best_d2 = closer ? d2 : best_d2;
+  }
+  double best_t;
+  {
+    const CoreEdge& e = g.edges[best_edge];
+    best_t = ClampToUnit(Dot(p - e.start, e.direction) * e.inverse_length2);
+    best.point = e.start + e.direction * best_t;
   }
   best.distance = std::sqrt(best_d2);
   if (g.closed) {

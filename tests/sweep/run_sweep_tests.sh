@@ -9,8 +9,9 @@
 #       again; every results.csv equal to the reference but for wall_s.
 #       Also: the same DIR with another sweep file is refused.
 #   run_sweep_tests.sh CROWDRECON SWEEP OUT mpi
-#       OUT/mpi under `mpirun -np 2 --oversubscribe`, compared with OUT/j1
-#       (exit 77 = skipped if mpirun is absent).
+#       OUT/mpi under `mpirun -np 2 --oversubscribe`, compared with OUT/j1;
+#       OUT/mpi-stop interrupted after 2 runs (every rank exits 130), then
+#       continued and compared (exit 77 = skipped if mpirun is absent).
 set -euo pipefail
 exe=$1; sweep=$2; out=$3; mode=$4
 mkdir -p "$out"
@@ -96,6 +97,21 @@ elif [[ $mode == mpi ]]; then
   cat "$out/mpi.txt"
   grep -q "on each of 2 MPI ranks" "$out/mpi.txt" || { echo "FAIL: the sweep did not run on 2 ranks"; exit 1; }
   same "$out/j1" "$out/mpi" "mpirun -np 2"
+  # Interrupted under MPI (--stop-after-runs on rank 0): every rank exits 130
+  # (a worker rank used to exit 0 as if its sweep were complete), and the
+  # same command again completes it, equal to the reference.
+  rm -rf "$out/mpi-stop" "$out"/mpi-stop.rc.*
+  set +e
+  mpirun -np 2 --oversubscribe sh -c '"$0" sweep "$1" -o "$2" -q --stop-after-runs 2; echo $? >"$2.rc.$OMPI_COMM_WORLD_RANK"' \
+    "$exe" "$sweep" "$out/mpi-stop" >"$out/mpi-stop.txt" 2>&1
+  set -e
+  for r in 0 1; do
+    [[ $(cat "$out/mpi-stop.rc.$r" 2>/dev/null) == 130 ]] ||
+      { echo "FAIL: rank $r of the interrupted sweep exited $(cat "$out/mpi-stop.rc.$r" 2>/dev/null), expected 130"; cat "$out/mpi-stop.txt"; exit 1; }
+  done
+  mpirun -np 2 --oversubscribe "$exe" sweep "$sweep" -o "$out/mpi-stop" -q >"$out/mpi-continued.txt" 2>&1 ||
+    { echo "FAIL: the continued sweep exited $?"; cat "$out/mpi-continued.txt"; exit 1; }
+  same "$out/j1" "$out/mpi-stop" "mpirun -np 2, interrupted and continued"
   echo "sweeps, MPI: OK"
 else
   echo "usage: run_sweep_tests.sh CROWDRECON SWEEP OUT local|mpi"; exit 2
