@@ -36,11 +36,9 @@ int RunSweepCommand(const SweepArgs& args) {
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.stop_after_runs = args.stop_after_runs;
   const sweep::SweepSummary s = sweep::RunSweep(options);
-  // MPI ranks other than 0 say nothing, but exit as rank 0 does (they know
-  // its status: failed, interrupted or done).
-  if (!s.coordinator) return s.exit_code != 0 ? s.exit_code : (s.interrupted ? 130 : 0);
-  std::printf("%s", s.BriefReport().c_str());
-  return s.interrupted ? 130 : 0;
+  // MPI ranks other than 0 say nothing, but exit as rank 0 does.
+  if (s.coordinator) std::printf("%s", s.BriefReport().c_str());
+  return s.ExitStatus();
 }
 
 }  // namespace

@@ -71,20 +71,16 @@ CROWDRECON_HOST_DEVICE CROWDRECON_INLINE Closest ClosestOnCore(Vec2 p, const Geo
     best_edge = closer ? j : best_edge;
     best_d2 = closer ? d2 : best_d2;
   }
-  double best_t;
-  {
-    const CoreEdge& e = g.edges[best_edge];
-    best_t = ClampToUnit(Dot(p - e.start, e.direction) * e.inverse_length2);
-    best.point = e.start + e.direction * best_t;
-  }
+  const CoreEdge& closest = g.edges[best_edge];
+  const double best_t = ClampToUnit(Dot(p - closest.start, closest.direction) * closest.inverse_length2);
+  best.point = closest.start + closest.direction * best_t;
   best.distance = std::sqrt(best_d2);
   if (g.closed) {
     // Inside test from the closest feature: across an edge interior by the
     // side of its line; at a vertex, p is inside exactly when the vertex is reflex.
     bool inside;
     if (best_t > 0.0 && best_t < 1.0) {
-      const CoreEdge& e = g.edges[best_edge];
-      inside = Cross(e.direction, p - e.start) > 0.0;  // left of a counter-clockwise edge
+      inside = Cross(closest.direction, p - closest.start) > 0.0;  // left of a counter-clockwise edge
     } else {
       const std::size_t n = g.count();
       const std::size_t k = best_t <= 0.0 ? best_edge : (best_edge + 1 == n ? 0 : best_edge + 1);

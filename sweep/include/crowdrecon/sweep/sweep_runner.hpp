@@ -78,6 +78,9 @@ struct SweepSummary {
   std::filesystem::path results_sqlite, results_csv;
 
   std::string BriefReport() const;
+  // The command's exit status, the same on every MPI rank: exit_code when
+  // the sweep could not start or failed, 130 when interrupted, else 0.
+  int ExitStatus() const { return exit_code != 0 ? exit_code : (interrupted ? 130 : 0); }
 };
 
 // Runs (or continues) the sweep. Throws InputError for a bad sweep file, a
