@@ -35,8 +35,9 @@ int RunCalibrateCommand(const CalibrateArgs& args) {
   options.jobs = args.jobs;
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   const calibrate::Summary s = calibrate::Calibrate(options);
-  if (!s.coordinator) return 0;  // MPI ranks other than 0 say nothing
-  std::printf("%s", s.BriefReport().c_str());
+  // MPI ranks other than 0 say nothing, but exit as rank 0 does (every rank
+  // learns from it whether the calibration was interrupted).
+  if (s.coordinator) std::printf("%s", s.BriefReport().c_str());
   return s.interrupted ? 130 : 0;
 }
 

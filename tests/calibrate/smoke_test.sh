@@ -98,8 +98,11 @@ if [ "$mode" = mpi ]; then
   # every rank stops (a worker rank that went on to the next stage waited
   # for rank 0 forever), exit status 130; then continued, below.
   # (a hung one is ended after two minutes: exit status 124)
-  timeout 120 mpirun -np 2 --oversubscribe "$crowdrecon" calibrate "$d/calibration.json" -o "$d/mpi" -q \
-    > "$d/mpi-interrupted.txt" 2>&1 &
+  # Each rank's exit status is kept (a worker rank exited 0 until 2026-11-27).
+  rm -f "$d"/mpi.rc.*
+  timeout 120 mpirun -np 2 --oversubscribe sh -c \
+    '"$0" calibrate "$1" -o "$2" -q; rc=$?; echo $rc > "$3.rc.$OMPI_COMM_WORLD_RANK"; exit $rc' \
+    "$crowdrecon" "$d/calibration.json" "$d/mpi" "$d/mpi" > "$d/mpi-interrupted.txt" 2>&1 &
   launcher=$!
   for _ in $(seq 600); do compgen -G "$d/mpi/batches/*/runs/*.sqlite" > /dev/null && break; sleep 0.1; done
   for p in $(pgrep -f "calibrate $d/calibration.json -o $d/mpi"); do
@@ -111,6 +114,10 @@ if [ "$mode" = mpi ]; then
   set -e
   cat "$d/mpi-interrupted.txt"
   [ "$rc" = 130 ] || { echo "FAIL: the interrupted MPI calibration exited $rc, expected 130"; exit 1; }
+  for r in 0 1; do
+    [ "$(cat "$d/mpi.rc.$r" 2> /dev/null)" = 130 ] ||
+      { echo "FAIL: rank $r of the interrupted calibration exited $(cat "$d/mpi.rc.$r" 2> /dev/null), expected 130"; exit 1; }
+  done
   grep -q "interrupted: run the same command again" "$d/mpi-interrupted.txt"
   ! grep -q "cannot open" "$d/mpi-interrupted.txt" || { echo "FAIL: a rank looked for runs never made"; exit 1; }
   mpirun -np 2 --oversubscribe "$crowdrecon" calibrate "$d/calibration.json" -o "$d/mpi" -q > "$d/mpi.txt" 2>&1 ||
