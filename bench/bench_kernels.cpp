@@ -33,6 +33,8 @@
 #include "crowdrecon/engine/world_file.hpp"
 #include "crowdrecon/geometry/body.hpp"
 #include "crowdrecon/scenario/run_record.hpp"
+#include "crowdrecon/scenario/runner.hpp"
+#include "crowdrecon/scenario/scenario.hpp"
 
 namespace crowdrecon::bench {
 
@@ -334,16 +336,44 @@ void DumpWorlds(const std::filesystem::path& dir) {
   dump("box-10000", "box-10000-developed", kDevelopedSeconds);
 }
 
+// Writes DIR/<name>.world and DIR/<name>.state from an interrupted run of a
+// scenario (its checkpoint: scenario::ReadEngineAtCheckpoint), so that
+// bench_device can time a dense moment of a real run, e.g. the evacuation at
+// 30 s (`crowdrecon simulate ... --stop-after 30`).
+void DumpCheckpoint(const std::filesystem::path& dir, const std::string& spec) {
+  const std::size_t a = spec.find(',');
+  const std::size_t b = a == std::string::npos ? a : spec.find(',', a + 1);
+  if (b == std::string::npos)
+    throw std::runtime_error("--dump_run=\"" + spec + "\": expected SCENARIO,RUN.sqlite,NAME");
+  const scenario::Scenario sc = scenario::LoadScenario(spec.substr(0, a));
+  const scenario::EngineAtCheckpoint saved = scenario::ReadEngineAtCheckpoint(sc, spec.substr(a + 1, b - a - 1), 1);
+  const std::string name = spec.substr(b + 1);
+  std::filesystem::create_directories(dir);
+  engine::SaveWorldFile(saved.world, dir / (name + ".world"));
+  const std::filesystem::path file = dir / (name + ".state");
+  std::ofstream out(file, std::ios::binary);
+  out.write(saved.state.data(), static_cast<std::streamsize>(saved.state.size()));
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  std::printf("wrote %s and %s (t = %.3f s, %zu bodies)\n", (dir / (name + ".world")).c_str(), file.c_str(),
+              saved.time_s, saved.world.people.size());
+}
+
 }  // namespace
 
 }  // namespace crowdrecon::bench
 
 int main(int argc, char** argv) {
-  // --dump_worlds=DIR: write the worlds and states (see DumpWorlds), run nothing.
+  // --dump_worlds=DIR: write the worlds and states (see DumpWorlds), run
+  // nothing; with --dump_run=SCENARIO,RUN.sqlite,NAME, that run's checkpoint
+  // instead (see DumpCheckpoint).
+  std::string dump_run;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind("--dump_run=", 0) == 0) dump_run = std::string(argv[i]).substr(11);
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]).rfind("--dump_worlds=", 0) == 0) {
       try {
-        crowdrecon::bench::DumpWorlds(std::string(argv[i]).substr(14));
+        if (dump_run.empty()) crowdrecon::bench::DumpWorlds(std::string(argv[i]).substr(14));
+        else crowdrecon::bench::DumpCheckpoint(std::string(argv[i]).substr(14), dump_run);
         return 0;
       } catch (const std::exception& e) {
         std::fprintf(stderr, "crowdrecon_bench_kernels: %s\n", e.what());

@@ -276,6 +276,19 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
 
 }  // namespace
 
+EngineAtCheckpoint ReadEngineAtCheckpoint(const Scenario& scenario, const std::filesystem::path& run_file, int threads) {
+  BuiltWorld built = BuildWorld(scenario, threads, [](const std::string&) {});
+  std::int64_t steps_per_frame = 1;
+  ChooseTimeStep(scenario, built, &steps_per_frame);
+  EngineAtCheckpoint out;
+  out.state = ReadCheckpoint(CheckpointPath(run_file), ScenarioFingerprint(scenario)).state;
+  engine::Simulation sim(built.world);
+  sim.LoadState(out.state);  // checks that the state fits the world
+  out.time_s = sim.time_s();
+  out.world = std::move(built.world);
+  return out;
+}
+
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   const auto say = [&](const std::string& line) {
     if (options.show_progress) std::fprintf(stderr, "%s\n", line.c_str());

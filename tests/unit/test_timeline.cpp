@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/scenario/scenario.hpp"
@@ -359,6 +360,57 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
          "/timeline/recorded/0: missing required key \"max_speed_uncertainty_m_per_s\"");
   refuse(R"({"recorded": [{"time_s": 5, "max_speed_m_per_s": -1, "max_speed_uncertainty_m_per_s": 0.5}]})",
          "/timeline/recorded/0/max_speed_m_per_s");
+}
+
+
+// The engine at a run's checkpoint (for benchmarks on machines that cannot
+// build worlds): the state is that of the uninterrupted run at that frame,
+// and stepping it on gives the uninterrupted run's later frames exactly, so
+// its world carries the run's time step.
+TEST(Timeline, TheEngineAtACheckpointContinuesAsTheRunDoes) {
+  const Scenario s = LoadScenario(kSource / "tests/data/scenarios/hallway-short.json");
+  RunOptions whole, stopped;
+  whole.output = crowdrecon::testing::ScratchFile("engine-at-checkpoint-whole.sqlite");
+  stopped.output = crowdrecon::testing::ScratchFile("engine-at-checkpoint-stopped.sqlite");
+  for (const RunOptions* o : {&whole, &stopped}) {
+    std::filesystem::remove(o->output);
+    std::filesystem::remove(CheckpointPath(o->output));
+  }
+  stopped.stop_after_s = 1.0;
+  const RunSummary summary = RunScenario(s, whole);
+  ASSERT_EQ(RunScenario(s, stopped).status, "interrupted");
+
+  const EngineAtCheckpoint saved = ReadEngineAtCheckpoint(s, stopped.output, 2);
+  EXPECT_NEAR(saved.time_s, 1.0, 1e-9);
+  EXPECT_EQ(saved.world.parameters.time_step_s, summary.time_step_s);
+  engine::Simulation sim(saved.world);
+  sim.LoadState(saved.state);
+  const runfile::RunFileReader reader(whole.output);
+  std::vector<runfile::PersonFrame> frames;
+  runfile::PersonFrame f;
+  auto stream = reader.PersonFrames(20);
+  while (stream.Next(&f)) frames.push_back(f);
+  ASSERT_EQ(frames.size(), 21u);
+  const auto expect_frame = [&](const runfile::PersonFrame& frame) {
+    ASSERT_EQ(frame.person.size(), sim.bodies().size());
+    for (std::size_t i = 0; i < frame.person.size(); ++i) {
+      ASSERT_EQ(frame.position_m[i].x, sim.bodies().position_m[frame.person[i]].x) << "frame " << frame.frame;
+      ASSERT_EQ(frame.position_m[i].y, sim.bodies().position_m[frame.person[i]].y) << "frame " << frame.frame;
+    }
+  };
+  expect_frame(frames[10]);
+  sim.AdvanceTo(2.0);
+  expect_frame(frames[20]);
+
+  // Another scenario's checkpoint is refused, naming the file.
+  Scenario other = s;
+  other.json_text += " ";
+  try {
+    ReadEngineAtCheckpoint(other, stopped.output, 1);
+    ADD_FAILURE() << "another scenario's checkpoint was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("belongs to a different scenario"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace timeline_tests

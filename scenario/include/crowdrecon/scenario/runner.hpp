@@ -62,4 +62,18 @@ void InstallInterruptHandlers();
 
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
 
+// The engine's world and its state at the checkpoint of an interrupted run
+// (CheckpointPath(run_file)), built as RunScenario builds them (the same
+// world, time step and state a resumed run continues from), with `threads`.
+// For benchmarks on machines that cannot build worlds from scenarios (see
+// bench/README.md: a dense moment of a real run on a GPU machine). Throws
+// InputError naming the checkpoint if it is missing, damaged or belongs to
+// another scenario.
+struct EngineAtCheckpoint {
+  engine::WorldDef world;
+  std::string state;  // engine::Simulation::SaveState
+  double time_s = 0.0;
+};
+EngineAtCheckpoint ReadEngineAtCheckpoint(const Scenario& scenario, const std::filesystem::path& run_file, int threads);
+
 }  // namespace crowdrecon::scenario
