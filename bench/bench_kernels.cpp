@@ -317,6 +317,13 @@ void RegisterAll() {
           ->UseRealTime();
 }
 
+// A state (Simulation::SaveState) as DIR/<name>.state, for bench_device.
+void WriteStateFile(const std::filesystem::path& file, const std::string& state) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(state.data(), static_cast<std::streamsize>(state.size()));
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+}
+
 // Writes the worlds of the Step benchmarks, and their states after the
 // warm-up, as DIR/<name>.world and DIR/<name>.state, for bench_device on
 // machines that cannot build worlds from scenarios (a GPU machine).
@@ -324,11 +331,8 @@ void DumpWorlds(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
   const auto dump = [&](const std::string& world, const std::string& name, double warm_up_s) {
     engine::SaveWorldFile(CachedWorld(world).world, dir / (name + ".world"));
-    const std::string& state = WarmState(world, warm_up_s);
     const std::filesystem::path file = dir / (name + ".state");
-    std::ofstream out(file, std::ios::binary);
-    out.write(state.data(), static_cast<std::streamsize>(state.size()));
-    if (!out) throw std::runtime_error(file.string() + ": cannot write");
+    WriteStateFile(file, WarmState(world, warm_up_s));
     std::printf("wrote %s and %s\n", (dir / (name + ".world")).c_str(), file.c_str());
   };
   dump("hallway-400", "hallway-400", kWarmUpSeconds);
@@ -351,9 +355,7 @@ void DumpCheckpoint(const std::filesystem::path& dir, const std::string& spec) {
   std::filesystem::create_directories(dir);
   engine::SaveWorldFile(saved.world, dir / (name + ".world"));
   const std::filesystem::path file = dir / (name + ".state");
-  std::ofstream out(file, std::ios::binary);
-  out.write(saved.state.data(), static_cast<std::streamsize>(saved.state.size()));
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  WriteStateFile(file, saved.state);
   std::printf("wrote %s and %s (t = %.3f s, %zu bodies)\n", (dir / (name + ".world")).c_str(), file.c_str(),
               saved.time_s, saved.world.people.size());
 }
