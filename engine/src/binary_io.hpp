@@ -64,10 +64,17 @@ class BinaryReader {
   T Get() {
     static_assert(std::is_trivially_copyable_v<T>);
     if (sizeof(T) > remaining()) Truncated();
-    T value;
-    std::memcpy(&value, data_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return value;
+    if constexpr (std::is_same_v<T, bool>) {
+      // A byte other than 0 or 1 is no bool (reading it as one is undefined).
+      const unsigned char byte = static_cast<unsigned char>(data_[pos_++]);
+      if (byte > 1) throw InputError(name_ + ": damaged " + content_ + " (a flag of value " + std::to_string(byte) + ")");
+      return byte == 1;
+    } else {
+      T value;
+      std::memcpy(&value, data_.data() + pos_, sizeof(T));
+      pos_ += sizeof(T);
+      return value;
+    }
   }
   template <typename T>
   void GetVector(std::vector<T>& values, std::size_t expected_size = SIZE_MAX) {

@@ -2,6 +2,8 @@
 // (one of the stages of Simulation::Step; engine/include/crowdrecon/engine/stages.hpp)
 #include "simulation_internals.hpp"
 
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "binary_io.hpp"
@@ -61,6 +63,51 @@ ModelParameters GetParameters(StateReader& r, ModelParameters p) {
     }
   }
   return p;
+}
+
+// What a step relies on in a restored state, checked before it steps: a
+// checkpoint that passed its checksum yet holds values no run can reach (one
+// written by another build, or made by hand) is refused with what is wrong,
+// rather than stepped into out-of-range indices or non-numbers.
+bool Finite(double x) { return std::isfinite(x); }
+bool Finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+template <typename T>
+void RequireFinite(const std::vector<T>& values, const char* what) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!Finite(values[i]))
+      throw InputError(std::string("checkpoint: damaged state: ") + what + " of slot " + std::to_string(i) +
+                       " is not a finite number");
+}
+
+// The contacts of the last step (the tangential springs' history): each
+// names people or a wall that exist, carries finite numbers, and the list is
+// in the engine's order (by pair, then feature). Their `wall` flags are
+// checked as bytes before any is read as a bool.
+void RequireValidContacts(const std::vector<Contact>& contacts, std::size_t people, std::size_t walls) {
+  const auto damaged = [](std::size_t k, const std::string& why) {
+    return InputError("checkpoint: damaged contact " + std::to_string(k) + ": " + why);
+  };
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    unsigned char flag;
+    std::memcpy(&flag, reinterpret_cast<const unsigned char*>(&contacts[k]) + offsetof(Contact, wall), 1);
+    if (flag > 1) throw damaged(k, "a flag of value " + std::to_string(flag));
+  }
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Contact& c = contacts[k];
+    if (c.a >= people || c.b >= (c.wall ? walls : people))
+      throw damaged(k, "names person " + std::to_string(c.a + 1) + " and " + (c.wall ? "wall " : "person ") +
+                           std::to_string(c.b + 1) + ", which this run does not have");
+    if (!Finite(c.point_m) || !Finite(c.normal) || !Finite(c.overlap_m) || !Finite(c.normal_force_n) ||
+        !Finite(c.tangential_force_n) || !Finite(c.tangential_spring_m) || !Finite(c.viscous_normal_n) ||
+        !Finite(c.viscous_tangential_n) || !Finite(c.trailing_fraction) || !Finite(c.leading_fraction))
+      throw damaged(k, "a value is not a finite number");
+    if (k > 0) {
+      const Contact& p = contacts[k - 1];
+      if (PairKey(c) < PairKey(p) || (PairKey(c) == PairKey(p) && c.feature <= p.feature))
+        throw damaged(k, "out of order");
+    }
+  }
 }
 
 bool HasMagic(const std::string& data, const char* magic) {
@@ -170,6 +217,45 @@ void Simulation::LoadState(const std::string& data) {
           in_->family_geometry[in_->shape_family[s]].core_radius_m * in_->shape_scale[s] * (1.0 + 1e-12);
     }
   }
+  // What the steps rely on (the body arrays' lengths were checked as read).
+  if (!std::isfinite(time_s_)) throw InputError("checkpoint: damaged state: the time is not a finite number");
+  RequireFinite(bodies_.position_m, "position");
+  RequireFinite(bodies_.angle_rad, "angle");
+  RequireFinite(bodies_.velocity_m_per_s, "velocity");
+  RequireFinite(bodies_.angular_velocity_rad_per_s, "angular velocity");
+  RequireFinite(bodies_.force_n, "force");
+  RequireFinite(bodies_.torque_n_m, "torque");
+  RequireFinite(bodies_.contact_force_n, "contact force");
+  RequireFinite(bodies_.contact_torque_n_m, "contact torque");
+  RequireFinite(bodies_.external_force_n, "external force");
+  RequireFinite(bodies_.desired_speed_m_per_s, "desired speed");
+  RequireFinite(bodies_.mass_kg, "mass");
+  RequireFinite(bodies_.inertia_kg_m2, "moment of inertia");
+  RequireFinite(in_->averaged_along, "averaged velocity");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (static_cast<std::uint8_t>(bodies_.state[i]) > static_cast<std::uint8_t>(PersonState::kRemoved))
+      throw InputError("checkpoint: damaged state: slot " + std::to_string(i) + " has no valid state");
+    if (bodies_.target[i] >= def_.targets.size())
+      throw InputError("checkpoint: damaged state: slot " + std::to_string(i) + " heads for target " +
+                       std::to_string(bodies_.target[i]) + " of " + std::to_string(def_.targets.size()));
+  }
+  if (in_->leading_force.size() != n || in_->leading_torque.size() != n)
+    throw InputError("checkpoint: damaged state: the last step's forces are not one per slot");
+  RequireFinite(in_->leading_force, "last step's force");
+  RequireFinite(in_->leading_torque, "last step's torque");
+  if (in_->gear_initialised && (in_->gear_xy.size() != n || in_->gear_theta.size() != n))
+    throw InputError("checkpoint: damaged state: the Gear predictor's history is not one per slot");
+  for (std::size_t i = 0; i < in_->gear_xy.size(); ++i)
+    for (const Vec2& x : in_->gear_xy[i])
+      if (!Finite(x)) throw InputError("checkpoint: damaged state: Gear history of slot " + std::to_string(i));
+  for (std::size_t i = 0; i < in_->gear_theta.size(); ++i)
+    for (const double x : in_->gear_theta[i])
+      if (!Finite(x)) throw InputError("checkpoint: damaged state: Gear history of slot " + std::to_string(i));
+  for (std::size_t g = 0; g < in_->group_gamma.size(); ++g)  // NaN: the group has no value of its own
+    if (std::isinf(in_->group_gamma[g]) || std::isinf(in_->group_lambda[g]))
+      throw InputError("checkpoint: damaged per-group drive");
+  RequireValidContacts(contacts_, n, def_.walls.size());
+
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
   in_->cuda_has_history = false;  // the device's last contacts are not these
   PlaceShapes();  // orientations of the restored angles (Drive reads them)

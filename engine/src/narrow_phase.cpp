@@ -111,8 +111,12 @@ double VerticesAgainst(const PlacedShape& from, const PlacedShape& to, bool flip
     Closest cl;
     if (use_grid) {
       const double fx = (p.x - g.grid_origin.x) * inverse_cell, fy = (p.y - g.grid_origin.y) * inverse_cell;
-      const std::uint32_t cx = fx <= 0.0 ? 0 : std::min(g.grid_nx - 1, static_cast<std::uint32_t>(fx));
-      const std::uint32_t cy = fy <= 0.0 ? 0 : std::min(g.grid_ny - 1, static_cast<std::uint32_t>(fy));
+      // Clamped before the conversion: a point beyond the range of the
+      // integer (or not a number, in a step that is going numerically wrong
+      // and that the check stage will stop) must not be converted; the same
+      // cells as clamping the integers.
+      const std::uint32_t cx = !(fx > 0.0) ? 0 : static_cast<std::uint32_t>(std::min(fx, double(g.grid_nx - 1)));
+      const std::uint32_t cy = !(fy > 0.0) ? 0 : static_cast<std::uint32_t>(std::min(fy, double(g.grid_ny - 1)));
       const std::uint32_t cell = cy * g.grid_nx + cx;
       const std::uint32_t first = g.cell_start[cell], last = g.cell_start[cell + 1];
       if (first == last) {  // farther than the reach from the core

@@ -59,16 +59,25 @@ void Simulation::UpdatePairs() {
     const double count = std::floor(extent / cutoff);
     return static_cast<std::int64_t>(std::clamp(count, 1.0, periodic ? 1e6 : 1e6));
   };
-  const std::int64_t ncx = cells_along(hi.x - lo.x + (box.x ? 0.0 : 1e-9), box.x);
-  const std::int64_t ncy = cells_along(hi.y - lo.y + (box.y ? 0.0 : 1e-9), box.y);
+  std::int64_t ncx = cells_along(hi.x - lo.x + (box.x ? 0.0 : 1e-9), box.x);
+  std::int64_t ncy = cells_along(hi.y - lo.y + (box.y ? 0.0 : 1e-9), box.y);
+  // People spread over an absurd extent (a state far beyond any venue: a 1 km
+  // square at the usual range is 1.6 million cells, under the cap) would ask
+  // for more cells than memory holds; coarser cells then find the same pairs.
+  const double max_cells = std::max(double(1 << 22), 64.0 * double(active.size()));
+  while (double(ncx) * double(ncy) > max_cells) {
+    if (ncx >= ncy) ncx = (ncx + 1) / 2;
+    else ncy = (ncy + 1) / 2;
+  }
   const double cell_w = box.x ? (hi.x - lo.x) / double(ncx) : std::max(cutoff, (hi.x - lo.x) / double(ncx));
   const double cell_h = box.y ? (hi.y - lo.y) / double(ncy) : std::max(cutoff, (hi.y - lo.y) / double(ncy));
   const auto cell_of = [&](Vec2 p) {
-    std::int64_t cx = static_cast<std::int64_t>(std::floor((p.x - lo.x) / cell_w));
-    std::int64_t cy = static_cast<std::int64_t>(std::floor((p.y - lo.y) / cell_h));
-    cx = std::clamp<std::int64_t>(cx, 0, ncx - 1);
-    cy = std::clamp<std::int64_t>(cy, 0, ncy - 1);
-    return std::pair{cx, cy};
+    // Clamped before the conversion (a value beyond the range of the integer
+    // would be undefined); the same cells as clamping the integers.
+    const auto clamped = [](double f, std::int64_t count) {
+      return !(f > 0.0) ? std::int64_t{0} : static_cast<std::int64_t>(std::min(f, double(count - 1)));
+    };
+    return std::pair{clamped(std::floor((p.x - lo.x) / cell_w), ncx), clamped(std::floor((p.y - lo.y) / cell_h), ncy)};
   };
   // Counting sort of bodies into cells.
   const std::size_t ncells = static_cast<std::size_t>(ncx * ncy);

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/fnv.hpp"
 #include "engine_scenes.hpp"
 
 namespace crowdrecon::engine {
@@ -444,6 +445,46 @@ TEST(EnginePhysics, RestoredCheckpointContinuesBitForBit) {
     Simulation other(def);
     EXPECT_THROW(other.LoadState(damaged), InputError);
   }
+}
+
+// A state that passes its checksum yet holds what no run reaches (a contact
+// naming a person the run lacks, a position that is not a number) is refused
+// with what is wrong, before a step could index past the arrays (found by
+// fuzz_checkpoint; its reproducers are replayed by ctest).
+TEST(EnginePhysics, ACheckpointWithImpossibleValuesIsRefusedSayingWhat) {
+  WorldDef def = RandomGas(6, 0.42, 9, true);
+  Simulation sim(def);
+  sim.AdvanceTo(0.2);
+  ASSERT_FALSE(sim.contacts().empty());
+  const std::string state = sim.SaveState();
+  // Replaces the bytes of `from` (found once in the state) and re-signs it.
+  const auto patched = [&](const void* from, std::size_t size, const void* to) {
+    std::string s = state.substr(0, state.size() - 8);
+    const std::size_t at = s.find(std::string(static_cast<const char*>(from), size));
+    EXPECT_NE(at, std::string::npos);
+    EXPECT_EQ(s.find(std::string(static_cast<const char*>(from), size), at + 1), std::string::npos);
+    s.replace(at, size, static_cast<const char*>(to), size);
+    const std::uint64_t checksum = Fnv1a(s.data(), s.size());
+    return s.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+  };
+  const auto refused = [&](const std::string& bad, const std::string& expected) {
+    Simulation other(def);
+    try {
+      other.LoadState(bad);
+      ADD_FAILURE() << "accepted; expected: " << expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  Contact c = sim.contacts().front();
+  const Contact original = c;
+  c.b = 999;
+  refused(patched(&original, sizeof original, &c), "damaged contact 0: names person");
+  const Vec2 p = sim.bodies().position_m[3], nan{std::nan(""), 0.0};
+  refused(patched(&p, sizeof p, &nan), "position of slot 3 is not a finite number");
+  // The untouched state still loads.
+  Simulation again(def);
+  EXPECT_NO_THROW(again.LoadState(state));
 }
 
 TEST(EnginePhysics, InterpenetrationStopsWithTheNamesAndTheTime) {
