@@ -14,7 +14,7 @@ namespace crowdrecon::viz {
 
 namespace {
 
-constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 80, kPanel = 150, kGap = 26;
+constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 150, kGap = 26;
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
 const Color kRecorded = Color::Hex(0xe6550d), kFatal = Color::Hex(0xb2182b), kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
