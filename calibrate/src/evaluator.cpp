@@ -66,7 +66,9 @@ json CompactObservation(const observe::Observation& o) {
   return {{"t0_s", o.t0_s}, {"bin_s", o.bin_s}, {"bins", o.bins}, {"series", std::move(series)}, {"events", std::move(events)}};
 }
 
-observe::Observation ReadCompact(const fs::path& file) {
+}  // namespace
+
+observe::Observation ReadCachedObservation(const fs::path& file) {
   const json j = json::parse(ReadInputFile(file, "cached observation"), nullptr, false);
   if (j.is_discarded() || !j.is_object())
     throw InputError(file.string() + ": a damaged cache file; delete it (its set's runs are made again)");
@@ -98,9 +100,6 @@ observe::Observation ReadCompact(const fs::path& file) {
   }
   return o;
 }
-
-
-}  // namespace
 
 Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& statistics, fs::path dir, int jobs,
                      bool show_progress)
@@ -165,7 +164,7 @@ SetResult Evaluator::Load(const std::vector<double>& values, const std::string& 
       r.failures.push_back("seed " + std::to_string(seed) + ": " + ReadInputFile(d / (stem + ".failed"), "failure note"));
     } else {
       std::vector<observe::Observation> simulated;
-      for (const std::string& tag : spec_tag_) simulated.push_back(ReadCompact(d / (stem + "-" + tag + ".json")));
+      for (const std::string& tag : spec_tag_) simulated.push_back(ReadCachedObservation(d / (stem + "-" + tag + ".json")));
       for (std::size_t i = 0; i < spec_.observations.size(); ++i) {
         std::vector<double> part;
         SimulatedStatistics(i, simulated[spec_of_observation_[i]], statistics_, &part);

@@ -5,6 +5,7 @@
 // (docs/calibration.md, "Statistics").
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -46,5 +47,10 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec);
 // where a window holds no value.
 void SimulatedStatistics(std::size_t index, const observe::Observation& simulated,
                          const std::vector<Statistic>& statistics, std::vector<double>* values);
+
+// A run's observation as a calibration keeps it (DIR/cache/KEY/seedN-TAG.json,
+// read instead of running that set again): its bins, series and events.
+// Throws InputError naming the file, and saying to delete it, if it is damaged.
+observe::Observation ReadCachedObservation(const std::filesystem::path& file);
 
 }  // namespace crowdrecon::calibrate

@@ -1,0 +1,42 @@
+// A calibration's cached observations (DIR/cache/KEY/seedN-TAG.json: a run's
+// bins, series and events, which a resumed calibration reads instead of
+// running that set again; calibrate::ReadCachedObservation), through a
+// scratch file, then every statistic of the hallway recovery calibration
+// (venues/madrid-arena/calibrations/hallway-recovery.json, read once)
+// computed from it, as the calibration does. The seed is a cache file of
+// that calibration.
+#include "crowdrecon/calibrate/calibration_file.hpp"
+#include "crowdrecon/calibrate/statistics.hpp"
+#include "fuzz_harness.hpp"
+
+namespace {
+
+struct Calibration {
+  crowdrecon::calibrate::CalibrationSpec spec;
+  std::vector<crowdrecon::calibrate::Statistic> statistics;
+};
+
+const Calibration& Recovery() {
+  static const Calibration c = [] {
+    Calibration r;
+    r.spec = crowdrecon::calibrate::LoadCalibration(crowdrecon::fuzz::SourceDir() /
+                                                    "venues/madrid-arena/calibrations/hallway-recovery.json");
+    r.statistics = crowdrecon::calibrate::ObservedStatistics(r.spec);
+    return r;
+  }();
+  return c;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace crowdrecon;
+  const Calibration& c = Recovery();
+  const std::filesystem::path file = fuzz::WriteScratchFile(data, size, "json");
+  return fuzz::Parse([&] {
+    const observe::Observation simulated = calibrate::ReadCachedObservation(file);
+    std::vector<double> values;
+    for (std::size_t i = 0; i < c.spec.observations.size(); ++i)
+      calibrate::SimulatedStatistics(i, simulated, c.statistics, &values);
+  });
+}
