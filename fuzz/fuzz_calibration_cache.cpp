@@ -9,34 +9,17 @@
 #include "crowdrecon/calibrate/statistics.hpp"
 #include "fuzz_harness.hpp"
 
-namespace {
-
-struct Calibration {
-  crowdrecon::calibrate::CalibrationSpec spec;
-  std::vector<crowdrecon::calibrate::Statistic> statistics;
-};
-
-const Calibration& Recovery() {
-  static const Calibration c = [] {
-    Calibration r;
-    r.spec = crowdrecon::calibrate::LoadCalibration(crowdrecon::fuzz::SourceDir() /
-                                                    "venues/madrid-arena/calibrations/hallway-recovery.json");
-    r.statistics = crowdrecon::calibrate::ObservedStatistics(r.spec);
-    return r;
-  }();
-  return c;
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace crowdrecon;
-  const Calibration& c = Recovery();
+  // The calibration and its statistics, read once per process.
+  static const calibrate::CalibrationSpec spec =
+      calibrate::LoadCalibration(fuzz::SourceDir() / "venues/madrid-arena/calibrations/hallway-recovery.json");
+  static const std::vector<calibrate::Statistic> statistics = calibrate::ObservedStatistics(spec);
   const std::filesystem::path file = fuzz::WriteScratchFile(data, size, "json");
   return fuzz::Parse([&] {
     const observe::Observation simulated = calibrate::ReadCachedObservation(file);
     std::vector<double> values;
-    for (std::size_t i = 0; i < c.spec.observations.size(); ++i)
-      calibrate::SimulatedStatistics(i, simulated, c.statistics, &values);
+    for (std::size_t i = 0; i < spec.observations.size(); ++i)
+      calibrate::SimulatedStatistics(i, simulated, statistics, &values);
   });
 }

@@ -37,8 +37,9 @@ void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
   if (!out.flush()) std::abort();  // the harness's own failure
 }
 
+// The run file: the scratch file that WriteScratchFile writes for "sqlite".
 const std::filesystem::path& RunFile() {
-  static const std::filesystem::path file = crowdrecon::fuzz::ScratchDir() / "resume.sqlite";
+  static const std::filesystem::path file = crowdrecon::fuzz::ScratchDir() / "input.sqlite";
   return file;
 }
 
@@ -69,11 +70,8 @@ const Saved& Interrupted() {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace crowdrecon;
   const Saved& saved = Interrupted();
-  for (const char* suffix : {"-wal", "-shm", "-journal"}) {
-    std::error_code ignored;
-    std::filesystem::remove(RunFile().string() + suffix, ignored);
-  }
-  WriteBytes(RunFile(), saved.run_file);
+  // The interrupted run's file as it was, then its checkpoint with this input as the systems' part.
+  fuzz::WriteScratchFile(reinterpret_cast<const std::uint8_t*>(saved.run_file.data()), saved.run_file.size(), "sqlite");
   WriteBytes(scenario::CheckpointPath(RunFile()), saved.checkpoint + fuzz::Text(data, size));
   return fuzz::Parse([&] {
     scenario::RunOptions options;
