@@ -27,6 +27,7 @@
 
 #include "bench_worlds.hpp"
 #include "step_benchmark.hpp"
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
 #include "crowdrecon/engine/simulation.hpp"
@@ -317,13 +318,6 @@ void RegisterAll() {
           ->UseRealTime();
 }
 
-// A state (Simulation::SaveState) as DIR/<name>.state, for bench_device.
-void WriteStateFile(const std::filesystem::path& file, const std::string& state) {
-  std::ofstream out(file, std::ios::binary);
-  out.write(state.data(), static_cast<std::streamsize>(state.size()));
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
-}
-
 // Writes the worlds of the Step benchmarks, and their states after the
 // warm-up, as DIR/<name>.world and DIR/<name>.state, for bench_device on
 // machines that cannot build worlds from scenarios (a GPU machine).
@@ -332,7 +326,7 @@ void DumpWorlds(const std::filesystem::path& dir) {
   const auto dump = [&](const std::string& world, const std::string& name, double warm_up_s) {
     engine::SaveWorldFile(CachedWorld(world).world, dir / (name + ".world"));
     const std::filesystem::path file = dir / (name + ".state");
-    WriteStateFile(file, WarmState(world, warm_up_s));
+    WriteFileAtomically(file, WarmState(world, warm_up_s));
     std::printf("wrote %s and %s\n", (dir / (name + ".world")).c_str(), file.c_str());
   };
   dump("hallway-400", "hallway-400", kWarmUpSeconds);
@@ -355,7 +349,7 @@ void DumpCheckpoint(const std::filesystem::path& dir, const std::string& spec) {
   std::filesystem::create_directories(dir);
   engine::SaveWorldFile(saved.world, dir / (name + ".world"));
   const std::filesystem::path file = dir / (name + ".state");
-  WriteStateFile(file, saved.state);
+  WriteFileAtomically(file, saved.state);
   std::printf("wrote %s and %s (t = %.3f s, %zu bodies)\n", (dir / (name + ".world")).c_str(), file.c_str(),
               saved.time_s, saved.world.people.size());
 }

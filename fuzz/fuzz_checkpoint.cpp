@@ -11,10 +11,8 @@
 // state holds, LoadState either refuses it (InputError) or the world it
 // leaves steps without a fault: a SimulationError (a state that goes
 // numerically wrong, stopped with a message) is the engine doing its job too.
-#include <fstream>
-#include <iterator>
-
 #include "crowdrecon/common/fnv.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
 #include "fuzz_harness.hpp"
@@ -23,10 +21,8 @@ namespace {
 
 const crowdrecon::engine::WorldDef& World() {
   static const crowdrecon::engine::WorldDef world = [] {
-    std::ifstream in(crowdrecon::fuzz::SourceDir() / "fuzz/corpus/fuzz_world_file/gas-2x2-wall-grid.world-nochecksum",
-                     std::ios::binary);
-    std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    if (bytes.empty()) std::abort();  // the harness's own failure
+    std::string bytes = crowdrecon::ReadInputFile(
+        crowdrecon::fuzz::SourceDir() / "fuzz/corpus/fuzz_world_file/gas-2x2-wall-grid.world-nochecksum", "world");
     const std::uint64_t checksum = crowdrecon::Fnv1a(bytes.data(), bytes.size());
     bytes.append(reinterpret_cast<const char*>(&checksum), sizeof(checksum));
     return crowdrecon::engine::LoadWorld(bytes, "fuzz.world");

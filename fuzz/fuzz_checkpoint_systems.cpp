@@ -10,7 +10,9 @@
 // cleanly. The seed is the systems part of that checkpoint itself. The
 // engine state has its own harness (fuzz_checkpoint).
 #include <cstring>
-#include <iterator>
+
+#include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/output_path.hpp"
 
 #include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/scenario/scenario.hpp"
@@ -25,17 +27,6 @@ struct Saved {
   std::string run_file;    // the interrupted run's file, bytes
   std::string checkpoint;  // its checkpoint up to the end of the engine state
 };
-
-std::string ReadBytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void WriteBytes(const std::filesystem::path& file, const std::string& bytes) {
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out.flush()) std::abort();  // the harness's own failure
-}
 
 // The run file: the scratch file that WriteScratchFile writes for "sqlite".
 const std::filesystem::path& RunFile() {
@@ -52,8 +43,8 @@ const Saved& Interrupted() {
     options.output = RunFile();
     options.stop_after_s = 0.5;
     crowdrecon::scenario::RunScenario(s.scenario, options);
-    s.run_file = ReadBytes(RunFile());
-    const std::string checkpoint = ReadBytes(crowdrecon::scenario::CheckpointPath(RunFile()));
+    s.run_file = crowdrecon::ReadInputFile(RunFile(), "run file");
+    const std::string checkpoint = crowdrecon::ReadInputFile(crowdrecon::scenario::CheckpointPath(RunFile()), "checkpoint");
     // magic, fingerprint, last frame, then the engine state as a length and bytes
     std::uint64_t length = 0;
     if (checkpoint.size() < 32) std::abort();
@@ -72,7 +63,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const Saved& saved = Interrupted();
   // The interrupted run's file as it was, then its checkpoint with this input as the systems' part.
   fuzz::WriteScratchFile(reinterpret_cast<const std::uint8_t*>(saved.run_file.data()), saved.run_file.size(), "sqlite");
-  WriteBytes(scenario::CheckpointPath(RunFile()), saved.checkpoint + fuzz::Text(data, size));
+  WriteFileAtomically(scenario::CheckpointPath(RunFile()), saved.checkpoint + fuzz::Text(data, size));
   return fuzz::Parse([&] {
     scenario::RunOptions options;
     options.output = RunFile();

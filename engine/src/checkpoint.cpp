@@ -2,6 +2,8 @@
 // (one of the stages of Simulation::Step; engine/include/crowdrecon/engine/stages.hpp)
 #include "simulation_internals.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -71,6 +73,10 @@ ModelParameters GetParameters(StateReader& r, ModelParameters p) {
 // rather than stepped into out-of-range indices or non-numbers.
 bool Finite(double x) { return std::isfinite(x); }
 bool Finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+template <typename T, std::size_t N>
+bool Finite(const std::array<T, N>& values) {
+  return std::all_of(values.begin(), values.end(), [](const T& x) { return Finite(x); });
+}
 
 template <typename T>
 void RequireFinite(const std::vector<T>& values, const char* what) {
@@ -245,12 +251,8 @@ void Simulation::LoadState(const std::string& data) {
   RequireFinite(in_->leading_torque, "last step's torque");
   if (in_->gear_initialised && (in_->gear_xy.size() != n || in_->gear_theta.size() != n))
     throw InputError("checkpoint: damaged state: the Gear predictor's history is not one per slot");
-  for (std::size_t i = 0; i < in_->gear_xy.size(); ++i)
-    for (const Vec2& x : in_->gear_xy[i])
-      if (!Finite(x)) throw InputError("checkpoint: damaged state: Gear history of slot " + std::to_string(i));
-  for (std::size_t i = 0; i < in_->gear_theta.size(); ++i)
-    for (const double x : in_->gear_theta[i])
-      if (!Finite(x)) throw InputError("checkpoint: damaged state: Gear history of slot " + std::to_string(i));
+  RequireFinite(in_->gear_xy, "Gear history");
+  RequireFinite(in_->gear_theta, "Gear history");
   for (std::size_t g = 0; g < in_->group_gamma.size(); ++g)  // NaN: the group has no value of its own
     if (std::isinf(in_->group_gamma[g]) || std::isinf(in_->group_lambda[g]))
       throw InputError("checkpoint: damaged per-group drive");

@@ -55,12 +55,11 @@ void Simulation::UpdatePairs() {
       (box.y && box.max_m.y - box.min_m.y < 2.0 * cutoff))
     throw InputError("periodic box is shorter than twice the interaction range " +
                      FormatNumber(cutoff) + " m; make it longer");
-  const auto cells_along = [&](double extent, bool periodic) {
-    const double count = std::floor(extent / cutoff);
-    return static_cast<std::int64_t>(std::clamp(count, 1.0, periodic ? 1e6 : 1e6));
+  const auto cells_along = [&](double extent) {
+    return static_cast<std::int64_t>(std::clamp(std::floor(extent / cutoff), 1.0, 1e6));
   };
-  std::int64_t ncx = cells_along(hi.x - lo.x + (box.x ? 0.0 : 1e-9), box.x);
-  std::int64_t ncy = cells_along(hi.y - lo.y + (box.y ? 0.0 : 1e-9), box.y);
+  std::int64_t ncx = cells_along(hi.x - lo.x + (box.x ? 0.0 : 1e-9));
+  std::int64_t ncy = cells_along(hi.y - lo.y + (box.y ? 0.0 : 1e-9));
   // People spread over an absurd extent (a state far beyond any venue: a 1 km
   // square at the usual range is 1.6 million cells, under the cap) would ask
   // for more cells than memory holds; coarser cells then find the same pairs.
