@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "crowdrecon/analysis/density_map.hpp"
+#include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/common/error.hpp"
@@ -93,6 +94,10 @@ void RunTimeline(const TimelineArgs& args) {
               s.time_s.size(), analysis::ClockText(s.clock_start, s.time_s.front()).c_str(),
               analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
               s.recorded.size());
+  {
+    const analysis::Plausibility validity = analysis::ComputePlausibility(args.run);
+    std::printf("validity: %s\n", validity.Statement(analysis::PlausibilityOptions{}).c_str());
+  }
   if (!args.density_maps.empty()) {
     analysis::DensityMapOptions o;
     o.times_s = args.density_times_s;

@@ -76,6 +76,12 @@ std::vector<SummaryValue> RunAnalysis::SummaryTable() const {
       {"regime_code", static_cast<double>(static_cast<int>(regime.regime)), ""},
       {"regime_classifier_version", static_cast<double>(kRegimeClassifierVersion), ""},
       {"avalanche_mean_rise_time_s", avalanche_mean_rise_time_s, "s"},
+      {"peak_density_per_m2", plausibility.peak_density_per_m2, "1/m^2"},
+      {"peak_equivalent_density_per_m2", plausibility.peak_equivalent_density_per_m2, "1/m^2"},
+      {"time_beyond_static_critical_s", plausibility.time_beyond_static_s, "s"},
+      {"time_beyond_measured_s", plausibility.time_beyond_measured_s, "s"},
+      {"max_overlap_m", plausibility.contacts_available ? plausibility.max_overlap_m : std::numeric_limits<double>::quiet_NaN(), "m"},
+      {"plausibility_code", static_cast<double>(static_cast<int>(plausibility.verdict)), ""},
   };
   t.insert(t.end(), rest.begin(), rest.end());
   // Per direction of travel (group): its own verdict and its passages.
@@ -162,6 +168,7 @@ std::string RunAnalysis::BriefReport() const {
        Printf("; above threshold: %.2f %% of person-frames", 100.0 * above_load_person_frames) + ", " +
        std::to_string(people_ever_above_load) + " people ever" +
        Printf(", longest %.1f s", longest_above_load_s) + "\n";
+  r += "validity: " + plausibility.Statement(PlausibilityOptions{}) + "\n";
   for (const std::string& note : notes) r += "note: " + note + "\n";
   return r;
 }

@@ -611,6 +611,7 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
     out.passages.push_back(AnalyzePassages(std::move(pass.passage_times[g]), contents.time_s[first_stationary],
                                            contents.time_s.back(), options.passages));
   Summarize(speed_for_regime, first_stationary, std::move(pass.stationary_loads), options, &out);
+  out.plausibility = ComputePlausibility(run_file);  // issue 39: states a human crowd can reach
   return out;
 }
 

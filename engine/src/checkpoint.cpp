@@ -171,6 +171,7 @@ void Simulation::LoadState(const std::string& data) {
                      std::to_string(bodies_.size()) + " (different scenario?)");
   step_count_ = r.Get<std::uint64_t>();
   time_s_ = r.Get<double>();
+  in_->drive_time_s = time_s_;
   const double dt = r.Get<double>();
   if (dt != dt_s_)
     throw InputError("checkpoint: time step " + FormatNumber(dt) + " s differs from this run's " +

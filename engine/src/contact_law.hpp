@@ -32,6 +32,9 @@ struct ContactLaw {
   bool tensile;
   bool advance_springs;
   bool spring_history = true;  // false: TangentialSpring::kNone, no elastic tangential displacement
+  // What of the spring a step keeps: exp(-dt / T) for TangentialSpring::kCreeping
+  // (issue 39), 1 otherwise (then the product below is the spring itself, bit for bit).
+  double spring_keep = 1.0;
 
   // Restitution per pair. A pair touching at several points (a flat face) acts
   // as one spring of stiffness k_eff kn along the normal, and the pair's
@@ -73,7 +76,10 @@ struct ContactLaw {
     if (!tensile && fn < 0.0) fn = 0.0;
     // Tangential elastic displacement (eq. 9), accumulated while the contact
     // persists and capped by Coulomb's condition on the elastic parts (eq. 10).
-    double spring = spring_history ? previous_spring + (advance_springs ? vt * dt : 0.0) : 0.0;
+    // With creep (issue 39) the displacement relaxes over T while it lasts:
+    // a Maxwell element, spring and dashpot in series.
+    double spring = spring_history ? previous_spring * (advance_springs ? spring_keep : 1.0) + (advance_springs ? vt * dt : 0.0)
+                                   : 0.0;
     const double cap = mu * elastic_n;
     if (kt * std::abs(spring) > cap) spring = std::copysign(cap / kt, spring);
     c.tangential_spring_m = spring;

@@ -17,7 +17,9 @@ constexpr const char* kTangentialDampingChoices[] = {"from_restitution", "equal_
 constexpr const char* kFacingChoices[] = {"velocity", "desired_direction"};
 constexpr const char* kIntegratorChoices[] = {"velocity_verlet", "gear5"};
 constexpr const char* kBackForceTriggerChoices[] = {"velocity", "averaged_velocity"};
-constexpr const char* kTangentialSpringChoices[] = {"history", "none"};
+constexpr const char* kTangentialSpringChoices[] = {"history", "none", "creeping"};
+constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
+constexpr const char* kYieldingChoices[] = {"none", "when_blocked"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -78,7 +80,8 @@ auto MakeTable() {
              "gamma_t when tangential_damping is fixed"),
       Choice<&P::tangential_spring>("tangential_spring", kTangentialSpringChoices, "eqs. 9-10; issue 19",
              "history: the tangential spring accumulates while a contact lasts (static friction); none: only "
-             "the tangential dashpot of eq. 12"),
+             "the tangential dashpot of eq. 12; creeping: as history, relaxing over "
+             "tangential_spring_relaxation_time_s (issue 39)"),
       Flag("allow_tensile_normal_force", &P::allow_tensile_normal_force, "eq. 19",
            "let the dashpot pull at the end of a contact (false: normal force clamped at zero)"),
       // --- Ground reaction forces (eqs. 3, 15) ---
@@ -111,6 +114,30 @@ auto MakeTable() {
              "time step; 0: chosen by the engine from every stiffness and the lightest body"),
       Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
              "the engine's step as a fraction of the integrator's stability limit"),
+      // --- Extensions beyond the paper (issue 39; off by default) ---
+      Choice<&P::gait_jitter>("gait_jitter", kGaitJitterChoices, "issue 39; Wuppertal trajectories",
+             "none: eq. 3 as printed; isotropic: eq. 3's desired velocity plus a band-limited random velocity "
+             "on both axes (people shifting and stepping in place)"),
+      Number("gait_jitter_velocity_m_per_s", &P::gait_jitter_velocity_m_per_s, "m/s", 0.0, 5.0,
+             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)",
+             "sigma_u, standard deviation per axis of the jitter's velocity"),
+      Number("gait_jitter_band_low_hz", &P::gait_jitter_band_low_hz, "Hz", 0.01, 20.0,
+             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)", "lowest frequency of the jitter"),
+      Number("gait_jitter_band_high_hz", &P::gait_jitter_band_high_hz, "Hz", 0.01, 20.0,
+             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)",
+             "highest frequency of the jitter (at least the lowest)"),
+      Number("gait_jitter_seed", &P::gait_jitter_seed, "", 0.0, 4503599627370496.0, "crowdrecon",
+             "whole number: the seed of each person's jitter (a scenario without it uses population.seed "
+             "modulo 2^52)"),
+      Choice<&P::yielding>("yielding", kYieldingChoices, "issue 39; Wuppertal trajectories",
+             "none: eq. 3 as printed; when_blocked: a person whose contacts push back against the desired "
+             "direction drives toward yielding_push_share times the desired speed"),
+      Number("yielding_push_share", &P::yielding_push_share, "", 0.0, 1.0,
+             "Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
+             "share of the desired speed a blocked person still drives toward (1: the paper's push)"),
+      Number("tangential_spring_relaxation_time_s", &P::tangential_spring_relaxation_time_s, "s", 1e-3, 1e4,
+             "issue 39; Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
+             "T of tangential_spring = creeping: a contact held at rest loses its tangential elastic force as exp(-t/T)"),
   };
 }
 
@@ -179,6 +206,16 @@ bool ModelParameters::IsValid(std::string* error) const {
         return false;
       }
     }
+  }
+  if (gait_jitter_band_high_hz < gait_jitter_band_low_hz) {
+    if (error)
+      *error = "gait_jitter_band_high_hz = " + FormatNumber(gait_jitter_band_high_hz) +
+               ", expected at least gait_jitter_band_low_hz = " + FormatNumber(gait_jitter_band_low_hz);
+    return false;
+  }
+  if (gait_jitter_seed != std::floor(gait_jitter_seed)) {
+    if (error) *error = "gait_jitter_seed = " + FormatNumber(gait_jitter_seed) + ", expected a whole number";
+    return false;
   }
   return true;
 }

@@ -259,6 +259,7 @@ void Simulation::ComputeForces() {
 void Simulation::Step() {
   in_->previous_contacts.swap(contacts_);
   advance_springs_ = true;
+  in_->drive_time_s = static_cast<double>(step_count_ + 1) * dt_s_;  // the forces are evaluated at the step's end
   if (def_.parameters.integrator == Integrator::kVelocityVerlet) {
     VerletKickDrift();
     ComputeForces();
@@ -270,6 +271,7 @@ void Simulation::Step() {
   }
   time_s_ = static_cast<double>(step_count_ + 1) * dt_s_;
   ++step_count_;
+  in_->drive_time_s = time_s_;
   AverageBackForceTrigger();
   Check();
 }

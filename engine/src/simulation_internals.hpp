@@ -277,6 +277,10 @@ struct Simulation::Internals {
   // desired direction averaged over back_force_reaction_time_s (updated once
   // per step, after the integrator; empty otherwise).
   std::vector<double> averaged_along;
+  // The time at which Drive evaluates the forces (s): within a step, the end
+  // of the step (the integrators evaluate there), between steps time_s_.
+  // Only the gait jitter (a function of time) reads it.
+  double drive_time_s = 0.0;
 
   // Per body, the navigation field's cell it last sampled (Drive,
   // AverageBackForceTrigger): the grid is read only when someone enters a

@@ -199,7 +199,10 @@ void Simulation::Collide() {
   const ContactLaw law{mp.normal_stiffness_n_per_m, mp.tangential_stiffness_n_per_m, mp.friction_coefficient,
                        dt_s_, in.restitution_factor, mp.tangential_damping, mp.tangential_damping_rate_per_s,
                        mp.allow_tensile_normal_force, advance_springs_,
-                       mp.tangential_spring == TangentialSpring::kHistory};
+                       mp.tangential_spring != TangentialSpring::kNone,
+                       mp.tangential_spring == TangentialSpring::kCreeping
+                           ? std::exp(-dt_s_ / mp.tangential_spring_relaxation_time_s)
+                           : 1.0};
   ContactLaw wall_law = law;
   wall_law.damping_factor = in.wall_restitution_factor;
   const PairCollider collider(bodies_, in, def_.periodic, law, wall_law);

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 
 #include "crowdrecon/common/fast_math.hpp"
 
@@ -14,6 +16,52 @@
 namespace crowdrecon::engine {
 
 using namespace detail;  // the stages' shared helpers (simulation_internals.hpp)
+
+namespace {
+
+// SplitMix64's finaliser (Steele, Lea and Flood, OOPSLA 2014): a 64-bit
+// hash whose outputs pass statistical tests as random numbers.
+std::uint64_t Mix(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+double UnitInterval(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }  // [0, 1)
+
+// Cosines per axis of a person's gait jitter: four give a nearly Gaussian
+// sum (its kurtosis is 3 - 3/(2K) = 2.63 instead of 3) at 8 cosines a person.
+constexpr int kJitterComponents = 4;
+
+// u_i(t) of the gait jitter (ModelParameters::gait_jitter): per axis
+// sigma sqrt(2/K) sum_k cos(2 pi (f_k t + phi_k)), f_k uniform in the band
+// and phi_k uniform in [0, 1), drawn from the seed and the person's id. A
+// sum of cosines with random phases and frequencies drawn from a spectrum
+// is the spectral representation of a stationary random process
+// (Shinozuka and Deodatis, Appl. Mech. Rev. 44:191, 1991): its variance is
+// sigma^2 and its expected spectrum flat in the band. It is a function of
+// time alone: no state to save, the same on any thread count and resume.
+Vec2 JitterVelocity(std::uint64_t seed, std::uint32_t id, double t_s, const ModelParameters& mp) {
+  const double amplitude = mp.gait_jitter_velocity_m_per_s * std::sqrt(2.0 / kJitterComponents);
+  const double f_low = mp.gait_jitter_band_low_hz, f_span = mp.gait_jitter_band_high_hz - mp.gait_jitter_band_low_hz;
+  std::uint64_t h = Mix(seed ^ Mix(std::uint64_t{id} + 1));
+  double axis_sum[2];
+  for (double& sum : axis_sum) {
+    sum = 0.0;
+    for (int k = 0; k < kJitterComponents; ++k) {
+      h = Mix(h);
+      const double frequency = f_low + f_span * UnitInterval(h);
+      h = Mix(h);
+      const double cycles = frequency * t_s + UnitInterval(h);
+      double sine, cosine;
+      SinCos(2.0 * std::numbers::pi * (cycles - std::floor(cycles)), sine, cosine);
+      sum += cosine;
+    }
+  }
+  return Vec2{axis_sum[0], axis_sum[1]} * amplitude;
+}
+
+}  // namespace
 
 void Simulation::Drive() {
   ScopedTimer timer(profile_.stage_s[Index(Stage::kDrive)]);
@@ -31,6 +79,10 @@ void Simulation::Drive() {
       def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
+  const bool yielding = mp.yielding == Yielding::kWhenBlocked;
+  const bool jitter = mp.gait_jitter == GaitJitter::kIsotropic && mp.gait_jitter_velocity_m_per_s > 0.0;
+  const auto jitter_seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
+  const double drive_time_s = in.drive_time_s;
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
   // In blocks of bodies, in three passes: the motive torque's angle (eq. 16)
   // is a long chain of dependent operations (a division, a polynomial), so
@@ -83,7 +135,12 @@ void Simulation::Drive() {
         const double v0 = bodies_.desired_speed_m_per_s[i];
         const Vec2 v = bodies_.velocity_m_per_s[i];
         const Vec2 e = direction[k];
-        force += (e * v0 - v) * (m * inverse_tau);  // eq. (3)
+        // Yielding (issue 39, off by default): held up by what is ahead, the
+        // person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
+        const double pace = yielding && Dot(bodies_.contact_force_n[i], e) < 0.0 ? v0 * mp.yielding_push_share : v0;
+        force += (e * pace - v) * (m * inverse_tau);  // eq. (3)
+        // Gait jitter (issue 39, off by default): eq. (3)'s desired velocity plus u_i(t).
+        if (jitter) force += JitterVelocity(jitter_seed, bodies_.id[i], drive_time_s, mp) * (m * inverse_tau);
         // Back force, eq. (15): only when pushed backwards (Theta(x) = 1 for x > 0
         // only, ERRATA 9), along e plus e x k, which points to the person's right.
         // (With the averaged trigger, Theta reads u_i, see AverageBackForceTrigger.)

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
@@ -376,6 +377,7 @@ std::string ReportSummary::BriefReport() const {
   };
   s += line(main);
   if (other.runs > 0) s += line(other);
+  for (const std::string& v : validity_lines) s += "  validity: " + v + "\n";
   if (danger_ratio.runs > 0)
     s += "  danger fraction, " + other.label + " / " + main.label + ": " + Short(danger_ratio.median) + " [" +
          Short(danger_ratio.low) + ", " + Short(danger_ratio.high) + "] over " + std::to_string(danger_ratio.runs) +
@@ -552,6 +554,45 @@ ReportSummary WriteReport(const ReportOptions& options) {
     else if (!other_runs.empty())
       h += "<p><b>No ratio of the fractions in danger</b>: nobody reached the danger zone in " + Escape(options.label) +
            ".</p>\n";
+  }
+
+  // Validity: whether the states are ones a human crowd can reach (issue 39).
+  {
+    const analysis::PlausibilityOptions po;
+    h += "<h3>Are these states a human crowd can reach?</h3>\n";
+    const auto validity = [&](const std::string& label, const std::vector<fs::path>& files) {
+      if (files.empty()) return;
+      std::vector<double> peak, equivalent, overlap;
+      analysis::Plausibility worst;
+      bool first_run = true;
+      for (const fs::path& f : files) {
+        say("checking the densities of " + f.string());
+        const analysis::Plausibility p = analysis::ComputePlausibility(f, po);
+        peak.push_back(p.peak_density_per_m2);
+        equivalent.push_back(p.peak_equivalent_density_per_m2);
+        if (p.contacts_available) overlap.push_back(p.max_overlap_m);
+        if (first_run || p.peak_equivalent_density_per_m2 > worst.peak_equivalent_density_per_m2) worst = p;
+        first_run = false;
+      }
+      const Spread sp = SpreadOf(peak), se = SpreadOf(equivalent);
+      std::string line = label + ": peak local density " + Short(sp.median) + " persons/m2 (" + Short(sp.low) + "-" +
+                         Short(sp.high) + " over " + std::to_string(files.size()) + " runs), as real-size people " +
+                         Short(se.median) + " (" + Short(se.low) + "-" + Short(se.high) + ")";
+      if (!overlap.empty()) line += "; largest overlap " + Short(SpreadOf(overlap).high * 100.0) + " cm";
+      line += std::string("; ") + (worst.verdict == analysis::PlausibilityVerdict::kWithin ? "within the range of human crowds"
+                                   : worst.verdict == analysis::PlausibilityVerdict::kBeyondStatic
+                                       ? "beyond Fruin's critical static density, within what crushes have reached"
+                                       : "BEYOND what any human crowd has been measured to reach");
+      summary.validity_lines.push_back(line);
+      h += "<p><b>" + Escape(label) + ".</b> " + Escape(line.substr(label.size() + 2)) + ". The run that comes closest "
+           "to the edge: " + Escape(worst.Statement(po)) + "</p>\n";
+    };
+    validity(options.label, main_files);
+    validity(options.compare_label, other_files);
+    h += "<p class=\"note\">Local density: people whose centres lie within 1 m² of a person, the peak over every person "
+         "and frame; as real-size people: the same floor covered by ANSUR II median bodies (0.0868 m², thorax with "
+         "arms). Range: Fruin's 7.1 /m² (critical static crowd), about 9–10 /m² measured in crushes, 38 % chest "
+         "compression (Viano et al. 1989) for overlaps (docs/analysis.md, \"States a human crowd can reach\").</p>\n";
   }
 
   // Force network at the worst moment.

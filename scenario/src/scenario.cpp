@@ -144,6 +144,8 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     pop.Finish();
   }
 
+  // The gait jitter's seed (issue 39) follows the population's unless the model gives one.
+  s.model.gait_jitter_seed = static_cast<double>(s.population.seed & ((std::uint64_t{1} << 52) - 1));
   if (auto model = root.Find("model")) ReadModel(*model, s.model);
   {
     std::string error;

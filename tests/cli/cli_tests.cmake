@@ -8,6 +8,8 @@ crowdrecon_cli_test(venue.check.hallway_open ok "walkable area: 36.00 m2 in 1 pa
                     venue check venues/madrid-arena/hallway-open.json --picture @TMP@/hallway-open.svg)
 crowdrecon_cli_test(venue.check.ground_floor ok "walkable area: 1925.00 m2"
                     venue check venues/madrid-arena/ground-floor.json --picture @TMP@/ground-floor.png)
+crowdrecon_cli_test(venue.check.wuppertal_bottleneck ok "walkable area: 64.27 m2 in 1 part"
+                    venue check venues/juelich/wuppertal-bottleneck.json --picture @TMP@/wuppertal-bottleneck.png)
 crowdrecon_cli_test(venue.check.capacity ok "capacity: 183 persons at 4.7 /m2, 234 at 6.0 /m2"
                     venue check tests/data/venues/room.json)
 crowdrecon_cli_test(venue.import.wkt ok "39.00 m2 walkable in 1 part\\(s\\), 1 obstacle"

@@ -503,3 +503,65 @@ TEST(AnalyzeRun, Errors) {
 
 }  // namespace
 }  // namespace crowdrecon::analysis
+
+namespace crowdrecon::analysis {
+namespace {
+
+// A square lattice of disks (radius 0.12 m, area 0.0452 m^2) with spacing a
+// in a periodic 6 m x 6 m box, written as a one-frame run with its contacts.
+std::filesystem::path WriteLatticeRun(const std::string& name, double spacing_m) {
+  engine::WorldDef def = engine::testing::PassiveWorld();
+  def.shapes.push_back(engine::testing::DiskShape(0.12));
+  const int per_side = static_cast<int>(std::lround(6.0 / spacing_m));
+  for (int i = 0; i < per_side; ++i)
+    for (int j = 0; j < per_side; ++j) {
+      engine::PersonDef p;
+      engine::testing::SetMassFromShape(def.shapes[0], 1000.0, p);
+      p.position_m = {(i + 0.5) * spacing_m, (j + 0.5) * spacing_m};
+      def.people.push_back(p);
+    }
+  def.periodic.x = def.periodic.y = true;
+  def.periodic.max_m = {6.0, 6.0};
+  engine::Simulation sim(def);
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / name;
+  runfile::RunHeader header;
+  header.scenario_json = "{}";
+  header.walkable_wkt = engine::testing::RectangleWkt(6.0, 6.0);
+  header.periodic_box = def.periodic;
+  header.output_fps = 10.0;
+  header.time_step_s = sim.time_step_s();
+  runfile::RunFileWriter writer = scenario::CreateRunFile(file, header, sim, {"to_exit"});
+  scenario::WriteFrame(writer, sim, 0, {}, /*with_contacts=*/true);
+  writer.SetStatus("complete");
+  return file;
+}
+
+// Within a 1 m^2 disc (radius 0.564 m) a square lattice of spacing 0.3 m
+// puts 9 centres (i^2 + j^2 <= 3.5), of spacing 0.2 m 21 (i^2 + j^2 <= 7.96),
+// everyone alike across the periodic seams. The disks cover
+// 9 x 0.0452 / 0.0868 = 4.7 and 21 x 0.0452 / 0.0868 = 10.9 real-size
+// people's floor: within the range, and beyond any crowd measured.
+TEST(Plausibility, PeakDensityOfALatticeAndWhatItMeans) {
+  const double disk_area = std::numbers::pi * 0.12 * 0.12;
+  const PlausibilityOptions options;
+  const Plausibility loose = ComputePlausibility(WriteLatticeRun("plausibility-loose.sqlite", 0.3));
+  EXPECT_DOUBLE_EQ(loose.peak_density_per_m2, 9.0);
+  EXPECT_NEAR(loose.peak_equivalent_density_per_m2, 9.0 * disk_area / options.reference_body_area_m2, 1e-9);
+  EXPECT_NEAR(loose.peak_mean_body_area_m2, disk_area, 1e-12);
+  EXPECT_EQ(loose.verdict, PlausibilityVerdict::kWithin);
+  EXPECT_EQ(loose.max_overlap_m, 0.0);
+  EXPECT_NE(loose.Statement(options).find("within Fruin's critical density of a static crowd (7.1 /m2)"), std::string::npos)
+      << loose.Statement(options);
+
+  const Plausibility dense = ComputePlausibility(WriteLatticeRun("plausibility-dense.sqlite", 0.2));
+  EXPECT_DOUBLE_EQ(dense.peak_density_per_m2, 21.0);
+  EXPECT_EQ(dense.verdict, PlausibilityVerdict::kBeyondMeasured);
+  EXPECT_TRUE(dense.contacts_available);
+  EXPECT_NEAR(dense.max_overlap_m, 0.04, 1e-9);  // 2 x 0.12 - 0.2
+  const std::string said = dense.Statement(options);
+  EXPECT_NE(said.find("beyond any density measured in a human crowd"), std::string::npos) << said;
+  EXPECT_NE(said.find("4.0 cm"), std::string::npos) << said;
+}
+
+}  // namespace
+}  // namespace crowdrecon::analysis

@@ -415,3 +415,30 @@ TEST(Timeline, TheEngineAtACheckpointContinuesAsTheRunDoes) {
 
 }  // namespace timeline_tests
 }  // namespace crowdrecon::scenario
+
+namespace crowdrecon::scenario {
+namespace timeline_tests {
+
+// The gait jitter's seed (issue 39) follows the population's seed unless the
+// model gives its own, so that every seed of an ensemble jitters
+// differently without a second key to keep in step.
+TEST(Scenario, TheGaitJittersSeedFollowsThePopulationsUnlessGiven) {
+  const std::string venue = (kSource / "venues/madrid-arena/hallway-open.json").string();
+  const auto scenario = [&](const std::string& model) {
+    return R"({"format": "crowdrecon-scenario", "version": 1, "venue": ")" + venue +
+           R"(", "population": {"count": 10, "target": "to_exit", "seed": 4242}, "model": )" + model + "}";
+  };
+  EXPECT_EQ(ParseScenario(scenario(R"({"gait_jitter": "isotropic"})"), "a.json", kSource).model.gait_jitter_seed, 4242.0);
+  EXPECT_EQ(ParseScenario(scenario(R"({"gait_jitter": "isotropic", "gait_jitter_seed": 7})"), "b.json", kSource)
+                .model.gait_jitter_seed,
+            7.0);
+  try {
+    ParseScenario(scenario(R"({"gait_jitter_seed": 1.5})"), "c.json", kSource);
+    ADD_FAILURE() << "a seed that is not whole was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("gait_jitter_seed = 1.5, expected a whole number"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace timeline_tests
+}  // namespace crowdrecon::scenario

@@ -39,6 +39,7 @@
 
 #include "crowdrecon/analysis/metrics.hpp"
 #include "crowdrecon/analysis/passages.hpp"
+#include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/vec2.hpp"
@@ -167,6 +168,9 @@ struct RunAnalysis {
   double avalanche_mean_rise_time_s = 0.0;  // over the stationary avalanches of the crowd
 
   RegimeResult regime;  // regime.directions: one verdict per group with people
+  // Whether the run's states are ones a human crowd can reach (issue 39):
+  // peak local density, largest overlap, against the stated range.
+  Plausibility plausibility;
   std::vector<std::string> notes;  // fallbacks taken, run not complete, ...
 
   // Every summary number by name, for tables (metric_summary, sweep results).

@@ -38,6 +38,26 @@ enum class BackForceTrigger {
 enum class TangentialSpring {
   kHistory,  // delta_t accumulates while the contact lasts, capped by Coulomb (eqs. 9-10; default)
   kNone,     // no elastic tangential displacement: only the tangential dashpot (eq. 12) acts
+  kCreeping, // issue 39: as kHistory, and the displacement relaxes over tangential_spring_relaxation_time_s
+};
+
+// Whether people move on their own while they stand or walk in a crowd
+// (issue 39; docs/decisions.md, "Issue 39: gait jitter"): people in a dense
+// crowd shift their weight and step in place, so their desired velocity is
+// not exactly v0 e_i. Measured in the Wuppertal bottleneck's waiting crowd
+// (scripts/gait-jitter-from-data.py).
+enum class GaitJitter {
+  kNone,        // the paper's eq. (3): the desired velocity is v0 e_i (default)
+  kIsotropic,   // eq. (3) with v0 e_i + u_i(t), u_i band-limited noise on both axes
+};
+
+// Whether people who are held up by what is ahead keep pushing with their
+// whole self-driven force (issue 39; docs/decisions.md, "Issue 39:
+// yielding"): eq. (3) drives everyone toward v0 e_i whatever stands in the
+// way, so a blocked crowd leans on its front with the sum of its drives.
+enum class Yielding {
+  kNone,          // the paper's eq. (3) (default)
+  kWhenBlocked,   // a person whose contacts push back against e_i (F_c . e_i < 0) drives toward push_share v0 e_i
 };
 
 enum class Integrator {
@@ -83,6 +103,27 @@ struct ModelParameters {
   // (ERRATA 8), so it defaults to tau.
   double rotation_relaxation_time_s = 2.0 / 3.0;
   FacingTarget facing_target = FacingTarget::kVelocity;
+
+  // --- Extensions beyond the paper (issue 39; off by default) ------------
+  // Gait jitter: eq. (3) reads m/tau (v0 e + u - v), u_i(t) a stationary
+  // random velocity of standard deviation gait_jitter_velocity_m_per_s per
+  // axis whose spectrum is flat between the band's edges (a sum of
+  // cosines with random frequencies in the band and random phases, drawn
+  // per person from gait_jitter_seed and the person's id: no state, so the
+  // same on any thread count and after any resume).
+  GaitJitter gait_jitter = GaitJitter::kNone;
+  double gait_jitter_velocity_m_per_s = 0.3;  // sigma_u per axis (Wuppertal waiting crowd)
+  double gait_jitter_band_low_hz = 0.5;       // where the measured S_u is flat
+  double gait_jitter_band_high_hz = 1.5;
+  double gait_jitter_seed = 0.0;              // whole number; a scenario's default is its population seed
+
+  // Yielding: a blocked person (contact force against e_i) drives toward
+  // yielding_push_share * v0 e_i instead of v0 e_i (1: the paper's push).
+  Yielding yielding = Yielding::kNone;
+  double yielding_push_share = 0.0;
+  // T of tangential_spring = kCreeping (s): a contact held at rest loses its
+  // tangential elastic force as e^(-t/T) (issue 39; docs/decisions.md).
+  double tangential_spring_relaxation_time_s = 1.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)

@@ -78,6 +78,9 @@ struct ReportSummary {
   bool envelope = false;            // a sweep's design envelope (then main/other are empty)
   std::size_t envelope_runs = 0;
   std::vector<std::string> envelope_lines;  // per variant and row of the diagram: the envelope's reach
+  // Per ensemble: whether its states are ones a human crowd can reach
+  // (analysis/plausibility.hpp; issue 39), in plain words.
+  std::vector<std::string> validity_lines;
   double seconds = 0.0;
   std::string BriefReport() const;
 };
