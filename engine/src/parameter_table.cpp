@@ -130,8 +130,8 @@ auto MakeTable() {
              "whole number: the seed of each person's jitter (a scenario without it uses population.seed "
              "modulo 2^52)"),
       Choice<&P::yielding>("yielding", kYieldingChoices, "issue 39; Wuppertal trajectories",
-             "none: eq. 3 as printed; when_blocked: a person whose contacts push back against the desired "
-             "direction drives toward yielding_push_share times the desired speed"),
+             "none: eq. 3 as printed; when_blocked: a person pushed back against the desired direction by a "
+             "contact with a person drives toward yielding_push_share times the desired speed (walls do not count)"),
       Number("yielding_push_share", &P::yielding_push_share, "", 0.0, 1.0,
              "Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
              "share of the desired speed a blocked person still drives toward (1: the paper's push)"),

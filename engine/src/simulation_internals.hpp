@@ -277,6 +277,13 @@ struct Simulation::Internals {
   // desired direction averaged over back_force_reaction_time_s (updated once
   // per step, after the integrator; empty otherwise).
   std::vector<double> averaged_along;
+
+  // Yielding::kWhenBlocked: per body, its desired direction and the sum of
+  // the backward parts of its contact forces from people (<= 0), summed in
+  // Drive from the contact list in its order (one pass, no threads: the
+  // same on any thread count, and from the restored contacts after a resume).
+  std::vector<Vec2> yield_direction;
+  std::vector<double> held_back_n;
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.
   // Only the gait jitter (a function of time) reads it.

@@ -80,6 +80,32 @@ void Simulation::Drive() {
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
+  if (yielding) {
+    // Who is held up by the people ahead: the sum over a person's contacts
+    // with people ahead of the parts that push them back against e_i (walls
+    // do not count: a door's jamb guides a person through, it does not make
+    // them wait; people beside and behind do not count either).
+    std::vector<double>& held = in_->held_back_n;
+    held.assign(bodies_.size(), 0.0);
+    std::vector<Vec2>& desired = in_->yield_direction;
+    desired.resize(bodies_.size());
+    for (std::size_t i = 0; i < bodies_.size(); ++i)
+      if (bodies_.state[i] == PersonState::kWalking)
+        desired[i] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
+    // Only a contact ahead holds a person up: its point within 45 degrees of
+    // e_i seen from the person's centre (the person in front, not the
+    // shoulders beside, which would make everyone at a door wait for everyone).
+    constexpr double kAheadCosine = 0.70710678118654752;  // cos 45 degrees
+    const auto ahead = [](Vec2 arm, Vec2 e) { return Dot(arm, e) >= kAheadCosine * Length(arm); };
+    for (const Contact& c : contacts_) {
+      if (c.wall) continue;
+      const Vec2 f = c.Force();  // on a; -f on b
+      const Vec2 xa = bodies_.position_m[c.a];
+      const Vec2 xb = xa - detail::Separation(def_.periodic, xa, bodies_.position_m[c.b]);  // b's image near a
+      if (ahead(c.point_m - xa, desired[c.a])) held[c.a] += std::min(0.0, Dot(f, desired[c.a]));
+      if (ahead(c.point_m - xb, desired[c.b])) held[c.b] += std::min(0.0, -Dot(f, desired[c.b]));
+    }
+  }
   const bool jitter = mp.gait_jitter == GaitJitter::kIsotropic && mp.gait_jitter_velocity_m_per_s > 0.0;
   const auto jitter_seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
   const double drive_time_s = in.drive_time_s;
@@ -135,9 +161,9 @@ void Simulation::Drive() {
         const double v0 = bodies_.desired_speed_m_per_s[i];
         const Vec2 v = bodies_.velocity_m_per_s[i];
         const Vec2 e = direction[k];
-        // Yielding (issue 39, off by default): held up by what is ahead, the
-        // person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
-        const double pace = yielding && Dot(bodies_.contact_force_n[i], e) < 0.0 ? v0 * mp.yielding_push_share : v0;
+        // Yielding (issue 39, off by default): held up by the people ahead,
+        // the person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
+        const double pace = yielding && in.held_back_n[i] < 0.0 ? v0 * mp.yielding_push_share : v0;
         force += (e * pace - v) * (m * inverse_tau);  // eq. (3)
         // Gait jitter (issue 39, off by default): eq. (3)'s desired velocity plus u_i(t).
         if (jitter) force += JitterVelocity(jitter_seed, bodies_.id[i], drive_time_s, mp) * (m * inverse_tau);

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -576,7 +577,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
       }
       const Spread sp = SpreadOf(peak), se = SpreadOf(equivalent);
       std::string line = label + ": peak local density " + Short(sp.median) + " persons/m2 (" + Short(sp.low) + "-" +
-                         Short(sp.high) + " over " + std::to_string(files.size()) + " runs), as real-size people " +
+                         Short(sp.high) + " over " + std::to_string(files.size()) + (files.size() == 1 ? " run" : " runs") + "), as real-size people " +
                          Short(se.median) + " (" + Short(se.low) + "-" + Short(se.high) + ")";
       if (!overlap.empty()) line += "; largest overlap " + Short(SpreadOf(overlap).high * 100.0) + " cm";
       line += std::string("; ") + (worst.verdict == analysis::PlausibilityVerdict::kWithin ? "within the range of human crowds"
@@ -584,7 +585,9 @@ ReportSummary WriteReport(const ReportOptions& options) {
                                        ? "beyond Fruin's critical static density, within what crushes have reached"
                                        : "BEYOND what any human crowd has been measured to reach");
       summary.validity_lines.push_back(line);
-      h += "<p><b>" + Escape(label) + ".</b> " + Escape(line.substr(label.size() + 2)) + ". The run that comes closest "
+      std::string body = line.substr(label.size() + 2);
+      body[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(body[0])));
+      h += "<p><b>" + Escape(label) + ".</b> " + Escape(body) + ". The run that comes closest "
            "to the edge: " + Escape(worst.Statement(po)) + "</p>\n";
     };
     validity(options.label, main_files);

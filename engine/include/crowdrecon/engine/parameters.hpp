@@ -57,7 +57,7 @@ enum class GaitJitter {
 // way, so a blocked crowd leans on its front with the sum of its drives.
 enum class Yielding {
   kNone,          // the paper's eq. (3) (default)
-  kWhenBlocked,   // a person whose contacts push back against e_i (F_c . e_i < 0) drives toward push_share v0 e_i
+  kWhenBlocked,   // a person pushed back against e_i by a contact with a person drives toward push_share v0 e_i
 };
 
 enum class Integrator {
@@ -117,7 +117,7 @@ struct ModelParameters {
   double gait_jitter_band_high_hz = 1.5;
   double gait_jitter_seed = 0.0;              // whole number; a scenario's default is its population seed
 
-  // Yielding: a blocked person (contact force against e_i) drives toward
+  // Yielding: a blocked person (pushed back against e_i by someone ahead) drives toward
   // yielding_push_share * v0 e_i instead of v0 e_i (1: the paper's push).
   Yielding yielding = Yielding::kNone;
   double yielding_push_share = 0.0;
