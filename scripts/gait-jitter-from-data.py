@@ -20,7 +20,7 @@ stated with the result, neither is corrected.
 
 usage: scripts/gait-jitter-from-data.py [TRAJECTORIES.txt]  (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)
 """
-import collections
+import importlib.util
 import math
 import os
 import sys
@@ -33,16 +33,12 @@ BAND_HZ = (0.5, 1.5)       # where S_u is flat (printed below: the evidence for 
 
 
 def load(path):
-    people = collections.defaultdict(list)
-    with open(path) as f:
-        for line in f:
-            if line.startswith('#') or not line.strip():
-                continue
-            pid, frame, x, y = line.split()[:4]
-            people[int(pid)].append((int(frame), float(x), float(y)))
-    for track in people.values():
-        track.sort()
-    return people
+    """The PeTrack file's tracks (id -> [(frame, x, y)]), read as the bottleneck study reads it."""
+    spec = importlib.util.spec_from_file_location('bottleneck_study', os.path.join(os.path.dirname(__file__),
+                                                                                   'bottleneck-study.py'))
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    return study.read_petrack(path)[0]
 
 
 def detrended(values):
