@@ -61,6 +61,35 @@ Vec2 JitterVelocity(std::uint64_t seed, std::uint32_t id, double t_s, const Mode
   return Vec2{axis_sum[0], axis_sum[1]} * amplitude;
 }
 
+// Yielding (ModelParameters::yielding): per person, the sum over their
+// contacts with people ahead of the parts that push them back against e_i
+// (<= 0; `desired` receives each walking person's e_i). Walls do not count:
+// a door's jamb guides a person through, it does not make them wait; people
+// beside and behind do not count either. "Ahead": the contact point within
+// 45 degrees of e_i seen from the person's centre (the person in front, not
+// the shoulders beside, which would make everyone at a door wait for
+// everyone). One pass over the contact list in its order: the same sums on
+// any thread count, and from the restored contacts after a resume.
+void HeldBackByPeopleAhead(const BodyState& bodies, const std::vector<Contact>& contacts, const WorldDef& def,
+                           std::vector<geometry::NavigationField::CellCache>& field_cache, std::vector<Vec2>& desired,
+                           std::vector<double>& held) {
+  held.assign(bodies.size(), 0.0);
+  desired.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies.state[i] == PersonState::kWalking)
+      desired[i] = def.targets[bodies.target[i]].Direction(bodies.position_m[i], field_cache[i]);
+  constexpr double kAheadCosine = 0.70710678118654752;  // cos 45 degrees
+  const auto ahead = [](Vec2 arm, Vec2 e) { return Dot(arm, e) >= kAheadCosine * Length(arm); };
+  for (const Contact& c : contacts) {
+    if (c.wall) continue;
+    const Vec2 f = c.Force();  // on a; -f on b
+    const Vec2 xa = bodies.position_m[c.a];
+    const Vec2 xb = xa - Separation(def.periodic, xa, bodies.position_m[c.b]);  // b's image near a
+    if (ahead(c.point_m - xa, desired[c.a])) held[c.a] += std::min(0.0, Dot(f, desired[c.a]));
+    if (ahead(c.point_m - xb, desired[c.b])) held[c.b] += std::min(0.0, -Dot(f, desired[c.b]));
+  }
+}
+
 }  // namespace
 
 void Simulation::Drive() {
@@ -80,32 +109,7 @@ void Simulation::Drive() {
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
-  if (yielding) {
-    // Who is held up by the people ahead: the sum over a person's contacts
-    // with people ahead of the parts that push them back against e_i (walls
-    // do not count: a door's jamb guides a person through, it does not make
-    // them wait; people beside and behind do not count either).
-    std::vector<double>& held = in_->held_back_n;
-    held.assign(bodies_.size(), 0.0);
-    std::vector<Vec2>& desired = in_->yield_direction;
-    desired.resize(bodies_.size());
-    for (std::size_t i = 0; i < bodies_.size(); ++i)
-      if (bodies_.state[i] == PersonState::kWalking)
-        desired[i] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
-    // Only a contact ahead holds a person up: its point within 45 degrees of
-    // e_i seen from the person's centre (the person in front, not the
-    // shoulders beside, which would make everyone at a door wait for everyone).
-    constexpr double kAheadCosine = 0.70710678118654752;  // cos 45 degrees
-    const auto ahead = [](Vec2 arm, Vec2 e) { return Dot(arm, e) >= kAheadCosine * Length(arm); };
-    for (const Contact& c : contacts_) {
-      if (c.wall) continue;
-      const Vec2 f = c.Force();  // on a; -f on b
-      const Vec2 xa = bodies_.position_m[c.a];
-      const Vec2 xb = xa - detail::Separation(def_.periodic, xa, bodies_.position_m[c.b]);  // b's image near a
-      if (ahead(c.point_m - xa, desired[c.a])) held[c.a] += std::min(0.0, Dot(f, desired[c.a]));
-      if (ahead(c.point_m - xb, desired[c.b])) held[c.b] += std::min(0.0, -Dot(f, desired[c.b]));
-    }
-  }
+  if (yielding) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
   const bool jitter = mp.gait_jitter == GaitJitter::kIsotropic && mp.gait_jitter_velocity_m_per_s > 0.0;
   const auto jitter_seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
   const double drive_time_s = in.drive_time_s;
