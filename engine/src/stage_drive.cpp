@@ -138,7 +138,9 @@ void Simulation::Drive() {
       gain[k] = 0.0;
       if (!driven[k]) continue;
       const Vec2 v = bodies_.velocity_m_per_s[i];
-      direction[k] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
+      // (Yielding has looked every walking person's direction up already.)
+      direction[k] = yielding ? in.yield_direction[i]
+                              : def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
       const double speed = Length(v);
       // Only the direction of `facing` matters to the angle (atan2 of two
       // products with it), so the velocity needs no normalising.
