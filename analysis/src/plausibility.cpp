@@ -167,17 +167,13 @@ Plausibility ComputePlausibility(const std::filesystem::path& run_file, const Pl
     if (frame_peak_equivalent > options.static_critical_per_m2) result.time_beyond_static_s += frame_s;
     if (frame_peak_equivalent > options.crush_highest_per_m2) result.time_beyond_measured_s += frame_s;
   }
-  runfile::ContactFrameStream contacts = reader.ContactFrames(times.back().frame);
-  std::int64_t contact_frame = 0;
-  std::vector<runfile::Contact> list;
-  while (contacts.Next(&contact_frame, &list)) {
+  if (const auto largest = reader.LargestContactOverlap()) {
     result.contacts_available = true;
-    for (const runfile::Contact& c : list)
-      if (c.overlap_m > result.max_overlap_m) {
-        result.max_overlap_m = c.overlap_m;
-        result.max_overlap_time_s = time_of[contact_frame];
-        result.max_overlap_with_wall = c.wall;
-      }
+    if (largest->overlap_m > 0.0) {
+      result.max_overlap_m = largest->overlap_m;
+      result.max_overlap_time_s = time_of[largest->frame];
+      result.max_overlap_with_wall = largest->wall;
+    }
   }
   const bool overlap_beyond = result.max_overlap_m > options.critical_compression * options.reference_chest_depth_m;
   result.verdict = result.peak_equivalent_density_per_m2 > options.crush_highest_per_m2 || overlap_beyond

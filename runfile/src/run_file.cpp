@@ -737,6 +737,17 @@ ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {
   return stream;
 }
 
+std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverlap() const {
+  Statement q(*impl_->db, "SELECT frame, rowid, overlap_m, wall FROM contact ORDER BY overlap_m DESC, frame, rowid LIMIT 1");
+  q.Describe("contact", {0, 1});
+  if (!q.Next()) return std::nullopt;
+  LargestOverlap largest;
+  largest.frame = q.Int(0);
+  largest.overlap_m = q.Real(2, -run_limits::kCoordinate_m, run_limits::kCoordinate_m);
+  largest.wall = q.Integer(3, 0, 1) != 0;
+  return largest;
+}
+
 std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
   std::vector<Vec2> sums;
   Statement q(*impl_->db,

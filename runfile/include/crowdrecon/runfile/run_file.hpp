@@ -46,6 +46,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -351,6 +352,14 @@ class RunFileReader {
   bool HasPersonLoads() const;
   PersonLoadStream PersonLoads(std::int64_t last_frame) const;
   // The sum of every recorded velocity of each group's people (index = group).
+  // The contact with the largest overlap of the run (the earliest of equal
+  // ones), in one query; nullopt when the run has no contacts.
+  struct LargestOverlap {
+    std::int64_t frame = 0;
+    double overlap_m = 0.0;
+    bool wall = false;
+  };
+  std::optional<LargestOverlap> LargestContactOverlap() const;
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;
   // A timeline's head count per frame (empty for a run without a timeline).
