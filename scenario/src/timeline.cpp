@@ -317,6 +317,9 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     if (f.sample_s > f.window_s) falls->At("sample_s").Fail("must not exceed window_s (" + FormatNumber(f.window_s) + " s)");
     f.load_n = falls->Number("load_n", f.load_n, 1.0, 1e6);
     f.load_duration_s = falls->Number("load_duration_s", f.load_duration_s, 0.0, 3600.0);
+    f.trip_over_fallen = falls->Bool("trip_over_fallen", f.trip_over_fallen);
+    if (f.trip_over_fallen && f.criterion != FallSpec::Criterion::kAcceleration)
+      falls->At("trip_over_fallen").Fail("applies to the criterion \"acceleration\" only (the criterion is \"" + c + "\")");
     falls->Finish();
   }
   t.max_present = static_cast<std::size_t>(reader.Integer("max_present", 0, 0, 200000));

@@ -288,16 +288,23 @@ class FallSystem : public RunSystem {
       const double sample = static_cast<double>(every_) * sim.time_step_s();
       depth_ = static_cast<std::size_t>(std::max<long long>(1, std::llround(spec_.window_s / sample)));
     }
-    if (static_cast<std::int64_t>(sim.step_count()) % every_ != 0) return;
     const engine::BodyState& b = sim.bodies();
     const std::size_t n = b.size();
-    const double sample_s = static_cast<double>(every_) * sim.time_step_s();
     if (id_.size() != n) {
       id_.assign(n, UINT32_MAX);
       filled_.assign(n, 0);
       history_.assign(n * (depth_ + 1), Vec2{});
       above_s_.assign(n, 0.0);
+      if (spec_.trip_over_fallen) {
+        fallen_impulse_.assign(n, Vec2{});
+        unheld_.assign(n * (depth_ + 1), Vec2{});
+      }
     }
+    // Tripping: the impulse of the fallen's hold, every step (none to count
+    // until someone has fallen).
+    if (spec_.trip_over_fallen && s_.fallen > 0) AddImpulseOfTheFallen(sim);
+    if (static_cast<std::int64_t>(sim.step_count()) % every_ != 0) return;
+    const double sample_s = static_cast<double>(every_) * sim.time_step_s();
     if (spec_.criterion == FallSpec::Criterion::kLoad) PersonChestLoads(sim, &load_);
     for (std::uint32_t i = 0; i < n; ++i) {
       if (b.state[i] != engine::PersonState::kWalking) continue;
@@ -305,6 +312,7 @@ class FallSystem : public RunSystem {
         id_[i] = b.id[i];
         filled_[i] = 0;
         above_s_[i] = 0.0;
+        if (spec_.trip_over_fallen) fallen_impulse_[i] = Vec2{};
       }
       std::string cause;
       if (spec_.criterion == FallSpec::Criterion::kAcceleration) {
@@ -312,6 +320,10 @@ class FallSystem : public RunSystem {
         Vec2* ring = &history_[i * (depth_ + 1)];
         const std::uint64_t count = filled_[i];
         ring[count % (depth_ + 1)] = b.velocity_m_per_s[i];
+        // Tripping: also the velocity they would have had without the
+        // fallen's hold (pushed onto a fallen body, they go over it).
+        Vec2* unheld = spec_.trip_over_fallen ? &unheld_[i * (depth_ + 1)] : nullptr;
+        if (unheld) unheld[count % (depth_ + 1)] = b.velocity_m_per_s[i] - fallen_impulse_[i] / b.mass_kg[i];
         filled_[i] = count + 1;
         if (count < depth_) continue;
         const Vec2 then = ring[(count - depth_) % (depth_ + 1)];
@@ -320,6 +332,14 @@ class FallSystem : public RunSystem {
         if (a > spec_.threshold_m_per_s2)
           cause = "acceleration: mean " + FormatFixed(a, 2) + " m/s^2 over " + FormatNumber(window) +
                   " s (threshold " + FormatNumber(spec_.threshold_m_per_s2) + " m/s^2)";
+        if (unheld) {
+          const double pushed =
+              Length(unheld[count % (depth_ + 1)] - unheld[(count - depth_) % (depth_ + 1)]) / window;
+          if (cause.empty() && pushed > spec_.threshold_m_per_s2)
+            cause = "tripped: pushed onto a fallen person, a mean " + FormatFixed(pushed, 2) + " m/s^2 over " +
+                    FormatNumber(window) + " s without the fallen's hold (threshold " +
+                    FormatNumber(spec_.threshold_m_per_s2) + " m/s^2)";
+        }
       } else {
         above_s_[i] = load_[i] > spec_.load_n ? above_s_[i] + sample_s : 0.0;
         if (above_s_[i] >= spec_.load_duration_s - 1e-9 && load_[i] > spec_.load_n)
@@ -340,16 +360,25 @@ class FallSystem : public RunSystem {
     w.PutVector(filled_);
     w.PutVector(history_);
     w.PutVector(above_s_);
+    if (spec_.trip_over_fallen) {
+      w.PutVector(fallen_impulse_);
+      w.PutVector(unheld_);
+    }
     return w.out;
   }
   void LoadState(const std::string& state) override {
     StateReader r(state, "the timeline's fall filters");
     every_ = r.Get<std::int64_t>();
     depth_ = r.Get<std::uint64_t>();
+    if (every_ < 0 || depth_ > 100000) r.Fail();
     id_ = r.GetVector<std::uint32_t>();
     filled_ = r.GetVector<std::uint64_t>(id_.size());
     history_ = r.GetVector<Vec2>(id_.empty() ? 0 : id_.size() * (depth_ + 1));
     above_s_ = r.GetVector<double>(id_.size());
+    if (spec_.trip_over_fallen) {
+      fallen_impulse_ = r.GetVector<Vec2>(id_.size());
+      unheld_ = r.GetVector<Vec2>(id_.empty() ? 0 : id_.size() * (depth_ + 1));
+    }
     if (!r.AtEnd() || every_ < 0 || depth_ > 100000) r.Fail();
   }
 
@@ -363,6 +392,23 @@ class FallSystem : public RunSystem {
   std::vector<Vec2> history_;           // per slot, a ring of depth_ + 1 velocities
   std::vector<double> above_s_;         // per slot, time above the load threshold
   std::vector<double> load_;
+  // Tripping: per slot, the impulse of contacts with fallen people (N s), and
+  // a ring of the velocities they would have had without it.
+  std::vector<Vec2> fallen_impulse_;
+  std::vector<Vec2> unheld_;
+
+  // Adds this step's impulse of every contact between a walking and a
+  // fallen person to the walking one's account.
+  void AddImpulseOfTheFallen(const engine::Simulation& sim) {
+    const engine::BodyState& b = sim.bodies();
+    const double dt = sim.time_step_s();
+    for (const engine::Contact& c : sim.contacts()) {
+      if (c.wall) continue;
+      const engine::PersonState sa = b.state[c.a], sb = b.state[c.b];
+      if (sa == engine::PersonState::kWalking && sb == engine::PersonState::kFallen) fallen_impulse_[c.a] += c.Force() * dt;
+      if (sb == engine::PersonState::kWalking && sa == engine::PersonState::kFallen) fallen_impulse_[c.b] -= c.Force() * dt;
+    }
+  }
 };
 
 // ---------------------------------------------------------------------------

@@ -10,6 +10,10 @@ crowdrecon_cli_test(venue.check.ground_floor ok "walkable area: 1925.00 m2"
                     venue check venues/madrid-arena/ground-floor.json --picture @TMP@/ground-floor.png)
 crowdrecon_cli_test(venue.check.wuppertal_bottleneck ok "walkable area: 64.27 m2 in 1 part"
                     venue check venues/juelich/wuppertal-bottleneck.json --picture @TMP@/wuppertal-bottleneck.png)
+crowdrecon_cli_test(venue.check.verification_gate_corridor ok "walkable area: 48.00 m2 in 1 part"
+                    venue check venues/verification/gate-corridor.json --picture @TMP@/gate-corridor.png)
+crowdrecon_cli_test(venue.check.verification_sloping_corridor ok "slope: .*0.1"
+                    venue check venues/verification/sloping-corridor.json)
 crowdrecon_cli_test(venue.check.capacity ok "capacity: 183 persons at 4.7 /m2, 234 at 6.0 /m2"
                     venue check tests/data/venues/room.json)
 crowdrecon_cli_test(venue.import.wkt ok "39.00 m2 walkable in 1 part\\(s\\), 1 obstacle"

@@ -18,6 +18,7 @@
 //       {"time_s": 900, "close_exit": "court"}, {"time_s": 950, "stop_inflow": "arriving"}
 //     ],
 //     "falls": {"criterion": "acceleration", "threshold_m_per_s2": 5, "window_s": 0.5}
+//              (or "criterion": "load"; with "acceleration", "trip_over_fallen": true)
 //   }
 //
 // The schedule is deterministic: the k-th arrival of an inflow is due when
@@ -107,6 +108,14 @@ struct FallSpec {
   // hallway with counter-flow: docs/decisions.md, "Falls").
   double threshold_m_per_s2 = 5.0;
   double window_s = 0.5;
+  // Tripping (issue 39; off: the paper's rule). A fallen person lies on the
+  // floor: whoever runs into them is stopped (the acceleration above), and
+  // whoever is pushed onto them is not held up at chest height but goes over
+  // them. With it on, the same filter also runs on the velocity each person
+  // would have had without the forces of their contacts with fallen people,
+  // and either mean above the threshold fells them. Until the first fall it
+  // is the paper's rule bit for bit (docs/decisions.md, "Falls that happen").
+  bool trip_over_fallen = false;
   // Load criterion: the person's chest load (the larger of across the chest
   // and across the shoulders, reports/chest_load.hpp; table person_load)
   // above load_n for load_duration_s without a break.
