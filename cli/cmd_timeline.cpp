@@ -19,6 +19,7 @@
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/reports/ensemble.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/sweep/phase_diagram.hpp"
 #include "crowdrecon/viz/density_figure.hpp"
@@ -30,7 +31,8 @@ namespace crowdrecon::cli {
 namespace {
 
 struct TimelineArgs {
-  std::string run;
+  std::vector<std::string> runs;
+  std::string run;  // the first
   std::vector<std::string> figures;
   std::string phase;
   std::string phase_output;
@@ -39,6 +41,8 @@ struct TimelineArgs {
   std::vector<std::string> density_maps;
   std::vector<double> density_times_s;
   double density_cell_m = 0.5, density_sigma_m = 0.5;
+  std::vector<std::string> scores;
+  double tolerance_s = 120.0;
   bool force = false;
 };
 
@@ -65,6 +69,53 @@ sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
   path.caption = "path of " + s.run_file + ": density and counter-flow share, " + FormatNumber(step_s) +
                  "-s means (clamped to the diagram's range)";
   return path;
+}
+
+// Several runs of one incident (seeds): one row per run beside the recorded
+// marks, and the score table (reports/ensemble.hpp).
+void RunEnsemble(const TimelineArgs& args) {
+  if (!args.phase.empty()) throw InputError("--phase draws one run's path: give one run file, not " + std::to_string(args.runs.size()));
+  if (!args.density_maps.empty())
+    throw InputError("--density-maps draws one run's maps: give one run file, not " + std::to_string(args.runs.size()));
+  reports::EnsembleOptions options;
+  options.tolerance_s = args.tolerance_s;
+  options.smooth_s = args.smooth_s;
+  if (std::string error; !options.IsValid(&error)) throw InputError("--tolerance / --smooth: " + error);
+  std::vector<PlannedOutput> outputs;
+  for (const std::string& f : args.figures) outputs.push_back({"-o", f, PictureOutputKind()});
+  for (const std::string& f : args.scores) {
+    const std::string ext = std::filesystem::path(f).extension().string();
+    if (ext != ".md" && ext != ".csv")
+      throw InputError("--scores " + f + ": expected a file ending in .md (the score table) or .csv (one row per run)");
+    outputs.push_back({"--scores", f, reports::EnsembleScoresOutput()});
+  }
+  std::vector<NamedInput> inputs;
+  for (const std::string& r : args.runs) inputs.push_back({"a run file", r});
+  CheckOutputs(outputs, inputs, args.force);
+  std::vector<reports::EnsembleRun> runs;
+  for (std::size_t k = 0; k < args.runs.size(); ++k) {
+    for (std::size_t j = 0; j < k; ++j)
+      if (std::filesystem::equivalent(args.runs[j], args.runs[k]))
+        throw InputError(args.runs[k] + ": given twice (also as " + args.runs[j] + "); each run counts once");
+    std::fprintf(stderr, "reading %s (%zu of %zu)\n", args.runs[k].c_str(), k + 1, args.runs.size());
+    runs.push_back(reports::ReadEnsembleRun(args.runs[k], options));
+  }
+  const reports::EnsembleScore score = reports::ScoreEnsemble(std::move(runs), options);
+  const nlohmann::json scenario =
+      nlohmann::json::parse(runfile::RunFileReader(args.runs.front()).RunValue("scenario"), nullptr, false);
+  const std::string name =
+      scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
+  for (const std::string& f : args.figures) {
+    const std::filesystem::path partial = PartialPath(f);
+    reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " + std::to_string(score.runs.size()) + " runs", partial);
+    std::filesystem::rename(partial, f);
+    std::printf("wrote %s\n", f.c_str());
+  }
+  for (const std::string& f : args.scores) {
+    WriteFileAtomically(f, std::filesystem::path(f).extension() == ".csv" ? score.Csv() : score.Markdown());
+    std::printf("wrote %s\n", f.c_str());
+  }
+  std::printf("%s", score.Markdown().c_str());
 }
 
 void RunTimeline(const TimelineArgs& args) {
@@ -132,7 +183,10 @@ void RegisterTimelineCommand(CLI::App& app) {
       "Draw the figure of an incident timeline's run: density, counter-flow, speed per direction, flow, people waiting "
       "at the entries, the run's avalanches and falls and the incident's recorded marks over time; with --phase, the "
       "run's path over a sweep's phase diagrams");
-  cmd->add_option("RUN", args->run, "Run file of a scenario with a timeline")->required();
+  cmd->add_option("RUN", args->runs,
+                  "Run file of a scenario with a timeline; several (seeds of one incident): the ensemble's figure, one "
+                  "row per run, and its score against the recorded marks")
+      ->required();
   cmd->add_option("-o,--output", args->figures, "Figure file(s): .png, .svg or .pdf (repeat for several)")->required();
   cmd->add_option("--phase", args->phase, "Sweep output folder whose phase diagrams the run's path is drawn over");
   cmd->add_option("--phase-output", args->phase_output, "Folder for those diagrams (default: the sweep's phase/)");
@@ -148,8 +202,22 @@ void RegisterTimelineCommand(CLI::App& app) {
   cmd->add_option("--density-cell", args->density_cell_m, "Cell of the density maps (m)")->check(CLI::Range(0.05, 10.0));
   cmd->add_option("--density-sigma", args->density_sigma_m, "Width of each person's Gaussian in the density maps (m)")
       ->check(CLI::Range(0.05, 10.0));
+  cmd->add_option("--scores", args->scores,
+                  "Score file(s) of the runs against the recorded marks: .md (the score table) or .csv (one row per "
+                  "run); also with one run")
+      ->allow_extra_args(false);
+  cmd->add_option("--tolerance", args->tolerance_s,
+                  "A run's avalanche matches a recorded one within this many seconds of run time (default 120; scale it "
+                  "with a compressed scenario's marks)")
+      ->check(CLI::Range(0.001, 1e7));
   AddForceFlag(cmd, &args->force);
-  cmd->callback([args] { RunTimeline(*args); });
+  cmd->callback([args] {
+    args->run = args->runs.front();
+    if (args->runs.size() > 1 || !args->scores.empty())
+      RunEnsemble(*args);
+    else
+      RunTimeline(*args);
+  });
 }
 
 }  // namespace crowdrecon::cli

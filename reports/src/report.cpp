@@ -30,13 +30,8 @@ namespace fs = std::filesystem;
 using svg::Escape;
 using svg::Short;
 
-namespace {
-
-constexpr const char* kGenerator = "<meta name=\"generator\" content=\"crowdrecon report\">";
-constexpr std::array<const char*, kZones> kZoneColor = {"#2e8b57", "#e0a800", "#c0392b"};
-constexpr const char* kOtherColor = "#7b3f98";
-
 Spread SpreadOf(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
   Spread s;
   s.runs = v.size();
   if (v.empty()) return s;
@@ -47,6 +42,12 @@ Spread SpreadOf(std::vector<double> v) {
   s.median = v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
   return s;
 }
+
+namespace {
+
+constexpr const char* kGenerator = "<meta name=\"generator\" content=\"crowdrecon report\">";
+constexpr std::array<const char*, kZones> kZoneColor = {"#2e8b57", "#e0a800", "#c0392b"};
+constexpr const char* kOtherColor = "#7b3f98";
 
 // Counts whole (a median of an even number of runs may end in .5); other
 // values with `digits` significant digits.

@@ -56,6 +56,8 @@ struct Spread {
   double median = 0.0, low = 0.0, high = 0.0;
   std::size_t runs = 0;
 };
+// The spread of values over runs (NaN values, runs without the figure, left out).
+Spread SpreadOf(std::vector<double> values);
 
 struct EnsembleSummary {
   std::string label;

@@ -1,0 +1,107 @@
+// An ensemble of an incident's runs (issue 39, point 5): several seeds of a
+// timeline scenario scored against what was recorded of the incident, and
+// their figure, one row per run with its avalanches and falls beside the
+// recorded times.
+//
+//   reports::EnsembleOptions o;               // tolerance, clog rule, risk
+//   std::vector<reports::EnsembleRun> runs;
+//   for (auto& f : files) runs.push_back(reports::ReadEnsembleRun(f, o));
+//   const reports::EnsembleScore s = reports::ScoreEnsemble(runs, o);
+//   s.Markdown(); s.Csv(); reports::DrawEnsembleFigure(s, "Madrid night", "ensemble.png");
+//
+// The score, for each recorded avalanche: the share of runs with an
+// avalanche of their own within +-tolerance of it; per run: its avalanches
+// that match no recorded one, when its venue clogs for good (against the
+// recorded fatal clog), its falls before that, the people in the danger zone
+// at its worst moment and its peak local density -- each as a median and
+// range over the runs. Definitions: docs/reports.md, "Ensembles of an
+// incident".
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/analysis/timeline_series.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/reports/report.hpp"
+
+namespace crowdrecon::reports {
+
+struct EnsembleOptions {
+  // A run's avalanche matches a recorded one within this many seconds of run
+  // time (the issue's +-2 minutes; a compressed scenario scales it with its
+  // marks, e.g. 6 s for the demo's 1/20).
+  double tolerance_s = 120.0;
+  // Clogged: every direction of travel present moves slower than this along
+  // its desired direction (the mean over the timeline's smoothing window;
+  // the regime classifier's stop speed).
+  double clog_speed_m_per_s = 0.1;
+  // Clogged for good: clogged from some time to the end of the run, for at
+  // least this long (the classifier's frozen window).
+  double clog_min_s = 10.0;
+  // The timeline series' smoothing window (s).
+  double smooth_s = 10.0;
+  // The danger zone's lower edge (reports::RiskOptions::danger_n).
+  double danger_n = 1112.0;
+  bool IsValid(std::string* error) const;
+};
+
+struct EnsembleRun {
+  std::string run_file;
+  std::string label;  // "seed 3", or the file's name
+  std::string clock_start;
+  double end_s = 0.0;
+  std::vector<double> avalanche_s;  // the run's avalanche events
+  std::vector<double> fall_s;       // its falls
+  std::vector<double> time_s, density_per_m2;  // smoothed density, for the figure
+  double clog_for_good_s = std::numeric_limits<double>::quiet_NaN();  // NaN: never
+  std::size_t danger_peak = 0;  // most people above danger_n at once (1-s smoothed chest load)
+  double danger_peak_time_s = std::numeric_limits<double>::quiet_NaN();
+  bool loads_available = false;
+  double peak_density_per_m2 = 0.0;             // local, over ~1 m^2 (analysis/plausibility.hpp)
+  double peak_equivalent_density_per_m2 = 0.0;  // the same floor covered by real-size people
+  std::vector<analysis::TimelineMark> recorded;  // the scenario's marks
+};
+
+// Reads one run (throws InputError naming the file if it is not a finished
+// timeline run).
+EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options);
+
+struct RecordedScore {
+  analysis::TimelineMark mark;
+  std::size_t runs_matching = 0;   // runs with an avalanche within +-tolerance
+  std::vector<bool> matched;       // per run
+};
+
+struct EnsembleScore {
+  EnsembleOptions options;
+  std::vector<EnsembleRun> runs;
+  std::vector<RecordedScore> avalanches;  // one per recorded avalanche, in time order
+  std::vector<analysis::TimelineMark> fatal;  // recorded marks of kind "fatal"
+  std::vector<std::size_t> unmatched;     // per run: its avalanches within +-tolerance of no recorded one
+  std::vector<std::size_t> falls_before_clog;  // per run (all its falls if it never clogs for good)
+  // Median and range over the runs (reports::Spread; runs without the figure left out).
+  Spread unmatched_spread, clog_spread, clog_minus_fatal_spread, falls_before_clog_spread, danger_spread,
+      density_spread, equivalent_density_spread, avalanche_count_spread;
+  std::size_t runs_clogging_for_good = 0;
+
+  std::string Markdown() const;  // the score table and one row per run
+  std::string Csv() const;       // one row per run (RFC 4180)
+};
+
+// Scores runs of one scenario against its recorded marks (those of the first
+// run; every run must carry the same). Throws InputError if they differ.
+EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions& options);
+
+// A previous score file (Markdown or CSV, recognised by its first line).
+OutputKind EnsembleScoresOutput();
+
+// The figure: the runs' densities over time (top), then one row per run
+// with its avalanches, falls and the stretch clogged for good, the recorded
+// avalanches and their +-tolerance across every row. PNG, SVG or PDF.
+void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, const std::filesystem::path& file);
+
+}  // namespace crowdrecon::reports

@@ -1,0 +1,383 @@
+// An ensemble of an incident's runs scored against its recorded marks, and
+// its figure (reports/ensemble.hpp; docs/reports.md, "Ensembles of an
+// incident").
+#include "crowdrecon/reports/ensemble.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "crowdrecon/analysis/plausibility.hpp"
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/reports/risk.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/viz/canvas.hpp"
+
+namespace crowdrecon::reports {
+
+bool EnsembleOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(tolerance_s)) return fail("tolerance_s must be a positive number of seconds");
+  if (!positive(clog_speed_m_per_s)) return fail("clog_speed_m_per_s must be a positive speed");
+  if (!positive(clog_min_s)) return fail("clog_min_s must be a positive number of seconds");
+  if (!(std::isfinite(smooth_s) && smooth_s >= 0.0)) return fail("smooth_s must be at least 0 s");
+  if (!positive(danger_n)) return fail("danger_n must be a positive force");
+  return true;
+}
+
+namespace {
+
+// The start of the stretch, reaching the last frame, in which every
+// direction present moves slower than the clog speed (NaN if the last
+// frame is not clogged or the stretch is shorter than clog_min_s).
+double ClogForGood(const analysis::TimelineSeries& s, const EnsembleOptions& o) {
+  std::vector<std::vector<double>> speeds;
+  for (const std::vector<double>& g : s.group_speed_m_per_s) speeds.push_back(analysis::MovingMean(s.time_s, g, o.smooth_s));
+  const auto clogged = [&](std::size_t i) {
+    bool anyone = false;
+    for (const std::vector<double>& g : speeds) {
+      if (std::isnan(g[i])) continue;  // nobody of this direction present
+      anyone = true;
+      if (g[i] >= o.clog_speed_m_per_s) return false;
+    }
+    return anyone;
+  };
+  if (s.time_s.empty() || !clogged(s.time_s.size() - 1)) return std::numeric_limits<double>::quiet_NaN();
+  std::size_t first = s.time_s.size() - 1;
+  while (first > 0 && clogged(first - 1)) --first;
+  if (s.time_s.back() - s.time_s[first] < o.clog_min_s) return std::numeric_limits<double>::quiet_NaN();
+  return s.time_s[first];
+}
+
+std::string LabelOf(const std::filesystem::path& file, const runfile::RunFileReader& reader) {
+  const std::string seed = reader.RunValue("seed");
+  return seed.empty() ? file.filename().string() : "seed " + seed;
+}
+
+std::string Clock(const std::string& clock_start, double t) {
+  if (std::isnan(t)) return "never";
+  return clock_start.empty() ? FormatFixed(t, 1) + " s" : analysis::ClockText(clock_start, t);
+}
+
+std::string SpreadText(const Spread& s, int decimals, const std::string& unit = "") {
+  if (s.runs == 0) return "none";
+  const std::string u = unit.empty() ? "" : " " + unit;
+  if (s.low == s.high) return FormatFixed(s.median, decimals) + u;
+  return FormatFixed(s.median, decimals) + u + " (" + FormatFixed(s.low, decimals) + "–" + FormatFixed(s.high, decimals) + ")";
+}
+
+std::string CsvField(const std::string& v) {
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string out = "\"";
+  for (char c : v) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string Num(double v, int decimals) { return std::isnan(v) ? "" : FormatFixed(v, decimals); }
+
+}  // namespace
+
+EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options) {
+  if (!runfile::IsRunFile(run_file)) throw InputError(run_file.string() + ": not a crowdrecon run file");
+  EnsembleRun r;
+  r.run_file = run_file.string();
+  {
+    const runfile::RunFileReader reader(run_file);
+    const std::string status = reader.RunValue("status");
+    if (status != "complete")
+      throw InputError(run_file.string() + ": the run's status is \"" + status +
+                       "\"; an ensemble scores finished runs (resume it with crowdrecon simulate --resume)");
+    r.label = LabelOf(run_file, reader);
+  }
+  const analysis::TimelineSeries s = analysis::ComputeTimeline(run_file, options.smooth_s);
+  r.clock_start = s.clock_start;
+  r.end_s = s.time_s.empty() ? 0.0 : s.time_s.back();
+  for (const analysis::TimelineMark& a : s.avalanches) r.avalanche_s.push_back(a.time_s);
+  for (const analysis::TimelineMark& f : s.falls) r.fall_s.push_back(f.time_s);
+  r.time_s = s.time_s;
+  r.density_per_m2 = analysis::MovingMean(s.time_s, s.density_per_m2, options.smooth_s);
+  r.recorded = s.recorded;
+  r.clog_for_good_s = ClogForGood(s, options);
+  RiskOptions risk;
+  risk.danger_n = options.danger_n;
+  const RunRisk rr = AnalyseRunRisk(run_file, risk);
+  r.loads_available = rr.loads_recorded || rr.has_contacts;
+  for (const FrameRisk& f : rr.frames)
+    if (std::isnan(r.danger_peak_time_s) || f.above_danger > r.danger_peak) {
+      r.danger_peak = f.above_danger;
+      r.danger_peak_time_s = f.time_s;
+    }
+  const analysis::Plausibility p = analysis::ComputePlausibility(run_file);
+  r.peak_density_per_m2 = p.peak_density_per_m2;
+  r.peak_equivalent_density_per_m2 = p.peak_equivalent_density_per_m2;
+  return r;
+}
+
+EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions& options) {
+  if (std::string error; !options.IsValid(&error)) throw InputError("ensemble options: " + error);
+  if (runs.empty()) throw InputError("an ensemble needs at least one run");
+  const auto same_marks = [](const std::vector<analysis::TimelineMark>& a, const std::vector<analysis::TimelineMark>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (a[k].time_s != b[k].time_s || a[k].kind != b[k].kind || a[k].label != b[k].label) return false;
+    return true;
+  };
+  for (const EnsembleRun& r : runs)
+    if (!same_marks(r.recorded, runs.front().recorded) || r.clock_start != runs.front().clock_start)
+      throw InputError(r.run_file + ": its recorded marks or clock differ from those of " + runs.front().run_file +
+                       "; an ensemble is runs of one incident's scenario");
+  EnsembleScore s;
+  s.options = options;
+  s.runs = std::move(runs);
+  for (const analysis::TimelineMark& m : s.runs.front().recorded) {
+    if (m.kind == "avalanche") s.avalanches.push_back({m, 0, {}});
+    if (m.kind == "fatal") s.fatal.push_back(m);
+  }
+  std::sort(s.avalanches.begin(), s.avalanches.end(),
+            [](const RecordedScore& a, const RecordedScore& b) { return a.mark.time_s < b.mark.time_s; });
+  const auto near = [&](double a, double b) { return std::abs(a - b) <= options.tolerance_s; };
+  std::vector<double> unmatched, clog, clog_minus_fatal, falls_before, danger, density, equivalent, count;
+  for (const EnsembleRun& r : s.runs) {
+    for (RecordedScore& rec : s.avalanches) {
+      const bool hit = std::any_of(r.avalanche_s.begin(), r.avalanche_s.end(), [&](double t) { return near(t, rec.mark.time_s); });
+      rec.matched.push_back(hit);
+      rec.runs_matching += hit;
+    }
+    std::size_t none = 0;
+    for (double t : r.avalanche_s)
+      none += std::none_of(s.avalanches.begin(), s.avalanches.end(), [&](const RecordedScore& rec) { return near(t, rec.mark.time_s); });
+    s.unmatched.push_back(none);
+    std::size_t before = 0;
+    for (double t : r.fall_s) before += std::isnan(r.clog_for_good_s) || t <= r.clog_for_good_s;
+    s.falls_before_clog.push_back(before);
+    s.runs_clogging_for_good += !std::isnan(r.clog_for_good_s);
+    unmatched.push_back(static_cast<double>(none));
+    clog.push_back(r.clog_for_good_s);
+    clog_minus_fatal.push_back(s.fatal.empty() ? std::numeric_limits<double>::quiet_NaN() : r.clog_for_good_s - s.fatal.front().time_s);
+    falls_before.push_back(static_cast<double>(before));
+    danger.push_back(r.loads_available ? static_cast<double>(r.danger_peak) : std::numeric_limits<double>::quiet_NaN());
+    density.push_back(r.peak_density_per_m2);
+    equivalent.push_back(r.peak_equivalent_density_per_m2);
+    count.push_back(static_cast<double>(r.avalanche_s.size()));
+  }
+  s.unmatched_spread = SpreadOf(unmatched);
+  s.clog_spread = SpreadOf(clog);
+  s.clog_minus_fatal_spread = SpreadOf(clog_minus_fatal);
+  s.falls_before_clog_spread = SpreadOf(falls_before);
+  s.danger_spread = SpreadOf(danger);
+  s.density_spread = SpreadOf(density);
+  s.equivalent_density_spread = SpreadOf(equivalent);
+  s.avalanche_count_spread = SpreadOf(count);
+  return s;
+}
+
+std::string EnsembleScore::Markdown() const {
+  std::ostringstream o;
+  const std::string clock = runs.front().clock_start;
+  const std::size_t n = runs.size();
+  o << "| recorded | at | runs with an avalanche within ±" << FormatNumber(options.tolerance_s) << " s |\n";
+  o << "| --- | --- | --- |\n";
+  for (const RecordedScore& r : avalanches)
+    o << "| " << r.mark.label << " | " << Clock(clock, r.mark.time_s) << " | " << r.runs_matching << " of " << n << " ("
+      << FormatFixed(100.0 * static_cast<double>(r.runs_matching) / static_cast<double>(n), 0) << " %) |\n";
+  o << "\n| over the " << n << " runs | median (range) |\n| --- | --- |\n";
+  o << "| avalanches in the run | " << SpreadText(avalanche_count_spread, 1) << " |\n";
+  o << "| of them matching no recorded avalanche | " << SpreadText(unmatched_spread, 1) << " |\n";
+  o << "| runs whose venue clogs for good | " << runs_clogging_for_good << " of " << n << " |\n";
+  if (clog_spread.runs > 0) {
+    o << "| it clogs for good at | " << Clock(clock, clog_spread.median) << " (" << Clock(clock, clog_spread.low) << "–"
+      << Clock(clock, clog_spread.high) << ")";
+    if (!fatal.empty()) o << "; recorded fatal clog " << Clock(clock, fatal.front().time_s);
+    o << " |\n";
+    if (!fatal.empty())
+      o << "| clog for good minus the recorded fatal clog | " << SpreadText(clog_minus_fatal_spread, 0, "s") << " |\n";
+  }
+  o << "| falls before the clog for good (all falls where none) | " << SpreadText(falls_before_clog_spread, 1) << " |\n";
+  o << "| people in the danger zone (chest load above " << FormatNumber(options.danger_n)
+    << " N, 1-s mean) at the worst moment | " << SpreadText(danger_spread, 1) << " |\n";
+  o << "| peak local density, model persons/m² (~1 m²) | " << SpreadText(density_spread, 1) << " |\n";
+  o << "| the same floor covered by real-size persons/m² | " << SpreadText(equivalent_density_spread, 1) << " |\n";
+  o << "\n| run | avalanches (matching none) | falls | clogs for good | danger peak | peak density (real-size) |\n";
+  o << "| --- | --- | --- | --- | --- | --- |\n";
+  for (std::size_t k = 0; k < n; ++k) {
+    const EnsembleRun& r = runs[k];
+    o << "| " << r.label << " | " << r.avalanche_s.size() << " (" << unmatched[k] << ") | " << r.fall_s.size() << " | "
+      << Clock(clock, r.clog_for_good_s) << " | " << (r.loads_available ? std::to_string(r.danger_peak) : "no loads")
+      << " | " << FormatFixed(r.peak_density_per_m2, 1) << " (" << FormatFixed(r.peak_equivalent_density_per_m2, 1)
+      << ") |\n";
+  }
+  return o.str();
+}
+
+std::string EnsembleScore::Csv() const {
+  std::ostringstream o;
+  o << "run_file,label,avalanches,avalanches_matching_none";
+  for (std::size_t a = 0; a < avalanches.size(); ++a) o << ",matches_recorded_" << (a + 1);
+  o << ",falls,falls_before_clog,clog_for_good_s,danger_peak,danger_peak_time_s,peak_density_per_m2,"
+       "peak_equivalent_density_per_m2,end_s\n";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const EnsembleRun& r = runs[k];
+    o << CsvField(r.run_file) << ',' << CsvField(r.label) << ',' << r.avalanche_s.size() << ',' << unmatched[k];
+    for (const RecordedScore& rec : avalanches) o << ',' << (rec.matched[k] ? 1 : 0);
+    o << ',' << r.fall_s.size() << ',' << falls_before_clog[k] << ',' << Num(r.clog_for_good_s, 2) << ','
+      << (r.loads_available ? std::to_string(r.danger_peak) : "") << ',' << Num(r.danger_peak_time_s, 2) << ','
+      << Num(r.peak_density_per_m2, 3) << ',' << Num(r.peak_equivalent_density_per_m2, 3) << ',' << Num(r.end_s, 2)
+      << '\n';
+  }
+  return o.str();
+}
+
+OutputKind EnsembleScoresOutput() {
+  return {"ensemble score file", false, [](const std::filesystem::path& f) {
+            return FileStartsWith(f, "| recorded | at | runs with an avalanche within") ||
+                   FileStartsWith(f, "run_file,label,avalanches,avalanches_matching_none");
+          }};
+}
+
+// ---------------------------------------------------------------------------
+// The figure.
+
+namespace {
+
+constexpr double kWidth = 1400, kLeft = 150, kRight = 1130, kTop = 96, kDensity = 170, kRow = 34;
+const viz::Color kInk = viz::Color::Hex(0x222222), kGrid = viz::Color::Hex(0xe3e3e3);
+const viz::Color kRecorded = viz::Color::Hex(0xe6550d), kFatal = viz::Color::Hex(0xb2182b),
+                 kDetected = viz::Color::Hex(0x6a3d9a), kClog = viz::Color::Hex(0x525252);
+
+}  // namespace
+
+void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, const std::filesystem::path& file) {
+  const std::size_t n = score.runs.size();
+  const double rows_top = kTop + kDensity + 30;
+  const double height = rows_top + static_cast<double>(n) * kRow + 70;
+  viz::Canvas canvas(file, {0, 0}, {kWidth, height}, 1.0, 0.0);
+  const auto P = [&](double x, double y) { return Vec2{x, height - y}; };
+  const std::string clock = score.runs.front().clock_start;
+  double t1 = 1.0;
+  for (const EnsembleRun& r : score.runs) t1 = std::max(t1, r.end_s);
+  const double t0 = 0.0;
+  const auto X = [&](double t) { return kLeft + (std::clamp(t, t0, t1) - t0) / (t1 - t0) * (kRight - kLeft); };
+  canvas.FillPolygon({P(0, 0), P(kWidth, 0), P(kWidth, height), P(0, height)}, viz::Color::White());
+  canvas.TextPxAligned(kLeft, 26, title, 18, 0.0, 0.5, kInk, 0.0, true, kWidth - kLeft - 20);
+  canvas.TextPxAligned(kLeft, 52,
+                       std::to_string(n) + " runs; a run's avalanche matches a recorded one within ±" +
+                           FormatNumber(score.options.tolerance_s) + " s (shaded); density: centred " +
+                           FormatNumber(score.options.smooth_s) + "-s means",
+                       12, 0.0, 0.5, viz::Color::Hex(0x555555), 0.0, false, kWidth - kLeft - 20);
+  // Density panel.
+  double d_hi = 1.0;
+  for (const EnsembleRun& r : score.runs)
+    for (double d : r.density_per_m2)
+      if (!std::isnan(d)) d_hi = std::max(d_hi, d);
+  d_hi = std::ceil(d_hi / 2.0) * 2.0;
+  const double top = kTop, bottom = kTop + kDensity;
+  const auto Y = [&](double v) { return bottom - std::clamp(v / d_hi, 0.0, 1.0) * (bottom - top); };
+  const double d_step = d_hi <= 6 ? 1.0 : d_hi <= 12 ? 2.0 : d_hi <= 30 ? 5.0 : 10.0;
+  for (double v = 0.0; v <= d_hi + 1e-9; v += d_step) {
+    canvas.Line(P(kLeft, Y(v)), P(kRight, Y(v)), kGrid, 1.0);
+    canvas.TextPxAligned(kLeft - 8, Y(v), FormatNumber(v), 12, 1.0, 0.5, kInk);
+  }
+  canvas.TextPxAligned(kLeft - 56, 0.5 * (top + bottom), "persons / m^2", 12, 0.5, 1.0, kInk, 1.5707963267948966);
+  // Recorded marks and tolerance bands across the density panel and every row.
+  const double rows_bottom = rows_top + static_cast<double>(n) * kRow;
+  for (const RecordedScore& r : score.avalanches) {
+    const double a = X(r.mark.time_s - score.options.tolerance_s), b = X(r.mark.time_s + score.options.tolerance_s);
+    canvas.FillPolygon({P(a, rows_top), P(b, rows_top), P(b, rows_bottom), P(a, rows_bottom)},
+                       viz::Color::Hex(0xfdd0a2, 0.45));
+  }
+  for (const analysis::TimelineMark& m : score.runs.front().recorded) {
+    if (m.time_s < t0 || m.time_s > t1) continue;
+    const bool fatal = m.kind == "fatal";
+    for (auto [y0, y1] : {std::pair{top, bottom}, std::pair{rows_top, rows_bottom}})
+      canvas.StrokePolyline({P(X(m.time_s), y0), P(X(m.time_s), y1)}, fatal ? kFatal : kRecorded, fatal ? 2.5 : 1.6, !fatal);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const EnsembleRun& r = score.runs[k];
+    std::vector<Vec2> line;
+    for (std::size_t i = 0; i < r.time_s.size(); ++i)
+      if (!std::isnan(r.density_per_m2[i])) line.push_back(P(X(r.time_s[i]), Y(r.density_per_m2[i])));
+    if (line.size() >= 2) canvas.StrokePolyline(line, viz::Color::Hex(0x2166ac, 0.55), 1.4);
+  }
+  canvas.StrokePolygon({P(kLeft, top), P(kRight, top), P(kRight, bottom), P(kLeft, bottom)}, kInk, 1.0);
+  // Recorded marks' labels over the density panel.
+  int stagger = 0;
+  for (const analysis::TimelineMark& m : score.runs.front().recorded) {
+    if (m.time_s < t0 || m.time_s > t1) continue;
+    canvas.TextPxAligned(X(m.time_s) + 3, top - 4 - 11.0 * (stagger++ % 2), m.label, 10, 0.0, 1.0,
+                         m.kind == "fatal" ? kFatal : kRecorded);
+  }
+  // One row per run.
+  for (std::size_t k = 0; k < n; ++k) {
+    const EnsembleRun& r = score.runs[k];
+    const double y0 = rows_top + static_cast<double>(k) * kRow, yc = y0 + 0.5 * kRow;
+    if (k % 2 == 1)
+      canvas.FillPolygon({P(kLeft, y0), P(kRight, y0), P(kRight, y0 + kRow), P(kLeft, y0 + kRow)},
+                         viz::Color::Hex(0x000000, 0.04));
+    canvas.TextPxAligned(kLeft - 8, yc, r.label, 12, 1.0, 0.5, kInk, 0.0, false, kLeft - 16);
+    canvas.Line(P(kLeft, yc), P(X(r.end_s), yc), kGrid, 1.0);
+    if (!std::isnan(r.clog_for_good_s))
+      canvas.FillPolygon({P(X(r.clog_for_good_s), yc - 4), P(X(r.end_s), yc - 4), P(X(r.end_s), yc + 4),
+                          P(X(r.clog_for_good_s), yc + 4)},
+                         kClog);
+    for (double t : r.avalanche_s) {
+      const double x = X(t);
+      canvas.FillPolygon({P(x, yc + 8), P(x - 7, yc - 6), P(x + 7, yc - 6)}, kDetected);
+    }
+    for (double t : r.fall_s) {
+      const double x = X(t);
+      canvas.Line(P(x - 5, yc - 5), P(x + 5, yc + 5), kFatal, 2.0);
+      canvas.Line(P(x - 5, yc + 5), P(x + 5, yc - 5), kFatal, 2.0);
+    }
+    const std::size_t matched = static_cast<std::size_t>(std::count_if(
+        score.avalanches.begin(), score.avalanches.end(), [&](const RecordedScore& rec) { return rec.matched[k]; }));
+    canvas.TextPxAligned(kRight + 10, yc,
+                         std::to_string(r.avalanche_s.size()) + " aval., " + std::to_string(matched) + "/" +
+                             std::to_string(score.avalanches.size()) + " matched, " + std::to_string(r.fall_s.size()) +
+                             " falls",
+                         11, 0.0, 0.5, kInk, 0.0, false, kWidth - kRight - 16);
+  }
+  canvas.StrokePolygon({P(kLeft, rows_top), P(kRight, rows_top), P(kRight, rows_bottom), P(kLeft, rows_bottom)}, kInk, 1.0);
+  // Time axis.
+  const double span = t1 - t0;
+  double tick = 600.0;
+  for (double c : {5.0, 10.0, 30.0, 60.0, 300.0, 600.0, 900.0, 1800.0, 3600.0})
+    if (span / c <= 12.0) {
+      tick = c;
+      break;
+    }
+  for (double t = 0.0; t <= t1 + 1e-9; t += tick) {
+    canvas.Line(P(X(t), rows_bottom), P(X(t), rows_bottom + 4), kInk, 1.0);
+    canvas.Line(P(X(t), bottom), P(X(t), bottom + 4), kInk, 1.0);
+    canvas.TextPxAligned(X(t), rows_bottom + 8, tick >= 60.0 ? Clock(clock, t) : FormatNumber(t) + " s", 12, 0.5, 0.0, kInk);
+  }
+  canvas.TextPxAligned(0.5 * (kLeft + kRight), rows_bottom + 30,
+                       clock.empty() ? "time of the run" : "time of night (run time 0 = " + clock + ")", 13, 0.5, 0.0, kInk);
+  // Legend, right of the density panel.
+  double ly = top + 4;
+  const double lx = kRight + 12;
+  const auto text = [&](const std::string& t) {
+    canvas.TextPxAligned(lx + 30, ly + 6, t, 12, 0.0, 0.5, kInk, 0.0, false, kWidth - lx - 36);
+    ly += 22;
+  };
+  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::Color::Hex(0x2166ac, 0.55), 2.0);
+  text("density, one line per run");
+  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kRecorded, 2.0, true);
+  text("recorded avalanche");
+  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kFatal, 2.5);
+  text("recorded fatal clog");
+  canvas.FillPolygon({P(lx + 12, ly + 13), P(lx + 5, ly + 1), P(lx + 19, ly + 1)}, kDetected);
+  text("avalanche in a run");
+  canvas.Line(P(lx + 7, ly + 1), P(lx + 17, ly + 11), kFatal, 2.0);
+  canvas.Line(P(lx + 7, ly + 11), P(lx + 17, ly + 1), kFatal, 2.0);
+  text("fall in a run");
+  canvas.FillPolygon({P(lx, ly + 2), P(lx + 24, ly + 2), P(lx + 24, ly + 10), P(lx, ly + 10)}, kClog);
+  text("clogged for good");
+  canvas.Finish();
+}
+
+}  // namespace crowdrecon::reports

@@ -1,0 +1,36 @@
+#!/bin/bash
+# An ensemble of two seeds of a timeline scenario (issue 39): the figure and
+# both score files are written, one row per run; the same run given twice is
+# refused and nothing is written.
+# Usage: ensemble_two_seeds.sh CROWDRECON SCENARIO
+set -euo pipefail
+crowdrecon=$1
+scenario=$(realpath "$2")
+d=$(mktemp -d)
+trap 'rm -rf "$d"' EXIT
+# The second seed: the same scenario with its paths made absolute.
+python3 - "$scenario" "$d/b.json" <<'PY'
+import json, os, sys
+src, dst = sys.argv[1], sys.argv[2]
+s = json.load(open(src))
+base = os.path.dirname(src)
+s["venue"] = os.path.normpath(os.path.join(base, s["venue"]))
+s["population"]["body"]["reference"] = os.path.normpath(os.path.join(base, s["population"]["body"]["reference"]))
+s["population"]["seed"] = s["population"]["seed"] + 1
+json.dump(s, open(dst, "w"))
+PY
+"$crowdrecon" simulate "$scenario" -o "$d/a.sqlite" -q
+"$crowdrecon" simulate "$d/b.json" -o "$d/b.sqlite" -q
+"$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" -o "$d/e.png" --scores "$d/e.md" --scores "$d/e.csv" --tolerance 1 > "$d/out.txt"
+cat "$d/out.txt"
+test -s "$d/e.png"
+grep -q '| over the 2 runs | median (range) |' "$d/e.md"
+grep -q '^| seed 11 |' "$d/e.md"
+grep -q '^| seed 12 |' "$d/e.md"
+test "$(wc -l < "$d/e.csv")" -eq 3
+if "$crowdrecon" timeline "$d/a.sqlite" "$d/a.sqlite" -o "$d/f.png" > "$d/twice.txt" 2>&1; then
+  echo "the same run given twice was accepted"; exit 1
+fi
+grep -q 'given twice' "$d/twice.txt"
+test ! -e "$d/f.png"
+echo "ensemble of two seeds: OK"

@@ -1,0 +1,114 @@
+// Ensembles of an incident (issue 39, point 5; reports/ensemble.hpp): the
+// score of runs against the recorded marks -- per recorded avalanche, the
+// runs with an avalanche within the tolerance (each recorded mark on its
+// own, so one avalanche may match two close marks); per run, its
+// avalanches that match none, its clog for good against the fatal mark,
+// its falls before it; medians and ranges; runs of another incident
+// refused; the score files recognised as previous outputs.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/reports/ensemble.hpp"
+#include "scratch.hpp"
+
+namespace crowdrecon::reports {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::vector<analysis::TimelineMark> Recorded() {
+  return {{100.0, "avalanche A", "avalanche"}, {160.0, "avalanche B", "avalanche"}, {600.0, "avalanche C", "avalanche"},
+          {900.0, "fatal clog", "fatal"}};
+}
+
+EnsembleRun MakeRun(std::string label, std::vector<double> avalanches, std::vector<double> falls, double clog,
+                std::size_t danger, double density) {
+  EnsembleRun r;
+  r.run_file = label + ".sqlite";
+  r.label = label;
+  r.end_s = 1000.0;
+  r.avalanche_s = std::move(avalanches);
+  r.fall_s = std::move(falls);
+  r.clog_for_good_s = clog;
+  r.danger_peak = danger;
+  r.loads_available = true;
+  r.peak_density_per_m2 = density;
+  r.peak_equivalent_density_per_m2 = density * 0.6;
+  r.recorded = Recorded();
+  return r;
+}
+
+TEST(Ensemble, EachRecordedAvalancheCountsTheRunsWithOneWithinTheTolerance) {
+  EnsembleOptions o;
+  o.tolerance_s = 60.0;
+  const EnsembleScore s = ScoreEnsemble(
+      {MakeRun("seed 1", {130.0, 400.0}, {850.0, 950.0}, 880.0, 3, 12.0),  // 130 matches A and B; 400 matches none
+       MakeRun("seed 2", {659.0}, {}, kNaN, 0, 8.0),                       // matches C (within 60 s)
+       MakeRun("seed 3", {39.0, 661.0}, {}, 700.0, 7, 10.0)},              // 39 and 661: just outside A and C
+      o);
+  ASSERT_EQ(s.avalanches.size(), 3u);
+  EXPECT_EQ(s.avalanches[0].runs_matching, 1u);
+  EXPECT_EQ(s.avalanches[1].runs_matching, 1u);
+  EXPECT_EQ(s.avalanches[2].runs_matching, 1u);
+  EXPECT_EQ(s.avalanches[2].matched, (std::vector<bool>{false, true, false}));
+  EXPECT_EQ(s.unmatched, (std::vector<std::size_t>{1, 0, 2}));
+  ASSERT_EQ(s.fatal.size(), 1u);
+  // Falls before the clog for good: 850 of seed 1 (950 came after it).
+  EXPECT_EQ(s.falls_before_clog, (std::vector<std::size_t>{1, 0, 0}));
+  EXPECT_EQ(s.runs_clogging_for_good, 2u);
+  // Medians and ranges over the runs that have the figure.
+  EXPECT_DOUBLE_EQ(s.clog_spread.median, 790.0);
+  EXPECT_DOUBLE_EQ(s.clog_spread.low, 700.0);
+  EXPECT_DOUBLE_EQ(s.clog_spread.high, 880.0);
+  EXPECT_EQ(s.clog_spread.runs, 2u);
+  EXPECT_DOUBLE_EQ(s.clog_minus_fatal_spread.median, -110.0);
+  EXPECT_DOUBLE_EQ(s.danger_spread.median, 3.0);
+  EXPECT_DOUBLE_EQ(s.density_spread.high, 12.0);
+  EXPECT_DOUBLE_EQ(s.avalanche_count_spread.median, 2.0);
+  // The table says it in words.
+  const std::string md = s.Markdown();
+  EXPECT_NE(md.find("| avalanche A | 100.0 s | 1 of 3 (33 %) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| runs whose venue clogs for good | 2 of 3 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| seed 2 | 1 (0) | 0 | never | 0 | 8.0 (4.8) |"), std::string::npos) << md;
+  const std::string csv = s.Csv();
+  EXPECT_NE(csv.find("seed 1.sqlite,seed 1,2,1,1,1,0,2,1,880.00,3,"), std::string::npos) << csv;
+}
+
+TEST(Ensemble, RunsOfAnotherIncidentAndBadOptionsAreRefused) {
+  EnsembleRun other = MakeRun("seed 2", {}, {}, kNaN, 0, 8.0);
+  other.recorded.pop_back();
+  try {
+    ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0), other}, EnsembleOptions{});
+    ADD_FAILURE() << "runs with different recorded marks were scored together";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("seed 2.sqlite: its recorded marks or clock differ"), std::string::npos) << e.what();
+  }
+  EnsembleOptions bad;
+  bad.tolerance_s = std::nan("");
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("tolerance_s"), std::string::npos);
+  EXPECT_THROW(ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0)}, bad), InputError);
+  EXPECT_THROW(ScoreEnsemble({}, EnsembleOptions{}), InputError);
+}
+
+TEST(Ensemble, ItsScoreFilesAreKnownAsPreviousOutputs) {
+  const EnsembleScore s = ScoreEnsemble({MakeRun("seed 1", {130.0}, {}, kNaN, 0, 8.0)}, EnsembleOptions{});
+  const OutputKind kind = EnsembleScoresOutput();
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"scores.md", s.Markdown()}, {"scores.csv", s.Csv()},
+                                   {"other.md", "# notes\n"}}) {
+    const std::filesystem::path f = crowdrecon::testing::ScratchFile(name);
+    std::ofstream(f) << text;
+    EXPECT_EQ(kind.is_previous(f), name != "other.md") << name;
+  }
+}
+
+}  // namespace
+}  // namespace crowdrecon::reports
