@@ -314,6 +314,7 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
   const JsonReader observations = root.At("observations");
   if (observations.Size() == 0) observations.Fail("expected at least one observation file");
   const scenario::Scenario sc = sweep::RunScenarioOf(c.base, sweep::RunPlan{0, "base", 0, {}, c.base.seeds[0], ""});
+  c.run_duration_s = sc.run.duration_s;
   for (std::size_t i = 0; i < observations.Size(); ++i) {
     const JsonReader item = observations.Element(i);
     if (!item.IsObject()) item.Fail("expected {\"file\": ..., \"series\": [...]}, found " + item.ValueText());

@@ -81,6 +81,24 @@ std::string Window(double a, double b) { return "[" + FormatNumber(a) + ", " + F
 
 }  // namespace
 
+namespace {
+
+// A statistic compares the runs over [sim_from_s, sim_to_s]: a window that
+// reaches beyond the runs would compare nothing (no simulated value, no
+// chi-square) and is refused before anything runs, naming it.
+void CheckWithinTheRuns(const CalibrationSpec& spec, const ObservationMatch& m, const Statistic& st) {
+  const double end = spec.run_duration_s;
+  if (end <= 0.0 || (st.sim_from_s >= -1e-9 && st.sim_to_s <= end + 1e-9 && st.sim_from_s < end)) return;
+  throw InputError(spec.origin + ": " + m.file.string() + ": " + st.name + " is compared with the runs over " +
+                   Window(st.sim_from_s, st.sim_to_s) + " (the observation's window" +
+                   (m.time_offset_s != 0.0 ? " plus its time_offset_s of " + FormatNumber(m.time_offset_s) + " s" : "") +
+                   "), beyond the runs, which last " + FormatNumber(end) +
+                   " s (run.duration_s); expected windows within [0, " + FormatNumber(end) +
+                   "] s: shorten the window, change time_offset_s or lengthen the runs");
+}
+
+}  // namespace
+
 std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
   std::vector<Statistic> out;
   for (std::size_t i = 0; i < spec.observations.size(); ++i) {
@@ -116,6 +134,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         st.observed = w.mean;
         const double systematic = s.relative_error * std::abs(w.mean);
         st.observed_sigma = std::sqrt(w.standard_error * w.standard_error + systematic * systematic);
+        CheckWithinTheRuns(spec, m, st);
         out.push_back(st);
       }
     }
@@ -142,6 +161,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         // Onsets at the checkpoint count (a count just after the event).
         st.observed = static_cast<double>(std::min(k + 1, checkpoints.size() - 1));
         st.observed_sigma = 0.5;
+        CheckWithinTheRuns(spec, m, st);
         out.push_back(st);
       }
     }

@@ -421,6 +421,7 @@ std::string Calibration(const std::string& observation_file, const std::string& 
     "observations": [{"file": ")" + observation_file + R"(",
       "series": [{"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0, "to_s": 10, "window_s": 5}],
       "events": [{"kind": "stop", "where": "hallway", "direction": "forward", "from_s": 2, "to_s": 10}]}],
+    "set": {"run.duration_s": 12},
     "seeds": {"first": 1, "count": 3})" + more + "}";
 }
 
@@ -462,6 +463,29 @@ TEST(CalibrationStatistics, WindowMeansCountsAndAnOffset) {
   EXPECT_DOUBLE_EQ(ost[0].observed, 0.5);
   SimulatedStatistics(0, MadeObservation(), ost, &values);
   EXPECT_DOUBLE_EQ(values[0], 1.0);
+}
+
+// Issue 40: an observation compared beyond the runs' end (an offset of 100 s
+// with 12-s runs; before, the pooled seed covariance of no values crashed
+// the calibration) is refused before anything runs, naming the statistic,
+// the window and the runs' length; so is a window partly beyond them.
+TEST(CalibrationStatistics, WindowsBeyondTheRunsAreRefusedUpFront) {
+  const auto file = ScratchFile("made.observation.json");
+  observe::WriteObservation(MadeObservation(), file);
+  CalibrationSpec spec = ParseCalibration(Calibration(file.string(), R"([{"path": "model.back_force_gamma"}])"), "cal.json", "");
+  ASSERT_EQ(spec.run_duration_s, 12.0);
+  EXPECT_NO_THROW(ObservedStatistics(spec));
+  spec.observations[0].time_offset_s = 100.0;
+  std::string e = ErrorOf([&] { ObservedStatistics(spec); });
+  EXPECT_NE(e.find("cal.json: " + file.string() + ": obs0 speed hallway forward [0, 5) s is compared with the runs over [100, 105) s "
+                   "(the observation's window plus its time_offset_s of 100 s), beyond the runs, which last 12 s"),
+            std::string::npos) << e;
+  spec.observations[0].time_offset_s = 3.0;  // the second window, [5, 10) s, runs to 13 s
+  e = ErrorOf([&] { ObservedStatistics(spec); });
+  EXPECT_NE(e.find("is compared with the runs over [8, 13) s"), std::string::npos) << e;
+  spec.observations[0].time_offset_s = -1.0;  // before the runs begin
+  e = ErrorOf([&] { ObservedStatistics(spec); });
+  EXPECT_NE(e.find("is compared with the runs over [-1, 4) s"), std::string::npos) << e;
 }
 
 // The run's avalanches in "any" direction: one surge seen by two detectors
@@ -550,16 +574,22 @@ TEST(CalibrationFile, ASpeedRecordedOfTheIncident) {
   run.bin_s = 0.2;
   run.bins = 1500;
   observe::Series m{"max_speed", "exit end", "all", "m/s", {}};
-  for (std::size_t k = 0; k < run.bins; ++k) m.points.push_back({k == 1000 ? 2.6 : (k == 1450 ? 4.0 : 1.0), 0.1, 5.0});
+  for (std::size_t k = 0; k < run.bins; ++k) m.points.push_back({k == 1000 ? 2.6 : (k == 1400 ? 4.0 : 1.0), 0.1, 5.0});
   run.series.push_back(m);
   std::vector<double> values;
   SimulatedStatistics(0, run, st, &values);
-  EXPECT_DOUBLE_EQ(values[0], 2.6);  // bin 1000 (200.1 s); bin 1450 (290.1 s) lies after the window
+  EXPECT_DOUBLE_EQ(values[0], 2.6);  // bin 1000 (200.1 s); bin 1400 (280.1 s) lies after the window
   // A window of one's own.
   const std::vector<Statistic> own =
-      ObservedStatistics(ParseCalibration(calibration(night, fast, R"("where": "exit end", "from_s": 260, "to_s": 300)"), "cal.json", ""));
+      ObservedStatistics(ParseCalibration(calibration(night, fast, R"("where": "exit end", "from_s": 260, "to_s": 285)"), "cal.json", ""));
   SimulatedStatistics(0, run, own, &values);
   EXPECT_DOUBLE_EQ(values[0], 4.0);
+  // One reaching past the runs' 285 s is refused (issue 40).
+  const std::string beyond = ErrorOf([&] {
+    ObservedStatistics(ParseCalibration(calibration(night, fast, R"("where": "exit end", "from_s": 260, "to_s": 300)"), "cal.json", ""));
+  });
+  EXPECT_NE(beyond.find("is compared with the runs over [260, 300) s (the observation's window), beyond the runs, which last 285 s"),
+            std::string::npos) << beyond;
   const auto expect = [&](const std::string& text, const std::string& part) {
     const std::string e = ErrorOf([&] { ParseCalibration(text, "cal.json", ""); });
     EXPECT_NE(e.find(part), std::string::npos) << "error: " << e << "\nexpected: " << part;

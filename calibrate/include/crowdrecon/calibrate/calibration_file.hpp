@@ -148,6 +148,9 @@ struct CalibrationSpec {
   // first, then the file's "starts".
   std::vector<std::vector<double>> starts;
   CalibrationOptions options;
+  // The length of every run (the base scenario's run.duration_s, after
+  // "set"): every simulated window must lie within [0, run_duration_s].
+  double run_duration_s = 0.0;
   // What a run depends on besides the parameter values and its seed: the
   // build (runs of different builds are never mixed, as in sweeps), the base
   // scenario, "set" and the parameters' paths. Cached runs are keyed by it
