@@ -14,6 +14,7 @@
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/runfile/trajectory_export.hpp"
+#include "crowdrecon/scenario/runner.hpp"
 
 namespace crowdrecon::cli {
 
@@ -53,6 +54,13 @@ void RunExport(const ExportArgs& args) {
                 DescribeSeams(s.box).c_str(), static_cast<long long>(s.splits), static_cast<long long>(s.tracks));
   else
     std::printf("not periodic: ids kept, no splits\n");
+  for (const std::string& side : s.removed_sidecars)
+    std::printf("removed %s: a killed writer's log beside the file replaced (it would have been applied to the export)\n",
+                side.c_str());
+  // A killed run's checkpoint belonged to the file this export replaced.
+  const std::filesystem::path checkpoint = scenario::CheckpointPath(args.output);
+  if (std::filesystem::exists(checkpoint, ec) && std::filesystem::remove(checkpoint, ec))
+    std::printf("removed %s: the checkpoint of the run that %s held before\n", checkpoint.c_str(), args.output.c_str());
   std::printf("wrote %s\n", args.output.c_str());
 }
 

@@ -141,7 +141,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
     throw InputError(file.string() + ": exists and is " + DescribeExisting(file) +
                      ", not a crowdrecon run file; a folder is never replaced by a file");
   std::filesystem::remove(file, ec);
-  for (const char* suffix : {"-journal", "-wal", "-shm"}) std::filesystem::remove(file.string() + suffix, ec);
+  sqlite::RemoveSidecars(file);
   RunFileWriter w;
   w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
   Database& db = *w.impl_->db;

@@ -201,6 +201,9 @@ ExportSummary ExportTrajectories(const RunFileReader& run, const fs::path& file)
       Database db(partial.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
       summary = WriteExport(run, db);
     }  // closed before it is renamed
+    // A killed writer's log beside the file replaced would be applied to
+    // the export by every reader.
+    summary.removed_sidecars = sqlite::RemoveSidecars(file);
     fs::rename(partial, file, ec);
     if (ec)
       throw InputError(file.string() + ": cannot write the export (renaming " + partial.string() + ": " +

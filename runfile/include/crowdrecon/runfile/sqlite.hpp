@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <utility>
@@ -15,6 +16,21 @@
 #include "crowdrecon/common/error.hpp"
 
 namespace crowdrecon::sqlite {
+
+// Removes the journal, write-ahead log and shared-memory files that a
+// killed writer may have left beside `file` ("-journal", "-wal", "-shm"):
+// a writer that replaces `file` calls it first, or SQLite would apply the
+// old log to the new file. Returns the names removed.
+inline std::vector<std::string> RemoveSidecars(const std::filesystem::path& file) {
+  std::vector<std::string> removed;
+  for (const char* suffix : {"-journal", "-wal", "-shm"}) {
+    const std::filesystem::path side = file.string() + suffix;
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::symlink_status(side, ec)) && std::filesystem::remove(side, ec))
+      removed.push_back(side.string());
+  }
+  return removed;
+}
 
 class Database {
  public:

@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -46,6 +47,9 @@ struct ExportSummary {
   std::int64_t tracks = 0;   // ids written (people + splits)
   std::int64_t splits = 0;   // steps across a seam of the periodic box
   PeriodicBox box;           // the run's
+  // Stale "-journal", "-wal" or "-shm" files of a killed writer that were
+  // beside `file` and were removed (they would have been applied to it).
+  std::vector<std::string> removed_sidecars;
 };
 
 // Writes the export of `run` to `file`: into a temporary file beside it
