@@ -10,6 +10,8 @@ crowdrecon_cli_test(venue.check.ground_floor ok "walkable area: 1925.00 m2"
                     venue check venues/madrid-arena/ground-floor.json --picture @TMP@/ground-floor.png)
 crowdrecon_cli_test(venue.check.wuppertal_bottleneck ok "walkable area: 64.27 m2 in 1 part"
                     venue check venues/juelich/wuppertal-bottleneck.json --picture @TMP@/wuppertal-bottleneck.png)
+crowdrecon_cli_test(venue.check.hallway_antechambers ok "walkable area: 120.00 m2 in 1 part"
+                    venue check venues/madrid-arena/hallway-antechambers.json --picture @TMP@/antechambers.png)
 crowdrecon_cli_test(venue.check.verification_gate_corridor ok "walkable area: 48.00 m2 in 1 part"
                     venue check venues/verification/gate-corridor.json --picture @TMP@/gate-corridor.png)
 crowdrecon_cli_test(venue.check.verification_sloping_corridor ok "slope: .*0.1"
