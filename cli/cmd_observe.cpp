@@ -90,6 +90,14 @@ void PrintSummary(const observe::Observation& obs) {
   for (const std::string& n : obs.notes) std::printf("  note: %s\n", n.c_str());
 }
 
+// An observation read as an input: its JSON and the series file it names,
+// neither of which an output may replace (not even with --force).
+void AddObservationInputs(const std::string& what, const std::string& json_file, std::vector<NamedInput>* inputs) {
+  if (json_file.empty()) return;
+  inputs->push_back({what, json_file});
+  inputs->push_back({what + "'s series", observe::ObservationSeriesPath(json_file)});
+}
+
 void CheckObservationOutputs(const std::string& output, const std::vector<NamedInput>& inputs, bool force) {
   if (std::filesystem::path(output).extension() != ".json")
     throw InputError("-o " + output + ": expected a file name ending in .json (the series go beside it, in .csv)");
@@ -263,9 +271,10 @@ struct FootageArgs {
 
 void RunFootage(const FootageArgs& args) {
   std::vector<PlannedOutput> outputs = {{"--figure", args.figure, PictureOutputKind()}};
-  CheckObservationOutputs(args.output, {{"the video", args.video}, {"the homography", args.homography}, {"the spec", args.spec}},
-                          args.force);
-  CheckOutputs(outputs, {{"the video", args.video}}, args.force);
+  std::vector<NamedInput> inputs = {{"the video", args.video}, {"the homography", args.homography}, {"the spec", args.spec}};
+  AddObservationInputs("the reference", args.reference, &inputs);
+  CheckObservationOutputs(args.output, inputs, args.force);
+  CheckOutputs(outputs, inputs, args.force);
   observe::FootageOptions options;
   options.flow = args.flow;
   options.grid_spacing_m = args.grid_m;
@@ -352,7 +361,13 @@ void RunCompare(const CompareArgs& args) {
   CheckOutputs({{"--csv", args.csv, OutputKind{"a comparison (CSV)", false, [](const std::filesystem::path& f) {
                                                 return FileStartsWith(f, "where,quantity,direction,reference,observed");
                                               }}}},
-               {{"the reference", args.reference}, {"the observation", args.test}}, args.force);
+               [&] {
+                 std::vector<NamedInput> inputs;
+                 AddObservationInputs("the reference", args.reference, &inputs);
+                 AddObservationInputs("the observation", args.test, &inputs);
+                 return inputs;
+               }(),
+               args.force);
   const observe::Observation ref = observe::ReadObservation(args.reference);
   const observe::Observation obs = observe::ReadObservation(args.test);
   std::string csv = "where,quantity,direction,reference,observed,error,error_percent,bins\n";

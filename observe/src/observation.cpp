@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -440,6 +442,18 @@ std::filesystem::path ObservationCsvPath(const std::filesystem::path& json_file)
   std::filesystem::path csv = json_file;
   csv.replace_extension(".csv");
   return csv;
+}
+
+std::filesystem::path ObservationSeriesPath(const std::filesystem::path& json_file) {
+  std::ifstream in(json_file, std::ios::binary);
+  if (in) {
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_object() && j.contains("series_file") && j["series_file"].is_object() && j["series_file"].contains("name") &&
+        j["series_file"]["name"].is_string())
+      return json_file.parent_path() / j["series_file"]["name"].get<std::string>();
+  }
+  return ObservationCsvPath(json_file);
 }
 
 namespace {

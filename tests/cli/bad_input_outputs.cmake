@@ -164,3 +164,13 @@ add_test(NAME cli.outputs.resume_before_first_checkpoint
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/resume_before_checkpoint.sh ${CROWDRECON_EXE}
                  ${PROJECT_SOURCE_DIR}/tests/data/scenarios/hallway-short.json
          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+
+# --- observe: an observation read is an input, its series file too (issue 40) ---
+crowdrecon_output_test(observe.compare_csv_is_the_references_series fail
+                       "--csv ref.csv: is the reference's series \\(ref.csv\\), an input of this command. ${NOT_EVEN_FORCE}"
+                       "make_scenario && make_run && make_observation" "ref.json ref.csv"
+                       observe compare ref.json ref.json --csv ref.csv --force)
+crowdrecon_output_test(observe.footage_o_writes_the_references_series fail
+                       "-o \\(its series\\) .*ref.csv: is the reference's series"
+                       "make_scenario && make_run && make_observation && mv ref.json renamed.json" "renamed.json ref.csv"
+                       observe footage video.mp4 --homography h.json --spec s.json -o ref.json --reference renamed.json)

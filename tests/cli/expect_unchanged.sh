@@ -7,6 +7,7 @@
 #   make_scenario      scenario.json, venue.json, body.json (a 0.2 s hallway run)
 #   make_run           run.sqlite, a run of scenario.json (a previous run file)
 #   make_sweep         sweep.json (the tiny test sweep)
+#   make_observation   ref.json + ref.csv, an observation of run.sqlite
 #   foreign NAME       a text file that is nobody's output
 # KEEP is a space-separated list of paths relative to the scratch folder ("."
 # for all of it). COMMAND runs in the scratch folder; $SRC is the project root.
@@ -29,6 +30,10 @@ make_run() { "$EXE" simulate scenario.json -o run.sqlite -q >/dev/null; }
 make_sweep() {
   sed -e "s#\"\.\./scenarios/sweep-tiny.json\"#\"$SRC/tests/data/scenarios/sweep-tiny.json\"#" \
       "$SRC/tests/data/sweeps/tiny.json" >sweep.json
+}
+# ref.json and ref.csv: an observation of run.sqlite (needs make_scenario, make_run).
+make_observation() {
+  "$EXE" observe trajectories run.sqlite --spec "$SRC/venues/madrid-arena/observations/hallway.json" -o ref.json >/dev/null
 }
 foreign() { echo "notes of an investigator, not an output of crowdrecon" >"$1"; }
 

@@ -140,6 +140,11 @@ void WriteObservation(const Observation& observation, const std::filesystem::pat
 Observation ReadObservation(const std::filesystem::path& json_file);
 // The CSV beside an observation file (same name, .csv).
 std::filesystem::path ObservationCsvPath(const std::filesystem::path& json_file);
+// The series file that an existing observation file names (its
+// "series_file"), or ObservationCsvPath where it names none or cannot be
+// read: with the JSON, what a command that reads the observation must never
+// overwrite (common/output_path.hpp).
+std::filesystem::path ObservationSeriesPath(const std::filesystem::path& json_file);
 // Previous outputs, which observe -o may replace (common/output_path.hpp).
 OutputKind ObservationJsonOutput();
 OutputKind ObservationCsvOutput();
