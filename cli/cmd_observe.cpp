@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/observe/footage.hpp"
@@ -452,7 +453,7 @@ void RegisterObserveCommands(CLI::App& app) {
   traj->add_option("-o,--output", targs->output, "observation file (.json; its series go to the same name .csv)")
       ->required();
   traj->add_option("--fps", targs->fps, "frame rate, replacing the file's (a PeTrack file without one needs it)")
-      ->check(CLI::Range(0.001, 10000.0));
+      ->check(NumberIn(0.001, 10000.0, "frames/s"));
   traj->add_option("--figure", targs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   traj->add_flag("-q,--quiet", targs->quiet, "print only the output's name");
   AddForceFlag(traj, &targs->force);
@@ -466,7 +467,7 @@ void RegisterObserveCommands(CLI::App& app) {
   fd->add_option("--spec", fargs->specs, "observation spec: one for every file, or one per file in order")->required();
   fd->add_option("-o,--picture", fargs->pictures, "picture (.png, .svg or .pdf; repeat for several)")->required();
   fd->add_option("--csv", fargs->csv, "also write every point (source, time, density, speed, people) as CSV");
-  fd->add_option("--frame-step", fargs->frame_step, "use every N-th frame (default 5)")->check(CLI::Range(1, 10000));
+  fd->add_option("--frame-step", fargs->frame_step, "use every N-th frame (default 5)")->check(IntegerIn(1, 10000));
   AddForceFlag(fd, &fargs->force);
   fd->callback([fargs] { RunFundamentalDiagram(*fargs); });
 
@@ -480,25 +481,25 @@ void RegisterObserveCommands(CLI::App& app) {
   footage->add_option("--spec", vargs->spec, "observation spec (axis, regions, bins)")->required();
   footage->add_option("-o,--output", vargs->output, "observation file (.json; its series go to the same name .csv)")->required();
   footage->add_option("--flow", vargs->flow, "optical flow: dis-medium (DIS, medium preset; default), dis-fast (DIS, fast preset: about three times faster, speeds lower; docs/observations.md) or farneback")->check(CLI::IsMember({"dis-fast", "dis-medium", "farneback"}));
-  footage->add_option("--grid", vargs->grid_m, "spacing of the floor points sampled (m, default 0.1)")->check(CLI::Range(0.01, 2.0));
-  footage->add_option("--from", vargs->from_s, "start at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
-  footage->add_option("--to", vargs->to_s, "stop at this time of the video (s)")->check(CLI::Range(0.0, 1e7));
+  footage->add_option("--grid", vargs->grid_m, "spacing of the floor points sampled (m, default 0.1)")->check(NumberIn(0.01, 2.0, "m"));
+  footage->add_option("--from", vargs->from_s, "start at this time of the video (s)")->check(NumberIn(0.0, 1e7, "s"));
+  footage->add_option("--to", vargs->to_s, "stop at this time of the video (s)")->check(NumberIn(0.0, 1e7, "s"));
   footage->add_option("--pictures", vargs->picture_dir, "folder for the flow-field pictures (with --picture-at)");
   footage->add_option("--picture-at", vargs->picture_at, "times (s) of the flow-field pictures, e.g. 2,10.5")
       ->delimiter(',')
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(NumberIn(0.0, 1e7, "s"));
   footage->add_option("--figure", vargs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   footage->add_option("--reference", vargs->reference, "an observation to draw beside it in --figure (e.g. the trajectories')");
   footage->add_option("--min-brightness", vargs->defaults.min_brightness,
                       "a frame darker than this mean grey level (of 255) in the regions is flagged dark (default 8)")
-      ->check(CLI::Range(0.0, 255.0));
+      ->check(NumberIn(0.0, 255.0, "grey levels"));
   footage->add_option("--min-contrast", vargs->defaults.min_contrast,
                       "a frame whose grey levels in the regions vary less than this (standard deviation) is flagged flat "
                       "(default 3; 0 lets every frame through)")
-      ->check(CLI::Range(0.0, 128.0));
+      ->check(NumberIn(0.0, 128.0, "grey levels"));
   footage->add_option("--min-correlation", vargs->defaults.min_correlation,
                       "a frame correlated less than this with the previous one is flagged as a cut (default 0.5)")
-      ->check(CLI::Range(-1.0, 1.0));
+      ->check(NumberIn(-1.0, 1.0));
   footage->add_flag("--no-enhance", vargs->no_enhance, "no contrast enhancement (CLAHE) before the flow");
   footage->add_flag("-q,--quiet", vargs->quiet, "no progress, print only the output's name");
   AddForceFlag(footage, &vargs->force);
@@ -530,7 +531,7 @@ void RegisterObserveCommands(CLI::App& app) {
   compare->add_option("REFERENCE", cargs->reference, "reference observation (.json)")->required();
   compare->add_option("OBSERVATION", cargs->test, "observation to check (.json)")->required();
   compare->add_option("--csv", cargs->csv, "also write the table as CSV");
-  compare->add_option("--match", cargs->match_s, "events match within this time (s, default 3)")->check(CLI::Range(0.0, 60.0));
+  compare->add_option("--match", cargs->match_s, "events match within this time (s, default 3)")->check(NumberIn(0.0, 60.0, "s"));
   AddForceFlag(compare, &cargs->force);
   compare->callback([cargs] { RunCompare(*cargs); });
 }

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/reports/report.hpp"
 
 namespace crowdrecon::cli {
@@ -79,7 +80,7 @@ void RegisterReportCommand(CLI::App& app) {
                   "people_uncomfortable, people_beyond_tolerance, ...)");
   cmd->add_option("--envelope-level", args->envelope_level,
                   "For a sweep's folder: the envelope holds the cells whose median over seeds is at most this")
-      ->check(CLI::Range(0.0, 1e12));
+      ->check(NumberIn(0.0, 1e12));
   cmd->add_flag("--no-pdf", args->no_pdf, "Write no report.pdf (no Chromium needed)");
   cmd->add_option("--chromium", args->chromium, "The browser that prints report.pdf (default: chromium on PATH)");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress lines");

@@ -82,7 +82,10 @@ void RunEnsemble(const TimelineArgs& args) {
   options.smooth_s = args.smooth_s;
   if (std::string error; !options.IsValid(&error)) throw InputError("--tolerance / --smooth: " + error);
   std::vector<PlannedOutput> outputs;
-  for (const std::string& f : args.figures) outputs.push_back({"-o", f, PictureOutputKind()});
+  for (const std::string& f : args.figures) {
+    CheckPictureName("-o", f);
+    outputs.push_back({"-o", f, PictureOutputKind()});
+  }
   for (const std::string& f : args.scores) {
     const std::string ext = std::filesystem::path(f).extension().string();
     if (ext != ".md" && ext != ".csv")
@@ -106,9 +109,10 @@ void RunEnsemble(const TimelineArgs& args) {
   const std::string name =
       scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
   for (const std::string& f : args.figures) {
-    const std::filesystem::path partial = PartialPath(f);
-    reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " + std::to_string(score.runs.size()) + " runs", partial);
-    std::filesystem::rename(partial, f);
+    WritePictureAtomically(f, [&](const std::filesystem::path& to) {
+      reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " +
+                                             std::to_string(score.runs.size()) + " runs", to);
+    });
     std::printf("wrote %s\n", f.c_str());
   }
   for (const std::string& f : args.scores) {
@@ -130,15 +134,35 @@ void RunTimeline(const TimelineArgs& args) {
     outputs.push_back({"--phase-output", sweep::PhaseOutputFolder(phase), sweep::PhaseFolderOutput()});
   }
   CheckOutputs(outputs, {{"the run file", args.run}, {"the sweep results", args.phase}}, args.force);
+  // Every option is checked before anything is written (issue 40).
+  for (const std::string& f : args.figures) CheckPictureName("-o", f);
+  for (const std::string& f : args.density_maps) CheckPictureName("--density-maps", f);
+  analysis::DensityMapOptions density;
+  density.times_s = args.density_times_s;
+  density.cell_m = args.density_cell_m;
+  density.sigma_m = args.density_sigma_m;
+  if (std::string why; !args.density_maps.empty() && !density.IsValid(&why))
+    throw InputError("--density-times / --density-cell / --density-sigma: " + why);
   if (!runfile::IsRunFile(args.run)) throw InputError(args.run + ": " + DescribeExisting(args.run) + ", not a crowdrecon run file");
   const analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
+  // What may still refuse the run (the maps' times, the sweep's folder) is
+  // read or drawn before the run's own figures.
+  const std::vector<analysis::DensityMap> maps =
+      args.density_maps.empty() ? std::vector<analysis::DensityMap>{} : analysis::ComputeDensityMaps(args.run, density);
+  if (!args.phase.empty()) {
+    phase.path = PathOf(s, args.path_step_s);
+    const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
+    std::printf("%s", summary.BriefReport().c_str());
+  }
   // The title: the scenario's name, from the scenario stored in the run.
   const nlohmann::json scenario =
       nlohmann::json::parse(runfile::RunFileReader(args.run).RunValue("scenario"), nullptr, false);
   const std::string title =
       scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
   for (const std::string& f : args.figures) {
-    viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, f);
+    WritePictureAtomically(f, [&](const std::filesystem::path& to) {
+      viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, to);
+    });
     std::printf("wrote %s\n", f.c_str());
   }
   std::printf("%zu frames from %s to %s; %zu avalanches and %zu falls in the run; %zu recorded marks\n",
@@ -150,15 +174,12 @@ void RunTimeline(const TimelineArgs& args) {
     std::printf("validity: %s\n", validity.Statement(analysis::PlausibilityOptions{}).c_str());
   }
   if (!args.density_maps.empty()) {
-    analysis::DensityMapOptions o;
-    o.times_s = args.density_times_s;
-    o.cell_m = args.density_cell_m;
-    o.sigma_m = args.density_sigma_m;
-    const std::vector<analysis::DensityMap> maps = analysis::ComputeDensityMaps(args.run, o);
     const geometry::Venue venue =
         geometry::ParseVenue(runfile::RunFileReader(args.run).venue_json(), args.run + ": run value venue");
     for (const std::string& f : args.density_maps) {
-      viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, f);
+      WritePictureAtomically(f, [&](const std::filesystem::path& to) {
+        viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, to);
+      });
       std::printf("wrote %s\n", f.c_str());
     }
     for (const analysis::DensityMap& m : maps)
@@ -166,11 +187,6 @@ void RunTimeline(const TimelineArgs& args) {
                   s.clock_start.empty() ? ("t = " + FormatNumber(m.time_s) + " s").c_str()
                                         : analysis::ClockText(s.clock_start, m.time_s).c_str(),
                   m.people, m.max_per_m2);
-  }
-  if (!args.phase.empty()) {
-    phase.path = PathOf(s, args.path_step_s);
-    const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
-    std::printf("%s", summary.BriefReport().c_str());
   }
 }
 
@@ -191,17 +207,17 @@ void RegisterTimelineCommand(CLI::App& app) {
   cmd->add_option("--phase", args->phase, "Sweep output folder whose phase diagrams the run's path is drawn over");
   cmd->add_option("--phase-output", args->phase_output, "Folder for those diagrams (default: the sweep's phase/)");
   cmd->add_option("--smooth", args->smooth_s, "Moving-mean window of the figure's lines (s)")
-      ->check(CLI::Range(0.0, 3600.0));
+      ->check(NumberIn(0.0, 3600.0, "s"));
   cmd->add_option("--path-step", args->path_step_s, "Averaging step of the path's points (s)")
-      ->check(CLI::Range(1.0, 3600.0));
+      ->check(NumberIn(1.0, 3600.0, "s"));
   cmd->add_option("--density-maps", args->density_maps,
                   "Figure of density maps (persons/m2 over the venue) at --density-times: .png, .svg or .pdf (repeat for several)");
   cmd->add_option("--density-times", args->density_times_s,
                   "Times of the density maps (s, comma-separated; default: the start and the quarters of the run)")
       ->delimiter(',');
-  cmd->add_option("--density-cell", args->density_cell_m, "Cell of the density maps (m)")->check(CLI::Range(0.05, 10.0));
+  cmd->add_option("--density-cell", args->density_cell_m, "Cell of the density maps (m)")->check(NumberIn(0.05, 10.0, "m"));
   cmd->add_option("--density-sigma", args->density_sigma_m, "Width of each person's Gaussian in the density maps (m)")
-      ->check(CLI::Range(0.05, 10.0));
+      ->check(NumberIn(0.05, 10.0, "m"));
   cmd->add_option("--scores", args->scores,
                   "Score file(s) of the runs against the recorded marks: .md (the score table) or .csv (one row per "
                   "run); also with one run")
@@ -209,7 +225,7 @@ void RegisterTimelineCommand(CLI::App& app) {
   cmd->add_option("--tolerance", args->tolerance_s,
                   "A run's avalanche matches a recorded one within this many seconds of run time (default 120; scale it "
                   "with a compressed scenario's marks)")
-      ->check(CLI::Range(0.001, 1e7));
+      ->check(NumberIn(0.001, 1e7, "s"));
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] {
     args->run = args->runs.front();

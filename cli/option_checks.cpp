@@ -3,8 +3,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 
 namespace crowdrecon::cli {
 
@@ -39,6 +41,24 @@ CLI::Validator IntegerIn(long long min, long long max) {
         return "";
       },
       "INTEGER in " + range);
+}
+
+void CheckPictureName(const std::string& option, const std::string& file) {
+  const std::string ext = std::filesystem::path(file).extension().string();
+  if (ext != ".png" && ext != ".svg" && ext != ".pdf")
+    throw InputError(option + " " + file + ": unknown picture format \"" + ext + "\"; expected .png, .svg or .pdf");
+}
+
+void WritePictureAtomically(const std::string& file, const std::function<void(const std::filesystem::path&)>& draw) {
+  const std::filesystem::path partial = PartialPath(file);
+  try {
+    draw(partial);
+    std::filesystem::rename(partial, file);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);
+    throw;
+  }
 }
 
 }  // namespace crowdrecon::cli

@@ -4,6 +4,8 @@
 // check as "--option: MESSAGE" and exits with status 105.
 #pragma once
 
+#include <filesystem>
+#include <functional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -15,5 +17,14 @@ CLI::Validator NumberIn(double min, double max, const std::string& unit = "");
 
 // A whole number in [min, max] (decimal digits, optional sign).
 CLI::Validator IntegerIn(long long min, long long max);
+
+// Throws InputError naming the option unless `file` ends in .png, .svg or
+// .pdf (the pictures viz::Canvas writes): checked before anything is written.
+void CheckPictureName(const std::string& option, const std::string& file);
+
+// Draws a picture under a temporary name beside `file` and renames it over
+// `file` when complete, so that a failure or a kill never leaves a truncated
+// picture (or an empty one in place of the previous) under the final name.
+void WritePictureAtomically(const std::string& file, const std::function<void(const std::filesystem::path&)>& draw);
 
 }  // namespace crowdrecon::cli

@@ -174,3 +174,17 @@ crowdrecon_output_test(observe.footage_o_writes_the_references_series fail
                        "-o \\(its series\\) .*ref.csv: is the reference's series"
                        "make_scenario && make_run && make_observation && mv ref.json renamed.json" "renamed.json ref.csv"
                        observe footage video.mp4 --homography h.json --spec s.json -o ref.json --reference renamed.json)
+
+# --- every option checked before anything is written (issue 40) ----------------
+crowdrecon_output_test(timeline.bad_density_time_writes_nothing fail
+                       "--density-times / --density-cell / --density-sigma: time -1 s, expected a time at or after the start"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png --density-maps d.png --density-times -1)
+crowdrecon_output_test(timeline.bad_second_extension_writes_nothing fail
+                       "-o t.bmp: unknown picture format .*bmp.*expected .png, .svg or .pdf"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png -o t.bmp)
+crowdrecon_output_test(timeline.bad_phase_folder_writes_nothing fail
+                       "nowhere"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png --phase nowhere)

@@ -237,3 +237,15 @@ crowdrecon_cli_test(calibrate.missing_observation fail "bad-observation.json: /o
                     calibrate ${calibration_data}/bad-observation.json -o @TMP@/c)
 crowdrecon_cli_test(calibrate.output_is_a_foreign_folder fail "-o .*calibration: exists and is a folder .*not a calibration folder"
                     calibrate ${calibration_data}/bad-parameter.json -o ${calibration_data})
+
+# --- numbers: NaN and infinity are refused by every numeric option (issue 40) ---
+crowdrecon_cli_test(timeline.smooth_nan fail "--smooth: value nan is not finite. expected a number in \\[0, 3600\\] s"
+                    timeline README.md -o @TMP@/t.png --smooth nan)
+crowdrecon_cli_test(timeline.tolerance_inf fail "--tolerance: value inf is not finite"
+                    timeline README.md -o @TMP@/t.png --tolerance inf)
+crowdrecon_cli_test(observe.compare_match_nan fail "--match: value nan is not finite"
+                    observe compare a.json b.json --match nan)
+crowdrecon_cli_test(observe.footage_to_nan fail "--to: value nan is not finite"
+                    observe footage v.mp4 --homography h.json --spec s.json -o o.json --to nan)
+crowdrecon_cli_test(report.envelope_level_nan fail "--envelope-level: value nan is not finite"
+                    report README.md -o @TMP@/r --envelope-level nan)
