@@ -19,6 +19,7 @@ struct PhaseArgs {
   std::string output;
   bool no_heat_maps = false;
   bool heat_maps_png_only = false;
+  bool single_release = false;
   bool force = false;
 };
 
@@ -28,6 +29,7 @@ void RunPhase(const PhaseArgs& args) {
   options.output_dir = args.output;
   options.heat_maps = !args.no_heat_maps;
   options.heat_map_svg = !args.heat_maps_png_only;
+  options.single_release_reading = args.single_release;
   CheckOutputs({{"-o", sweep::PhaseOutputFolder(options), sweep::PhaseFolderOutput()}},
                {{"the sweep results", args.results}}, args.force);
   const sweep::PhaseSummary s = sweep::DrawPhaseDiagrams(options);
@@ -48,6 +50,9 @@ void RegisterPhaseCommand(CLI::App& app) {
   cmd->add_flag("--no-heat-maps", args->no_heat_maps, "Phase diagrams only");
   cmd->add_flag("--heat-maps-png-only", args->heat_maps_png_only,
                 "Heat maps as PNG only (about 200 kB each as SVG); index.html then links each to its PNG");
+  cmd->add_flag("--single-release", args->single_release,
+                "Read each run's regime as a single release: one clog of at least 5 s that releases is the avalanche "
+                "regime (results column regime_code_single_release; docs/analysis.md)");
   cmd->callback([args] { RunPhase(*args); });
 }
 

@@ -75,6 +75,7 @@ std::vector<SummaryValue> RunAnalysis::SummaryTable() const {
       {"longest_above_load_s", longest_above_load_s, "s"},
       {"regime_code", static_cast<double>(static_cast<int>(regime.regime)), ""},
       {"regime_classifier_version", static_cast<double>(kRegimeClassifierVersion), ""},
+      {"regime_code_single_release", static_cast<double>(static_cast<int>(regime_single_release.regime)), ""},
       {"avalanche_mean_rise_time_s", avalanche_mean_rise_time_s, "s"},
       {"peak_density_per_m2", plausibility.peak_density_per_m2, "1/m^2"},
       {"peak_equivalent_density_per_m2", plausibility.peak_equivalent_density_per_m2, "1/m^2"},
@@ -126,6 +127,9 @@ std::string RunAnalysis::BriefReport() const {
   for (const DirectionRegime& d : regime.directions)
     r += "  direction " + d.name + " (" + std::to_string(d.people) + " people): " + ToString(d.result.regime) + " (" +
          d.result.reason + ")\n";
+  if (regime_single_release.regime != regime.regime)
+    r += std::string("regime, read as a single release (a clog of at least 5 s released once is enough): ") +
+         ToString(regime_single_release.regime) + " (" + regime_single_release.reason + ")\n";
   for (std::size_t g = 0; g < passages.size() && g < group_name.size(); ++g) {
     const PassageStatistics& p = passages[g];
     if (g < group_people.size() && group_people[g] == 0) continue;

@@ -72,6 +72,10 @@ bool RegimeOptions::IsValid(std::string* error) const {
              " s) must be at least frozen_window_s (" + FormatNumber(frozen_window_s) + " s)";
     return false;
   }
+  if (!(std::isfinite(min_released_stop_s) && min_released_stop_s >= 0.0)) {
+    *error = "regime min_released_stop_s = " + FormatNumber(min_released_stop_s) + " s, expected at least 0 s";
+    return false;
+  }
   if (min_avalanches < 1) {
     *error = "regime min_avalanches = " + std::to_string(min_avalanches) + ", expected at least 1";
     return false;
@@ -197,7 +201,8 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
   r.frozen_at_end = r.end_mean_speed_m_per_s < options.frozen_speed_m_per_s;
 
   r.avalanches = FindAvalanches(time_s, mean_speed_m_per_s, options);
-  for (const Avalanche& a : r.avalanches) r.stationary_avalanches += a.stationary ? 1 : 0;
+  for (const Avalanche& a : r.avalanches)
+    r.stationary_avalanches += a.stationary && a.stopped_before_s >= options.min_released_stop_s ? 1 : 0;
 
   // The decision, in the order of regime.hpp.
   const std::string speed_text = "mean speed along the desired direction over the last " +
@@ -214,7 +219,7 @@ RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector
   } else if (r.stationary_avalanches >= options.min_avalanches) {
     r.regime = Regime::kAvalanches;
     r.reason = std::to_string(r.stationary_avalanches) + " avalanches (stop >= " +
-               FormatNumber(options.min_stop_duration_s) + " s below " + FormatNumber(options.stop_speed_m_per_s) +
+               FormatNumber(std::max(options.min_stop_duration_s, options.min_released_stop_s)) + " s below " + FormatNumber(options.stop_speed_m_per_s) +
                " m/s, then a burst above " + FormatNumber(options.burst_speed_m_per_s) +
                " m/s) in the stationary stage, at least " + std::to_string(options.min_avalanches) +
                ", and not frozen (" + speed_text + ")";
@@ -313,6 +318,12 @@ RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::v
     r.reason += "; every direction free (" + speeds + ")";
   }
   return r;
+}
+
+RegimeOptions SingleReleaseReading(RegimeOptions options) {
+  options.min_avalanches = 1;
+  options.min_released_stop_s = 5.0;
+  return options;
 }
 
 }  // namespace crowdrecon::analysis

@@ -605,6 +605,8 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
       directions.push_back({out.group_name[g], out.group_people[g], out.series.group_mean_speed_m_per_s[g]});
   out.regime = ClassifyByDirection(contents.time_s, speed_for_regime, directions, out.series.lane_order,
                                    options.regime);
+  out.regime_single_release = ClassifyByDirection(contents.time_s, speed_for_regime, directions, out.series.lane_order,
+                                                  SingleReleaseReading(options.regime));
   AvalancheSizes(pass, contents.people.size(), options, &out);
   // 9. Passages per direction over the stationary stage.
   for (std::size_t g = 0; g < out.groups; ++g)

@@ -45,6 +45,18 @@ const std::array<CategoryStyle, kCategoryCount> kStyles = {{
     {"run failed", Color::Hex(0x222222)},
 }};
 
+// The regime code of analysis::Regime (0 lanes, 1 avalanches, 2 clogging,
+// 3 unclassified) as the text of the regime column.
+ResultsTable::Cell RegimeTextOf(const ResultsTable::Cell& code) {
+  ResultsTable::Cell c;
+  c.null = code.null;
+  if (!code.null) {
+    const int k = static_cast<int>(code.number);
+    c.text = k == 0 ? "lanes" : k == 1 ? "avalanches" : k == 2 ? "clogging" : "unclassified";
+  }
+  return c;
+}
+
 Category CategoryOf(const ResultsTable::Cell& status, const ResultsTable::Cell& regime) {
   if (status.text != "complete") return kFailed;
   if (regime.text == "lanes") return kLanes;
@@ -157,6 +169,7 @@ struct Panel {
   // judged them (1 where the table predates the column).
   double shortest_s = std::numeric_limits<double>::infinity(), longest_s = 0.0;
   std::set<int> classifiers;
+  bool single_release = false;  // PhaseOptions::single_release_reading
 };
 
 // "120 runs of 30 s, classifier version 1" (or "of 21-240 s" when the runs
@@ -168,7 +181,8 @@ std::string RunsText(const Panel& p) {
   else std::snprintf(length, sizeof length, "of %.0f-%.0f s", p.shortest_s, p.longest_s);
   std::string versions;
   for (int v : p.classifiers) versions += (versions.empty() ? "" : " and ") + std::to_string(v);
-  return std::to_string(p.runs) + " runs " + length + ", classifier version " + versions;
+  return std::to_string(p.runs) + " runs " + length + ", classifier version " + versions +
+         (p.single_release ? ", read as a single release (a clog of at least 5 s released once)" : "");
 }
 
 // Page layout in device pixels (y down).
@@ -587,9 +601,14 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
     throw InputError(t.file.string() + ": the sweep table's axes or variants are not readable");
   }
 
+  if (options.single_release_reading && !t.FindColumn("regime_code_single_release"))
+    throw InputError(t.file.string() + ": the runs table has no column \"regime_code_single_release\": the sweep was "
+                     "analysed before the single-release reading existed (2026-11-27); run it again into a new folder "
+                     "for --single-release");
   PlotAxis x = MakeAxis(t, x_path), y = MakeAxis(t, y_path);
   const std::size_t c_variant = t.Column("variant"), c_seed = t.Column("seed"), c_status = t.Column("status"),
-                    c_regime = t.Column("regime"), c_x = t.Column(x_path), c_y = t.Column(y_path);
+                    c_regime = t.Column(options.single_release_reading ? "regime_code_single_release" : "regime"),
+                    c_x = t.Column(x_path), c_y = t.Column(y_path);
   std::vector<std::size_t> c_other;
   for (const std::string& a : axes)
     if (a != x_path && a != y_path) c_other.push_back(t.Column(a));
@@ -619,6 +638,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
         panels.push_back({variant, slice, stem, {}, 0, std::numeric_limits<double>::infinity(), 0.0, {}});
       }
       Panel& p = panels[panel_of[key]];
+      p.single_release = options.single_release_reading;
       ++p.runs;
       if (!row[c_duration].null) {
         p.shortest_s = std::min(p.shortest_s, row[c_duration].number);
@@ -627,7 +647,8 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
       if (c_classifier && !row[*c_classifier].null) p.classifiers.insert(static_cast<int>(row[*c_classifier].number));
       else if (!c_classifier) p.classifiers.insert(1);
       Point& point = p.points[{x.IndexOf(row[c_x]), y.IndexOf(row[c_y])}];
-      const Category category = CategoryOf(row[c_status], row[c_regime]);
+      const Category category =
+          CategoryOf(row[c_status], options.single_release_reading ? RegimeTextOf(row[c_regime]) : row[c_regime]);
       if (category == kFailed) ++failed;
       point.votes.push_back(category);
       point.seeds.push_back(static_cast<std::uint64_t>(row[c_seed].number));

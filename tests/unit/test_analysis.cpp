@@ -156,6 +156,39 @@ TEST(Regime, OneReleaseIsIntermittentAndShortRunsAreUnclassified) {
   EXPECT_NE(s.reason.find("run too short"), std::string::npos) << s.reason;
 }
 
+// Issue 39, candidate (d): read as a single release, one clog of 5 s or more
+// that releases to flow is the avalanche regime; a shorter one is not, and a
+// clog that never releases is still clogging.
+TEST(Regime, TheSingleReleaseReadingTakesOneLongClogThatReleases) {
+  const std::vector<double> t = Times(40.0);
+  const RegimeOptions single = SingleReleaseReading(RegimeOptions{});
+  EXPECT_EQ(single.min_avalanches, 1);
+  EXPECT_EQ(single.min_released_stop_s, 5.0);
+  std::string error;
+  EXPECT_TRUE(single.IsValid(&error)) << error;
+  // Flow, a 6-s clog from 15 s, then flow again.
+  const auto released = Series(t, [](double x) { return x >= 15.0 && x < 21.0 ? 0.0 : 0.8; });
+  const RegimeResult recurring = ClassifyRegime(t, released, {}, RegimeOptions{});
+  EXPECT_NE(recurring.regime, Regime::kAvalanches) << recurring.reason;
+  const RegimeResult once = ClassifyRegime(t, released, {}, single);
+  EXPECT_EQ(once.regime, Regime::kAvalanches) << once.reason;
+  EXPECT_EQ(once.stationary_avalanches, 1);
+  EXPECT_NE(once.reason.find("stop >= 5 s"), std::string::npos) << once.reason;
+  // A 3-s clog is a stop, not a clog of this reading.
+  const auto brief = Series(t, [](double x) { return x >= 15.0 && x < 18.0 ? 0.0 : 0.8; });
+  const RegimeResult short_stop = ClassifyRegime(t, brief, {}, single);
+  EXPECT_NE(short_stop.regime, Regime::kAvalanches) << short_stop.reason;
+  EXPECT_EQ(short_stop.stationary_avalanches, 0);
+  EXPECT_EQ(short_stop.avalanches.size(), 1u);  // still found, not counted
+  // Released once, then frozen for good: clogging under either reading.
+  const auto refrozen = Series(t, [](double x) { return x >= 15.0 && x < 21.0 ? 0.0 : (x < 26.0 ? 0.8 : 0.0); });
+  EXPECT_EQ(ClassifyRegime(t, refrozen, {}, single).regime, Regime::kClogging);
+  RegimeOptions bad = single;
+  bad.min_released_stop_s = std::nan("");
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("min_released_stop_s"), std::string::npos) << error;
+}
+
 TEST(Regime, LaneOrderRequirement) {
   const std::vector<double> t = Times(30.0);
   const auto v = Series(t, [](double) { return 0.8; });

@@ -95,6 +95,11 @@ struct RegimeOptions {
   // release"; one stop-and-release may be a single rearrangement, two is the
   // least that recurs.
   int min_avalanches = 2;
+  // Shortest stop before a release for that avalanche to count towards
+  // min_avalanches (s); 0: every avalanche (the stop that armed it already
+  // lasted min_stop_duration_s). The single-release reading sets 5 s
+  // (SingleReleaseReading).
+  double min_released_stop_s = 0.0;
   // Largest fraction of the stationary stage with the flow stopped that still
   // counts as free flow (lanes): lanes are a moving stationary state.
   double max_stopped_fraction_for_lanes = 0.1;
@@ -128,6 +133,14 @@ struct Avalanche {
   // tau ln((v0 - v_stop)/(v0 - v_burst)) = 0.17 s for v0 = 1 m/s.
   double rise_time_s = 0.0;
 };
+
+// The paper describes the avalanche regime as "temporal clogging of the
+// pedestrian flow, followed by a sudden release". The default reading asks
+// for it to recur (min_avalanches = 2); this one (issue 39, candidate (d))
+// takes a single clog of at least 5 s that releases to flow as enough:
+// `options` with min_avalanches = 1 and min_released_stop_s = 5. 5 s: the
+// frozen window's half, 7.5 relaxation times -- a clog, not a hesitation.
+RegimeOptions SingleReleaseReading(RegimeOptions options);
 
 // Start of the stationary stage of a run from t_first to t_last:
 // max(t_first + transient_s, t_last - stationary_window_s).

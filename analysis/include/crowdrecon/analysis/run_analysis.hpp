@@ -168,6 +168,9 @@ struct RunAnalysis {
   double avalanche_mean_rise_time_s = 0.0;  // over the stationary avalanches of the crowd
 
   RegimeResult regime;  // regime.directions: one verdict per group with people
+  // The same series under the single-release reading (SingleReleaseReading;
+  // issue 39): a clog of at least 5 s that releases is enough for avalanches.
+  RegimeResult regime_single_release;
   // Whether the run's states are ones a human crowd can reach (issue 39):
   // peak local density, largest overlap, against the stated range.
   Plausibility plausibility;

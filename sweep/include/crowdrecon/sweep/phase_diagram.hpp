@@ -42,6 +42,11 @@ struct PhaseOptions {
   bool heat_maps = true;
   bool heat_map_svg = true;  // false: heat maps as PNG only (each ~200 kB as SVG), linked to their PNG
   PathOverlay path;          // drawn over the phase diagrams when it has points
+  // Issue 39, candidate (d): each run's regime read as a single release
+  // (results column regime_code_single_release: a clog of at least 5 s
+  // released once is enough for avalanches; analysis/regime.hpp,
+  // SingleReleaseReading) instead of the recurring reading (column regime).
+  bool single_release_reading = false;
 };
 
 struct PhaseSummary {
