@@ -520,7 +520,8 @@ void RegisterObserveCommands(CLI::App& app) {
   synth->add_option("--noise", sargs->options.noise_sigma, "sensor noise (sigma, grey levels)");
   synth->add_option("--quality", sargs->options.jpeg_quality, "Motion-JPEG quality (1-100, default 95)");
   synth->add_option("--frame-step", sargs->options.frame_step, "every N-th frame of the run (a lower frame rate)");
-  synth->add_option("--seed", sargs->options.seed, "seed of the textures and the noise");
+  synth->add_option("--seed", sargs->options.seed, "seed of the textures and the noise")
+      ->check(IntegerIn(0, 4611686018427387904LL));
   AddForceFlag(synth, &sargs->force);
   synth->callback([sargs] { RunSynthesize(*sargs); });
 

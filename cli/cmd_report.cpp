@@ -74,7 +74,8 @@ void RegisterReportCommand(CLI::App& app) {
   cmd->add_option("--tolerance-long", args->risk.lethal_long_n, "Tolerance point 2: load (N), with --tolerance-long-time");
   cmd->add_option("--tolerance-long-time", args->risk.lethal_long_s, "Tolerance point 2: time (s)");
   cmd->add_option("--smoothing", args->risk.smoothing_s, "Moving mean of the chest load (s)");
-  cmd->add_option("--table-rows", args->table_rows, "People listed in the HTML table (all are in people.csv)");
+  cmd->add_option("--table-rows", args->table_rows, "People listed in the HTML table (all are in people.csv)")
+      ->check(IntegerIn(0, 1000000));
   cmd->add_option("--envelope-metric", args->envelope_metric,
                   "For a sweep's folder: the risk column of its results the design envelope bounds (people_danger, "
                   "people_uncomfortable, people_beyond_tolerance, ...)");

@@ -249,3 +249,7 @@ crowdrecon_cli_test(observe.footage_to_nan fail "--to: value nan is not finite"
                     observe footage v.mp4 --homography h.json --spec s.json -o o.json --to nan)
 crowdrecon_cli_test(report.envelope_level_nan fail "--envelope-level: value nan is not finite"
                     report README.md -o @TMP@/r --envelope-level nan)
+crowdrecon_cli_test(observe.synthesize_negative_seed fail "--seed: value -1 is out of range. expected a whole number in \\[0, 4611686018427387904\\]"
+                    observe synthesize run.sqlite -o @TMP@/v.avi --homography-out @TMP@/h.json --seed -1)
+crowdrecon_cli_test(report.negative_table_rows fail "--table-rows: value -1 is out of range. expected a whole number in \\[0, 1000000\\]"
+                    report README.md -o @TMP@/r --table-rows -1)
