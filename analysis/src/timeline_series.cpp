@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <limits>
 
@@ -136,7 +137,13 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
         for (auto f = static_cast<std::size_t>(from - s.time_s.begin()); f < left.size(); ++f) left[f] += 1.0;
       }
     }
-    if (e.kind == "avalanche") s.avalanches.push_back({e.time_s, e.detail, e.kind});
+    if (e.kind == "avalanche") {
+      TimelineMark m{e.time_s, e.detail, e.kind};
+      // The detail's format is the avalanche system's (scenario/src/timeline_systems.cpp).
+      if (const std::size_t at = e.detail.find("rise time "); at != std::string::npos)
+        m.rise_time_s = std::strtod(e.detail.c_str() + at + 10, nullptr);
+      s.avalanches.push_back(m);
+    }
     if (e.kind == "fall") s.falls.push_back({e.time_s, e.detail, e.kind});
   }
   const std::string recorded = reader.RunValue("timeline_recorded");

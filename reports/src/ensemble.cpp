@@ -97,7 +97,10 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   const analysis::TimelineSeries s = analysis::ComputeTimeline(run_file, options.smooth_s);
   r.clock_start = s.clock_start;
   r.end_s = s.time_s.empty() ? 0.0 : s.time_s.back();
-  for (const analysis::TimelineMark& a : s.avalanches) r.avalanche_s.push_back(a.time_s);
+  for (const analysis::TimelineMark& a : s.avalanches) {
+    r.avalanche_s.push_back(a.time_s);
+    r.rise_time_s.push_back(a.rise_time_s);
+  }
   for (const analysis::TimelineMark& f : s.falls) r.fall_s.push_back(f.time_s);
   r.time_s = s.time_s;
   r.density_per_m2 = analysis::MovingMean(s.time_s, s.density_per_m2, options.smooth_s);
@@ -141,7 +144,7 @@ EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions
   std::sort(s.avalanches.begin(), s.avalanches.end(),
             [](const RecordedScore& a, const RecordedScore& b) { return a.mark.time_s < b.mark.time_s; });
   const auto near = [&](double a, double b) { return std::abs(a - b) <= options.tolerance_s; };
-  std::vector<double> unmatched, clog, clog_minus_fatal, falls_before, danger, density, equivalent, count;
+  std::vector<double> unmatched, clog, clog_minus_fatal, falls_before, danger, density, equivalent, count, rise;
   for (const EnsembleRun& r : s.runs) {
     for (RecordedScore& rec : s.avalanches) {
       const bool hit = std::any_of(r.avalanche_s.begin(), r.avalanche_s.end(), [&](double t) { return near(t, rec.mark.time_s); });
@@ -164,7 +167,9 @@ EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions
     density.push_back(r.peak_density_per_m2);
     equivalent.push_back(r.peak_equivalent_density_per_m2);
     count.push_back(static_cast<double>(r.avalanche_s.size()));
+    rise.insert(rise.end(), r.rise_time_s.begin(), r.rise_time_s.end());
   }
+  s.rise_time_spread = SpreadOf(rise);
   s.unmatched_spread = SpreadOf(unmatched);
   s.clog_spread = SpreadOf(clog);
   s.clog_minus_fatal_spread = SpreadOf(clog_minus_fatal);
@@ -188,6 +193,8 @@ std::string EnsembleScore::Markdown() const {
   o << "\n| over the " << n << " runs | median (range) |\n| --- | --- |\n";
   o << "| avalanches in the run | " << SpreadText(avalanche_count_spread, 1) << " |\n";
   o << "| of them matching no recorded avalanche | " << SpreadText(unmatched_spread, 1) << " |\n";
+  o << "| rise time of the avalanches (all runs' together; a free start takes 0.17 s) | "
+    << SpreadText(rise_time_spread, 2, "s") << (rise_time_spread.runs > 0 ? " over " + std::to_string(rise_time_spread.runs) + " avalanches" : "") << " |\n";
   o << "| runs whose venue clogs for good | " << runs_clogging_for_good << " of " << n << " |\n";
   if (clog_spread.runs > 0) {
     o << "| it clogs for good at | " << Clock(clock, clog_spread.median) << " (" << Clock(clock, clog_spread.low) << "–"

@@ -42,6 +42,7 @@ EnsembleRun MakeRun(std::string label, std::vector<double> avalanches, std::vect
   r.peak_density_per_m2 = density;
   r.peak_equivalent_density_per_m2 = density * 0.6;
   r.recorded = Recorded();
+  for (std::size_t k = 0; k < r.avalanche_s.size(); ++k) r.rise_time_s.push_back(0.1 * static_cast<double>(k + 1));
   return r;
 }
 
@@ -72,6 +73,10 @@ TEST(Ensemble, EachRecordedAvalancheCountsTheRunsWithOneWithinTheTolerance) {
   EXPECT_DOUBLE_EQ(s.danger_spread.median, 3.0);
   EXPECT_DOUBLE_EQ(s.density_spread.high, 12.0);
   EXPECT_DOUBLE_EQ(s.avalanche_count_spread.median, 2.0);
+  // Rise times over every avalanche: 0.1, 0.2 (seed 1), 0.1 (seed 2), 0.1, 0.2 (seed 3).
+  EXPECT_EQ(s.rise_time_spread.runs, 5u);
+  EXPECT_DOUBLE_EQ(s.rise_time_spread.median, 0.1);
+  EXPECT_DOUBLE_EQ(s.rise_time_spread.high, 0.2);
   // The table says it in words.
   const std::string md = s.Markdown();
   EXPECT_NE(md.find("| avalanche A | 100.0 s | 1 of 3 (33 %) |"), std::string::npos) << md;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct TimelineMark {
   double time_s = 0.0;
   std::string label;
   std::string kind;  // recorded: "avalanche", "fatal", "other"; detected: the event's kind
+  // A detected avalanche's rise time (s), from its event ("... rise time
+  // 0.05 s ...", written by the timeline's avalanche system); NaN otherwise.
+  double rise_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct TimelineSeries {

@@ -55,6 +55,7 @@ struct EnsembleRun {
   std::string clock_start;
   double end_s = 0.0;
   std::vector<double> avalanche_s;  // the run's avalanche events
+  std::vector<double> rise_time_s;  // their rise times (NaN where the event gives none)
   std::vector<double> fall_s;       // its falls
   std::vector<double> time_s, density_per_m2;  // smoothed density, for the figure
   double clog_for_good_s = std::numeric_limits<double>::quiet_NaN();  // NaN: never
@@ -85,7 +86,8 @@ struct EnsembleScore {
   std::vector<std::size_t> falls_before_clog;  // per run (all its falls if it never clogs for good)
   // Median and range over the runs (reports::Spread; runs without the figure left out).
   Spread unmatched_spread, clog_spread, clog_minus_fatal_spread, falls_before_clog_spread, danger_spread,
-      density_spread, equivalent_density_spread, avalanche_count_spread;
+      density_spread, equivalent_density_spread, avalanche_count_spread,
+      rise_time_spread;  // over every avalanche of every run (s), against a free start's 0.17 s
   std::size_t runs_clogging_for_good = 0;
 
   std::string Markdown() const;  // the score table and one row per run
