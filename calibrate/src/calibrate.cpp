@@ -574,7 +574,7 @@ Summary Calibrate(const Options& options) {
   std::string error;
   if (!options.IsValid(&error)) throw InputError("calibrate: " + error);
   const CalibrationSpec spec = LoadCalibration(options.calibration_file);
-  fs::create_directories(options.output_dir);
+  CreateOutputFolder(options.output_dir);
   WriteFileAtomically(options.output_dir / ".crowdrecon-calibration", spec.file.string() + "\n");
   CalibrationResult r;
   r.summary.name = spec.name;

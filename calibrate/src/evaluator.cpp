@@ -199,7 +199,7 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
   if (attempt > 0) joined += "attempt " + std::to_string(attempt);
   const std::string batch = Sha256Hex(joined).substr(0, 16);
   const fs::path batches = dir_ / "batches";
-  fs::create_directories(batches);
+  CreateOutputFolder(batches);
   const fs::path sweep_file = batches / (batch + ".json");
 
   json sweep = {{"format", "crowdrecon-sweep"},
@@ -229,7 +229,7 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
   options.after_run = [this](const sweep::RunPlan& run, const fs::path& run_file, const std::string& status) {
     const std::string key = run.id.substr(run.id.find('-') + 1, 16);
     const fs::path d = dir_ / "cache" / key;
-    fs::create_directories(d);
+    CreateOutputFolder(d);
     const std::string stem = "seed" + std::to_string(run.seed);
     if (status != "complete") {
       WriteFileAtomically(d / (stem + ".failed"), status);

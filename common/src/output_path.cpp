@@ -197,4 +197,16 @@ OutputKind VideoOutputKind() {
           }};
 }
 
+void CreateOutputFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (!ec && std::filesystem::is_directory(dir, ec)) return;
+  std::string why = ec ? ec.message() : "";
+  std::error_code ignored;
+  if (std::filesystem::exists(dir, ignored) && !std::filesystem::is_directory(dir, ignored))
+    why = "it exists and is " + DescribeExisting(dir) + ", not a folder";
+  throw InputError(dir.string() + ": cannot create the output folder" + (why.empty() ? "" : ": " + why) +
+                   "; expected a folder that can be made (a writable parent, names of at most 255 bytes)");
+}
+
 }  // namespace crowdrecon

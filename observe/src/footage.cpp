@@ -1,3 +1,4 @@
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/observe/footage.hpp"
 
 #include <algorithm>
@@ -266,7 +267,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   std::deque<Held> held;  // the last span + 1 frames
   std::vector<double> pictures_left = options.picture_times_s;
   std::sort(pictures_left.begin(), pictures_left.end());
-  if (!pictures_left.empty()) std::filesystem::create_directories(options.picture_dir);
+  if (!pictures_left.empty()) CreateOutputFolder(options.picture_dir);
   cv::Mat frame, flow, change;
   std::size_t index = 0;
   for (;; ++index) {

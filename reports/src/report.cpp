@@ -1,3 +1,4 @@
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/reports/report.hpp"
 
 #include <nlohmann/json.hpp>
@@ -294,7 +295,7 @@ std::string ChromiumFor(const ReportOptions& options) {
 // Writes DIR/report.html and, with a browser, DIR/report.pdf printed from it
 // (each complete or not at all).
 void WritePage(const ReportOptions& options, const std::string& chromium, const std::string& html, ReportSummary* summary) {
-  fs::create_directories(options.output_dir);
+  CreateOutputFolder(options.output_dir);
   summary->html = options.output_dir / "report.html";
   WriteFileAtomically(summary->html, html);
   if (!options.pdf) return;
@@ -919,8 +920,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
   h += "</body></html>\n";
 
   // --- Files: written complete or not at all --------------------------------
-  fs::create_directories(options.output_dir);
-  fs::create_directories(options.output_dir);
+  CreateOutputFolder(options.output_dir);
   summary.csv = options.output_dir / "people.csv";
   WriteFileAtomically(summary.csv, csv);
   WritePage(options, chromium, h, &summary);

@@ -1,3 +1,4 @@
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/sweep/phase_diagram.hpp"
 
 #include <algorithm>
@@ -670,9 +671,7 @@ PhaseSummary DrawPhaseDiagrams(const PhaseOptions& options) {
   }
   if (panels.empty()) throw InputError(t.file.string() + ": no runs have results yet; nothing to draw");
 
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (!fs::is_directory(out)) throw InputError(out.string() + ": cannot create the output folder");
+  CreateOutputFolder(out);
 
   PhaseSummary summary;
   summary.runs = t.rows.size();

@@ -1,3 +1,4 @@
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
 
 #include <unistd.h>
@@ -366,10 +367,7 @@ SweepSetup SetUpSweep(const SweepOptions& options, int rank) {
     setup.spec = LoadSweep(options.sweep_file);
     setup.runs = ExpandRuns(setup.spec);
     ValidateRuns(setup.spec, setup.runs);
-    std::error_code ec;
-    fs::create_directories(setup.runs_dir, ec);
-    if (!fs::is_directory(setup.runs_dir))
-      throw InputError(setup.runs_dir.string() + ": cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+    CreateOutputFolder(setup.runs_dir);
     if (rank == 0)
       setup.store = std::make_unique<ResultsStore>(options.output_dir, setup.spec, setup.runs, analysis::OptionsToJson({}));
   } catch (...) {

@@ -188,3 +188,14 @@ crowdrecon_output_test(timeline.bad_phase_folder_writes_nothing fail
                        "nowhere"
                        "make_scenario && make_run" "."
                        timeline run.sqlite -o t.png --phase nowhere)
+
+# --- an output folder that cannot be made is an answer, not an internal error (issue 40) ---
+set(LONG_NAME "nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn")
+crowdrecon_output_test(report.folder_name_too_long fail
+                       "cannot create the output folder: File name too long"
+                       "make_scenario && make_run" "."
+                       report run.sqlite -o ${LONG_NAME} --no-pdf)
+crowdrecon_output_test(calibrate.folder_name_too_long fail
+                       "cannot create the output folder: File name too long"
+                       "true" "."
+                       calibrate ${PROJECT_SOURCE_DIR}/venues/madrid-arena/calibrations/madrid-night-demo.json -o ${LONG_NAME})

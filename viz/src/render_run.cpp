@@ -1,3 +1,4 @@
+#include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 
 #include <algorithm>
@@ -665,11 +666,7 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
 // 3. The output folder, made only once every selected frame has been read and
 //    checked (ChooseLayout), so that a damaged run file leaves nothing behind.
 void MakeOutputFolder(const std::filesystem::path& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    throw InputError(dir.string() + ": cannot create the output folder" +
-                     (ec ? ": " + ec.message() : std::string(": a file of that name exists")));
+  CreateOutputFolder(dir);
 }
 
 // 4. The video, opened before any drawing so that a bad path fails early; its

@@ -64,6 +64,11 @@ std::string DescribeExisting(const std::filesystem::path& path);
 // so that an error or a kill never leaves a partial, complete-looking file.
 void WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
 
+// Creates `dir` (and its parents) if needed; throws InputError naming it and
+// the reason ("Permission denied", "File name too long", a file of that
+// name) if it cannot be made -- an answer, not an internal error.
+void CreateOutputFolder(const std::filesystem::path& dir);
+
 // A temporary name next to `file` with the same extension (for writers that
 // choose the format from it), to be renamed over `file` when complete.
 std::filesystem::path PartialPath(const std::filesystem::path& file);
