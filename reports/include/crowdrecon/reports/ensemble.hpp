@@ -24,9 +24,11 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/analysis/regime.hpp"
 #include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/reports/report.hpp"
+#include "crowdrecon/reports/risk.hpp"
 
 namespace crowdrecon::reports {
 
@@ -38,14 +40,14 @@ struct EnsembleOptions {
   // Clogged: every direction of travel present moves slower than this along
   // its desired direction (the mean over the timeline's smoothing window;
   // the regime classifier's stop speed).
-  double clog_speed_m_per_s = 0.1;
+  double clog_speed_m_per_s = analysis::RegimeOptions{}.stop_speed_m_per_s;
   // Clogged for good: clogged from some time to the end of the run, for at
   // least this long (the classifier's frozen window).
-  double clog_min_s = 10.0;
+  double clog_min_s = analysis::RegimeOptions{}.frozen_window_s;
   // The timeline series' smoothing window (s).
   double smooth_s = 10.0;
   // The danger zone's lower edge (reports::RiskOptions::danger_n).
-  double danger_n = 1112.0;
+  double danger_n = RiskOptions{}.danger_n;
   bool IsValid(std::string* error) const;
 };
 
