@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -62,6 +63,7 @@ void RunExport(const ExportArgs& args) {
   if (std::filesystem::exists(checkpoint, ec) && std::filesystem::remove(checkpoint, ec))
     std::printf("removed %s: the checkpoint of the run that %s held before\n", checkpoint.c_str(), args.output.c_str());
   std::printf("wrote %s\n", args.output.c_str());
+  SayIfUnfinished(args.run_file);
 }
 
 }  // namespace

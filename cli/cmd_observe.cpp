@@ -344,6 +344,7 @@ void RunSynthesize(const SynthesizeArgs& args) {
               options.width_px, options.height_px, FormatNumber(options.darkness).c_str(),
               FormatNumber(options.blur_sigma_px).c_str(), FormatNumber(options.noise_sigma).c_str(), options.jpeg_quality);
   std::printf("homography: %s\n", args.homography.c_str());
+  SayIfUnfinished(args.run);
 }
 
 // Compares an observation with a reference (e.g. footage with the run's own

@@ -59,6 +59,7 @@ void RunRender(const RenderArgs& args) {
   std::printf("%s", summary.BriefReport().c_str());
   std::printf("pictures: %s (frame_%06lld.png ...)\n", args.output_dir.c_str(),
               static_cast<long long>(summary.first_frame));
+  SayIfUnfinished(args.run_file);
 }
 
 }  // namespace

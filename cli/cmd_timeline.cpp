@@ -169,6 +169,7 @@ void RunTimeline(const TimelineArgs& args) {
               s.time_s.size(), analysis::ClockText(s.clock_start, s.time_s.front()).c_str(),
               analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
               s.recorded.size());
+  SayIfUnfinished(args.run);
   {
     const analysis::Plausibility validity = analysis::ComputePlausibility(args.run);
     std::printf("validity: %s\n", validity.Statement(analysis::PlausibilityOptions{}).c_str());

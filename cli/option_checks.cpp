@@ -2,11 +2,13 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 
 namespace crowdrecon::cli {
 
@@ -47,6 +49,12 @@ void CheckPictureName(const std::string& option, const std::string& file) {
   const std::string ext = std::filesystem::path(file).extension().string();
   if (ext != ".png" && ext != ".svg" && ext != ".pdf")
     throw InputError(option + " " + file + ": unknown picture format \"" + ext + "\"; expected .png, .svg or .pdf");
+}
+
+void SayIfUnfinished(const std::string& run_file) {
+  if (!runfile::IsRunFile(run_file)) return;
+  const std::string note = runfile::RunFileReader(run_file).UnfinishedNote();
+  if (!note.empty()) std::printf("note: %s\n", note.c_str());
 }
 
 void WritePictureAtomically(const std::string& file, const std::function<void(const std::filesystem::path&)>& draw) {

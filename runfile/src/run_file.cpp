@@ -470,6 +470,20 @@ std::string RunFileReader::RunValue(const std::string& key) const {
   return s.Next() ? s.Text(0) : "";
 }
 
+std::string RunFileReader::UnfinishedNote() const {
+  const std::string status = RunValue("status");
+  if (status == "complete") return "";
+  const std::string why = status == "running"       ? "still being written, or killed"
+                          : status == "interrupted" ? "stopped before its end"
+                          : status.empty()          ? "no status recorded"
+                                                    : "it did not finish";
+  Statement last(*impl_->db, "SELECT MAX(time_s) FROM frame_time");
+  const bool has = last.Next() && last.Type(0) != SQLITE_NULL;
+  return impl_->file + " is unfinished (status \"" + status + "\": " + why + "): what follows covers " +
+         (has ? "its frames up to t = " + FormatNumber(last.Double(0)) + " s only" : "no frame") +
+         "; resume it with crowdrecon simulate --resume to finish it";
+}
+
 double RunFileReader::RunNumber(const std::string& key, double fallback, double min, double max) const {
   Statement s(*impl_->db, "SELECT value FROM run WHERE key = ?");
   s.Bind(1, key);

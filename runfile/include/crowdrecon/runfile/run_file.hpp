@@ -331,6 +331,11 @@ class RunFileReader {
 
   const std::string& file() const;
   std::string RunValue(const std::string& key) const;  // "" if absent
+  // "" for a finished run (status "complete"); otherwise one sentence for the
+  // outputs drawn from it: its status, what it means and how far it got
+  // ("... unfinished (status \"running\": still being written, or killed):
+  // what follows covers its frames up to t = 12.3 s only; ...").
+  std::string UnfinishedNote() const;
   // A run value that must be a number in [min, max]; absent: `fallback`.
   double RunNumber(const std::string& key, double fallback, double min, double max) const;
   double fps() const;
