@@ -158,6 +158,10 @@ void RunFundamentalDiagram(const FdArgs& args) {
     const observe::Trajectories t = observe::ReadTrajectories(args.files[i]);
     diagrams.push_back(observe::ComputeFundamentalDiagram(t, spec.regions.front(), spec.velocity_span_s, args.frame_step));
     const observe::FundamentalDiagram& fd = diagrams.back();
+    if (fd.points.empty())
+      throw InputError(args.files[i] + ": no frame (of every " + std::to_string(args.frame_step) +
+                       ") has anyone in the measurement area " + fd.area +
+                       "; expected trajectories that pass through the spec's first region");
     std::printf("%s, area %s (%s m2): %zu frames; density %s", t.source.c_str(), fd.area.c_str(),
                 FormatNumber(spec.regions.front().Area_m2()).c_str(), fd.points.size(), "");
     double lo = 1e9, hi = 0, mean_v = 0;
