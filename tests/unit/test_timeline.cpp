@@ -355,6 +355,9 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
   refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
   refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
+  // Issue 40: an event after the run's end (10 s) would never happen.
+  refuse(R"({"events": [{"time_s": 1, "close_exit": "court"}, {"time_s": 12.5, "close_exit": "exit"}]})",
+         "bad.json: /timeline/events/1/time_s: 12.5 s lies after the run's end (run.duration_s = 10 s)");
   // A speed read at a recorded mark comes with its uncertainty.
   refuse(R"({"recorded": [{"time_s": 5, "label": "a", "max_speed_m_per_s": 3}]})",
          "/timeline/recorded/0: missing required key \"max_speed_uncertainty_m_per_s\"");
