@@ -199,3 +199,7 @@ crowdrecon_output_test(calibrate.folder_name_too_long fail
                        "cannot create the output folder: File name too long"
                        "true" "."
                        calibrate ${PROJECT_SOURCE_DIR}/venues/madrid-arena/calibrations/madrid-night-demo.json -o ${LONG_NAME})
+crowdrecon_output_test(report.same_run_twice fail
+                       "run.sqlite: given twice .also as run.sqlite.. each run counts once"
+                       "make_scenario && make_run" "."
+                       report run.sqlite run.sqlite -o r --no-pdf)
