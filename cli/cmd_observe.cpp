@@ -36,6 +36,7 @@ struct TrajectoryArgs {
   std::string spec;
   std::string output;
   double fps = 0.0;
+  std::string unit;
   bool quiet = false;
   bool force = false;
 };
@@ -114,7 +115,7 @@ void RunTrajectories(const TrajectoryArgs& args) {
   CheckObservationOutputs(args.output, {{"the trajectories", args.file}, {"the spec", args.spec}}, args.force);
   CheckOutputs({{"--figure", args.figure, PictureOutputKind()}}, {{"the trajectories", args.file}}, args.force);
   const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
-  const observe::Trajectories t = observe::ReadTrajectories(args.file, args.fps);
+  const observe::Trajectories t = observe::ReadTrajectories(args.file, args.fps, args.unit);
   const observe::Observation obs = observe::ObserveTrajectories(t, spec);
   observe::WriteObservation(obs, args.output);
   if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
@@ -132,6 +133,7 @@ struct FdArgs {
   std::vector<std::string> pictures;
   std::string csv;
   int frame_step = 5;
+  std::string unit;
   bool force = false;
 };
 
@@ -155,7 +157,7 @@ void RunFundamentalDiagram(const FdArgs& args) {
   std::string csv = "source,area,time_s,density_per_m2,speed_m_per_s,people\n";
   for (std::size_t i = 0; i < args.files.size(); ++i) {
     const observe::ObservationSpec spec = observe::ReadObservationSpec(args.specs.size() == 1 ? args.specs[0] : args.specs[i]);
-    const observe::Trajectories t = observe::ReadTrajectories(args.files[i]);
+    const observe::Trajectories t = observe::ReadTrajectories(args.files[i], 0.0, args.unit);
     diagrams.push_back(observe::ComputeFundamentalDiagram(t, spec.regions.front(), spec.velocity_span_s, args.frame_step));
     const observe::FundamentalDiagram& fd = diagrams.back();
     if (fd.points.empty())
@@ -459,6 +461,8 @@ void RegisterObserveCommands(CLI::App& app) {
       ->required();
   traj->add_option("--fps", targs->fps, "frame rate, replacing the file's (a PeTrack file without one needs it)")
       ->check(NumberIn(0.001, 10000.0, "frames/s"));
+  traj->add_option("--unit", targs->unit, "unit of a PeTrack file's coordinates, replacing its header's (m, cm or mm)")
+      ->check(CLI::IsMember({"m", "cm", "mm"}));
   traj->add_option("--figure", targs->figure, "picture of the series with the detected events (.png, .svg, .pdf)");
   traj->add_flag("-q,--quiet", targs->quiet, "print only the output's name");
   AddForceFlag(traj, &targs->force);
@@ -473,6 +477,8 @@ void RegisterObserveCommands(CLI::App& app) {
   fd->add_option("-o,--picture", fargs->pictures, "picture (.png, .svg or .pdf; repeat for several)")->required();
   fd->add_option("--csv", fargs->csv, "also write every point (source, time, density, speed, people) as CSV");
   fd->add_option("--frame-step", fargs->frame_step, "use every N-th frame (default 5)")->check(IntegerIn(1, 10000));
+  fd->add_option("--unit", fargs->unit, "unit of a PeTrack file's coordinates, replacing its header's (m, cm or mm)")
+      ->check(CLI::IsMember({"m", "cm", "mm"}));
   AddForceFlag(fd, &fargs->force);
   fd->callback([fargs] { RunFundamentalDiagram(*fargs); });
 

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "crowdrecon/common/error.hpp"
@@ -55,12 +56,16 @@ bool Integer(std::string_view s, std::int64_t* v) {
 
 }  // namespace
 
-Trajectories ParsePeTrack(std::string_view text, const std::string& source, double fps_override) {
+Trajectories ParsePeTrack(std::string_view text, const std::string& source, double fps_override,
+                          const std::string& unit) {
   Trajectories t;
   t.source = source;
   double file_fps = 0.0;
   bool unit_stated = false;
   double scale = 1.0;  // file unit to metres
+  const double given_scale = unit == "m" ? 1.0 : unit == "cm" ? 1e-2 : unit == "mm" ? 1e-3 : 0.0;
+  if (!unit.empty() && given_scale == 0.0)
+    throw InputError(source + ": unit \"" + unit + "\"; expected m, cm or mm");
   std::unordered_set<std::uint32_t> ids;
   std::size_t line_no = 0;
   std::size_t at = 0;
@@ -91,7 +96,7 @@ Trajectories ParsePeTrack(std::string_view text, const std::string& source, doub
       }
       // The column header: "x/m", "x/cm", "x/mm" give the unit.
       for (const auto& [name, factor] : {std::pair<const char*, double>{"x/mm", 1e-3}, {"x/cm", 1e-2}, {"x/m", 1.0}})
-        if (lower.find(name) != std::string::npos) {
+        if (given_scale == 0.0 && lower.find(name) != std::string::npos) {
           scale = factor;
           t.unit = std::string(name).substr(2);
           unit_stated = true;
@@ -99,6 +104,11 @@ Trajectories ParsePeTrack(std::string_view text, const std::string& source, doub
         }
       if (end == text.size()) break;
       continue;
+    }
+    if (given_scale != 0.0 && !unit_stated) {  // the unit given replaces any header
+      scale = given_scale;
+      t.unit = unit;
+      unit_stated = true;
     }
     if (f.size() < 4 || f.size() > 5)
       fail("\"" + Shown(line) + "\": " + std::to_string(f.size()) +
@@ -135,11 +145,28 @@ Trajectories ParsePeTrack(std::string_view text, const std::string& source, doub
   if (fps_override > 0.0 && file_fps > 0.0 && fps_override != file_fps)
     t.notes.push_back("frame rate " + FormatNumber(fps_override) + " fps as given, not the file's " + FormatNumber(file_fps));
   if (!unit_stated) t.notes.push_back("the file states no unit (x/m, x/cm, x/mm): metres assumed");
+  // Beyond human: the fastest step between consecutive frames of a track.
+  std::unordered_map<std::uint32_t, const TrajectoryPoint*> last;
+  double fastest = 0.0;
+  for (const TrajectoryPoint& p : t.points) {
+    const auto it = last.find(p.id);
+    if (it != last.end() && p.frame > it->second->frame)
+      fastest = std::max(fastest, Length(p.position_m - it->second->position_m) * t.fps /
+                                      static_cast<double>(p.frame - it->second->frame));
+    last[p.id] = &p;
+  }
+  if (fastest > kMaxHumanSpeed_m_per_s)
+    throw InputError(source + ": people move at up to " + FormatFixed(fastest, 1) + " m/s between frames, faster than " +
+                     "any human (" + FormatNumber(kMaxHumanSpeed_m_per_s) + " m/s) with coordinates in " +
+                     (t.unit == "m" && !unit_stated ? "metres (assumed: the file states no unit)" : t.unit) +
+                     " at " + FormatNumber(t.fps) + " fps; the coordinates are likely in " +
+                     (fastest > 100.0 * kMaxHumanSpeed_m_per_s ? "mm" : "cm") +
+                     " (give --unit cm or --unit mm, or a header # id frame x/cm y/cm), or the frame rate is wrong");
   return t;
 }
 
-Trajectories ReadPeTrack(const std::filesystem::path& file, double fps_override) {
-  return ParsePeTrack(ReadInputFile(file, "PeTrack trajectory file"), file.string(), fps_override);
+Trajectories ReadPeTrack(const std::filesystem::path& file, double fps_override, const std::string& unit) {
+  return ParsePeTrack(ReadInputFile(file, "PeTrack trajectory file"), file.string(), fps_override, unit);
 }
 
 }  // namespace crowdrecon::observe

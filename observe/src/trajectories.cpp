@@ -9,11 +9,15 @@
 
 namespace crowdrecon::observe {
 
-Trajectories ReadTrajectories(const std::filesystem::path& file, double fps_override) {
+Trajectories ReadTrajectories(const std::filesystem::path& file, double fps_override, const std::string& unit) {
   // SQLite files begin with "SQLite format 3" and a NUL. (A missing or
   // unreadable file goes to the PeTrack reader, whose error names it.)
-  if (FileStartsWith(file, std::string("SQLite format 3", 16))) return ReadJuPedSim(file, fps_override);
-  Trajectories t = ReadPeTrack(file, fps_override);
+  if (FileStartsWith(file, std::string("SQLite format 3", 16))) {
+    if (!unit.empty() && unit != "m")
+      throw InputError(file.string() + ": a SQLite trajectory file is in metres; --unit " + unit + " is for PeTrack text files");
+    return ReadJuPedSim(file, fps_override);
+  }
+  Trajectories t = ReadPeTrack(file, fps_override, unit);
   t.format = "petrack";
   return t;
 }

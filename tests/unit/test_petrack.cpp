@@ -72,5 +72,38 @@ TEST(PeTrack, BadFilesNameTheLineAndWhatWasExpected) {
   EXPECT_THROW(ReadPeTrack("/nonexistent/x.txt"), InputError);
 }
 
+// Issue 40: a file in centimetres without a header (as PedPy's own demo
+// file) gave speeds of 207 m/s "with a note". Speeds beyond any human are
+// refused, naming the likely unit; --unit (here `unit`) reads it right.
+TEST(PeTrack, SpeedsBeyondHumanNameTheLikelyUnitAndTheUnitCanBeGiven) {
+  std::string text = "# framerate: 25 fps\n";
+  for (int frame = 0; frame < 10; ++frame) text += "1 " + std::to_string(frame) + " " + std::to_string(5 * frame) + " 100\n";
+  try {
+    ParsePeTrack(text, "uo.txt");
+    ADD_FAILURE() << "125 m/s accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("uo.txt: people move at up to 125.0 m/s between frames, faster than any human (12 m/s) with "
+                     "coordinates in metres (assumed: the file states no unit) at 25 fps; the coordinates are likely in cm"),
+              std::string::npos) << m;
+  }
+  const Trajectories cm = ParsePeTrack(text, "uo.txt", 0.0, "cm");
+  EXPECT_EQ(cm.unit, "cm");
+  EXPECT_DOUBLE_EQ(cm.points[1].position_m.x, 0.05);
+  EXPECT_DOUBLE_EQ(cm.points[1].position_m.y, 1.0);
+  // In mm the same numbers are 0.125 m/s; a file in mm read as metres: mm named.
+  EXPECT_EQ(ParsePeTrack(text, "uo.txt", 0.0, "mm").unit, "mm");
+  std::string fast = "# framerate: 25 fps\n";
+  for (int frame = 0; frame < 3; ++frame) fast += "1 " + std::to_string(frame) + " " + std::to_string(2000 * frame) + " 0\n";
+  try {
+    ParsePeTrack(fast, "mm.txt", 0.0, "m");
+    ADD_FAILURE() << "50 km/s accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("with coordinates in m at 25 fps; the coordinates are likely in mm"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ParsePeTrack(text, "uo.txt", 0.0, "ft"), InputError);
+}
+
 }  // namespace
 }  // namespace crowdrecon::observe

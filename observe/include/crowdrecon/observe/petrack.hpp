@@ -19,8 +19,17 @@
 
 namespace crowdrecon::observe {
 
-// `fps_override` > 0 replaces the file's frame rate (a file without one needs it).
-Trajectories ParsePeTrack(std::string_view text, const std::string& source, double fps_override = 0.0);
-Trajectories ReadPeTrack(const std::filesystem::path& file, double fps_override = 0.0);
+// `fps_override` > 0 replaces the file's frame rate (a file without one
+// needs it); `unit` ("m", "cm" or "mm"; "" = the file's column header, else
+// metres) gives the coordinates' unit (a file without a header needs it
+// when it is not in metres). A file whose people move faster than any human
+// (kMaxHumanSpeed_m_per_s between two frames of a track) is refused, naming
+// the likely unit mistake: PedPy's own demo file has no header and is in cm.
+Trajectories ParsePeTrack(std::string_view text, const std::string& source, double fps_override = 0.0,
+                          const std::string& unit = "");
+Trajectories ReadPeTrack(const std::filesystem::path& file, double fps_override = 0.0, const std::string& unit = "");
+
+// Faster than the fastest sprinters (about 12 m/s, over a few metres).
+inline constexpr double kMaxHumanSpeed_m_per_s = 12.0;
 
 }  // namespace crowdrecon::observe

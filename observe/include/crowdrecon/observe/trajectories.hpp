@@ -57,7 +57,9 @@ inline constexpr double kMaxCoordinate_m = 1e5;
 // Reads a trajectory file of any supported kind, told apart by its content
 // (an SQLite file is read as JuPedSim/crowdrecon, anything else as PeTrack
 // text). `fps_override` > 0 replaces the file's frame rate.
-Trajectories ReadTrajectories(const std::filesystem::path& file, double fps_override = 0.0);
+// `unit` ("m", "cm", "mm" or "" for the file's own) is for PeTrack files
+// (ReadPeTrack); SQLite trajectory files are in metres.
+Trajectories ReadTrajectories(const std::filesystem::path& file, double fps_override = 0.0, const std::string& unit = "");
 
 // JuPedSim SQLite trajectory files: version 1 (geometry(wkt)), version 2
 // (trajectory_data with ori_x, ori_y; geometry(hash, wkt); frame_data) and
