@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "option_checks.hpp"
+#include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/observe/footage.hpp"
@@ -172,7 +173,7 @@ void RunFundamentalDiagram(const FdArgs& args) {
       lo = std::min(lo, p.density_per_m2);
       hi = std::max(hi, p.density_per_m2);
       if (std::isfinite(p.speed_m_per_s)) mean_v += p.speed_m_per_s, ++n;
-      csv += std::filesystem::path(t.source).filename().string() + "," + fd.area + "," + FormatNumber(p.time_s) + "," +
+      csv += CsvField(std::filesystem::path(t.source).filename().string()) + "," + CsvField(fd.area) + "," + FormatNumber(p.time_s) + "," +
              FormatNumber(p.density_per_m2) + "," + (std::isfinite(p.speed_m_per_s) ? FormatNumber(p.speed_m_per_s) : "") +
              "," + std::to_string(p.people) + "\n";
     }
@@ -405,7 +406,7 @@ void RunCompare(const CompareArgs& args) {
       const double mr = sr / static_cast<double>(n), mo = so / static_cast<double>(n), e = mo - mr;
       std::printf("%-10s %-18s %-9s %10.4f %10.4f %+10.4f %+8.1f %6zu\n", region.name.c_str(), quantity.c_str(),
                   direction.c_str(), mr, mo, e, mr != 0 ? 100 * e / std::abs(mr) : std::nan(""), n);
-      csv += region.name + "," + quantity + "," + direction + "," + FormatNumber(mr) + "," + FormatNumber(mo) + "," +
+      csv += CsvField(region.name) + "," + quantity + "," + direction + "," + FormatNumber(mr) + "," + FormatNumber(mo) + "," +
              FormatNumber(e) + "," + (mr != 0 ? FormatNumber(100 * e / std::abs(mr)) : "") + "," + std::to_string(n) + "\n";
     }
   for (const observe::Event& e : ref.events) {
@@ -418,12 +419,12 @@ void RunCompare(const CompareArgs& args) {
     if (best) {
       std::printf("%-10s %-18s %-9s %10.2f %10.2f %+10.2f %8s %6s\n", e.where.c_str(), (e.kind + " onset").c_str(),
                   e.direction.c_str(), e.time_s, best->time_s, best->time_s - e.time_s, "", "");
-      csv += e.where + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + "," +
+      csv += CsvField(e.where) + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + "," +
              FormatNumber(best->time_s) + "," + FormatNumber(best->time_s - e.time_s) + ",,\n";
     } else {
       std::printf("%-10s %-18s %-9s %10.2f %10s\n", e.where.c_str(), (e.kind + " onset").c_str(), e.direction.c_str(), e.time_s,
                   "missed");
-      csv += e.where + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + ",,,,\n";
+      csv += CsvField(e.where) + "," + e.kind + "_onset_s," + e.direction + "," + FormatNumber(e.time_s) + ",,,,\n";
     }
   }
   std::size_t extra = 0;

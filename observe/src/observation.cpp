@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "crowdrecon/analysis/metrics.hpp"
+#include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
@@ -479,7 +480,8 @@ void WriteObservation(const Observation& obs, const std::filesystem::path& json_
   const std::vector<double> times = obs.BinTimes();
   for (const Series& s : obs.series)
     for (std::size_t b = 0; b < s.points.size(); ++b)
-      csv << CsvNumber(times[b]) << ',' << s.quantity << ',' << s.where << ',' << s.direction << ',' << s.unit << ','
+      csv << CsvNumber(times[b]) << ',' << CsvField(s.quantity) << ',' << CsvField(s.where) << ','
+          << CsvField(s.direction) << ',' << CsvField(s.unit) << ','
           << CsvNumber(s.points[b].value) << ',' << CsvNumber(s.points[b].uncertainty) << ','
           << CsvNumber(s.points[b].samples) << '\n';
   const std::string csv_text = csv.str();
@@ -580,8 +582,6 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
   if (Sha256Hex(text) != csv_sha)
     throw InputError(csv_file.string() + ": its SHA-256 differs from the one " + json_file.string() +
                      " records; expected the series written with it (the CSV was changed or replaced)");
-  std::istringstream in(text);
-  std::string row;
   std::size_t line_no = 0;
   const auto number = [&](const std::string& field, const char* column) {
     if (field.empty()) return kNaN;
@@ -592,14 +592,10 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
                        "\"; expected a number or nothing");
     return v;
   };
-  while (std::getline(in, row)) {
-    ++line_no;
-    if (line_no == 1) continue;  // header
-    std::vector<std::string> f;
-    std::stringstream fields(row);
-    std::string cell;
-    while (std::getline(fields, cell, ',')) f.push_back(cell);
-    if (!row.empty() && row.back() == ',') f.emplace_back();
+  const std::vector<CsvRecord> records = ParseCsv(text, csv_file.string());
+  for (std::size_t r = 1; r < records.size(); ++r) {  // records[0]: the header
+    line_no = records[r].line;
+    const std::vector<std::string>& f = records[r].fields;
     if (f.size() != 8)
       throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": " + std::to_string(f.size()) +
                        " fields; expected time_s,quantity,where,direction,unit,value,uncertainty,samples");

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "crowdrecon/analysis/plausibility.hpp"
+#include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/reports/risk.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -69,13 +70,6 @@ std::string SpreadText(const Spread& s, int decimals, const std::string& unit = 
   const std::string u = unit.empty() ? "" : " " + unit;
   if (s.low == s.high) return FormatFixed(s.median, decimals) + u;
   return FormatFixed(s.median, decimals) + u + " (" + FormatFixed(s.low, decimals) + "–" + FormatFixed(s.high, decimals) + ")";
-}
-
-std::string CsvField(const std::string& v) {
-  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
-  std::string out = "\"";
-  for (char c : v) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
 }
 
 std::string Num(double v, int decimals) { return std::isnan(v) ? "" : FormatFixed(v, decimals); }

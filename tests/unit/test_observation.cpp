@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/observe/events.hpp"
 #include "crowdrecon/observe/fundamental_diagram.hpp"
@@ -231,6 +232,43 @@ TEST(Observation, WrittenAndReadBackAndAChangedSeriesFileIsRefused) {
   const std::string error = ErrorOf([&] { ReadObservation(file); });
   EXPECT_NE(error.find("SHA-256"), std::string::npos) << error;
   EXPECT_NE(error.find("obs.csv"), std::string::npos) << error;
+}
+
+// Issue 40: a region named with a comma, quotes or letters beyond ASCII is
+// written as RFC 4180 CSV and read back (before: an unquoted CSV that the
+// tools then refused).
+TEST(Observation, ARegionNamedWithCommasAndQuotesIsReadBack) {
+  ObservationSpec spec = CorridorSpec();
+  spec.regions.front().name = "exit end, \"north\" — Zürich";
+  const Observation obs = ObserveTrajectories(Corridor(8, 3, 0.0), spec);
+  const auto file = ScratchFile("quoted.json");
+  WriteObservation(obs, file);
+  const Observation back = ReadObservation(file);
+  const Series* speed = back.Find("speed", "exit end, \"north\" — Zürich", "forward");
+  ASSERT_NE(speed, nullptr);
+  const Series* original = obs.Find("speed", "exit end, \"north\" — Zürich", "forward");
+  for (std::size_t k = 0; k < obs.bins; ++k) {
+    if (!std::isnan(original->points[k].value)) {
+      EXPECT_NEAR(speed->points[k].value, original->points[k].value, 1e-8);
+    }
+  }
+}
+
+TEST(Csv, FieldsAreQuotedWhereTheyMustBeAndReadBack) {
+  EXPECT_EQ(CsvField("plain"), "plain");
+  EXPECT_EQ(CsvField("a,b"), "\"a,b\"");
+  EXPECT_EQ(CsvField("say \"hi\""), "\"say \"\"hi\"\"\"");
+  const std::string text = "h1,h2,h3\r\n" + CsvField("a,b") + "," + CsvField("two\nlines") + ",\n\nx," +
+                           CsvField("q\"") + ",z\n";
+  const std::vector<CsvRecord> r = ParseCsv(text, "t.csv");
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[1].line, 2u);
+  EXPECT_EQ(r[1].fields, (std::vector<std::string>{"a,b", "two\nlines", ""}));
+  EXPECT_EQ(r[2].line, 5u);
+  EXPECT_EQ(r[2].fields, (std::vector<std::string>{"x", "q\"", "z"}));
+  EXPECT_NE(ErrorOf([] { ParseCsv("a,\"open\n", "t.csv"); }).find("t.csv:1: a quoted field is never closed"), std::string::npos);
+  EXPECT_NE(ErrorOf([] { ParseCsv("a,b\"c\n", "t.csv"); }).find("t.csv:1: a double quote inside an unquoted field"),
+            std::string::npos);
 }
 
 TEST(ObservationSpec, BadSpecsAreRefusedWithTheirJsonPath) {
