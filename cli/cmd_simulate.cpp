@@ -52,6 +52,12 @@ int RunSimulate(const SimulateArgs& args) {
   std::printf("scenario: %s\n", sc.name.c_str());
   if (s.slots > 0)
     std::printf("timeline: %zu people at the start, room in the engine for %zu at once\n", s.people, s.slots);
+  // A max_present the engine could not keep is said (issue 40: it was raised without a word).
+  if (const std::size_t asked = sc.timeline.max_present; asked > 0 && s.slots > 0 && asked != s.slots)
+    std::printf("note: timeline.max_present %zu %s: the engine holds %zu at once\n", asked,
+                asked < s.slots ? ("is below the " + std::to_string(s.people) + " people of the start").c_str()
+                                : "is more than the start and every arrival together",
+                s.slots);
   std::printf("people: %zu, time step %.6g s, %d thread(s)%s\n", s.people, s.time_step_s, options.threads,
               options.device != engine::ComputeDevice::kCuda ? ""
               : s.device_fallback.empty()                      ? ", person-pair forces on CUDA"

@@ -172,7 +172,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     // accepted without a word).
     for (const TimelineEvent& e : s.timeline.events)
       if (e.time_s > s.run.duration_s)
-        throw InputError(s.file.string() + ": " + e.where + "/time_s: " + FormatNumber(e.time_s) +
+        throw InputError(e.where + "/time_s: " + FormatNumber(e.time_s) +
                          " s lies after the run's end (run.duration_s = " + FormatNumber(s.run.duration_s) +
                          " s), so the event would never happen; expected a time within the run");
     if (arrivals > static_cast<double>(geometry::kMaxPeople))
