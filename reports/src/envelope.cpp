@@ -52,10 +52,17 @@ Envelope ReadEnvelope(const fs::path& dir, const std::string& metric, double lev
   for (const std::string& c : {e.x_axis, e.y_axis})
     if (!columns.count(c))
       throw InputError(e.results.string() + ": table runs has no column \"" + c + "\" (the diagram's axis)");
-  if (!columns.count(metric))
+  if (!columns.count(metric)) {
+    // A sweep that records injury risk has people_danger: then the metric is
+    // simply not one of its columns (issue 40: the age was blamed).
+    if (columns.count("people_danger"))
+      throw InputError("--envelope-metric " + metric + ": " + e.results.string() + " has no column \"" + metric +
+                       "\"; expected a numeric column of its table runs (the header of results.csv lists them), "
+                       "e.g. people_danger or max_chest_load_n");
     throw InputError(e.results.string() + ": table runs has no column \"" + metric +
                      "\"; the sweep was made before runs recorded injury risk (2026-11-26): run it again with this "
                      "crowdrecon into a new folder");
+  }
   std::map<std::string, std::map<std::pair<double, double>, std::vector<double>>> cells;
   std::set<double> xs, ys;
   Statement s(db, "SELECT variant, " + Quoted(e.x_axis) + ", " + Quoted(e.y_axis) + ", status, " + Quoted(metric) +
