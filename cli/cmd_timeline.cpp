@@ -71,6 +71,15 @@ sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
   return path;
 }
 
+// The scenario's name, from the scenario stored in the run ("" if none):
+// the figures' titles.
+std::string ScenarioNameOf(const std::string& run) {
+  const nlohmann::json scenario = nlohmann::json::parse(runfile::RunFileReader(run).RunValue("scenario"), nullptr, false);
+  return scenario.is_object() && scenario.contains("name") && scenario["name"].is_string()
+             ? scenario["name"].get<std::string>()
+             : "";
+}
+
 // Several runs of one incident (seeds): one row per run beside the recorded
 // marks, and the score table (reports/ensemble.hpp).
 void RunEnsemble(const TimelineArgs& args) {
@@ -95,19 +104,14 @@ void RunEnsemble(const TimelineArgs& args) {
   std::vector<NamedInput> inputs;
   for (const std::string& r : args.runs) inputs.push_back({"a run file", r});
   CheckOutputs(outputs, inputs, args.force);
+  RefuseRepeatedFiles({args.runs.begin(), args.runs.end()}, "each run counts once in an ensemble");
   std::vector<reports::EnsembleRun> runs;
   for (std::size_t k = 0; k < args.runs.size(); ++k) {
-    for (std::size_t j = 0; j < k; ++j)
-      if (std::filesystem::equivalent(args.runs[j], args.runs[k]))
-        throw InputError(args.runs[k] + ": given twice (also as " + args.runs[j] + "); each run counts once");
     std::fprintf(stderr, "reading %s (%zu of %zu)\n", args.runs[k].c_str(), k + 1, args.runs.size());
     runs.push_back(reports::ReadEnsembleRun(args.runs[k], options));
   }
   const reports::EnsembleScore score = reports::ScoreEnsemble(std::move(runs), options);
-  const nlohmann::json scenario =
-      nlohmann::json::parse(runfile::RunFileReader(args.runs.front()).RunValue("scenario"), nullptr, false);
-  const std::string name =
-      scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
+  const std::string name = ScenarioNameOf(args.runs.front());
   for (const std::string& f : args.figures) {
     WritePictureAtomically(f, [&](const std::filesystem::path& to) {
       reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " +
@@ -154,11 +158,7 @@ void RunTimeline(const TimelineArgs& args) {
     const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
     std::printf("%s", summary.BriefReport().c_str());
   }
-  // The title: the scenario's name, from the scenario stored in the run.
-  const nlohmann::json scenario =
-      nlohmann::json::parse(runfile::RunFileReader(args.run).RunValue("scenario"), nullptr, false);
-  const std::string title =
-      scenario.is_object() && scenario.contains("name") && scenario["name"].is_string() ? scenario["name"].get<std::string>() : "";
+  const std::string title = ScenarioNameOf(args.run);
   for (const std::string& f : args.figures) {
     WritePictureAtomically(f, [&](const std::filesystem::path& to) {
       viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, to);

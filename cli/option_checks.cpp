@@ -9,6 +9,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/viz/canvas.hpp"
 
 namespace crowdrecon::cli {
 
@@ -46,9 +47,8 @@ CLI::Validator IntegerIn(long long min, long long max) {
 }
 
 void CheckPictureName(const std::string& option, const std::string& file) {
-  const std::string ext = std::filesystem::path(file).extension().string();
-  if (ext != ".png" && ext != ".svg" && ext != ".pdf")
-    throw InputError(option + " " + file + ": unknown picture format \"" + ext + "\"; expected .png, .svg or .pdf");
+  if (const std::string problem = viz::PictureFormatProblem(file); !problem.empty())
+    throw InputError(option + " " + file + ": " + problem);
 }
 
 void SayIfUnfinished(const std::string& run_file) {

@@ -1,7 +1,10 @@
-// Range checks of numeric option values. CLI::Range lets "nan" through (every
-// comparison with NaN is false) and does not say what the value means; these
-// reject NaN and infinity and name the range and unit. CLI11 reports a failed
-// check as "--option: MESSAGE" and exits with status 105.
+// What the commands check and say about their options and outputs before
+// and after the work. Range checks of numeric option values: CLI::Range lets
+// "nan" through (every comparison with NaN is false) and does not say what
+// the value means; these reject NaN and infinity and name the range and unit.
+// CLI11 reports a failed check as "--option: MESSAGE" and exits with status
+// 105. Then picture names checked up front, pictures written atomically, and
+// the note on an unfinished run.
 #pragma once
 
 #include <filesystem>

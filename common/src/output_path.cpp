@@ -197,6 +197,15 @@ OutputKind VideoOutputKind() {
           }};
 }
 
+void RefuseRepeatedFiles(const std::vector<std::filesystem::path>& files, const std::string& why) {
+  for (std::size_t k = 0; k < files.size(); ++k)
+    for (std::size_t j = 0; j < k; ++j) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(files[j], files[k], ec))
+        throw InputError(files[k].string() + ": given twice (also as " + files[j].string() + "); " + why);
+    }
+}
+
 void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -360,13 +360,7 @@ std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs) {
     }
   }
   // The same run twice would count as two seeds (issue 40).
-  for (std::size_t k = 0; k < files.size(); ++k)
-    for (std::size_t j = 0; j < k; ++j) {
-      std::error_code ec;
-      if (fs::equivalent(files[j], files[k], ec))
-        throw InputError(files[k].string() + ": given twice (also as " + files[j].string() +
-                         "); each run counts once in an ensemble");
-    }
+  RefuseRepeatedFiles(files, "each run counts once in an ensemble");
   return files;
 }
 

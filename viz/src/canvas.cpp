@@ -18,10 +18,15 @@ Format FormatOf(const std::filesystem::path& file) {
   if (ext == ".png") return Format::kPng;
   if (ext == ".svg") return Format::kSvg;
   if (ext == ".pdf") return Format::kPdf;
-  throw InputError(file.string() + ": unknown picture format \"" + ext +
-                   "\"; expected .png, .svg or .pdf");
+  throw InputError(file.string() + ": " + PictureFormatProblem(file));
 }
 }  // namespace
+
+std::string PictureFormatProblem(const std::filesystem::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".png" || ext == ".svg" || ext == ".pdf") return "";
+  return "unknown picture format \"" + ext + "\"; expected .png, .svg or .pdf";
+}
 
 struct Canvas::Impl {
   std::filesystem::path file;

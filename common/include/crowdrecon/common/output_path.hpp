@@ -64,6 +64,10 @@ std::string DescribeExisting(const std::filesystem::path& path);
 // so that an error or a kill never leaves a partial, complete-looking file.
 void WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
 
+// Throws InputError naming the second of two entries of `files` that are
+// the same file (also through links): "B: given twice (also as A); " + why.
+void RefuseRepeatedFiles(const std::vector<std::filesystem::path>& files, const std::string& why);
+
 // Creates `dir` (and its parents) if needed; throws InputError naming it and
 // the reason ("Permission denied", "File name too long", a file of that
 // name) if it cannot be made -- an answer, not an internal error.

@@ -26,6 +26,10 @@ struct Color {
   static Color White() { return {1, 1, 1, 1}; }
 };
 
+// "" if a Canvas can write `file` (by its extension: .png, .svg, .pdf), else
+// what is wrong with it, for a message.
+std::string PictureFormatProblem(const std::filesystem::path& file);
+
 class Canvas {
  public:
   // World window [min, max] drawn at `pixels_per_metre`, with `margin_px` around.
