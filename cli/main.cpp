@@ -50,6 +50,9 @@ int main(int argc, char** argv) {
   } catch (const crowdrecon::InputError& e) {
     std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
     return 2;
+  } catch (const crowdrecon::SetupError& e) {
+    std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
+    return 2;
   } catch (const std::bad_alloc&) {
     // The limits on people, runs, nesting and image size should keep every
     // input within memory; if one still is not, say so rather than "internal error".

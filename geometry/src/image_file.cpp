@@ -14,6 +14,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/input_limits.hpp"
+#include "crowdrecon/media/media.hpp"
 
 namespace crowdrecon::geometry::detail {
 
@@ -144,7 +145,7 @@ cv::Mat ReadImage(const std::filesystem::path& file, int flags) {
   CheckImageFile(file);
   cv::Mat image;
   try {
-    image = cv::imread(file.string(), flags);
+    image = media::ReadImage(file.string(), flags);
   } catch (const cv::Exception& e) {
     // OpenCV's own pixel limit (OPENCV_IO_MAX_IMAGE_PIXELS, 2^30 by default)
     // and decoder failures of formats whose header is not read above.

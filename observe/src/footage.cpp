@@ -15,6 +15,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/sha256.hpp"
+#include "crowdrecon/media/media.hpp"
 #include "series_builder.hpp"
 
 namespace crowdrecon::observe {
@@ -159,7 +160,7 @@ void DrawFlowPicture(const cv::Mat& frame, const cv::Mat& flow, const std::vecto
     if (std::abs(v) > still) cv::arrowedLine(out, s.pixel, tip, colour, 1, cv::LINE_AA, 0, 0.3);
     else cv::circle(out, s.pixel, 1, colour, -1);
   }
-  if (!cv::imwrite(file.string(), out)) throw InputError(file.string() + ": cannot write the flow picture");
+  if (!media::WriteImage(file.string(), out)) throw InputError(file.string() + ": cannot write the flow picture");
 }
 
 }  // namespace
@@ -171,15 +172,16 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   if (!options.IsValid(&error)) throw InputError("footage options: " + error);
   if (!std::filesystem::is_regular_file(video)) throw InputError(video.string() + ": no such video file");
   const auto started = std::chrono::steady_clock::now();
-  cv::VideoCapture capture(video.string(), cv::CAP_FFMPEG);
-  if (!capture.isOpened()) capture.open(video.string(), cv::CAP_ANY);
-  if (!capture.isOpened())
+  const std::unique_ptr<media::VideoReader> reader = media::MakeVideoReader();
+  media::VideoReader& capture = *reader;
+  if (!capture.Open(video.string(), cv::CAP_FFMPEG)) capture.Open(video.string(), cv::CAP_ANY);
+  if (!capture.IsOpened())
     throw InputError(video.string() + ": cannot be read as a video (expected a file FFmpeg or OpenCV can decode: AVI, MP4, MKV, ...)");
   FootageSummary s;
   s.video = video.string();
-  s.fps = capture.get(cv::CAP_PROP_FPS);
-  s.width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
-  s.height = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_HEIGHT));
+  s.fps = capture.Get(cv::CAP_PROP_FPS);
+  s.width = static_cast<int>(capture.Get(cv::CAP_PROP_FRAME_WIDTH));
+  s.height = static_cast<int>(capture.Get(cv::CAP_PROP_FRAME_HEIGHT));
   if (!(s.fps > 0.0 && s.fps <= 1000.0))
     throw InputError(video.string() + ": the video states no frame rate (" + FormatNumber(s.fps) + "); expected (0, 1000] fps");
   if (s.width <= 0 || s.height <= 0) throw InputError(video.string() + ": the video states no picture size");
@@ -187,7 +189,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     throw InputError(video.string() + ": the picture is " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                      " but the homography was made for " + std::to_string(homography.image_width) + "x" +
                      std::to_string(homography.image_height));
-  const double total_frames = capture.get(cv::CAP_PROP_FRAME_COUNT);
+  const double total_frames = capture.Get(cv::CAP_PROP_FRAME_COUNT);
   const int span = std::max(1, static_cast<int>(std::lround(spec.velocity_span_s * s.fps)));
   s.span_frames = span;
   const Vec2 axis = spec.axis * (1.0 / Length(spec.axis));
@@ -271,7 +273,7 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   cv::Mat frame, flow, change;
   std::size_t index = 0;
   for (;; ++index) {
-    if (!capture.read(frame) || frame.empty()) break;
+    if (!capture.Read(frame) || frame.empty()) break;
     const double t = static_cast<double>(index) / s.fps;
     if (t > options.to_s) break;
     ++s.frames_read;

@@ -9,6 +9,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/media/media.hpp"
 
 namespace crowdrecon::observe {
 
@@ -186,10 +187,11 @@ SyntheticFootageSummary RenderSyntheticFootage(const std::filesystem::path& run_
   summary.fps = run.fps() / options.frame_step;
   summary.first_time_s = times.front().time_s;
   const std::filesystem::path partial = PartialPath(video);
-  cv::VideoWriter writer(partial.string(), cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), summary.fps,
-                         cv::Size(options.width_px, options.height_px), true);
-  if (!writer.isOpened()) throw InputError(video.string() + ": cannot write a Motion-JPEG video there");
-  writer.set(cv::VIDEOWRITER_PROP_QUALITY, options.jpeg_quality);
+  const std::unique_ptr<media::VideoWriter> writer = media::MakeVideoWriter();
+  writer->Open(partial.string(), cv::CAP_OPENCV_MJPEG, media::FourCc('M', 'J', 'P', 'G'), summary.fps,
+               cv::Size(options.width_px, options.height_px), true);
+  if (!writer->IsOpened()) throw InputError(video.string() + ": cannot write a Motion-JPEG video there");
+  writer->Set(cv::VIDEOWRITER_PROP_QUALITY, options.jpeg_quality);
   const double image_offsets[3] = {0.0, box.x ? box.max_m.x - box.min_m.x : 0.0, box.x ? -(box.max_m.x - box.min_m.x) : 0.0};
   runfile::PersonFrameStream stream = run.PersonFrames(times.back().frame);
   runfile::PersonFrame rows;
@@ -233,11 +235,11 @@ SyntheticFootageSummary RenderSyntheticFootage(const std::filesystem::path& run_
       wide += noise;
       wide.convertTo(picture, CV_8UC3);
     }
-    writer.write(picture);
+    writer->Write(picture);
     ++summary.frames;
     if (options.progress) options.progress(summary.frames, total);
   }
-  writer.release();
+  writer->Release();
   std::filesystem::rename(partial, video);
   WriteFileAtomically(homography_file, HomographyToJson(summary.homography));
   return summary;

@@ -127,3 +127,12 @@ geometry_case(directory_dxf "dir plan.dxf" fail "plan.dxf: is a directory; expec
   venue import @TMP@/plan.dxf -o @TMP@/out.json)
 geometry_case(directory_plan "dir plan.png" fail "plan.png: is a directory; expected a picture file" 10
   venue import @TMP@/plan.png --pixels-per-metre 50 -o @TMP@/out.json)
+
+# The picture and video codecs are a module loaded on first use
+# (media/CMakeLists.txt); when it cannot be loaded, the command says which
+# file and how to mend it, and writes nothing.
+geometry_case(codecs_module_missing "png 40 40 dark.png" fail
+  "cannot load the picture and video codecs \\(/nonexistent/codecs.so\\): .*set CROWDRECON_MEDIA_CODECS" 10
+  shape @TMP@/dark.png -o @TMP@/out.json)
+set_tests_properties(cli.bad_geometry.codecs_module_missing PROPERTIES
+  ENVIRONMENT "PYTHON=${Python3_EXECUTABLE};CROWDRECON_MEDIA_CODECS=/nonexistent/codecs.so")

@@ -16,6 +16,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A part of crowdrecon's own installation is missing or broken (not the
+// user's input, not a bug): the message says what and how to mend it.
+class SetupError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // Invalid geometry (a shape or venue that cannot be built as asked).
 class GeometryError : public InputError {
  public:
