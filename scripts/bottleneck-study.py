@@ -45,13 +45,14 @@ DATA = os.path.join(ROOT, '..', 'shared', 'data', 'juelich-bottleneck', '040_c_5
 AREA = (-0.4, 0.4, 0.5, 1.3)
 AREA_M2 = 0.8 * 0.8
 
-# A variant is BODY[+jitter|+jitter=SIGMA][+face-desired][+no-spring|+creep=T][+yield=SHARE]: the
+# A variant is BODY[+jitter|+jitter=SIGMA][+face-desired][+no-spring|+creep=T][+yield=SHARE][+turn|+turn=DEG]: the
 # body mode (paper, anthropometric, circle), then options of the model
 # (docs/decisions.md, "Issue 39"): the gait jitter at its measured strength
 # and band (the parameter table's defaults) or at SIGMA m/s, the motive
 # torque turning people to their desired direction (ERRATA 5's option),
 # contacts without the tangential spring (issue 19's option) or with a
-# spring that creeps over T seconds, yielding with the given push share.
+# spring that creeps over T seconds, yielding with the given push share,
+# a blocked person turning a shoulder into the way (by 90 degrees or DEG).
 DEFAULT_VARIANTS = ['paper', 'anthropometric', 'circle', 'paper+jitter', 'anthropometric+jitter', 'circle+jitter']
 
 
@@ -76,8 +77,13 @@ def parse_variant(name):
         elif part.startswith('yield='):
             model['yielding'] = 'when_blocked'
             model['yielding_push_share'] = float(part[len('yield='):])
+        elif part == 'turn' or part.startswith('turn='):
+            model['shoulder_turn'] = 'when_blocked'
+            if part.startswith('turn='):
+                model['shoulder_turn_angle_deg'] = float(part[len('turn='):])
         else:
-            raise ValueError(f'variant {name!r}: {part!r}; expected jitter, jitter=SIGMA, face-desired, no-spring, creep=T or yield=SHARE')
+            raise ValueError(f'variant {name!r}: {part!r}; expected jitter, jitter=SIGMA, face-desired, no-spring, '
+                             'creep=T, yield=SHARE, turn or turn=DEG')
     return body, model
 
 

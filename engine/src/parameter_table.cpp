@@ -19,7 +19,8 @@ constexpr const char* kIntegratorChoices[] = {"velocity_verlet", "gear5"};
 constexpr const char* kBackForceTriggerChoices[] = {"velocity", "averaged_velocity"};
 constexpr const char* kTangentialSpringChoices[] = {"history", "none", "creeping"};
 constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
-constexpr const char* kYieldingChoices[] = {"none", "when_blocked"};
+// Yielding and ShoulderTurn: what a person does when blocked.
+constexpr const char* kWhenBlockedChoices[] = {"none", "when_blocked"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -129,7 +130,7 @@ auto MakeTable() {
       Number("gait_jitter_seed", &P::gait_jitter_seed, "", 0.0, 4503599627370496.0, "crowdrecon",
              "whole number: the seed of each person's jitter (a scenario without it uses population.seed "
              "modulo 2^52)"),
-      Choice<&P::yielding>("yielding", kYieldingChoices, "issue 39; Wuppertal trajectories",
+      Choice<&P::yielding>("yielding", kWhenBlockedChoices, "issue 39; Wuppertal trajectories",
              "none: eq. 3 as printed; when_blocked: a person pushed back against the desired direction by a "
              "contact with a person drives toward yielding_push_share times the desired speed (walls do not count)"),
       Number("yielding_push_share", &P::yielding_push_share, "", 0.0, 1.0,
@@ -138,6 +139,14 @@ auto MakeTable() {
       Number("tangential_spring_relaxation_time_s", &P::tangential_spring_relaxation_time_s, "s", 1e-3, 1e4,
              "issue 39; Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
              "T of tangential_spring = creeping: a contact held at rest loses its tangential elastic force as exp(-t/T)"),
+      Choice<&P::shoulder_turn>("shoulder_turn", kWhenBlockedChoices,
+             "issue 39; Yamamoto et al. 2019 (passing in narrow corridors)",
+             "none: eq. 16 as printed; when_blocked: a person pushed back against the desired direction by a "
+             "person ahead is turned (eq. 16's torque at full gain) toward the desired direction rotated by "
+             "shoulder_turn_angle_deg, to the nearer side"),
+      Number("shoulder_turn_angle_deg", &P::shoulder_turn_angle_deg, "deg", 0.0, 90.0,
+             "issue 39; Yamamoto et al. 2019",
+             "how far a blocked person turns from the desired direction (90: sideways, a shoulder first)"),
   };
 }
 

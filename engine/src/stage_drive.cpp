@@ -109,7 +109,12 @@ void Simulation::Drive() {
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
-  if (yielding) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
+  const bool shoulder_turn = mp.shoulder_turn == ShoulderTurn::kWhenBlocked;
+  const bool blocked_known = yielding || shoulder_turn;
+  if (blocked_known) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
+  // The shoulder's turn as a rotation of e_i (cos, sin of the turn angle).
+  const double turn_rad = mp.shoulder_turn_angle_deg * (std::numbers::pi / 180.0);
+  const Vec2 turn{std::cos(turn_rad), std::sin(turn_rad)};
   const bool jitter = mp.gait_jitter == GaitJitter::kIsotropic && mp.gait_jitter_velocity_m_per_s > 0.0;
   const auto jitter_seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
   const double drive_time_s = in.drive_time_s;
@@ -138,15 +143,29 @@ void Simulation::Drive() {
       gain[k] = 0.0;
       if (!driven[k]) continue;
       const Vec2 v = bodies_.velocity_m_per_s[i];
-      // (Yielding has looked every walking person's direction up already.)
-      direction[k] = yielding ? in.yield_direction[i]
-                              : def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
+      // (Yielding and the shoulder's turn have looked every walking person's direction up already.)
+      direction[k] = blocked_known ? in.yield_direction[i]
+                                   : def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
       const double speed = Length(v);
+      const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
+      if (shoulder_turn && in.held_back_n[i] < 0.0) {
+        // Turning the shoulder (issue 39, off by default): blocked, the
+        // person turns e_i by the turn angle to the nearer side, on purpose
+        // (full gain, not eq. 16's share of the speed).
+        const Vec2 e = direction[k];
+        const Vec2 left{e.x * turn.x - e.y * turn.y, e.x * turn.y + e.y * turn.x};
+        const Vec2 right{e.x * turn.x + e.y * turn.y, -e.x * turn.y + e.y * turn.x};
+        const Vec2 facing = Dot(orientation, left) >= Dot(orientation, right) ? left : right;
+        turning[k] = true;
+        sine[k] = Cross(orientation, facing);
+        cosine[k] = Dot(orientation, facing);
+        gain[k] = 1.0;
+        continue;
+      }
       // Only the direction of `facing` matters to the angle (atan2 of two
       // products with it), so the velocity needs no normalising.
       const Vec2 facing = face_velocity ? v : direction[k];
       if (facing.x != 0.0 || facing.y != 0.0) {
-        const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
         turning[k] = true;
         sine[k] = Cross(orientation, facing);
         cosine[k] = Dot(orientation, facing);

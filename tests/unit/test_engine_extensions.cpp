@@ -2,7 +2,9 @@
 // "Issue 39"): each off by default, each verified against what it claims.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <numbers>
@@ -310,6 +312,78 @@ TEST(TangentialSpringCreep, OffIsThePapersModelAndOnIsDeterministic) {
   resumed.LoadState(first.SaveState());
   resumed.AdvanceTo(0.5);
   EXPECT_EQ(std::memcmp(c.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+}
+
+// Two people meet head-on in a corridor narrower than their two breadths
+// (0.6 m against 2 x 0.42 m) and wider than their two depths (2 x 0.24 m):
+// Yamamoto et al. (Transp. Res. B 122:486, 2019) saw people in this
+// situation turn their bodies and pass. Returns the time (s) at which both
+// have passed each other's starting point (negative: not by 30 s);
+// *level_turn_rad receives the smaller of their turns away from the
+// corridor's axis at the moment their centres are level.
+double HeadOnInANarrowCorridor(ShoulderTurn turn, double* level_turn_rad) {
+  WorldDef def;
+  def.parameters.shoulder_turn = turn;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+  def.shapes.push_back(ThoraxLikeShape());
+  for (int i = 0; i < 2; ++i) {
+    PersonDef p;
+    SetMassFromShape(def.shapes[0], 1000.0, p);
+    p.mass_kg *= 1.0 + 0.1 * i;
+    p.position_m = {i == 0 ? -1.5 : 1.5, i == 0 ? 0.01 : -0.01};
+    p.angle_rad = i == 0 ? 0.0 : std::numbers::pi;
+    p.target = static_cast<std::uint32_t>(i);
+    p.desired_speed_m_per_s = 1.0 + 0.1 * i;
+    def.people.push_back(p);
+  }
+  def.walls.push_back({{{-20.0, -0.3}, {20.0, -0.3}}, false, 0.0});
+  def.walls.push_back({{{-20.0, 0.3}, {20.0, 0.3}}, false, 0.0});
+  Simulation sim(def);
+  *level_turn_rad = -1.0;
+  for (int k = 1; k <= 30000; ++k) {
+    sim.AdvanceTo(0.001 * k);
+    const auto& b = sim.bodies();
+    if (*level_turn_rad < 0.0 && b.position_m[0].x >= b.position_m[1].x) {
+      // |sin| of the angle: the share of the breadth turned out of the way.
+      *level_turn_rad = std::min(std::asin(std::abs(std::sin(b.angle_rad[0]))), std::asin(std::abs(std::sin(b.angle_rad[1]))));
+    }
+    if (b.position_m[0].x > 1.5 && b.position_m[1].x < -1.5) return sim.time_s();
+  }
+  return -1.0;
+}
+
+TEST(ShoulderTurn, TwoPeopleMeetingInACorridorTooNarrowForBothTurnAndPass) {
+  double paper_turn = 0.0, turn = 0.0;
+  const double paper_s = HeadOnInANarrowCorridor(ShoulderTurn::kNone, &paper_turn);
+  const double passed_s = HeadOnInANarrowCorridor(ShoulderTurn::kWhenBlocked, &turn);
+  std::printf("paper: passed at %.2f s, turn when level %.2f rad; turning: passed at %.2f s, turn when level %.2f rad\n",
+              paper_s, paper_turn, passed_s, turn);
+  ASSERT_GT(passed_s, 0.0) << "turned sideways, they fit";
+  EXPECT_TRUE(paper_s < 0.0 || passed_s < paper_s) << "turning on purpose passes sooner than being turned by the contacts";
+  EXPECT_GT(turn, 1.0) << "both pass with a shoulder first";
+}
+
+// Off, the angle changes nothing: the paper's model bit for bit.
+TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
+  ExpectOnlyTheExtensionActs(std::vector<ParameterChange>{[](ModelParameters& p) { p.shoulder_turn_angle_deg = 30.0; }},
+                             [](ModelParameters& p) { p.shoulder_turn = ShoulderTurn::kWhenBlocked; });
+  WorldDef on = RandomGas(6, 0.42, 5, true);
+  on.parameters.ground_reaction = true;
+  on.parameters.shoulder_turn = ShoulderTurn::kWhenBlocked;
+  Simulation one(on);
+  one.AdvanceTo(0.5);
+  on.threads = 2;
+  Simulation two(on);
+  two.AdvanceTo(0.5);
+  const std::size_t bytes = one.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
+  Simulation first(on);
+  first.AdvanceTo(0.25);
+  Simulation resumed(on);
+  resumed.LoadState(first.SaveState());
+  resumed.AdvanceTo(0.5);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/canvas.hpp"
+#include "crowdrecon/media/media.hpp"
 
 namespace crowdrecon::viz {
 
@@ -392,7 +393,7 @@ class VideoOut {
     std::filesystem::path path = requested;
     std::string codec = ext == ".mp4" ? "mp4v" : "MJPG";
     Open(path, codec, fps);
-    if (!writer_.isOpened() && ext == ".mp4") {
+    if (!writer_->IsOpened() && ext == ".mp4") {
       const std::filesystem::path fallback = std::filesystem::path(requested).replace_extension(".avi");
       summary->notes.push_back(requested.string() + ": OpenCV cannot write MPEG-4 (mp4v) here; wrote " +
                             fallback.string() + " (Motion-JPEG) instead");
@@ -400,7 +401,7 @@ class VideoOut {
       codec = "MJPG";
       Open(path, codec, fps);
     }
-    if (!writer_.isOpened())
+    if (!writer_->IsOpened())
       throw InputError(path.string() + ": cannot write video (" + codec + " at " + FormatNumber(fps) +
                        " fps); check that the folder exists and is writable");
     summary->video_written = path;
@@ -411,7 +412,7 @@ class VideoOut {
   // Appends a PNG written for this frame. Frames are padded with white to the
   // video's size (all frames share one layout, so this only adds the odd row).
   void Append(const std::filesystem::path& png) {
-    cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+    cv::Mat image = media::ReadImage(png.string(), cv::IMREAD_COLOR);
     if (image.empty()) throw InputError(png.string() + ": cannot read back the frame for the video");
     if (image.cols > size_.width || image.rows > size_.height) {
       cv::resize(image, image, size_, 0, 0, cv::INTER_AREA);
@@ -419,16 +420,16 @@ class VideoOut {
       cv::copyMakeBorder(image, image, 0, size_.height - image.rows, 0, size_.width - image.cols,
                          cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
     }
-    writer_.write(image);
+    writer_->Write(image);
   }
-  void Close() { writer_.release(); }
+  void Close() { writer_->Release(); }
 
  private:
   void Open(const std::filesystem::path& path, const std::string& codec, double fps) {
     // OpenCV may print backend warnings on failure; the fallback above reports the outcome.
-    writer_.open(path.string(), cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps, size_, true);
+    writer_->Open(path.string(), -1, media::FourCc(codec[0], codec[1], codec[2], codec[3]), fps, size_, true);
   }
-  cv::VideoWriter writer_;
+  std::unique_ptr<media::VideoWriter> writer_ = media::MakeVideoWriter();
   cv::Size size_;
 };
 

@@ -60,6 +60,18 @@ enum class Yielding {
   kWhenBlocked,   // a person pushed back against e_i by a contact with a person drives toward push_share v0 e_i
 };
 
+// Whether a blocked person turns a shoulder into the way (issue 39;
+// docs/decisions.md, "Issue 39: turning the shoulder"): people passing one
+// another where there is no room for both breadths turn their bodies
+// (Yamamoto et al., Transp. Res. B 122:486, 2019; at a bottleneck the turn
+// grows as the width falls toward the shoulders': Sensors 24:1720, 2024).
+// Eq. (16) turns a person toward theta_D only in proportion to their speed,
+// so a blocked person keeps facing the way they were going.
+enum class ShoulderTurn {
+  kNone,         // the paper's eq. (16) (default)
+  kWhenBlocked,  // a person pushed back against e_i by a person ahead turns toward e_i rotated by the turn angle
+};
+
 enum class Integrator {
   kVelocityVerlet,  // second order, symplectic for conservative forces; default
   kGear5,           // fifth-order Gear predictor-corrector, as in the paper's SPOLY code
@@ -124,6 +136,11 @@ struct ModelParameters {
   // T of tangential_spring = kCreeping (s): a contact held at rest loses its
   // tangential elastic force as e^(-t/T) (issue 39; docs/decisions.md).
   double tangential_spring_relaxation_time_s = 1.0;
+  // Turning the shoulder: a blocked person (as for yielding) is turned by
+  // eq. (16)'s torque, at full gain, toward e_i rotated by
+  // shoulder_turn_angle_deg to whichever side is nearer their orientation.
+  ShoulderTurn shoulder_turn = ShoulderTurn::kNone;
+  double shoulder_turn_angle_deg = 90.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
