@@ -150,6 +150,13 @@ std::string Simulation::SaveState() const {
   // Only with BackForceTrigger::kAveragedVelocity (the definition, which the
   // checkpoint is restored into, says which).
   if (!in_->averaged_along.empty()) w.PutVector(in_->averaged_along);
+  // Only with GiveWay::kWhereRoom (the same).
+  if (!in_->give_way_along.empty()) {
+    w.PutVector(in_->give_way_along);
+    w.PutVector(in_->give_way_blocked_s);
+    w.PutVector(in_->give_way_left_s);
+    w.PutVector(in_->give_way_direction);
+  }
   w.PutVector(bodies_.id);
   w.PutVector(bodies_.shape);
   w.PutVector(bodies_.mass_kg);
@@ -196,6 +203,12 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
   if (!in_->averaged_along.empty()) r.GetVector(in_->averaged_along, n);
+  if (!in_->give_way_along.empty()) {
+    r.GetVector(in_->give_way_along, n);
+    r.GetVector(in_->give_way_blocked_s, n);
+    r.GetVector(in_->give_way_left_s, n);
+    r.GetVector(in_->give_way_direction, n);
+  }
   if (!v1) {
     r.GetVector(bodies_.id, n);
     r.GetVector(bodies_.shape, n);
@@ -239,6 +252,9 @@ void Simulation::LoadState(const std::string& data) {
   RequireFinite(bodies_.mass_kg, "mass");
   RequireFinite(bodies_.inertia_kg_m2, "moment of inertia");
   RequireFinite(in_->averaged_along, "averaged velocity");
+  RequireFinite(in_->give_way_along, "give-way velocity");
+  RequireFinite(in_->give_way_blocked_s, "give-way blocked time");
+  RequireFinite(in_->give_way_left_s, "give-way time left");
   for (std::size_t i = 0; i < n; ++i) {
     if (static_cast<std::uint8_t>(bodies_.state[i]) > static_cast<std::uint8_t>(PersonState::kRemoved))
       throw InputError("checkpoint: damaged state: slot " + std::to_string(i) + " has no valid state");

@@ -2,7 +2,9 @@
 
 #include <array>
 #include <cmath>
+#include <string>
 #include <type_traits>
+#include <utility>
 
 #include "crowdrecon/common/error.hpp"
 
@@ -21,6 +23,7 @@ constexpr const char* kTangentialSpringChoices[] = {"history", "none", "creeping
 constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
 // Yielding and ShoulderTurn: what a person does when blocked.
 constexpr const char* kWhenBlockedChoices[] = {"none", "when_blocked"};
+constexpr const char* kGiveWayChoices[] = {"none", "where_room"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -147,6 +150,18 @@ auto MakeTable() {
       Number("shoulder_turn_angle_deg", &P::shoulder_turn_angle_deg, "deg", 0.0, 90.0,
              "issue 39; Yamamoto et al. 2019",
              "how far a blocked person turns from the desired direction (90: sideways, a shoulder first)"),
+      Choice<&P::give_way>("give_way", kGiveWayChoices, "issue 39 (candidate b); issue 19's give-up",
+             "none: the paper's model; where_room: a person blocked for give_way_blocked_s who touches at most "
+             "give_way_max_contacts people, most heading against them, walks their way for give_way_duration_s"),
+      Number("give_way_blocked_s", &P::give_way_blocked_s, "s", 0.1, 600.0, "issue 19's give-up",
+             "how long a person is blocked (velocity along the desired direction, averaged over 1 s, below "
+             "give_way_speed_m_per_s) before giving way"),
+      Number("give_way_speed_m_per_s", &P::give_way_speed_m_per_s, "m/s", 0.0, 2.0, "issue 19's give-up",
+             "below this averaged velocity along the desired direction a person is blocked"),
+      Number("give_way_duration_s", &P::give_way_duration_s, "s", 0.1, 600.0, "issue 19's give-up",
+             "how long a person who gives way walks with the people against them"),
+      Number("give_way_max_contacts", &P::give_way_max_contacts, "", 0.0, 20.0, "issue 39 (candidate b)",
+             "whole number: a person touching more people than this has no room to turn and does not give way"),
   };
 }
 
@@ -222,9 +237,12 @@ bool ModelParameters::IsValid(std::string* error) const {
                ", expected at least gait_jitter_band_low_hz = " + FormatNumber(gait_jitter_band_low_hz);
     return false;
   }
-  if (gait_jitter_seed != std::floor(gait_jitter_seed)) {
-    if (error) *error = "gait_jitter_seed = " + FormatNumber(gait_jitter_seed) + ", expected a whole number";
-    return false;
+  for (const auto& [name, value] : {std::pair{"gait_jitter_seed", gait_jitter_seed},
+                                     std::pair{"give_way_max_contacts", give_way_max_contacts}}) {
+    if (value != std::floor(value)) {
+      if (error) *error = std::string(name) + " = " + FormatNumber(value) + ", expected a whole number";
+      return false;
+    }
   }
   return true;
 }

@@ -137,6 +137,12 @@ void Simulation::LoadBodies() {
   in_->cos_angle.assign(n, 1.0);
   // People are placed at rest: u_i = 0, no back force until pushed back.
   if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
+  if (def_.parameters.give_way == GiveWay::kWhereRoom) {
+    in_->give_way_along.assign(n, 0.0);
+    in_->give_way_blocked_s.assign(n, 0.0);
+    in_->give_way_left_s.assign(n, 0.0);
+    in_->give_way_direction.assign(n, {});
+  }
   in_->sin_angle.assign(n, 0.0);
   in_->travel_m.assign(n, 0.0);
   in_->field_cache.assign(n, {});
@@ -273,6 +279,7 @@ void Simulation::Step() {
   ++step_count_;
   in_->drive_time_s = time_s_;
   AverageBackForceTrigger();
+  UpdateGiveWay();
   Check();
 }
 
@@ -379,6 +386,12 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
   if (slot < in.gear_xy.size()) in.gear_xy[slot] = {};
   if (slot < in.gear_theta.size()) in.gear_theta[slot] = {};
   if (!in.averaged_along.empty()) in.averaged_along[slot] = 0.0;
+  if (!in.give_way_along.empty()) {
+    in.give_way_along[slot] = 0.0;
+    in.give_way_blocked_s[slot] = 0.0;
+    in.give_way_left_s[slot] = 0.0;
+    in.give_way_direction[slot] = {};
+  }
   in.pairs_valid = false;
   in.cuda_has_history = false;
   Drive();  // the newcomer's own forces enter the current evaluation (the others' are unchanged)

@@ -284,6 +284,16 @@ struct Simulation::Internals {
   // same on any thread count, and from the restored contacts after a resume).
   std::vector<Vec2> yield_direction;
   std::vector<double> held_back_n;
+
+  // GiveWay::kWhereRoom (empty otherwise), per body: the velocity along the
+  // desired direction averaged over 1 s, how long it has been below the
+  // threshold, how long the person still gives way, and the direction they
+  // walk meanwhile. Updated once per step after the integrator
+  // (UpdateGiveWay); in the checkpoint.
+  std::vector<double> give_way_along;
+  std::vector<double> give_way_blocked_s;
+  std::vector<double> give_way_left_s;
+  std::vector<Vec2> give_way_direction;
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.
   // Only the gait jitter (a function of time) reads it.

@@ -111,6 +111,7 @@ void Simulation::Drive() {
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
   const bool shoulder_turn = mp.shoulder_turn == ShoulderTurn::kWhenBlocked;
   const bool blocked_known = yielding || shoulder_turn;
+  const bool giving_way = mp.give_way == GiveWay::kWhereRoom;
   if (blocked_known) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
   // The shoulder's turn as a rotation of e_i (cos, sin of the turn angle).
   const double turn_rad = mp.shoulder_turn_angle_deg * (std::numbers::pi / 180.0);
@@ -146,6 +147,8 @@ void Simulation::Drive() {
       // (Yielding and the shoulder's turn have looked every walking person's direction up already.)
       direction[k] = blocked_known ? in.yield_direction[i]
                                    : def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], field_cache[i]);
+      // Giving way (issue 39, off by default): the way of the people they gave way to.
+      if (giving_way && in.give_way_left_s[i] > 0.0) direction[k] = in.give_way_direction[i];
       const double speed = Length(v);
       const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
       if (shoulder_turn && in.held_back_n[i] < 0.0) {
@@ -227,6 +230,59 @@ void Simulation::AverageBackForceTrigger() {
     if (bodies_.state[i] != PersonState::kWalking) continue;
     const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], in_->field_cache[i]);
     u[i] += a * (Dot(e, bodies_.velocity_m_per_s[i]) - u[i]);
+  }
+}
+
+// Giving way (ModelParameters::give_way), once per step after the
+// integrator, in one serial pass (the same on any thread count; its state is
+// in the checkpoint): per walking person, the velocity along e_i averaged
+// over 1 s (the exact update of du/dt = (e.v - u)/T, as the back force's
+// trigger), the time it has stayed below the threshold, and, once that time
+// reaches give_way_blocked_s, whether to give way: touching at most
+// give_way_max_contacts people (room to turn) whose desired directions sum
+// against e_i (most of them head the other way). Then the person walks that
+// way for give_way_duration_s, and starts afresh.
+void Simulation::UpdateGiveWay() {
+  const ModelParameters& mp = def_.parameters;
+  if (mp.give_way != GiveWay::kWhereRoom) return;
+  Internals& in = *in_;
+  const std::size_t n = bodies_.size();
+  // Each walking person's own desired direction, then, per person, the
+  // people they touch and the sum of those people's directions.
+  std::vector<Vec2>& desired = in.yield_direction;
+  desired.assign(n, {});
+  for (std::size_t i = 0; i < n; ++i)
+    if (bodies_.state[i] == PersonState::kWalking)
+      desired[i] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], in.field_cache[i]);
+  std::vector<int> touching(n, 0);
+  std::vector<Vec2> their_way(n, Vec2{});
+  std::uint32_t last_a = UINT32_MAX, last_b = UINT32_MAX;
+  for (const Contact& c : contacts_) {
+    if (c.wall || (c.a == last_a && c.b == last_b)) continue;  // a pair once, whatever its features
+    last_a = c.a;
+    last_b = c.b;
+    ++touching[c.a];
+    ++touching[c.b];
+    their_way[c.a] += desired[c.b];
+    their_way[c.b] += desired[c.a];
+  }
+  const double h = dt_s_;
+  const double a = -std::expm1(-h / 1.0);  // averaged over 1 s
+  for (std::size_t i = 0; i < n; ++i) {
+    if (bodies_.state[i] != PersonState::kWalking) continue;
+    const Vec2 e = desired[i];
+    in.give_way_along[i] += a * (Dot(e, bodies_.velocity_m_per_s[i]) - in.give_way_along[i]);
+    if (in.give_way_left_s[i] > 0.0) {
+      in.give_way_left_s[i] = std::max(0.0, in.give_way_left_s[i] - h);
+      continue;
+    }
+    in.give_way_blocked_s[i] = in.give_way_along[i] < mp.give_way_speed_m_per_s ? in.give_way_blocked_s[i] + h : 0.0;
+    if (in.give_way_blocked_s[i] < mp.give_way_blocked_s) continue;
+    const Vec2 way = their_way[i];
+    if (touching[i] > static_cast<int>(mp.give_way_max_contacts) || !(Dot(way, e) < 0.0)) continue;
+    in.give_way_direction[i] = way * (1.0 / Length(way));
+    in.give_way_left_s[i] = mp.give_way_duration_s;
+    in.give_way_blocked_s[i] = 0.0;
   }
 }
 

@@ -386,5 +386,81 @@ TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
   EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
 }
 
+// Two people meet head-on in a corridor too narrow to pass at all (0.45 m:
+// less than two depths, more than a breadth). Returns the lowest velocity
+// along its own desired direction that the person heading +x reached after
+// the first 3 s (negative: it walked back), and the world's end state.
+double HeadOnWithNoWayPast(const ModelParameters& parameters, int threads, std::vector<Vec2>* end_positions) {
+  WorldDef def;
+  def.parameters = parameters;
+  def.threads = threads;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+  def.shapes.push_back(ThoraxLikeShape());
+  for (int i = 0; i < 2; ++i) {
+    PersonDef p;
+    SetMassFromShape(def.shapes[0], 1000.0, p);
+    p.position_m = {i == 0 ? -1.0 : 1.0, 0.0};
+    p.angle_rad = i == 0 ? 0.0 : std::numbers::pi;
+    p.target = static_cast<std::uint32_t>(i);
+    p.desired_speed_m_per_s = 1.0;
+    def.people.push_back(p);
+  }
+  def.walls.push_back({{{-20.0, -0.225}, {20.0, -0.225}}, false, 0.0});
+  def.walls.push_back({{{-20.0, 0.225}, {20.0, 0.225}}, false, 0.0});
+  Simulation sim(def);
+  double lowest = 1e9;
+  for (int k = 1; k <= 120; ++k) {
+    if (k == 80) {  // while giving way (from about 6 s), resume from a checkpoint: the same run
+      Simulation resumed(def);
+      resumed.LoadState(sim.SaveState());
+      resumed.AdvanceTo(0.1 * k);
+      sim.AdvanceTo(0.1 * k);
+      EXPECT_EQ(std::memcmp(sim.bodies().position_m.data(), resumed.bodies().position_m.data(), 2 * sizeof(Vec2)), 0);
+      continue;
+    }
+    sim.AdvanceTo(0.1 * k);
+    if (k > 30) lowest = std::min(lowest, sim.bodies().velocity_m_per_s[0].x);  // after their collision's bounce
+  }
+  *end_positions = sim.bodies().position_m;
+  return lowest;
+}
+
+TEST(GiveWay, APersonBlockedByPeopleHeadingTheOtherWayGivesWayOnlyWhereThereIsRoom) {
+  ModelParameters paper;
+  std::vector<Vec2> paper_end, no_room_end, room_end, two_threads_end;
+  const double paper_lowest = HeadOnWithNoWayPast(paper, 1, &paper_end);
+  EXPECT_GT(paper_lowest, -0.05) << "the paper's people stand chest to chest";
+  ModelParameters give_way;
+  give_way.give_way = GiveWay::kWhereRoom;
+  give_way.give_way_max_contacts = 0;  // touching one person is already too many
+  HeadOnWithNoWayPast(give_way, 1, &no_room_end);
+  EXPECT_EQ(std::memcmp(paper_end.data(), no_room_end.data(), 2 * sizeof(Vec2)), 0) << "no room: the paper's model";
+  give_way.give_way_max_contacts = 1;
+  const double lowest = HeadOnWithNoWayPast(give_way, 1, &room_end);
+  EXPECT_LT(lowest, -0.5) << "after " << give_way.give_way_blocked_s << " s blocked it walks back with the other";
+  HeadOnWithNoWayPast(give_way, 2, &two_threads_end);
+  EXPECT_EQ(std::memcmp(room_end.data(), two_threads_end.data(), 2 * sizeof(Vec2)), 0);
+}
+
+// Off, its settings change nothing: the paper's model bit for bit (that it
+// acts when on is the test above).
+TEST(GiveWay, OffIsThePapersModelBitForBit) {
+  WorldDef paper = RandomGas(6, 0.42, 5, true);
+  paper.parameters.ground_reaction = true;
+  WorldDef off = paper;
+  off.parameters.give_way_blocked_s = 0.1;
+  off.parameters.give_way_max_contacts = 20;
+  Simulation a(paper), b(off);
+  a.AdvanceTo(0.4);
+  b.AdvanceTo(0.4);
+  EXPECT_EQ(std::memcmp(a.bodies().position_m.data(), b.bodies().position_m.data(), a.bodies().size() * sizeof(Vec2)), 0);
+  ModelParameters invalid;
+  invalid.give_way_max_contacts = 2.5;
+  std::string error;
+  EXPECT_FALSE(invalid.IsValid(&error));
+  EXPECT_NE(error.find("give_way_max_contacts = 2.5, expected a whole number"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace crowdrecon::engine

@@ -72,6 +72,16 @@ enum class ShoulderTurn {
   kWhenBlocked,  // a person pushed back against e_i by a person ahead turns toward e_i rotated by the turn angle
 };
 
+// Whether a blocked person gives way to the crowd against them where there
+// is room to turn (issue 39, candidate (b); docs/decisions.md, "Issue 39:
+// giving way where there is room"): issue 19's give-up released plugs and
+// then let lanes win for good; conditioned on room to turn, dense plugs stay.
+enum class GiveWay {
+  kNone,       // the paper's model (default)
+  kWhereRoom,  // blocked for give_way_blocked_s, touching at most give_way_max_contacts people, most of them
+               // heading against e_i: walk their way for give_way_duration_s
+};
+
 enum class Integrator {
   kVelocityVerlet,  // second order, symplectic for conservative forces; default
   kGear5,           // fifth-order Gear predictor-corrector, as in the paper's SPOLY code
@@ -141,6 +151,14 @@ struct ModelParameters {
   // shoulder_turn_angle_deg to whichever side is nearer their orientation.
   ShoulderTurn shoulder_turn = ShoulderTurn::kNone;
   double shoulder_turn_angle_deg = 90.0;
+  // Giving way: "blocked" is a velocity along e_i, averaged over 1 s, below
+  // give_way_speed_m_per_s; "room" is touching at most give_way_max_contacts
+  // people; "their way" is the mean desired direction of the people touched.
+  GiveWay give_way = GiveWay::kNone;
+  double give_way_blocked_s = 3.0;       // issue 19's give-up
+  double give_way_speed_m_per_s = 0.1;   // issue 19's give-up
+  double give_way_duration_s = 5.0;      // issue 19's give-up
+  double give_way_max_contacts = 3.0;    // whole number
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
