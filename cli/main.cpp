@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "crowdrecon/common/child_process.hpp"
 #include "crowdrecon/common/error.hpp"
 
 namespace crowdrecon::cli {
@@ -50,6 +51,10 @@ int main(int argc, char** argv) {
   } catch (const crowdrecon::InputError& e) {
     std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
     return 2;
+  } catch (const crowdrecon::Interrupted& e) {
+    // The file being written when it came is removed as the exception passes.
+    std::fprintf(stderr, "crowdrecon: %s\n", e.what());
+    return 128 + e.signal();
   } catch (const crowdrecon::SetupError& e) {
     std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
     return 2;

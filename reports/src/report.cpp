@@ -12,9 +12,9 @@
 #include <fstream>
 #include <random>
 #include <sstream>
-#include <sys/wait.h>
 
 #include "crowdrecon/analysis/plausibility.hpp"
+#include "crowdrecon/common/child_process.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
@@ -220,33 +220,41 @@ std::string FindChromium(const std::string& given) {
   return "";
 }
 
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+// How long Chromium may take to print a report (a few seconds as a rule).
+constexpr double kPrintTimeLimitS = 180.0;
 
 void PrintPdf(const std::string& chromium, const fs::path& html, const fs::path& pdf) {
   if (chromium.empty())
     throw InputError("report.pdf: no Chromium found (looked for chromium, chromium-browser and google-chrome on PATH); "
                      "install Debian's chromium (scripts/install-deps.sh) or give --chromium PATH, or --no-pdf");
   const fs::path profile = pdf.parent_path() / ".chromium-profile";
-  const std::string cmd = ShellQuote(chromium) + " --headless --no-sandbox --disable-gpu --no-first-run" +
-                          " --user-data-dir=" + ShellQuote(profile.string()) +
-                          " --no-pdf-header-footer --print-to-pdf=" + ShellQuote(pdf.string()) + " " +
-                          ShellQuote("file://" + fs::absolute(html).string()) + " > " +
-                          ShellQuote((pdf.parent_path() / ".chromium.log").string()) + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  std::error_code ec;
-  fs::remove_all(profile, ec);
-  const bool ok = status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::is_regular_file(pdf, ec) &&
-                  fs::file_size(pdf, ec) > 0;
   const fs::path log = pdf.parent_path() / ".chromium.log";
-  const std::string log_text = ok || !fs::is_regular_file(log, ec) ? "" : ReadInputFile(log, "Chromium log");
-  fs::remove(log, ec);
-  if (!ok)
-    throw InputError("report.pdf: " + chromium + " could not print " + html.string() + " (exit status " +
-                     std::to_string(status) + "): " + log_text.substr(0, 400));
+  // Chromium's own files go, whatever happens (an interruption included).
+  struct Tidy {
+    const fs::path &profile, &log;
+    ~Tidy() {
+      std::error_code ec;
+      fs::remove_all(profile, ec);
+      fs::remove(log, ec);
+    }
+  };
+  std::string log_text;
+  ChildResult run;
+  {
+    Tidy tidy{profile, log};
+    run = RunChildProcess({chromium, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                           "--user-data-dir=" + profile.string(), "--no-pdf-header-footer",
+                           "--print-to-pdf=" + pdf.string(), "file://" + fs::absolute(html).string()},
+                          log, kPrintTimeLimitS);
+    std::error_code ec;
+    if (!run.problem.empty() && fs::is_regular_file(log, ec)) log_text = ReadInputFile(log, "Chromium log");
+  }
+  std::error_code ec;
+  const bool printed = fs::is_regular_file(pdf, ec) && fs::file_size(pdf, ec) > 0;
+  if (run.problem.empty() && !printed) run.problem = "exit status 0 but no PDF written";
+  if (!run.problem.empty())
+    throw InputError("report.pdf: " + chromium + " could not print " + html.string() + " (" + run.problem + ")" +
+                     (log_text.empty() ? "" : ": " + log_text.substr(0, 400)));
 }
 
 std::string Css() {
@@ -302,7 +310,13 @@ void WritePage(const ReportOptions& options, const std::string& chromium, const 
   if (options.progress) options.progress("printing report.pdf with " + chromium);
   summary->pdf = options.output_dir / "report.pdf";
   const fs::path partial = PartialPath(summary->pdf);
-  PrintPdf(chromium, summary->html, partial);
+  try {
+    PrintPdf(chromium, summary->html, partial);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(partial, ec);
+    throw;
+  }
   fs::rename(partial, summary->pdf);
 }
 

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Ctrl-C and SIGTERM while `report` prints its PDF (issue 40: 2 of 4 tries
+# hung for minutes, Chromium left idle). A stand-in for Chromium that
+# ignores SIGINT and SIGTERM, and starts a helper that ignores them too,
+# plays the worst case. Checks, for each signal sent to report's process
+# group: exit 128 + signal within 2 s, no process of the stand-in left, no
+# leftover (.chromium-profile, .chromium.log, a partial PDF, report.pdf),
+# and a rerun into the same folder that succeeds. Then a browser that fails
+# at once is reported with its exit status (not a raw wait status).
+#   report_interrupted.sh CROWDRECON RUN_FILE
+set -uo pipefail
+exe=$1; run=$2
+d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
+cat > "$d/fake-chromium" <<SH
+#!/usr/bin/env bash
+trap '' INT TERM
+sleep 120 &
+echo \$! > "$d/helper.pid"
+echo \$\$ > "$d/browser.pid"
+wait
+SH
+chmod +x "$d/fake-chromium"
+fail() { echo "report_interrupted.sh: $*"; exit 1; }
+# Running: a process that exists and is not a zombie (an orphan ended by
+# SIGKILL waits a moment for init to reap it).
+alive() { [[ -f $1 ]] || return 1; local s; s=$(ps -o stat= -p "$(cat "$1")" 2>/dev/null) || return 1; [[ -n $s && $s != Z* ]]; }
+set -m  # the report gets a process group of its own, as in a terminal
+for signal in INT TERM; do
+  rm -f "$d/browser.pid" "$d/helper.pid"
+  "$exe" report "$run" -o "$d/report-$signal" --chromium "$d/fake-chromium" -q > "$d/out-$signal.txt" 2>&1 &
+  pid=$!
+  for _ in $(seq 100); do [[ -f $d/helper.pid ]] && break; sleep 0.1; done
+  [[ -f $d/helper.pid ]] || fail "the stand-in browser never started"
+  sent=$(date +%s%N)
+  kill -s "$signal" -- "-$pid"
+  wait "$pid"; rc=$?
+  took_ms=$(( ($(date +%s%N) - sent) / 1000000 ))
+  cat "$d/out-$signal.txt"
+  expected=$([[ $signal == INT ]] && echo 130 || echo 143)
+  [[ $rc -eq $expected ]] || fail "SIG$signal: exit $rc, expected $expected"
+  (( took_ms < 2000 )) || fail "SIG$signal: took $took_ms ms to stop"
+  grep -q "interrupted by SIG$signal while .*fake-chromium ran; it was ended" "$d/out-$signal.txt" || fail "SIG$signal: no message"
+  sleep 0.2
+  alive "$d/browser.pid" && fail "SIG$signal: the browser is still running"
+  alive "$d/helper.pid" && fail "SIG$signal: the browser's helper is still running"
+  left=$(ls -A "$d/report-$signal" | grep -E '^\.chromium|partial|report\.pdf' || true)
+  [[ -z $left ]] || fail "SIG$signal: left $left"
+  "$exe" report "$run" -o "$d/report-$signal" --no-pdf -q > /dev/null || fail "SIG$signal: the rerun failed"
+  echo "SIG$signal: exit $rc after $took_ms ms, nothing left, rerun done"
+done
+set +m
+printf '#!/bin/sh\necho "no display" >&2\nexit 3\n' > "$d/broken-chromium"; chmod +x "$d/broken-chromium"
+"$exe" report "$run" -o "$d/broken" --chromium "$d/broken-chromium" -q > "$d/broken.txt" 2>&1; rc=$?
+cat "$d/broken.txt"
+[[ $rc -eq 2 ]] || fail "a failing browser: exit $rc, expected 2"
+grep -q "could not print .* (exit status 3): no display" "$d/broken.txt" || fail "a failing browser: message"
+[[ ! -e $d/broken/report.pdf ]] || fail "a failing browser: a report.pdf was written"
