@@ -272,10 +272,14 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
   if (!pictures_left.empty()) CreateOutputFolder(options.picture_dir);
   cv::Mat frame, flow, change;
   std::size_t index = 0;
+  bool window_ended = false;  // the loop stopped at --to, not at the video's last readable frame
   for (;; ++index) {
     if (!capture.Read(frame) || frame.empty()) break;
     const double t = static_cast<double>(index) / s.fps;
-    if (t > options.to_s) break;
+    if (t > options.to_s) {
+      window_ended = true;
+      break;
+    }
     ++s.frames_read;
     if (t + static_cast<double>(span) / s.fps < options.from_s) continue;
     // 1. Is the picture usable?
@@ -366,6 +370,16 @@ Observation ObserveFootage(const std::filesystem::path& video, const Homography&
     }
   }
   if (s.frames_read == 0) throw InputError(video.string() + ": no frame could be decoded; expected a readable video");
+  const double last_frame_s = static_cast<double>(index - 1) / s.fps;
+  if (options.from_s > last_frame_s)
+    throw InputError(video.string() + ": --from " + FormatNumber(options.from_s) + " s is past the video's last frame at " +
+                     FormatNumber(last_frame_s) + " s; expected a start within the video");
+  // A container states its frame count; fewer decoded frames mean a cut file
+  // (one frame fewer is within what containers misstate).
+  if (!window_ended && total_frames > 0 && static_cast<double>(index) + 1.0 < total_frames)
+    s.notes.push_back("the video states " + FormatNumber(total_frames) + " frames but only " + std::to_string(index) +
+                      " could be decoded (up to " + FormatNumber(last_frame_s) +
+                      " s): the file may be truncated; the observation ends there");
   if (s.flows == 0)
     s.notes.push_back("no usable velocity field: every span of " + std::to_string(span) +
                       " frames held a flagged frame, or the video is shorter than the span");

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -112,6 +113,38 @@ TEST(Footage, DarkCutAndFrozenFramesAreFlaggedAndLeftOut) {
   bool noted = false;
   for (const std::string& n : obs.notes) noted = noted || n.find("3 dark") != std::string::npos;
   EXPECT_TRUE(noted);
+}
+
+// A start past the video's end is refused (before: an all-NaN observation
+// with exit 0), and a video cut short says so (before: 16 of 31 frames were
+// observed as if complete).
+TEST(Footage, AStartPastTheEndIsRefusedAndACutVideoIsSaidToBeCut) {
+  const auto video = SlidingFloor(0.6, 30, {}, -1, {});
+  FootageOptions late;
+  late.from_s = 100.0;
+  try {
+    ObserveFootage(video, Camera(), FloorSpec(), late, nullptr);
+    ADD_FAILURE() << "a start past the end was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--from 100 s is past the video's last frame at 1.16 s"), std::string::npos)
+        << e.what();
+  }
+  FootageSummary whole;
+  const Observation complete = ObserveFootage(video, Camera(), FloorSpec(), FootageOptions{}, &whole);
+  for (const std::string& n : complete.notes) EXPECT_EQ(n.find("truncated"), std::string::npos) << n;
+  // The same file cut at 60 % of its bytes (the end of a copy that stopped).
+  const auto cut = ScratchFile("cut.avi");
+  std::filesystem::copy_file(video, cut, std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(cut, std::filesystem::file_size(video) * 6 / 10);
+  FootageSummary summary;
+  const Observation obs = ObserveFootage(cut, Camera(), FloorSpec(), FootageOptions{}, &summary);
+  EXPECT_LT(summary.frames_read, 30u);
+  bool said = false;
+  for (const std::string& n : obs.notes)
+    said = said || (n.find("the video states 30 frames but only " + std::to_string(summary.frames_read) +
+                           " could be decoded") != std::string::npos &&
+                    n.find("may be truncated") != std::string::npos);
+  EXPECT_TRUE(said) << "frames read: " << summary.frames_read;
 }
 
 TEST(Homography, PairsAreReproducedAndDegenerateOnesRefused) {
