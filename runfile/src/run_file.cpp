@@ -639,7 +639,34 @@ std::vector<FrameTime> RunFileReader::FrameTimes() const {
 struct PersonFrameStream::Impl {
   std::unique_ptr<Statement> query;
   bool have_row = false;
+  // For the check at the end that the join with person_state left no row
+  // of trajectory_data out (a damaged file: an id or frame person_state lacks).
+  sqlite::Database* db = nullptr;
+  std::string file;
+  std::int64_t last_frame = 0;
+  std::int64_t rows = 0;
 };
+
+namespace {
+
+// Every row of trajectory_data up to `last_frame` has its person_state row:
+// otherwise the stream would have dropped it without a word.
+void RequireEveryTrajectoryRowStreamed(sqlite::Database& db, const std::string& file, std::int64_t last_frame,
+                                       std::int64_t streamed) {
+  Statement count(db, "SELECT COUNT(*) FROM trajectory_data WHERE frame <= ?1");
+  count.Bind(1, last_frame);
+  if (count.Next() && count.Int(0) == streamed) return;
+  Statement orphan(db,
+                   "SELECT t.frame, t.id FROM trajectory_data t LEFT JOIN person_state s ON s.frame = t.frame AND "
+                   "s.id = t.id WHERE t.frame <= ?1 AND s.id IS NULL LIMIT 1");
+  orphan.Bind(1, last_frame);
+  const std::string row = orphan.Next() ? "row frame " + orphan.Text(0) + ", id " + orphan.Text(1) : "a row";
+  throw InputError(file + ": table trajectory_data, " + row +
+                   ": no row of person_state with that frame and id; expected whole-number frames and ids that "
+                   "person_state also has (the run file is damaged)");
+}
+
+}  // namespace
 
 PersonFrameStream::PersonFrameStream() : impl_(std::make_unique<Impl>()) {}
 PersonFrameStream::PersonFrameStream(PersonFrameStream&&) noexcept = default;
@@ -649,7 +676,7 @@ bool PersonFrameStream::Next(PersonFrame* out) {
   using namespace run_limits;
   if (!impl_->have_row) return false;
   Statement& q = *impl_->query;
-  out->frame = q.Int(0);
+  out->frame = q.Integer(0, 0, kFrame);
   out->person.clear();
   out->position_m.clear();
   out->velocity_m_per_s.clear();
@@ -665,8 +692,11 @@ bool PersonFrameStream::Next(PersonFrame* out) {
     out->angular_velocity_rad_per_s.push_back(q.Real(7, -kAngularSpeed_rad_per_s, kAngularSpeed_rad_per_s));
     out->state.push_back(static_cast<PersonStatus>(q.Integer(8, 0, 2)));
     out->load_n.push_back(q.Real(9, 0.0, kForce_n));
+    ++impl_->rows;
     impl_->have_row = q.Next();
+    if (impl_->have_row) q.Integer(0, 0, kFrame);  // a frame of 7.5 is refused, not read as 7
   }
+  if (!impl_->have_row) RequireEveryTrajectoryRowStreamed(*impl_->db, impl_->file, impl_->last_frame, impl_->rows);
   return true;
 }
 
@@ -683,7 +713,11 @@ PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
       "JOIN person_state s ON s.frame = t.frame AND s.id = t.id WHERE t.frame <= ?1 "
       "ORDER BY t.frame, t.id");
   stream.impl_->query->Bind(1, last_frame).Describe("trajectory_data", {0, 1});
+  stream.impl_->db = impl_->db.get();
+  stream.impl_->file = impl_->file;
+  stream.impl_->last_frame = last_frame;
   stream.impl_->have_row = stream.impl_->query->Next();
+  if (!stream.impl_->have_row) RequireEveryTrajectoryRowStreamed(*impl_->db, impl_->file, last_frame, 0);
   return stream;
 }
 
