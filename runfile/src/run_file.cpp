@@ -428,6 +428,7 @@ void RunFileWriter::SetRunValue(const std::string& key, const std::string& value
 struct RunFileReader::Impl {
   std::unique_ptr<Database> db;
   std::string file;
+  bool frames_checked = false;  // Frame's one check of trajectory_data's frame column
 };
 
 RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
@@ -501,11 +502,11 @@ std::string RunFileReader::walkable_wkt() const {
   return s.Next() ? s.Text(0) : "";
 }
 
+// From FrameTimes, so that every command that lists the frames also checks
+// their times.
 std::vector<std::int64_t> RunFileReader::Frames() const {
   std::vector<std::int64_t> frames;
-  Statement s(*impl_->db, "SELECT frame FROM frame_time ORDER BY frame");
-  s.Describe("frame_time", {0});
-  while (s.Next()) frames.push_back(s.Integer(0, 0, run_limits::kFrame));
+  for (const FrameTime& t : FrameTimes()) frames.push_back(t.frame);
   return frames;
 }
 
@@ -531,6 +532,15 @@ Contact ReadContact(Statement& c) {
 }  // namespace
 
 RunFrame RunFileReader::Frame(std::int64_t frame) const {
+  if (!impl_->frames_checked) {
+    // Frame by frame, a row whose frame is not a whole number is never
+    // asked for: look for one once (a scan of the frame index).
+    Statement odd(*impl_->db, "SELECT frame, id FROM trajectory_data WHERE typeof(frame) != 'integer' LIMIT 1");
+    if (odd.Next())
+      throw InputError(impl_->file + ": table trajectory_data, row frame " + odd.Text(0) + ", id " + odd.Text(1) +
+                       ": the frame is not a whole number (the run file is damaged)");
+    impl_->frames_checked = true;
+  }
   RunFrame f;
   f.frame = frame;
   {
@@ -632,7 +642,15 @@ std::vector<FrameTime> RunFileReader::FrameTimes() const {
   std::vector<FrameTime> times;
   Statement s(*impl_->db, "SELECT frame, time_s FROM frame_time ORDER BY frame");
   s.Describe("frame_time", {0});
-  while (s.Next()) times.push_back({s.Integer(0, 0, run_limits::kFrame), s.Real(1, 0.0, run_limits::kTime_s)});
+  while (s.Next()) {
+    const FrameTime t{s.Integer(0, 0, run_limits::kFrame), s.Real(1, 0.0, run_limits::kTime_s)};
+    if (!times.empty() && !(t.time_s > times.back().time_s))
+      throw InputError(impl_->file + ": table frame_time, row frame " + std::to_string(t.frame) + ": time_s " +
+                       FormatNumber(t.time_s) + " s is not after frame " + std::to_string(times.back().frame) + "'s " +
+                       FormatNumber(times.back().time_s) + " s; expected times that increase with the frame (the run "
+                       "file is damaged)");
+    times.push_back(t);
+  }
   return times;
 }
 
