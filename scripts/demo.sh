@@ -55,4 +55,4 @@ for sweep in hallway-bodies hallway-gamma hallway-lambda; do
   "$exe" phase "results/sweeps/madrid-arena/$sweep" -o "$out/phase/$sweep" | tail -n 1
 done
 
-echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite: JuPedSim format, readable by PedPy; analysis), madrid-night/ (timeline run, its figure and its path over the phase diagram), evacuation/, report/ (report.html, report.pdf, people.csv), phase/"
+echo "Outputs written under $out/: venues/, bodies/, hallway/ (run.sqlite and its analysis; for PedPy: crowdrecon export out/hallway/run.sqlite -o run-pedpy.sqlite), madrid-night/ (timeline run, its figure and its path over the phase diagram), evacuation/, report/ (report.html, report.pdf, people.csv), phase/"

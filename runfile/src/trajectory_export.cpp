@@ -23,10 +23,11 @@ using sqlite::Database;
 using sqlite::Statement;
 
 // After the JuPedSim tables (jupedsim_tables.hpp): the map from the
-// export's ids to the run's people.
+// export's ids to the run's people, with each person's group and target (so
+// that a PedPy user splits by direction without opening the run file).
 constexpr const char* kTrackSchema = R"SQL(
 CREATE TABLE crowdrecon_track(id INTEGER PRIMARY KEY, person INTEGER NOT NULL, part INTEGER NOT NULL,
-  first_frame INTEGER NOT NULL, last_frame INTEGER NOT NULL);
+  first_frame INTEGER NOT NULL, last_frame INTEGER NOT NULL, grp INTEGER NOT NULL, target TEXT NOT NULL DEFAULT '');
 )SQL";
 
 // Rows per transaction: a commit per frame of a small run would cost more
@@ -91,7 +92,8 @@ ExportSummary WriteExport(const RunFileReader& run, Database& db) {
   const double fps = run.fps();
   // Ids of later pieces start above every person id, so that a first piece
   // keeps its person's id without ever meeting a later piece's.
-  std::vector<OpenPiece> pieces(run.People().size());
+  const std::vector<Person> people = run.People();
+  std::vector<OpenPiece> pieces(people.size());
   std::int64_t next_id = static_cast<std::int64_t>(pieces.size()) + 1;
 
   // The file gets its name only when complete (ExportTrajectories), so a
@@ -106,9 +108,10 @@ ExportSummary WriteExport(const RunFileReader& run, Database& db) {
     geo.Bind(1, geometry_hash).Bind(2, wkt).Run();
   }
   sqlite::BatchInsert trajectory(db, "trajectory_data", 6), frame_data(db, "frame_data", 2),
-      track(db, "crowdrecon_track", 5);
-  const auto close_piece = [&track](const OpenPiece& p, std::size_t person) {
+      track(db, "crowdrecon_track(id, person, part, first_frame, last_frame, grp)", 6);  // target: below
+  const auto close_piece = [&track, &people](const OpenPiece& p, std::size_t person) {
     track.Add(p.id).Add(static_cast<std::int64_t>(person) + 1).Add(p.part).Add(p.first_frame).Add(p.last_frame);
+    track.Add(static_cast<std::int64_t>(people[person].group));
   };
   Bounds bounds;
 
@@ -175,6 +178,15 @@ ExportSummary WriteExport(const RunFileReader& run, Database& db) {
     if (pieces[i].seen) close_piece(pieces[i], i);
   for (sqlite::BatchInsert* batch : {&trajectory, &frame_data, &track}) batch->Finish();
   summary.tracks = summary.people + summary.splits;
+  // Each track's target by name, set in one statement from the people's.
+  db.Exec("CREATE TEMP TABLE person_target(person INTEGER PRIMARY KEY, target TEXT NOT NULL)");
+  {
+    Statement put(db, "INSERT INTO person_target VALUES(?, ?)");
+    for (std::size_t i = 0; i < people.size(); ++i)
+      put.Bind(1, static_cast<std::int64_t>(i) + 1).Bind(2, people[i].target).Run();
+  }
+  db.Exec("UPDATE crowdrecon_track SET target = (SELECT target FROM person_target p WHERE p.person = crowdrecon_track.person)");
+  db.Exec("DROP TABLE person_target");
 
   WriteMetadata(db, run, fps, bounds, summary);
   // After the rows: one sort instead of an index kept up to date row by row.

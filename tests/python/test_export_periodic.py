@@ -144,6 +144,7 @@ def check(exe, run_path, mode, work):
     run_ori = {(f, i): (ox, oy) for f, i, ox, oy in run.execute("SELECT frame, id, ori_x, ori_y FROM trajectory_data")}
     run_wkt = [r[0] for r in run.execute("SELECT wkt FROM geometry")]
     run_frames = [r[0] for r in run.execute("SELECT frame FROM frame_time ORDER BY frame")]
+    run_people = {i: (g, t) for i, g, t in run.execute("SELECT id, grp, target FROM person")}
     run.close()
 
     exp = sqlite3.connect(f"file:{out}?mode=ro", uri=True)
@@ -170,6 +171,10 @@ def check(exe, run_path, mode, work):
         fail(f"{exp_rows} rows in the export, {run_rows} in the run")
     track = {i: (p, part, f0, f1) for i, p, part, f0, f1 in exp.execute(
         "SELECT id, person, part, first_frame, last_frame FROM crowdrecon_track")}
+    # Each piece carries its person's group and target, as the run's person table has them.
+    for i, p, g, t in exp.execute("SELECT id, person, grp, target FROM crowdrecon_track"):
+        if run_people.get(p) != (g, t):
+            fail(f"id {i}: group and target {(g, t)}, the run's person {p} has {run_people.get(p)}")
     exp_ori = {}
     for f, i, ox, oy in exp.execute("SELECT frame, id, ori_x, ori_y FROM trajectory_data"):
         exp_ori[(f, track[i][0] if i in track else -1)] = (ox, oy)
