@@ -31,7 +31,8 @@ test-long: build
 demo: build
 	@bash scripts/demo.sh $(CROWDRECON) out
 
-# The unit and command-line tests (all but `long`) under AddressSanitizer and
+# The unit and command-line tests (all but `long`; there the whole-scenario
+# tests count as long, tests/CMakeLists.txt) under AddressSanitizer and
 # UndefinedBehaviorSanitizer: -O1, no benchmarks (CMakePresets.json). CI runs it
 # after `make test`.
 sanitize:
