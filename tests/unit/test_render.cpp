@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -13,6 +14,7 @@
 
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/viz/canvas.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 #include "render_scene.hpp"
 
@@ -242,6 +244,35 @@ TEST(RenderRun, ReportsUserErrorsClearly) {
   RenderOptions narrow = options;
   narrow.width_px = 10;
   EXPECT_NE(ErrorOf([&] { RenderRun(run, narrow); }).find("--width: 10 px"), std::string::npos);
+}
+
+// A picture is drawn into a hidden partial file and renamed over the final
+// name only when complete (issue 40: a kill during a figure truncated the
+// previous picture to 0 bytes): a canvas given up before Finish leaves the
+// previous picture as it was and nothing else behind, in every format.
+TEST(Canvas, APictureReplacesThePreviousOneOnlyWhenComplete) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crowdrecon-canvas-atomic";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"figure.png", "figure.svg", "figure.pdf"}) {
+    const std::filesystem::path file = dir / name;
+    { std::ofstream(file) << "the previous picture"; }
+    {
+      Canvas abandoned(file, {0, 0}, {2, 1}, 100, 10);
+      abandoned.FillPolygon({{0, 0}, {1, 0}, {1, 1}}, Color::Black());
+    }  // no Finish: a command that failed while drawing
+    std::ifstream in(file);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text, "the previous picture") << name;
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator{}), 1) << name;
+    Canvas finished(file, {0, 0}, {2, 1}, 100, 10);
+    finished.FillPolygon({{0, 0}, {1, 0}, {1, 1}}, Color::Black());
+    finished.Finish();
+    EXPECT_GT(std::filesystem::file_size(file), 100u) << name;
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator{}), 1) << name;
+    std::filesystem::remove(file);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

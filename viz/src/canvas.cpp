@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/output_path.hpp"
 
 namespace crowdrecon::viz {
 
@@ -30,6 +31,11 @@ std::string PictureFormatProblem(const std::filesystem::path& file) {
 
 struct Canvas::Impl {
   std::filesystem::path file;
+  // Every picture is drawn into a hidden partial file beside `file` and
+  // renamed over it when complete: a kill or a full disk never leaves a
+  // truncated picture under the final name, nor empties the previous one.
+  std::filesystem::path partial;
+  bool written = false;
   Format format = Format::kPng;
   Vec2 world_min, world_max;
   double scale = 1.0;  // pixels per metre
@@ -57,6 +63,7 @@ Canvas::Canvas(const std::filesystem::path& file, Vec2 world_min, Vec2 world_max
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.file = file;
+  m.partial = PartialPath(file);
   m.format = FormatOf(file);
   m.world_min = world_min;
   m.world_max = world_max;
@@ -73,10 +80,10 @@ Canvas::Canvas(const std::filesystem::path& file, Vec2 world_min, Vec2 world_max
                                              static_cast<int>(m.height));
       break;
     case Format::kSvg:
-      m.surface = cairo_svg_surface_create(file.c_str(), m.width, m.height);
+      m.surface = cairo_svg_surface_create(m.partial.c_str(), m.width, m.height);
       break;
     case Format::kPdf:
-      m.surface = cairo_pdf_surface_create(file.c_str(), m.width, m.height);
+      m.surface = cairo_pdf_surface_create(m.partial.c_str(), m.width, m.height);
       break;
   }
   if (cairo_surface_status(m.surface) != CAIRO_STATUS_SUCCESS)
@@ -92,6 +99,10 @@ Canvas::Canvas(const std::filesystem::path& file, Vec2 world_min, Vec2 world_max
 Canvas::~Canvas() {
   if (impl_->cr) cairo_destroy(impl_->cr);
   if (impl_->surface) cairo_surface_destroy(impl_->surface);
+  if (!impl_->written) {
+    std::error_code ignored;
+    std::filesystem::remove(impl_->partial, ignored);
+  }
 }
 
 double Canvas::width_px() const { return impl_->width; }
@@ -227,7 +238,7 @@ void Canvas::Finish() {
   cairo_show_page(m.cr);
   cairo_surface_flush(m.surface);
   if (m.format == Format::kPng) {
-    const cairo_status_t status = cairo_surface_write_to_png(m.surface, m.file.c_str());
+    const cairo_status_t status = cairo_surface_write_to_png(m.surface, m.partial.c_str());
     if (status != CAIRO_STATUS_SUCCESS)
       throw InputError(m.file.string() + ": cannot write picture: " +
                        cairo_status_to_string(status));
@@ -236,6 +247,10 @@ void Canvas::Finish() {
   if (cairo_surface_status(m.surface) != CAIRO_STATUS_SUCCESS)
     throw InputError(m.file.string() + ": cannot write picture: " +
                      cairo_status_to_string(cairo_surface_status(m.surface)));
+  std::error_code ec;
+  std::filesystem::rename(m.partial, m.file, ec);
+  if (ec) throw InputError(m.file.string() + ": cannot write picture: " + ec.message());
+  m.written = true;
 }
 
 }  // namespace crowdrecon::viz
