@@ -1,16 +1,15 @@
 #include "crowdrecon/common/child_process.hpp"
 
 #include <fcntl.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <csignal>
+#include <cerrno>
 #include <cstring>
 #include <thread>
-
-extern char** environ;
 
 namespace crowdrecon {
 
@@ -78,29 +77,57 @@ ChildResult RunChildProcess(const std::vector<std::string>& argv, const std::fil
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&files, 1, 2);
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  posix_spawnattr_setpgroup(&attributes, 0);  // a group of its own: crowdrecon ends it as a whole
-  sigset_t defaults, none;
-  sigemptyset(&defaults);
-  sigaddset(&defaults, SIGINT);
-  sigaddset(&defaults, SIGTERM);
-  sigemptyset(&none);
-  posix_spawnattr_setsigdefault(&attributes, &defaults);
-  posix_spawnattr_setsigmask(&attributes, &none);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+  const std::string log_path = log.string();
   CatchInterruptions catching;
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, args[0], &files, &attributes, args.data(), environ);
-  posix_spawn_file_actions_destroy(&files);
-  posix_spawnattr_destroy(&attributes);
-  if (spawned != 0) {
-    result.problem = std::string("cannot be started: ") + std::strerror(spawned);
+  // A pipe that closes on exec tells a failed exec's errno to the parent.
+  int report[2];
+  if (pipe2(report, O_CLOEXEC) != 0) {
+    result.problem = std::string("cannot be started: ") + std::strerror(errno);
+    return result;
+  }
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(report[0]);
+    close(report[1]);
+    result.problem = std::string("cannot be started: ") + std::strerror(errno);
+    return result;
+  }
+  if (pid == 0) {
+    // The child: only async-signal-safe calls until exec. A group of its
+    // own (crowdrecon ends it as a whole); killed if crowdrecon dies, even
+    // by SIGKILL (Linux's parent-death signal), so no browser outlives it.
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
+    struct sigaction standard {};
+    standard.sa_handler = SIG_DFL;
+    sigemptyset(&standard.sa_mask);
+    sigaction(SIGINT, &standard, nullptr);
+    sigaction(SIGTERM, &standard, nullptr);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    const int in = open("/dev/null", O_RDONLY);
+    const int out = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || dup2(in, 0) < 0 || dup2(out, 1) < 0 || dup2(out, 2) < 0) {
+      const int e = errno;
+      (void)!write(report[1], &e, sizeof e);
+      _exit(127);
+    }
+    execv(args[0], args.data());
+    const int e = errno;
+    (void)!write(report[1], &e, sizeof e);
+    _exit(127);
+  }
+  close(report[1]);
+  int exec_errno = 0;
+  const ssize_t got = read(report[0], &exec_errno, sizeof exec_errno);
+  close(report[0]);
+  if (got == static_cast<ssize_t>(sizeof exec_errno)) {
+    int ignored = 0;
+    waitpid(pid, &ignored, 0);
+    result.problem = std::string("cannot be started: ") + std::strerror(exec_errno);
     return result;
   }
   result.started = true;

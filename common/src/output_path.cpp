@@ -1,8 +1,12 @@
 #include "crowdrecon/common/output_path.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <string>
+#include <vector>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -164,6 +168,33 @@ void WriteFileAtomically(const fs::path& file, const std::string& text) {
 bool FileStartsWith(const fs::path& file, const std::string& magic, std::size_t offset) {
   const std::string head = Head(file, offset + magic.size());
   return head.size() == offset + magic.size() && head.compare(offset, magic.size(), magic) == 0;
+}
+
+bool IsStalePartial(const fs::path& file) {
+  const std::string name = file.filename().string();
+  const auto at = name.find(".partial-");
+  if (name.empty() || name[0] != '.' || at == std::string::npos) return false;
+  const std::string rest = name.substr(at + 9);
+  const std::string digits = rest.substr(0, rest.find('.'));
+  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return false;
+  const pid_t pid = static_cast<pid_t>(std::stol(digits));
+  return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH;
+}
+
+std::vector<fs::path> RemoveLeftovers(const fs::path& folder, const std::vector<std::string>& leftovers) {
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  std::vector<fs::path> entries;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) entries.push_back(it->path());
+  std::sort(entries.begin(), entries.end());
+  for (const fs::path& p : entries) {
+    const std::string name = p.filename().string();
+    if (!IsStalePartial(p) && std::find(leftovers.begin(), leftovers.end(), name) == leftovers.end()) continue;
+    std::error_code gone;
+    fs::remove_all(p, gone);
+    if (!gone) removed.push_back(p);
+  }
+  return removed;
 }
 
 bool FolderHoldsOnly(const fs::path& folder, const std::function<bool(const fs::directory_entry&)>& ours) {

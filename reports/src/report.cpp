@@ -304,6 +304,8 @@ std::string ChromiumFor(const ReportOptions& options) {
 // (each complete or not at all).
 void WritePage(const ReportOptions& options, const std::string& chromium, const std::string& html, ReportSummary* summary) {
   CreateOutputFolder(options.output_dir);
+  for (const fs::path& left : RemoveLeftovers(options.output_dir, {".chromium-profile", ".chromium.log"}))
+    summary->notes.push_back("removed " + left.string() + ", left by a report that was killed");
   summary->html = options.output_dir / "report.html";
   WriteFileAtomically(summary->html, html);
   if (!options.pdf) return;
@@ -343,9 +345,11 @@ OutputKind ReportFolderOutput() {
             std::error_code ec;
             if (!fs::is_regular_file(dir / "report.html", ec)) return false;
             if (ReadInputFile(dir / "report.html", "report").find(kGenerator) == std::string::npos) return false;
+            // With what a killed report leaves (WritePage removes it).
             return FolderHoldsOnly(dir, [](const fs::directory_entry& e) {
               const std::string name = e.path().filename().string();
-              return name == "report.html" || name == "report.pdf" || name == "people.csv";
+              return name == "report.html" || name == "report.pdf" || name == "people.csv" ||
+                     name == ".chromium-profile" || name == ".chromium.log" || IsStalePartial(e.path());
             });
           }};
 }
@@ -385,7 +389,9 @@ std::string ReportSummary::BriefReport() const {
     for (const std::string& line : envelope_lines) s += "  " + line + "\n";
     return s + "  " + Short(seconds) + " s\n";
   }
-  std::string s = "report: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + ", " + csv.string() + "\n";
+  std::string s;
+  for (const std::string& n : notes) s += "note: " + n + "\n";
+  s += "report: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + ", " + csv.string() + "\n";
   const auto line = [](const EnsembleSummary& e) {
     return "  " + e.label + " (" + std::to_string(e.runs) + (e.runs == 1 ? " run" : " runs") + "): people " +
            Value(e.people.median, 3) + "; safe " + Value(e.zone[0].median, 3) + ", uncomfortable " +

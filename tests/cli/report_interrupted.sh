@@ -5,8 +5,9 @@
 # plays the worst case. Checks, for each signal sent to report's process
 # group: exit 128 + signal within 2 s, no process of the stand-in left, no
 # leftover (.chromium-profile, .chromium.log, a partial PDF, report.pdf),
-# and a rerun into the same folder that succeeds. Then a browser that fails
-# at once is reported with its exit status (not a raw wait status).
+# and a rerun into the same folder that succeeds; then SIGKILL to the report
+# alone (the browser must die with it; the rerun cleans up). Then a browser
+# that fails at once is reported with its exit status (not a raw wait status).
 #   report_interrupted.sh CROWDRECON RUN_FILE
 set -uo pipefail
 exe=$1; run=$2
@@ -48,6 +49,27 @@ for signal in INT TERM; do
   "$exe" report "$run" -o "$d/report-$signal" --no-pdf -q > /dev/null || fail "SIG$signal: the rerun failed"
   echo "SIG$signal: exit $rc after $took_ms ms, nothing left, rerun done"
 done
+# Killed outright (SIGKILL to the report alone): the browser dies with it
+# (the parent-death signal), and the rerun removes what the killed report
+# left and says so (before: refused as "not a report folder").
+rm -f "$d/browser.pid" "$d/helper.pid"
+"$exe" report "$run" -o "$d/report-KILL" --chromium "$d/fake-chromium" -q > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 100); do [[ -f $d/helper.pid ]] && break; sleep 0.1; done
+[[ -f $d/helper.pid ]] || fail "the stand-in browser never started"
+mkdir -p "$d/report-KILL/.chromium-profile"  # as Chromium makes it
+touch "$d/report-KILL/.report.partial-999999999.pdf"  # a partial PDF of a process long gone
+kill -KILL "$pid"; wait "$pid"
+sleep 0.3
+alive "$d/browser.pid" && fail "SIGKILL: the browser outlived the report"
+kill -KILL "$(cat "$d/helper.pid")" 2>/dev/null  # the stand-in's own helper is the stand-in's business
+"$exe" report "$run" -o "$d/report-KILL" --no-pdf > "$d/rerun.txt" 2>&1 || { cat "$d/rerun.txt"; fail "SIGKILL: the rerun was refused"; }
+cat "$d/rerun.txt"
+for left in .chromium-profile .chromium.log .report.partial-999999999.pdf; do
+  grep -q "note: removed $d/report-KILL/$left, left by a report that was killed" "$d/rerun.txt" || fail "SIGKILL: $left not said"
+  [[ ! -e $d/report-KILL/$left ]] || fail "SIGKILL: $left still there"
+done
+echo "SIGKILL: the browser ended with the report; the rerun removed what it left and said so"
 set +m
 printf '#!/bin/sh\necho "no display" >&2\nexit 3\n' > "$d/broken-chromium"; chmod +x "$d/broken-chromium"
 "$exe" report "$run" -o "$d/broken" --chromium "$d/broken-chromium" -q > "$d/broken.txt" 2>&1; rc=$?

@@ -383,6 +383,8 @@ void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend,
 // OpenCV's writer, chosen by the video's extension. Debian's OpenCV writes
 // Motion-JPEG AVI with its built-in encoder (no FFmpeg needed); MPEG-4 part 2
 // ("mp4v") in .mp4 needs its FFmpeg backend, so that one may fall back to AVI.
+// The video is written under a hidden partial name (same extension) and
+// renamed when Close succeeds; given up, the partial file is removed.
 class VideoOut {
  public:
   VideoOut(const std::filesystem::path& requested, double fps, int width_px, int height_px,
@@ -404,6 +406,7 @@ class VideoOut {
     if (!writer_->IsOpened())
       throw InputError(path.string() + ": cannot write video (" + codec + " at " + FormatNumber(fps) +
                        " fps); check that the folder exists and is writable");
+    final_ = path;
     summary->video_written = path;
     summary->video_codec = codec;
     summary->video_fps = fps;
@@ -422,15 +425,39 @@ class VideoOut {
     }
     writer_->Write(image);
   }
-  void Close() { writer_->Release(); }
+  void Close() {
+    writer_->Release();
+    std::error_code ec;
+    std::filesystem::rename(PartialPath(final_), final_, ec);
+    if (ec) throw InputError(final_.string() + ": cannot write video: " + ec.message());
+    closed_ = true;
+  }
+  VideoOut(VideoOut&& other) noexcept
+      : writer_(std::move(other.writer_)), size_(other.size_), final_(std::move(other.final_)), closed_(other.closed_) {
+    other.closed_ = true;  // the moved-from object owns no file
+  }
+  VideoOut& operator=(VideoOut&&) = delete;
+  ~VideoOut() {
+    if (closed_) return;
+    if (writer_) writer_->Release();
+    std::error_code ignored;
+    if (!final_.empty()) std::filesystem::remove(PartialPath(final_), ignored);
+  }
 
  private:
   void Open(const std::filesystem::path& path, const std::string& codec, double fps) {
     // OpenCV may print backend warnings on failure; the fallback above reports the outcome.
-    writer_->Open(path.string(), -1, media::FourCc(codec[0], codec[1], codec[2], codec[3]), fps, size_, true);
+    writer_->Open(PartialPath(path).string(), -1, media::FourCc(codec[0], codec[1], codec[2], codec[3]), fps, size_,
+                  true);
+    if (!writer_->IsOpened()) {
+      std::error_code ignored;
+      std::filesystem::remove(PartialPath(path), ignored);
+    }
   }
   std::unique_ptr<media::VideoWriter> writer_ = media::MakeVideoWriter();
   cv::Size size_;
+  std::filesystem::path final_;
+  bool closed_ = false;
 };
 
 }  // namespace

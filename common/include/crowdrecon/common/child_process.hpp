@@ -4,7 +4,9 @@
 // are caught, and the child's whole group is ended (SIGTERM, then SIGKILL
 // after a second) before Interrupted is thrown, so that nothing of
 // it keeps running; a child that outlives its time limit is ended the same
-// way. No shell is involved: the arguments reach the program as given.
+// way. If crowdrecon itself is killed (even by SIGKILL), the child gets
+// SIGKILL too (Linux's parent-death signal). No shell is involved: the
+// arguments reach the program as given.
 #pragma once
 
 #include <filesystem>

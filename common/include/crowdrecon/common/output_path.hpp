@@ -86,6 +86,14 @@ OutputKind PictureOutputKind();
 OutputKind VideoOutputKind();
 // True if the file begins with `magic` at `offset`.
 bool FileStartsWith(const std::filesystem::path& file, const std::string& magic, std::size_t offset = 0);
+// A hidden partial file of PartialPath's form (".NAME.partial-PID.EXT")
+// whose writing process no longer runs: what a killed writer left behind.
+bool IsStalePartial(const std::filesystem::path& file);
+// Removes from `folder` (not recursive) every stale partial file and every
+// entry named in `leftovers` (files or folders a killed command left);
+// returns what it removed, for the command to say so.
+std::vector<std::filesystem::path> RemoveLeftovers(const std::filesystem::path& folder,
+                                                   const std::vector<std::string>& leftovers = {});
 // True if every entry of `folder` (not recursive) satisfies `ours`.
 bool FolderHoldsOnly(const std::filesystem::path& folder,
                      const std::function<bool(const std::filesystem::directory_entry&)>& ours);

@@ -83,6 +83,7 @@ struct ReportSummary {
   // Per ensemble: whether its states are ones a human crowd can reach
   // (analysis/plausibility.hpp; issue 39), in plain words.
   std::vector<std::string> validity_lines;
+  std::vector<std::string> notes;  // e.g. what a killed report had left in the folder, now removed
   double seconds = 0.0;
   std::string BriefReport() const;
 };
