@@ -57,10 +57,28 @@ double Average(const observe::Series* s) {
   return weight > 0 ? sum / weight : std::nan("");
 }
 
+// What the summary's numbers are, stated where they are printed: the
+// velocities' window as used (a span rounded to whole frames), and how the
+// means over bins treat stopped directions.
+std::string Definitions(const observe::Observation& obs) {
+  const nlohmann::json o = nlohmann::json::parse(obs.method_options_json, nullptr, false);
+  std::string window;
+  if (o.is_object() && o.contains("velocity_half_span_frames") && o.contains("velocity_span_s"))
+    window = "velocities are centred differences over +-" + o["velocity_half_span_frames"].dump() + " frames (" +
+             FormatNumber(o["velocity_span_s"].get<double>()) + " s; one-sided at a track's ends)";
+  else if (o.is_object() && o.contains("span_frames") && o.contains("fps"))
+    window = "velocities are image motion over " + o["span_frames"].dump() + " frames (" +
+             FormatNumber(o["span_frames"].get<double>() / o["fps"].get<double>()) + " s)";
+  return "  definitions: " + (window.empty() ? std::string() : window + "; ") +
+         "speeds, shares and density are means over the bins, weighted by their samples; a direction stopped in "
+         "a bin counts with speed 0; flows are means over the bins\n";
+}
+
 void PrintSummary(const observe::Observation& obs) {
   std::printf("observation of %s (%s, by %s): %zu bins of %s s from %s s\n", obs.source_file.c_str(),
               obs.source_format.c_str(), obs.method.c_str(), obs.bins, FormatNumber(obs.bin_s).c_str(),
               FormatNumber(obs.t0_s).c_str());
+  std::printf("%s", Definitions(obs).c_str());
   for (const observe::Region& r : obs.spec.regions) {
     std::printf("  region %s (%s m2): speed forward %s m/s, backward %s m/s; moving forward %s, backward %s, still %s; "
                 "counter-flow share %s",
@@ -165,7 +183,7 @@ void RunFundamentalDiagram(const FdArgs& args) {
       throw InputError(args.files[i] + ": no frame (of every " + std::to_string(args.frame_step) +
                        ") has anyone in the measurement area " + fd.area +
                        "; expected trajectories that pass through the spec's first region");
-    std::printf("%s, area %s (%s m2): %zu frames; density %s", t.source.c_str(), fd.area.c_str(),
+    std::printf("%s, area %s (%s m2): %zu frames with someone in the area (the others are left out); density %s", t.source.c_str(), fd.area.c_str(),
                 FormatNumber(spec.regions.front().Area_m2()).c_str(), fd.points.size(), "");
     double lo = 1e9, hi = 0, mean_v = 0;
     std::size_t n = 0;
