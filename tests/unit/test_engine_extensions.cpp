@@ -65,6 +65,23 @@ void ExpectOnlyTheExtensionActs(Same same, Different different) {
   EXPECT_NE(std::memcmp(a.bodies().position_m.data(), d.bodies().position_m.data(), bytes), 0);  // and on, it acts
 }
 
+// `on` (an extension switched on) run to 0.5 s is the same bit for bit as
+// `one_thread` (the same world on one thread, run to 0.5 s) on two threads
+// and after a resume from a checkpoint at 0.25 s.
+void ExpectSameOnTwoThreadsAndAfterAResume(WorldDef on, const Simulation& one_thread) {
+  const std::size_t bytes = one_thread.bodies().size() * sizeof(Vec2);
+  on.threads = 2;
+  Simulation two(on);
+  two.AdvanceTo(0.5);
+  EXPECT_EQ(std::memcmp(one_thread.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
+  Simulation first(on);
+  first.AdvanceTo(0.25);
+  Simulation resumed(on);
+  resumed.LoadState(first.SaveState());
+  resumed.AdvanceTo(0.5);
+  EXPECT_EQ(std::memcmp(one_thread.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+}
+
 using ParameterChange = std::function<void(ModelParameters&)>;
 
 // Eq. (3) with the jitter, m dv/dt = m/tau (u - v), filters u by
@@ -302,16 +319,7 @@ TEST(TangentialSpringCreep, OffIsThePapersModelAndOnIsDeterministic) {
   const std::size_t bytes = a.bodies().size() * sizeof(Vec2);
   EXPECT_EQ(std::memcmp(a.bodies().position_m.data(), b.bodies().position_m.data(), bytes), 0);
   EXPECT_NE(std::memcmp(a.bodies().position_m.data(), c.bodies().position_m.data(), bytes), 0);
-  on.threads = 2;
-  Simulation two(on);
-  two.AdvanceTo(0.5);
-  EXPECT_EQ(std::memcmp(c.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
-  Simulation first(on);
-  first.AdvanceTo(0.25);
-  Simulation resumed(on);
-  resumed.LoadState(first.SaveState());
-  resumed.AdvanceTo(0.5);
-  EXPECT_EQ(std::memcmp(c.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+  ExpectSameOnTwoThreadsAndAfterAResume(on, c);
 }
 
 // Two people meet head-on in a corridor narrower than their two breadths
@@ -373,17 +381,7 @@ TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
   on.parameters.shoulder_turn = ShoulderTurn::kWhenBlocked;
   Simulation one(on);
   one.AdvanceTo(0.5);
-  on.threads = 2;
-  Simulation two(on);
-  two.AdvanceTo(0.5);
-  const std::size_t bytes = one.bodies().size() * sizeof(Vec2);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
-  Simulation first(on);
-  first.AdvanceTo(0.25);
-  Simulation resumed(on);
-  resumed.LoadState(first.SaveState());
-  resumed.AdvanceTo(0.5);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+  ExpectSameOnTwoThreadsAndAfterAResume(on, one);
 }
 
 // Two people meet head-on in a corridor too narrow to pass at all (0.45 m:
