@@ -355,15 +355,18 @@ OutputKind ReportFolderOutput() {
 }
 
 
-std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs) {
+std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs, std::vector<std::string>* notes) {
   std::vector<fs::path> files;
   for (const fs::path& in : inputs) {
     std::error_code ec;
     if (fs::is_directory(in, ec)) {
-      std::vector<fs::path> found;
+      std::vector<fs::path> found, skipped;
       for (const auto& e : fs::recursive_directory_iterator(in, ec))
-        if (e.is_regular_file() && e.path().extension() == ".sqlite" && runfile::IsRunFile(e.path()))
-          found.push_back(e.path());
+        if (e.is_regular_file() && e.path().extension() == ".sqlite")
+          (runfile::IsRunFile(e.path()) ? found : skipped).push_back(e.path());
+      std::sort(skipped.begin(), skipped.end());
+      for (const fs::path& f : skipped)
+        notes->push_back("left out " + f.string() + ": a .sqlite file that is not a crowdrecon run file (or is damaged)");
       if (found.empty())
         throw InputError(in.string() + ": a folder without crowdrecon run files (*.sqlite); expected run files, e.g. "
                          "a sweep's folder made with \"keep_runs\": true");
@@ -383,15 +386,15 @@ std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs) {
 }
 
 std::string ReportSummary::BriefReport() const {
+  std::string said;
+  for (const std::string& n : notes) said += "note: " + n + "\n";
   if (envelope) {
-    std::string s = "design envelope: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + " (" +
+    std::string s = said + "design envelope: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + " (" +
                     std::to_string(envelope_runs) + " runs)\n";
     for (const std::string& line : envelope_lines) s += "  " + line + "\n";
     return s + "  " + Short(seconds) + " s\n";
   }
-  std::string s;
-  for (const std::string& n : notes) s += "note: " + n + "\n";
-  s += "report: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + ", " + csv.string() + "\n";
+  std::string s = said + "report: " + html.string() + (pdf.empty() ? "" : ", " + pdf.string()) + ", " + csv.string() + "\n";
   const auto line = [](const EnsembleSummary& e) {
     return "  " + e.label + " (" + std::to_string(e.runs) + (e.runs == 1 ? " run" : " runs") + "): people " +
            Value(e.people.median, 3) + "; safe " + Value(e.zone[0].median, 3) + ", uncomfortable " +
@@ -492,8 +495,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
     for (const fs::path& f : options.compare) named.push_back({"an input", f});
     CheckOutputs({{"-o", options.output_dir, ReportFolderOutput()}}, named, options.force);
   }
-  const std::vector<fs::path> main_files = RunFilesOf(options.inputs);
-  const std::vector<fs::path> other_files = options.compare.empty() ? std::vector<fs::path>{} : RunFilesOf(options.compare);
+  std::vector<std::string> input_notes;
+  const std::vector<fs::path> main_files = RunFilesOf(options.inputs, &input_notes);
+  const std::vector<fs::path> other_files =
+      options.compare.empty() ? std::vector<fs::path>{} : RunFilesOf(options.compare, &input_notes);
   const std::string chromium = ChromiumFor(options);
   const auto say = [&](const std::string& text) {
     if (options.progress) options.progress(text);
@@ -508,7 +513,16 @@ ReportSummary WriteReport(const ReportOptions& options) {
   };
   const std::vector<RunRisk> main_runs = analyse(main_files);
   const std::vector<RunRisk> other_runs = analyse(other_files);
+  // An ensemble is seeds of one scenario: runs of another pooled into it
+  // would be averaged as if they were (issue 40).
+  for (const std::vector<RunRisk>* runs : {&main_runs, &other_runs})
+    for (const RunRisk& r : *runs)
+      if (r.scenario_name != runs->front().scenario_name)
+        throw InputError(r.file.string() + ": a run of scenario \"" + r.scenario_name + "\" in an ensemble of \"" +
+                         runs->front().scenario_name + "\" (" + runs->front().file.string() +
+                         "); expected the seeds of one scenario (give another scenario's runs with --compare)");
   ReportSummary summary;
+  summary.notes = input_notes;
   summary.main = Summarise(options.label, main_runs);
   summary.other = Summarise(options.compare_label, other_runs);
   if (!other_runs.empty()) {
