@@ -25,6 +25,23 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kFormat = "crowdrecon-observation";
 constexpr const char* kSpecFormat = "crowdrecon-observation-spec";
+
+// Every quantity an observation holds and its unit: the one list the series
+// are made from and an observation file is checked against.
+constexpr std::pair<const char*, const char*> kQuantityUnits[] = {
+    {"speed", "m/s"},         {"mean_velocity", "m/s"},     {"max_speed", "m/s"},   {"share_moving", "1"},
+    {"share_still", "1"},     {"counterflow_share", "1"},   {"density", "1/m2"},    {"flow", "1/(m s)"}};
+
+// The unit of `quantity`, or "" if no observation has it.
+const char* UnitOf(const std::string& quantity) {
+  for (const auto& [q, unit] : kQuantityUnits)
+    if (quantity == q) return unit;
+  return "";
+}
+
+// A bound no observed value reaches (speeds, shares, densities, flows): a
+// value beyond it is a damaged or foreign file.
+constexpr double kMaxObservedValue = 1e6;
 }  // namespace
 
 // --- regions ----------------------------------------------------------------
@@ -263,11 +280,13 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
   for (std::size_t r = 0; r < cells_.size(); ++r) {
     const std::string& where = spec_.regions[r].name;
     const double area = spec_.regions[r].Area_m2();
-    Series speed_f{"speed", where, "forward", "m/s", {}}, speed_b{"speed", where, "backward", "m/s", {}},
-        speed_a{"speed", where, "all", "m/s", {}}, share_f{"share_moving", where, "forward", "1", {}},
-        share_b{"share_moving", where, "backward", "1", {}}, still{"share_still", where, "all", "1", {}},
-        counter{"counterflow_share", where, "all", "1", {}}, mean_v{"mean_velocity", where, "all", "m/s", {}},
-        density{"density", where, "all", "1/m2", {}}, fastest{"max_speed", where, "all", "m/s", {}};
+    const auto series = [&where](const char* quantity, const char* direction) {
+      return Series{quantity, where, direction, UnitOf(quantity), {}};
+    };
+    Series speed_f = series("speed", "forward"), speed_b = series("speed", "backward"), speed_a = series("speed", "all"),
+           share_f = series("share_moving", "forward"), share_b = series("share_moving", "backward"),
+           still = series("share_still", "all"), counter = series("counterflow_share", "all"),
+           mean_v = series("mean_velocity", "all"), density = series("density", "all"), fastest = series("max_speed", "all");
     for (std::size_t b = 0; b < bins_; ++b) {
       const Cell& c = cells_[r][b];
       const double per = std::max(1.0, frames_[b]) * correlated_;  // samples per independent sample
@@ -326,7 +345,7 @@ void SeriesBuilder::Finish(Observation* obs, bool with_density, bool with_flow, 
     for (std::size_t l = 0; l < fwd_.size(); ++l) {
       const double scale = 1.0 / (spec_.bin_s * spec_.lines[l].Length_m());
       for (int d = 0; d < 2; ++d) {
-        Series s{"flow", spec_.lines[l].name, d == 0 ? "forward" : "backward", "1/(m s)", {}};
+        Series s{"flow", spec_.lines[l].name, d == 0 ? "forward" : "backward", UnitOf("flow"), {}};
         for (std::size_t b = 0; b < bins_; ++b) {
           if (frames_[b] == 0) {
             s.points.push_back({kNaN, kNaN, 0.0});
@@ -548,6 +567,12 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
   for (std::size_t i = 0; i < list.Size(); ++i) {
     const JsonReader s = list.Element(i);
     Series series{s.String("quantity"), s.String("where"), s.String("direction"), s.String("unit"), {}};
+    if (const std::string unit = UnitOf(series.quantity); unit.empty())
+      s.At("quantity").Fail("unknown quantity \"" + ShortText(series.quantity) +
+                            "\"; expected speed, mean_velocity, max_speed, share_moving, share_still, "
+                            "counterflow_share, density or flow");
+    else if (series.unit != unit)
+      s.At("unit").Fail("unit \"" + ShortText(series.unit) + "\" for " + series.quantity + "; expected \"" + unit + "\"");
     series.points.assign(obs.bins, SeriesPoint{kNaN, kNaN, 0.0});
     if (!index.emplace(std::tuple{series.quantity, series.where, series.direction}, i).second)
       s.Fail("a series named twice");
@@ -571,6 +596,9 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
     ev.censored = e.Bool("censored", false);
     ev.peak_speed_m_per_s = number_or_nan("peak_speed_m_per_s");
     ev.rise_time_s = number_or_nan("rise_time_s");
+    if (ev.end_s < ev.time_s)
+      e.At("end_s").Fail("the event ends at " + FormatNumber(ev.end_s) + " s, before it begins at " +
+                         FormatNumber(ev.time_s) + " s; expected an end after the onset");
     e.Finish();
     obs.events.push_back(std::move(ev));
   }
@@ -593,6 +621,10 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
     return v;
   };
   const std::vector<CsvRecord> records = ParseCsv(text, csv_file.string());
+  if (records.size() < 2)
+    throw InputError(csv_file.string() + ": no rows of series; expected the header " + kCsvHeader +
+                     " and a row per series and bin (an observation's series are never all empty)");
+  std::set<std::pair<std::size_t, std::size_t>> seen;  // (series, bin): each once
   for (std::size_t r = 1; r < records.size(); ++r) {  // records[0]: the header
     line_no = records[r].line;
     const std::vector<std::string>& f = records[r].fields;
@@ -608,8 +640,30 @@ Observation ReadObservation(const std::filesystem::path& json_file) {
     if (!(k >= 0 && k < static_cast<double>(obs.bins)))
       throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": time_s " + f[0] + " is outside the " +
                        std::to_string(obs.bins) + " bins");
-    obs.series[it->second].points[static_cast<std::size_t>(k)] = {number(f[5], "value"), number(f[6], "uncertainty"),
-                                                                  number(f[7], "samples")};
+    // The CSV's times are the centres of the JSON's bins (written with %.9g).
+    const double centre = obs.t0_s + (k + 0.5) * obs.bin_s;
+    if (std::abs(t - centre) > 1e-6 * std::max(1.0, std::abs(centre)))
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": time_s " + f[0] +
+                       " is not the centre of a bin (the nearest is " + FormatNumber(centre) + " s with t0_s " +
+                       FormatNumber(obs.t0_s) + " and bin_s " + FormatNumber(obs.bin_s) + " of " + json_file.string() +
+                       "); expected the times of its bins");
+    if (!seen.emplace(it->second, static_cast<std::size_t>(k)).second)
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": series " + f[1] + " " + f[2] + " " + f[3] +
+                       " at " + f[0] + " s a second time; expected one row per series and bin");
+    const SeriesPoint point{number(f[5], "value"), number(f[6], "uncertainty"), number(f[7], "samples")};
+    if (std::abs(point.value) > kMaxObservedValue)
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": value " + f[5] + " is beyond " +
+                       FormatNumber(kMaxObservedValue) + " in magnitude; expected an observed " + f[1] + " in " + f[4]);
+    if (point.uncertainty < 0.0 || point.uncertainty > kMaxObservedValue)
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": uncertainty " + f[6] +
+                       "; expected a number in [0, " + FormatNumber(kMaxObservedValue) + "] or nothing");
+    if (point.samples < 0.0)
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": samples " + f[7] +
+                       "; expected a count of at least 0");
+    if (f[4] != obs.series[it->second].unit)
+      throw InputError(csv_file.string() + ":" + std::to_string(line_no) + ": unit \"" + ShortText(f[4]) + "\" for " +
+                       f[1] + "; " + json_file.string() + " says \"" + obs.series[it->second].unit + "\"");
+    obs.series[it->second].points[static_cast<std::size_t>(k)] = point;
   }
   return obs;
 }

@@ -9,10 +9,16 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <sstream>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/observe/events.hpp"
 #include "crowdrecon/observe/fundamental_diagram.hpp"
 #include "crowdrecon/observe/observation.hpp"
@@ -232,6 +238,71 @@ TEST(Observation, WrittenAndReadBackAndAChangedSeriesFileIsRefused) {
   const std::string error = ErrorOf([&] { ReadObservation(file); });
   EXPECT_NE(error.find("SHA-256"), std::string::npos) << error;
   EXPECT_NE(error.find("obs.csv"), std::string::npos) << error;
+}
+
+// Issue 40: an observation whose files contradict each other or hold values
+// no observation has is refused, naming the file and line (before: observe
+// compare took them all).
+TEST(Observation, AFileThatContradictsItselfIsRefused) {
+  const Observation obs = ObserveTrajectories(Corridor(8, 3, 0.0), CorridorSpec());
+  const auto file = ScratchFile("contradicts.json");
+  const auto csv = ObservationCsvPath(file);
+  // Writes the observation, changes its JSON and its CSV (the CSV's
+  // checksum made to match, as a careful forger would), and returns the
+  // reader's error.
+  const auto refused = [&](const std::function<void(nlohmann::json&)>& change_json,
+                           const std::function<void(std::vector<std::string>&)>& change_csv) {
+    WriteObservation(obs, file);
+    std::ifstream in(csv);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    in.close();
+    change_csv(lines);
+    std::string text;
+    for (const std::string& line : lines) text += line + "\n";
+    std::ofstream(csv, std::ios::trunc) << text;
+    std::ifstream j(file);
+    nlohmann::json json = nlohmann::json::parse(j);
+    j.close();
+    json["series_file"]["sha256"] = Sha256Hex(text);
+    change_json(json);
+    std::ofstream(file, std::ios::trunc) << json.dump(1);
+    return ErrorOf([&] { ReadObservation(file); });
+  };
+  const auto no_json = [](nlohmann::json&) {};
+  const auto no_csv = [](std::vector<std::string>&) {};
+  // The first row with a value, and one of its fields replaced.
+  const auto with_field = [](std::size_t field, const std::string& value) {
+    return [field, value](std::vector<std::string>& lines) {
+      for (std::size_t r = 1; r < lines.size(); ++r) {
+        std::vector<std::string> f;
+        std::stringstream ss(lines[r]);
+        for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+        if (f.size() != 8 || f[5].empty()) continue;
+        f[field] = value;
+        std::string joined;
+        for (std::size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
+        lines[r] = joined;
+        return;
+      }
+    };
+  };
+  EXPECT_EQ(refused(no_json, no_csv), "") << "the unchanged files are read";
+  const std::string bins = refused([](nlohmann::json& j) { j["time"]["bin_s"] = j["time"]["bin_s"].get<double>() * 1.5; }, no_csv);
+  EXPECT_TRUE(bins.find("is not the centre of a bin") != std::string::npos || bins.find("is outside the") != std::string::npos)
+      << bins;
+  EXPECT_NE(refused(no_json, [](std::vector<std::string>& l) { l.resize(1); }).find("no rows of series"), std::string::npos);
+  EXPECT_NE(refused(no_json, with_field(5, "1e300")).find("value 1e300 is beyond 1000000 in magnitude"), std::string::npos);
+  EXPECT_NE(refused(no_json, with_field(6, "-1")).find("uncertainty -1; expected a number in [0, 1000000]"), std::string::npos);
+  EXPECT_NE(refused(no_json, with_field(4, "km/h")).find("unit \"km/h\" for"), std::string::npos);
+  EXPECT_NE(refused([](nlohmann::json& j) { j["series"][0]["unit"] = "km/h"; }, no_csv).find("expected \"m/s\""),
+            std::string::npos);
+  EXPECT_NE(refused(no_json, [](std::vector<std::string>& l) { l.push_back(l[1]); }).find("a second time"),
+            std::string::npos);
+  ASSERT_FALSE(obs.events.empty());
+  const std::string ends = refused(
+      [](nlohmann::json& j) { j["events"][0]["end_s"] = j["events"][0]["time_s"].get<double>() - 1.0; }, no_csv);
+  EXPECT_NE(ends.find("before it begins"), std::string::npos) << ends;
 }
 
 // Issue 40: a region named with a comma, quotes or letters beyond ASCII is
