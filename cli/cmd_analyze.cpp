@@ -27,6 +27,7 @@ struct AnalyzeArgs {
   std::string line;
   bool write = false;
   bool full = false;
+  bool digest = false;
   bool force = false;
   bool settle_check = false;
   double transient_s = -1.0;
@@ -108,6 +109,12 @@ void SettleCheck(const std::string& file, const analysis::RunAnalysis& whole,
 }
 
 void RunAnalyze(const AnalyzeArgs& args) {
+  if (args.digest) {
+    // Only the digest: what "a resumed run is the same run" means, checkable.
+    std::printf("tables digest (SHA-256 of every per-frame table, row by row): %s\n",
+                runfile::RunFileReader(args.run_file).TablesDigest().c_str());
+    return;
+  }
   CheckOutputs({{"--json", args.json, analysis::AnalysisJsonOutput()}}, {{"the run file", args.run_file}}, args.force);
   analysis::AnalysisOptions options;
   if (args.transient_s >= 0.0) options.regime.transient_s = args.transient_s;
@@ -140,6 +147,9 @@ void RegisterAnalyzeCommand(CLI::App& app) {
                 "metric_load_histogram; run values regime, regime_reason)");
   AddForceFlag(cmd, &args->force);
   cmd->add_flag("--full", args->full, "print the full report (set-up, every avalanche, load histogram)");
+  cmd->add_flag("--digest", args->digest,
+                "print only the SHA-256 of the run's per-frame tables: equal for a run and the same run resumed "
+                "from a checkpoint, or run on another number of threads (the file's own bytes may differ)");
   cmd->add_flag("--settle-check", args->settle_check,
                 "replay the run through the check of run.stop_when_settled: when it would have stopped, and "
                 "whether the verdict then is the whole run's (docs/analysis.md)");

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <limits>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
 #include "jupedsim_tables.hpp"
@@ -636,6 +638,42 @@ PeriodicBox RunFileReader::periodic_box() const {
                        " m along the periodic axis " + (axis == 0 ? "x" : "y"));
   }
   return box;
+}
+
+std::string RunFileReader::TablesDigest() const {
+  Sha256 hash;
+  std::vector<std::pair<const char*, const char*>> tables = {
+      {"trajectory_data", "frame, id"}, {"person_state", "frame, id"}, {"contact", "frame, rowid"},
+      {"frame_time", "frame"},          {"event", "frame, rowid"}};
+  if (sqlite::HasTable(*impl_->db, "person_load")) tables.emplace_back("person_load", "frame, id");
+  if (sqlite::HasTable(*impl_->db, "census")) tables.emplace_back("census", "frame");
+  for (const auto& [table, order] : tables) {
+    hash.Update(table, std::strlen(table) + 1);
+    Statement s(*impl_->db, std::string("SELECT * FROM ") + table + " ORDER BY " + order);
+    while (s.Next()) {
+      std::string row;
+      for (int c = 0; c < s.ColumnCount(); ++c) {
+        switch (s.Type(c)) {
+          case SQLITE_INTEGER: row += "i" + std::to_string(s.Int(c)); break;
+          case SQLITE_FLOAT: {
+            char text[32];
+            std::snprintf(text, sizeof text, "r%.17g", s.Double(c));
+            row += text;
+            break;
+          }
+          case SQLITE_NULL: row += "n"; break;
+          default: {  // text and blobs: their length, then their bytes
+            const std::string v = s.Text(c);
+            row += "t" + std::to_string(v.size()) + ":" + v;
+          }
+        }
+        row += ';';
+      }
+      row += '\n';
+      hash.Update(row.data(), row.size());
+    }
+  }
+  return hash.HexDigest();
 }
 
 std::vector<FrameTime> RunFileReader::FrameTimes() const {

@@ -335,6 +335,13 @@ class RunFileReader {
   // outputs drawn from it: its status, what it means and how far it got
   // ("... unfinished (status \"running\": still being written, or killed):
   // what follows covers its frames up to t = 12.3 s only; ...").
+  // SHA-256 of every table the run writes per frame (trajectory_data,
+  // person_state, contact, frame_time, event, and person_load and census
+  // where present), row by row in a fixed order, each value with its type.
+  // A run resumed from a checkpoint has the same digest as the run that was
+  // never stopped, though the files' own bytes differ (SQLite's pages are
+  // laid out by the order of writing): `crowdrecon analyze RUN --digest`.
+  std::string TablesDigest() const;
   std::string UnfinishedNote() const;
   // A run value that must be a number in [min, max]; absent: `fallback`.
   double RunNumber(const std::string& key, double fallback, double min, double max) const;
