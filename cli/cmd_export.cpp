@@ -55,6 +55,9 @@ void RunExport(const ExportArgs& args) {
                 DescribeSeams(s.box).c_str(), static_cast<long long>(s.splits), static_cast<long long>(s.tracks));
   else
     std::printf("not periodic: ids kept, no splits\n");
+  for (const std::string& partial : s.removed_partials)
+    std::printf("removed %s: the unfinished file of an export to %s that was killed\n", partial.c_str(),
+                args.output.c_str());
   for (const std::string& side : s.removed_sidecars)
     std::printf("removed %s: a killed writer's log beside the file replaced (it would have been applied to the export)\n",
                 side.c_str());

@@ -363,6 +363,8 @@ void RunSynthesize(const SynthesizeArgs& args) {
       std::fflush(stderr);
     };
   const observe::SyntheticFootageSummary s = observe::RenderSyntheticFootage(args.run, options, args.video, args.homography);
+  for (const std::filesystem::path& p : s.removed_partials)
+    std::printf("removed %s: the unfinished video of a synthesize that was killed\n", p.c_str());
   if (options.progress) std::fprintf(stderr, "\n");
   std::printf("video: %s (%zu frames at %s fps, from run time %s s; %dx%d; darkness %s, blur %s px, noise %s, JPEG quality %d)\n",
               args.video.c_str(), s.frames, FormatNumber(s.fps).c_str(), FormatNumber(s.first_time_s).c_str(),

@@ -197,6 +197,24 @@ std::vector<fs::path> RemoveLeftovers(const fs::path& folder, const std::vector<
   return removed;
 }
 
+std::vector<fs::path> RemoveStalePartialsOf(const fs::path& file) {
+  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  const std::string prefix = "." + file.stem().string() + ".partial-", extension = file.extension().string();
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  std::vector<fs::path> entries;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) entries.push_back(it->path());
+  std::sort(entries.begin(), entries.end());
+  for (const fs::path& p : entries) {
+    const std::string name = p.filename().string();
+    if (name.rfind(prefix, 0) != 0 || p.extension().string() != extension || !IsStalePartial(p)) continue;
+    std::error_code gone;
+    fs::remove_all(p, gone);
+    if (!gone) removed.push_back(p);
+  }
+  return removed;
+}
+
 bool FolderHoldsOnly(const fs::path& folder, const std::function<bool(const fs::directory_entry&)>& ours) {
   std::error_code ec;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))

@@ -186,6 +186,7 @@ SyntheticFootageSummary RenderSyntheticFootage(const std::filesystem::path& run_
   if (times.size() < 2) throw InputError(run_file.string() + ": the run has fewer than two frames");
   summary.fps = run.fps() / options.frame_step;
   summary.first_time_s = times.front().time_s;
+  summary.removed_partials = RemoveStalePartialsOf(video);
   const std::filesystem::path partial = PartialPath(video);
   const std::unique_ptr<media::VideoWriter> writer = media::MakeVideoWriter();
   writer->Open(partial.string(), cv::CAP_OPENCV_MJPEG, media::FourCc('M', 'J', 'P', 'G'), summary.fps,

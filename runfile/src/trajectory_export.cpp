@@ -207,6 +207,8 @@ ExportSummary ExportTrajectories(const RunFileReader& run, const fs::path& file)
                      "; expected an existing folder to write the export into");
   const fs::path partial = PartialPath(file);
   fs::remove(partial, ec);
+  std::vector<std::string> removed_partials;
+  for (const fs::path& p : RemoveStalePartialsOf(file)) removed_partials.push_back(p.string());
   ExportSummary summary;
   try {
     {
@@ -216,6 +218,7 @@ ExportSummary ExportTrajectories(const RunFileReader& run, const fs::path& file)
     // A killed writer's log beside the file replaced would be applied to
     // the export by every reader.
     summary.removed_sidecars = sqlite::RemoveSidecars(file);
+    summary.removed_partials = removed_partials;
     fs::rename(partial, file, ec);
     if (ec)
       throw InputError(file.string() + ": cannot write the export (renaming " + partial.string() + ": " +

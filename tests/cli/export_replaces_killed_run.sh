@@ -33,3 +33,12 @@ assert db.execute("select value from metadata where key = 'crowdrecon_export'").
 assert not db.execute("select name from sqlite_master where name = 'run'").fetchone(), "the killed run's tables are visible"
 PY
 echo "stale sidecars removed: OK"
+# An export killed outright leaves its unfinished file under a hidden
+# partial name; the next export to the same name removes it and says so.
+touch "$d/.pedpy.partial-999999999.sqlite" "$d/.other-name.partial-999999999.sqlite"
+"$crowdrecon" export "$d/other.sqlite" -o "$d/pedpy.sqlite" > "$d/out2.txt"
+cat "$d/out2.txt"
+grep -q "removed $d/.pedpy.partial-999999999.sqlite: the unfinished file of an export to $d/pedpy.sqlite that was killed" "$d/out2.txt"
+test ! -e "$d/.pedpy.partial-999999999.sqlite"
+test -e "$d/.other-name.partial-999999999.sqlite"  # another file's: left alone
+echo "a killed export's partial file removed: OK"

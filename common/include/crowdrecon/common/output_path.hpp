@@ -94,6 +94,9 @@ bool IsStalePartial(const std::filesystem::path& file);
 // returns what it removed, for the command to say so.
 std::vector<std::filesystem::path> RemoveLeftovers(const std::filesystem::path& folder,
                                                    const std::vector<std::string>& leftovers = {});
+// Removes the stale partial files of `file` (PartialPath's names for it,
+// left by writers of it that were killed); returns what it removed.
+std::vector<std::filesystem::path> RemoveStalePartialsOf(const std::filesystem::path& file);
 // True if every entry of `folder` (not recursive) satisfies `ours`.
 bool FolderHoldsOnly(const std::filesystem::path& folder,
                      const std::function<bool(const std::filesystem::directory_entry&)>& ours);

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "crowdrecon/observe/homography.hpp"
 
@@ -51,6 +52,7 @@ struct SyntheticFootageSummary {
   double fps = 0.0;
   double first_time_s = 0.0;  // run time of the video's first frame
   Homography homography;      // floor -> picture
+  std::vector<std::filesystem::path> removed_partials;  // unfinished videos of killed runs of synthesize
 };
 
 // Writes `video` (.avi) and `homography_file` (JSON). Throws InputError for

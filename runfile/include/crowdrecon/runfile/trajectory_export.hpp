@@ -50,6 +50,7 @@ struct ExportSummary {
   // Stale "-journal", "-wal" or "-shm" files of a killed writer that were
   // beside `file` and were removed (they would have been applied to it).
   std::vector<std::string> removed_sidecars;
+  std::vector<std::string> removed_partials;  // of exports to this file that were killed
 };
 
 // Writes the export of `run` to `file`: into a temporary file beside it
