@@ -113,10 +113,9 @@ void RunEnsemble(const TimelineArgs& args) {
   const reports::EnsembleScore score = reports::ScoreEnsemble(std::move(runs), options);
   const std::string name = ScenarioNameOf(args.runs.front());
   for (const std::string& f : args.figures) {
-    WritePictureAtomically(f, [&](const std::filesystem::path& to) {
-      reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " +
-                                             std::to_string(score.runs.size()) + " runs", to);
-    });
+    // (Every picture replaces its file only when complete: viz::Canvas.)
+    reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " +
+                                           std::to_string(score.runs.size()) + " runs", f);
     std::printf("wrote %s\n", f.c_str());
   }
   for (const std::string& f : args.scores) {
@@ -160,9 +159,7 @@ void RunTimeline(const TimelineArgs& args) {
   }
   const std::string title = ScenarioNameOf(args.run);
   for (const std::string& f : args.figures) {
-    WritePictureAtomically(f, [&](const std::filesystem::path& to) {
-      viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, to);
-    });
+    viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, f);
     std::printf("wrote %s\n", f.c_str());
   }
   std::printf("%zu frames from %s to %s; %zu avalanches and %zu falls in the run; %zu recorded marks\n",
@@ -178,9 +175,7 @@ void RunTimeline(const TimelineArgs& args) {
     const geometry::Venue venue =
         geometry::ParseVenue(runfile::RunFileReader(args.run).venue_json(), args.run + ": run value venue");
     for (const std::string& f : args.density_maps) {
-      WritePictureAtomically(f, [&](const std::filesystem::path& to) {
-        viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, to);
-      });
+      viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, f);
       std::printf("wrote %s\n", f.c_str());
     }
     for (const analysis::DensityMap& m : maps)

@@ -57,16 +57,4 @@ void SayIfUnfinished(const std::string& run_file) {
   if (!note.empty()) std::printf("note: %s\n", note.c_str());
 }
 
-void WritePictureAtomically(const std::string& file, const std::function<void(const std::filesystem::path&)>& draw) {
-  const std::filesystem::path partial = PartialPath(file);
-  try {
-    draw(partial);
-    std::filesystem::rename(partial, file);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(partial, ignored);
-    throw;
-  }
-}
-
 }  // namespace crowdrecon::cli

@@ -25,14 +25,9 @@ CLI::Validator IntegerIn(long long min, long long max);
 // .pdf (the pictures viz::Canvas writes): checked before anything is written.
 void CheckPictureName(const std::string& option, const std::string& file);
 
-// Draws a picture under a temporary name beside `file` and renames it over
-// `file` when complete, so that a failure or a kill never leaves a truncated
-// picture (or an empty one in place of the previous) under the final name.
 // Prints "note: RUN is unfinished (...)" when a run file's status is not
 // "complete" (issue 40: what is drawn, exported or observed from a killed or
 // interrupted run says so); nothing for a finished run or a file that is no run.
 void SayIfUnfinished(const std::string& run_file);
-
-void WritePictureAtomically(const std::string& file, const std::function<void(const std::filesystem::path&)>& draw);
 
 }  // namespace crowdrecon::cli

@@ -145,63 +145,73 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
   std::filesystem::remove(file, ec);
   sqlite::RemoveSidecars(file);
   RunFileWriter w;
-  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
-  Database& db = *w.impl_->db;
-  db.Exec(kJournal);
-  db.Exec("PRAGMA synchronous=NORMAL");
-  db.Exec("BEGIN");
-  db.Exec(detail::kJuPedSimSchema);
-  db.Exec(kSchema);
-  w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
-  {
-    Statement meta(db, "INSERT INTO metadata VALUES(?, ?)");
-    meta.Bind(1, std::string("version")).Bind(2, std::string("2")).Run();
-    meta.Bind(1, std::string("fps")).Bind(2, NumberText(header.output_fps)).Run();
-    Statement geo(db, "INSERT INTO geometry VALUES(?, ?)");
-    geo.Bind(1, w.impl_->geometry_hash).Bind(2, header.walkable_wkt).Run();
-    Statement run(db, "INSERT INTO run VALUES(?, ?)");
-    const auto put = [&](const std::string& k, const std::string& v) { run.Bind(1, k).Bind(2, v).Run(); };
-    put("format", "crowdrecon-run");
-    put("format_version", "2");  // 2: the venue is stored (key venue)
-    put("scenario", header.scenario_json);
-    put("scenario_file", header.scenario_origin);
-    put("seed", std::to_string(header.seed));
-    put("time_step_s", NumberText(header.time_step_s));
-    put("output_fps", NumberText(header.output_fps));
-    put("status", "running");
-    if (!header.venue_json.empty()) put("venue", header.venue_json);
-    const PeriodicBox& box = header.periodic_box;
-    if (box.any()) {
-      const nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
-                                {"max_m", {box.max_m.x, box.max_m.y}}};
-      put("periodic_box", j.dump());
+  // A file that could not be made whole (a full disk, a file-size limit) is
+  // removed with its logs: nothing is left that looks like a run.
+  try {
+    w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
+    Database& db = *w.impl_->db;
+    db.Exec(kJournal);
+    db.Exec("PRAGMA synchronous=NORMAL");
+    db.Exec("BEGIN");
+    db.Exec(detail::kJuPedSimSchema);
+    db.Exec(kSchema);
+    w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
+    {
+      Statement meta(db, "INSERT INTO metadata VALUES(?, ?)");
+      meta.Bind(1, std::string("version")).Bind(2, std::string("2")).Run();
+      meta.Bind(1, std::string("fps")).Bind(2, NumberText(header.output_fps)).Run();
+      Statement geo(db, "INSERT INTO geometry VALUES(?, ?)");
+      geo.Bind(1, w.impl_->geometry_hash).Bind(2, header.walkable_wkt).Run();
+      Statement run(db, "INSERT INTO run VALUES(?, ?)");
+      const auto put = [&](const std::string& k, const std::string& v) { run.Bind(1, k).Bind(2, v).Run(); };
+      put("format", "crowdrecon-run");
+      put("format_version", "2");  // 2: the venue is stored (key venue)
+      put("scenario", header.scenario_json);
+      put("scenario_file", header.scenario_origin);
+      put("seed", std::to_string(header.seed));
+      put("time_step_s", NumberText(header.time_step_s));
+      put("output_fps", NumberText(header.output_fps));
+      put("status", "running");
+      if (!header.venue_json.empty()) put("venue", header.venue_json);
+      const PeriodicBox& box = header.periodic_box;
+      if (box.any()) {
+        const nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
+                                  {"max_m", {box.max_m.x, box.max_m.y}}};
+        put("periodic_box", j.dump());
+      }
     }
-  }
-  {
-    Statement shape(db, "INSERT INTO shape VALUES(?, ?, ?)");
-    for (std::size_t s = 0; s < setup.shapes.size(); ++s)
-      shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, setup.shapes[s].radius_m).Bind(3, PointsJson(setup.shapes[s].vertices)).Run();
-    Statement person(db, "INSERT INTO person VALUES(?, ?, ?, ?, ?, ?, ?)");
-    for (std::size_t i = 0; i < setup.people.size(); ++i) {
-      const Person& p = setup.people[i];
-      person.Bind(1, static_cast<std::int64_t>(i + 1))
-          .Bind(2, static_cast<std::int64_t>(p.shape))
-          .Bind(3, p.mass_kg)
-          .Bind(4, p.inertia_kg_m2)
-          .Bind(5, p.desired_speed_m_per_s)
-          .Bind(6, static_cast<std::int64_t>(p.group))
-          .Bind(7, p.target)
-          .Run();
+    {
+      Statement shape(db, "INSERT INTO shape VALUES(?, ?, ?)");
+      for (std::size_t s = 0; s < setup.shapes.size(); ++s)
+        shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, setup.shapes[s].radius_m).Bind(3, PointsJson(setup.shapes[s].vertices)).Run();
+      Statement person(db, "INSERT INTO person VALUES(?, ?, ?, ?, ?, ?, ?)");
+      for (std::size_t i = 0; i < setup.people.size(); ++i) {
+        const Person& p = setup.people[i];
+        person.Bind(1, static_cast<std::int64_t>(i + 1))
+            .Bind(2, static_cast<std::int64_t>(p.shape))
+            .Bind(3, p.mass_kg)
+            .Bind(4, p.inertia_kg_m2)
+            .Bind(5, p.desired_speed_m_per_s)
+            .Bind(6, static_cast<std::int64_t>(p.group))
+            .Bind(7, p.target)
+            .Run();
+      }
+      Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
+      for (std::size_t k = 0; k < setup.walls.size(); ++k)
+        wall.Bind(1, static_cast<std::int64_t>(k))
+            .Bind(2, static_cast<std::int64_t>(setup.walls[k].closed))
+            .Bind(3, setup.walls[k].radius_m)
+            .Bind(4, PointsJson(setup.walls[k].points))
+            .Run();
     }
-    Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
-    for (std::size_t k = 0; k < setup.walls.size(); ++k)
-      wall.Bind(1, static_cast<std::int64_t>(k))
-          .Bind(2, static_cast<std::int64_t>(setup.walls[k].closed))
-          .Bind(3, setup.walls[k].radius_m)
-          .Bind(4, PointsJson(setup.walls[k].points))
-          .Run();
+    db.Exec("COMMIT");
+  } catch (...) {
+    w.impl_->db.reset();  // closes the file
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+    sqlite::RemoveSidecars(file);
+    throw;
   }
-  db.Exec("COMMIT");
   return w;
 }
 

@@ -231,6 +231,14 @@ void Canvas::ScaleBar(double length_m) {
   TextPx(x0 + length_m * impl_->scale + 6, y0 + 4, FormatNumber(length_m) + " m", 12);
 }
 
+namespace {
+// Cairo's reason, with the likely cause of a failed write.
+std::string Why(cairo_status_t status) {
+  return std::string(cairo_status_to_string(status)) +
+         (status == CAIRO_STATUS_WRITE_ERROR ? " (disk full, or no permission to write there?)" : "");
+}
+}  // namespace
+
 void Canvas::Finish() {
   Impl& m = *impl_;
   if (m.finished) return;
@@ -239,14 +247,11 @@ void Canvas::Finish() {
   cairo_surface_flush(m.surface);
   if (m.format == Format::kPng) {
     const cairo_status_t status = cairo_surface_write_to_png(m.surface, m.partial.c_str());
-    if (status != CAIRO_STATUS_SUCCESS)
-      throw InputError(m.file.string() + ": cannot write picture: " +
-                       cairo_status_to_string(status));
+    if (status != CAIRO_STATUS_SUCCESS) throw InputError(m.file.string() + ": cannot write picture: " + Why(status));
   }
   cairo_surface_finish(m.surface);
   if (cairo_surface_status(m.surface) != CAIRO_STATUS_SUCCESS)
-    throw InputError(m.file.string() + ": cannot write picture: " +
-                     cairo_status_to_string(cairo_surface_status(m.surface)));
+    throw InputError(m.file.string() + ": cannot write picture: " + Why(cairo_surface_status(m.surface)));
   std::error_code ec;
   std::filesystem::rename(m.partial, m.file, ec);
   if (ec) throw InputError(m.file.string() + ": cannot write picture: " + ec.message());
