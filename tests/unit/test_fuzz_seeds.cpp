@@ -1,0 +1,67 @@
+// The engine's fuzz seeds (fuzz/corpus/fuzz_world_file, fuzz_checkpoint)
+// must be in the current formats: a seed the reader refuses at its magic
+// gives the fuzzer no coverage, and fuzz_checkpoint reads its world from the
+// world seed (a world file from before CRWORLD5 made every input a refusal
+// without anyone noticing). Both seeds are stored without their checksum.
+// To write them again after a format change, run
+//   crowdrecon_engine_tests --gtest_also_run_disabled_tests
+//     --gtest_filter=FuzzSeeds.DISABLED_WriteTheCheckpointSeedFromTheWorldSeed
+// after converting the world seed (or writing a new one with SaveWorld).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "crowdrecon/common/fnv.hpp"
+#include "crowdrecon/engine/simulation.hpp"
+#include "crowdrecon/engine/world_file.hpp"
+
+namespace crowdrecon::engine {
+namespace {
+
+const std::string kWorldSeed = std::string(CROWDRECON_SOURCE_DIR) + "/fuzz/corpus/fuzz_world_file/gas-2x2-wall-grid.world-nochecksum";
+const std::string kStateSeed =
+    std::string(CROWDRECON_SOURCE_DIR) + "/fuzz/corpus/fuzz_checkpoint/gas-2x2-colliding-after-40-steps.state-nochecksum";
+
+std::string Read(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string WithChecksum(std::string bytes) {
+  const std::uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
+  bytes.append(reinterpret_cast<const char*>(&checksum), sizeof(checksum));
+  return bytes;
+}
+
+TEST(FuzzSeeds, TheWorldAndCheckpointSeedsAreInTheCurrentFormats) {
+  const WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
+  EXPECT_EQ(world.people.size(), 4u);
+  Simulation sim(world);
+  sim.LoadState(WithChecksum(Read(kStateSeed)));
+  EXPECT_GT(sim.contacts().size(), 0u) << "the seed state has people in contact";
+  for (int step = 0; step < 3; ++step) sim.Step();
+}
+
+// The checkpoint seed: the world seed's people drawn together (positions 0.7
+// times as far from their centre, moving towards it at 4 m/s per metre of
+// distance) and stepped 40 times, saved without its checksum.
+TEST(FuzzSeeds, DISABLED_WriteTheCheckpointSeedFromTheWorldSeed) {
+  WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
+  Vec2 centre{};
+  for (const PersonDef& p : world.people) centre += p.position_m * (1.0 / static_cast<double>(world.people.size()));
+  for (PersonDef& p : world.people) {
+    p.position_m = centre + (p.position_m - centre) * 0.7;
+    p.velocity_m_per_s = (centre - p.position_m) * 4.0;
+  }
+  Simulation sim(world);
+  for (int step = 0; step < 40; ++step) sim.Step();
+  std::string state = sim.SaveState();
+  state.resize(state.size() - sizeof(std::uint64_t));
+  std::ofstream(kStateSeed, std::ios::binary | std::ios::trunc) << state;
+}
+
+}  // namespace
+}  // namespace crowdrecon::engine
