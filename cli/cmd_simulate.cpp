@@ -84,7 +84,7 @@ int RunSimulate(const SimulateArgs& args) {
   if (s.status != "complete") {
     std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s -o %s --resume\n",
                  s.simulated_s, args.scenario.c_str(), args.output.c_str());
-    return 130;
+    return scenario::InterruptedExitStatus();
   }
   return 0;
 }

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/remove_on_interrupt.hpp"
 
 namespace crowdrecon {
 
@@ -145,6 +146,7 @@ fs::path PartialPath(const fs::path& file) {
 
 void WriteFileAtomically(const fs::path& file, const std::string& text) {
   const fs::path partial = PartialPath(file);
+  const RemoveOnInterrupt remove_on_interrupt(partial);
   std::error_code ec;
   {
     std::ofstream out(partial, std::ios::binary | std::ios::trunc);

@@ -8,6 +8,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/remove_on_interrupt.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/media/media.hpp"
 
@@ -188,6 +189,7 @@ SyntheticFootageSummary RenderSyntheticFootage(const std::filesystem::path& run_
   summary.first_time_s = times.front().time_s;
   summary.removed_partials = RemoveStalePartialsOf(video);
   const std::filesystem::path partial = PartialPath(video);
+  const RemoveOnInterrupt remove_on_interrupt(partial);
   const std::unique_ptr<media::VideoWriter> writer = media::MakeVideoWriter();
   writer->Open(partial.string(), cv::CAP_OPENCV_MJPEG, media::FourCc('M', 'J', 'P', 'G'), summary.fps,
                cv::Size(options.width_px, options.height_px), true);

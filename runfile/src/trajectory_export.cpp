@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/remove_on_interrupt.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
 #include "jupedsim_tables.hpp"
@@ -207,6 +208,7 @@ ExportSummary ExportTrajectories(const RunFileReader& run, const fs::path& file)
                      "; expected an existing folder to write the export into");
   const fs::path partial = PartialPath(file);
   fs::remove(partial, ec);
+  const RemoveOnInterrupt remove_on_interrupt(partial);
   std::vector<std::string> removed_partials;
   for (const fs::path& p : RemoveStalePartialsOf(file)) removed_partials.push_back(p.string());
   ExportSummary summary;

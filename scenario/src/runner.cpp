@@ -31,7 +31,12 @@ namespace {
 
 std::atomic<bool> g_stop_requested{false};
 
-extern "C" void OnInterrupt(int) { g_stop_requested.store(true); }
+std::atomic<int> g_interrupt_signal{0};
+
+extern "C" void OnInterrupt(int signal) {
+  g_interrupt_signal.store(signal);
+  g_stop_requested.store(true);
+}
 
 // FNV-1a of the scenario text and thread-independent settings: a checkpoint
 // only resumes the run it was written for.
@@ -175,6 +180,11 @@ std::string NothingToResume(const std::filesystem::path& run_file, const Scenari
 
 std::filesystem::path CheckpointPath(const std::filesystem::path& run_file) {
   return run_file.string() + ".checkpoint";
+}
+
+int InterruptedExitStatus() {
+  const int signal = g_interrupt_signal.load();
+  return signal == SIGTERM ? 128 + SIGTERM : 128 + SIGINT;
 }
 
 void InstallInterruptHandlers() {

@@ -8,6 +8,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/remove_on_interrupt.hpp"
 
 namespace crowdrecon::viz {
 
@@ -35,6 +36,7 @@ struct Canvas::Impl {
   // renamed over it when complete: a kill or a full disk never leaves a
   // truncated picture under the final name, nor empties the previous one.
   std::filesystem::path partial;
+  std::unique_ptr<RemoveOnInterrupt> remove_on_interrupt;  // the partial file goes on Ctrl-C
   bool written = false;
   Format format = Format::kPng;
   Vec2 world_min, world_max;
@@ -64,6 +66,7 @@ Canvas::Canvas(const std::filesystem::path& file, Vec2 world_min, Vec2 world_max
   Impl& m = *impl_;
   m.file = file;
   m.partial = PartialPath(file);
+  m.remove_on_interrupt = std::make_unique<RemoveOnInterrupt>(m.partial);
   m.format = FormatOf(file);
   m.world_min = world_min;
   m.world_max = world_max;

@@ -1,4 +1,5 @@
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/remove_on_interrupt.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 
 #include <algorithm>
@@ -407,6 +408,7 @@ class VideoOut {
       throw InputError(path.string() + ": cannot write video (" + codec + " at " + FormatNumber(fps) +
                        " fps); check that the folder exists and is writable");
     final_ = path;
+    remove_on_interrupt_ = std::make_unique<RemoveOnInterrupt>(PartialPath(path));
     summary->video_written = path;
     summary->video_codec = codec;
     summary->video_fps = fps;
@@ -433,7 +435,11 @@ class VideoOut {
     closed_ = true;
   }
   VideoOut(VideoOut&& other) noexcept
-      : writer_(std::move(other.writer_)), size_(other.size_), final_(std::move(other.final_)), closed_(other.closed_) {
+      : writer_(std::move(other.writer_)),
+        size_(other.size_),
+        final_(std::move(other.final_)),
+        remove_on_interrupt_(std::move(other.remove_on_interrupt_)),
+        closed_(other.closed_) {
     other.closed_ = true;  // the moved-from object owns no file
   }
   VideoOut& operator=(VideoOut&&) = delete;
@@ -457,6 +463,7 @@ class VideoOut {
   std::unique_ptr<media::VideoWriter> writer_ = media::MakeVideoWriter();
   cv::Size size_;
   std::filesystem::path final_;
+  std::unique_ptr<RemoveOnInterrupt> remove_on_interrupt_;
   bool closed_ = false;
 };
 
@@ -605,8 +612,9 @@ OutputKind FramesFolderOutput() {
     const OutputKind video = VideoOutputKind();
     return FolderHoldsOnly(dir, [&](const std::filesystem::directory_entry& e) {
       std::error_code ec;
-      return e.is_regular_file(ec) &&
-             (std::regex_match(e.path().filename().string(), frame_name) || video.is_previous(e.path()));
+      // With the unfinished pictures of a render that was killed (removed by the next).
+      return e.is_regular_file(ec) && (std::regex_match(e.path().filename().string(), frame_name) ||
+                                       video.is_previous(e.path()) || IsStalePartial(e.path()));
     });
   }};
 }
@@ -693,8 +701,10 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
 
 // 3. The output folder, made only once every selected frame has been read and
 //    checked (ChooseLayout), so that a damaged run file leaves nothing behind.
-void MakeOutputFolder(const std::filesystem::path& dir) {
+void MakeOutputFolder(const std::filesystem::path& dir, RenderSummary* summary) {
   CreateOutputFolder(dir);
+  for (const std::filesystem::path& left : RemoveLeftovers(dir))
+    summary->notes.push_back("removed " + left.string() + ", left by a render that was killed");
 }
 
 // 4. The video, opened before any drawing so that a bad path fails early; its
@@ -798,7 +808,7 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
   if (!scene.floor_note.empty()) summary.notes.push_back(scene.floor_note);
 
   const Layout layout = ChooseLayout(run, frames, scene, options, &summary);
-  MakeOutputFolder(options.output_dir);
+  MakeOutputFolder(options.output_dir, &summary);
   std::optional<VideoOut> video = OpenVideo(run, options, layout, &summary);
 
   std::vector<std::int64_t> slot_of_person;

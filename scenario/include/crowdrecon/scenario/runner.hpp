@@ -59,6 +59,9 @@ std::filesystem::path CheckpointPath(const std::filesystem::path& run_file);
 // Installs SIGINT/SIGTERM handlers that ask running scenarios to stop at the
 // next step (after writing a checkpoint).
 void InstallInterruptHandlers();
+// The exit status of a command those handlers stopped: 143 after SIGTERM,
+// 130 after SIGINT or a stop asked for otherwise (--stop-after: as Ctrl-C).
+int InterruptedExitStatus();
 
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
 
