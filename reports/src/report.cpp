@@ -15,6 +15,7 @@
 
 #include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/child_process.hpp"
+#include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
@@ -865,13 +866,14 @@ ReportSummary WriteReport(const ReportOptions& options) {
     for (const RunRisk& r : runs)
       for (const PersonRisk& p : r.people) {
         all.push_back({&r, &p});
-        char line[512];
-        std::snprintf(line, sizeof line, "%s,%s,%u,%u,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n",
-                      set.c_str(), r.file.filename().string().c_str(), p.id, p.group, p.first_seen_s, p.last_seen_s,
-                      p.max_load_n, p.max_load_time_s, p.max_load_position_m.x, p.max_load_position_m.y,
-                      p.max_raw_load_n, p.time_above_f0_s, p.longest_above_f0_s, p.time_above_danger_s, p.dose,
-                      p.fell ? 1 : 0, ToString(p.zone));
-        csv += line;
+        // The label and the file name as RFC 4180 fields (a comma or quote in
+        // either would shift the columns); the numbers after them.
+        char numbers[512];
+        std::snprintf(numbers, sizeof numbers, "%u,%u,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%s\n",
+                      p.id, p.group, p.first_seen_s, p.last_seen_s, p.max_load_n, p.max_load_time_s,
+                      p.max_load_position_m.x, p.max_load_position_m.y, p.max_raw_load_n, p.time_above_f0_s,
+                      p.longest_above_f0_s, p.time_above_danger_s, p.dose, p.fell ? 1 : 0, ToString(p.zone));
+        csv += CsvField(set) + "," + CsvField(r.file.filename().string()) + "," + numbers;
       }
     std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
       return a.second->dose != b.second->dose ? a.second->dose > b.second->dose : a.second->max_load_n > b.second->max_load_n;

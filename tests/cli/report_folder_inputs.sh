@@ -15,6 +15,14 @@ echo "not a database" > "$d/runs/notes.sqlite"
 cat "$d/out.txt"
 grep -q "note: left out $d/runs/notes.sqlite: a .sqlite file that is not a crowdrecon run file" "$d/out.txt" || fail "the stray file was not said"
 grep -q "(2 runs)" "$d/out.txt" || fail "expected an ensemble of 2 runs"
+# A label with a comma and quotes stays one field of people.csv (RFC 4180).
+"$exe" report "$d/runs" -o "$d/labelled" --no-pdf -q --label 'night, "seeds" 1-2' > /dev/null 2>&1 || fail "refused a label"
+python3 - "$d/labelled/people.csv" <<'PY' || fail "people.csv does not keep the label as one field"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], newline="")))
+assert rows and all(r["set"] == 'night, "seeds" 1-2' for r in rows), rows[:1]
+assert all(r["zone"] in ("safe", "uncomfortable", "danger") for r in rows), rows[:1]
+PY
 sqlite3 "$d/runs/seed-2.sqlite" "UPDATE run SET value = json_set(value, '\$.name', 'another scenario') WHERE key = 'scenario'"
 if "$exe" report "$d/runs" -o "$d/report2" --no-pdf -q > "$d/mixed.txt" 2>&1; then fail "pooled two scenarios into one ensemble"; fi
 cat "$d/mixed.txt"
