@@ -11,16 +11,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$out"; out=$(cd "$out" && pwd)
 w=$(mktemp -d); trap 'rm -rf "$w"' EXIT
 # A 20-s run of the hallway (5 /m2, 30 % counter-flow), checkpoints every 2 s.
-python3 - "$root/venues/madrid-arena/scenarios/hallway-5pm2-30cf.json" "$w/scenario.json" <<'PY'
-import json, os, sys
-src, dst = sys.argv[1], sys.argv[2]
-d = json.load(open(src)); base = os.path.dirname(os.path.abspath(src))
-d["venue"] = os.path.normpath(os.path.join(base, d["venue"]))
-body = d["population"].get("body", {})
-if "reference" in body: body["reference"] = os.path.normpath(os.path.join(base, body["reference"]))
-d["run"]["duration_s"] = 20; d["run"]["checkpoint_interval_s"] = 2; d["run"]["output_fps"] = 10
-json.dump(d, open(dst, "w"))
-PY
+python3 "$root/scripts/scenario-with.py" "$root/venues/madrid-arena/scenarios/hallway-5pm2-30cf.json" "$w/scenario.json" \
+  run.duration_s=20 run.checkpoint_interval_s=2 run.output_fps=10
 "$exe" simulate "$w/scenario.json" -o "$w/whole.sqlite" -q --threads 1 > /dev/null || exit 1
 whole_digest=$("$exe" analyze "$w/whole.sqlite" --digest)
 "$exe" export "$w/whole.sqlite" -o "$w/whole-export.sqlite" > /dev/null || exit 1

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <sstream>
 
@@ -183,15 +184,17 @@ bool IsStalePartial(const fs::path& file) {
   return pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH;
 }
 
-std::vector<fs::path> RemoveLeftovers(const fs::path& folder, const std::vector<std::string>& leftovers) {
-  std::vector<fs::path> removed;
+namespace {
+
+// Removes the entries of `folder` (not recursive, in name order) that
+// `remove` picks; returns those removed.
+std::vector<fs::path> RemoveEntries(const fs::path& folder, const std::function<bool(const fs::path&)>& remove) {
+  std::vector<fs::path> entries, removed;
   std::error_code ec;
-  std::vector<fs::path> entries;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) entries.push_back(it->path());
   std::sort(entries.begin(), entries.end());
   for (const fs::path& p : entries) {
-    const std::string name = p.filename().string();
-    if (!IsStalePartial(p) && std::find(leftovers.begin(), leftovers.end(), name) == leftovers.end()) continue;
+    if (!remove(p)) continue;
     std::error_code gone;
     fs::remove_all(p, gone);
     if (!gone) removed.push_back(p);
@@ -199,22 +202,20 @@ std::vector<fs::path> RemoveLeftovers(const fs::path& folder, const std::vector<
   return removed;
 }
 
+}  // namespace
+
+std::vector<fs::path> RemoveLeftovers(const fs::path& folder, const std::vector<std::string>& leftovers) {
+  return RemoveEntries(folder, [&](const fs::path& p) {
+    return IsStalePartial(p) || std::find(leftovers.begin(), leftovers.end(), p.filename().string()) != leftovers.end();
+  });
+}
+
 std::vector<fs::path> RemoveStalePartialsOf(const fs::path& file) {
   const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
   const std::string prefix = "." + file.stem().string() + ".partial-", extension = file.extension().string();
-  std::vector<fs::path> removed;
-  std::error_code ec;
-  std::vector<fs::path> entries;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) entries.push_back(it->path());
-  std::sort(entries.begin(), entries.end());
-  for (const fs::path& p : entries) {
-    const std::string name = p.filename().string();
-    if (name.rfind(prefix, 0) != 0 || p.extension().string() != extension || !IsStalePartial(p)) continue;
-    std::error_code gone;
-    fs::remove_all(p, gone);
-    if (!gone) removed.push_back(p);
-  }
-  return removed;
+  return RemoveEntries(folder, [&](const fs::path& p) {
+    return p.filename().string().rfind(prefix, 0) == 0 && p.extension().string() == extension && IsStalePartial(p);
+  });
 }
 
 bool FolderHoldsOnly(const fs::path& folder, const std::function<bool(const fs::directory_entry&)>& ours) {

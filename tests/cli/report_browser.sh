@@ -14,15 +14,7 @@ command -v pdftoppm >/dev/null || { echo "report_browser.sh: pdftoppm is not ins
 # Seeds 7, 8 (the ensemble) and 9 (the comparison): the scenario with its
 # seed changed and its paths made absolute.
 for seed in 7 8 9; do
-  python3 - "$scenario" "$out/s$seed.json" "$seed" <<'PY'
-import json, os, sys
-src, dst, seed = sys.argv[1], sys.argv[2], int(sys.argv[3])
-d = json.load(open(src)); base = os.path.dirname(os.path.abspath(src))
-d["venue"] = os.path.normpath(os.path.join(base, d["venue"]))
-d["population"]["body"]["reference"] = os.path.normpath(os.path.join(base, d["population"]["body"]["reference"]))
-d["population"]["seed"] = seed
-json.dump(d, open(dst, "w"))
-PY
+  python3 "$(dirname "$0")/../../scripts/scenario-with.py" "$scenario" "$out/s$seed.json" population.seed=$seed
   "$exe" simulate "$out/s$seed.json" -o "$out/run-$seed.sqlite" -q > /dev/null
 done
 "$exe" report "$out/run-7.sqlite" "$out/run-8.sqlite" --compare "$out/run-9.sqlite" --label "seeds 7, 8" \

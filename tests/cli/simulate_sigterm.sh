@@ -6,16 +6,7 @@
 set -uo pipefail
 exe=$1; scenario=$2
 d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
-python3 - "$scenario" "$d/long.json" <<'PY'
-import json, os, sys
-src, dst = sys.argv[1], sys.argv[2]
-d = json.load(open(src)); base = os.path.dirname(os.path.abspath(src))
-d["venue"] = os.path.normpath(os.path.join(base, d["venue"]))
-body = d["population"].get("body", {})
-if "reference" in body: body["reference"] = os.path.normpath(os.path.join(base, body["reference"]))
-d["run"]["duration_s"] = 600
-json.dump(d, open(dst, "w"))
-PY
+python3 "$(dirname "$0")/../../scripts/scenario-with.py" "$scenario" "$d/long.json" run.duration_s=600
 for signal in TERM INT; do
   rm -f "$d"/run.sqlite*
   "$exe" simulate "$d/long.json" -o "$d/run.sqlite" -q --threads 1 > /dev/null 2> "$d/err.txt" &

@@ -322,6 +322,32 @@ TEST(TangentialSpringCreep, OffIsThePapersModelAndOnIsDeterministic) {
   ExpectSameOnTwoThreadsAndAfterAResume(on, c);
 }
 
+// Two people facing each other on the axis of a corridor `width_m` wide,
+// `distance_m` from its middle, each walking toward the other's side; the
+// second `spread` heavier and faster, and both `offset_m` off the axis on
+// opposite sides.
+WorldDef TwoPeopleHeadOn(const ModelParameters& parameters, double width_m, double distance_m, double offset_m,
+                         double spread) {
+  WorldDef def;
+  def.parameters = parameters;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+  def.shapes.push_back(ThoraxLikeShape());
+  for (int i = 0; i < 2; ++i) {
+    PersonDef p;
+    SetMassFromShape(def.shapes[0], 1000.0, p);
+    p.mass_kg *= 1.0 + spread * i;
+    p.position_m = {i == 0 ? -distance_m : distance_m, i == 0 ? offset_m : -offset_m};
+    p.angle_rad = i == 0 ? 0.0 : std::numbers::pi;
+    p.target = static_cast<std::uint32_t>(i);
+    p.desired_speed_m_per_s = 1.0 + spread * i;
+    def.people.push_back(p);
+  }
+  def.walls.push_back({{{-20.0, -0.5 * width_m}, {20.0, -0.5 * width_m}}, false, 0.0});
+  def.walls.push_back({{{-20.0, 0.5 * width_m}, {20.0, 0.5 * width_m}}, false, 0.0});
+  return def;
+}
+
 // Two people meet head-on in a corridor narrower than their two breadths
 // (0.6 m against 2 x 0.42 m) and wider than their two depths (2 x 0.24 m):
 // Yamamoto et al. (Transp. Res. B 122:486, 2019) saw people in this
@@ -330,23 +356,9 @@ TEST(TangentialSpringCreep, OffIsThePapersModelAndOnIsDeterministic) {
 // *level_turn_rad receives the smaller of their turns away from the
 // corridor's axis at the moment their centres are level.
 double HeadOnInANarrowCorridor(ShoulderTurn turn, double* level_turn_rad) {
-  WorldDef def;
-  def.parameters.shoulder_turn = turn;
-  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
-  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
-  def.shapes.push_back(ThoraxLikeShape());
-  for (int i = 0; i < 2; ++i) {
-    PersonDef p;
-    SetMassFromShape(def.shapes[0], 1000.0, p);
-    p.mass_kg *= 1.0 + 0.1 * i;
-    p.position_m = {i == 0 ? -1.5 : 1.5, i == 0 ? 0.01 : -0.01};
-    p.angle_rad = i == 0 ? 0.0 : std::numbers::pi;
-    p.target = static_cast<std::uint32_t>(i);
-    p.desired_speed_m_per_s = 1.0 + 0.1 * i;
-    def.people.push_back(p);
-  }
-  def.walls.push_back({{{-20.0, -0.3}, {20.0, -0.3}}, false, 0.0});
-  def.walls.push_back({{{-20.0, 0.3}, {20.0, 0.3}}, false, 0.0});
+  ModelParameters parameters;
+  parameters.shoulder_turn = turn;
+  const WorldDef def = TwoPeopleHeadOn(parameters, 0.6, 1.5, 0.01, 0.1);
   Simulation sim(def);
   *level_turn_rad = -1.0;
   for (int k = 1; k <= 30000; ++k) {
@@ -389,23 +401,8 @@ TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
 // along its own desired direction that the person heading +x reached after
 // the first 3 s (negative: it walked back), and the world's end state.
 double HeadOnWithNoWayPast(const ModelParameters& parameters, int threads, std::vector<Vec2>* end_positions) {
-  WorldDef def;
-  def.parameters = parameters;
+  WorldDef def = TwoPeopleHeadOn(parameters, 0.45, 1.0, 0.0, 0.0);
   def.threads = threads;
-  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
-  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
-  def.shapes.push_back(ThoraxLikeShape());
-  for (int i = 0; i < 2; ++i) {
-    PersonDef p;
-    SetMassFromShape(def.shapes[0], 1000.0, p);
-    p.position_m = {i == 0 ? -1.0 : 1.0, 0.0};
-    p.angle_rad = i == 0 ? 0.0 : std::numbers::pi;
-    p.target = static_cast<std::uint32_t>(i);
-    p.desired_speed_m_per_s = 1.0;
-    def.people.push_back(p);
-  }
-  def.walls.push_back({{{-20.0, -0.225}, {20.0, -0.225}}, false, 0.0});
-  def.walls.push_back({{{-20.0, 0.225}, {20.0, 0.225}}, false, 0.0});
   Simulation sim(def);
   double lowest = 1e9;
   for (int k = 1; k <= 120; ++k) {
