@@ -24,8 +24,12 @@ namespace {
 
 // Version 2 adds what the incident timeline changes (who is in each slot,
 // their body, group, the per-group drive, the model parameters); version 1 is
-// still read (a run without a timeline changes none of it).
-constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
+// still read (a run without a timeline changes none of it). Version 3: the
+// model parameters of the shoulder's turn and giving way, and giving way's
+// state; a version-2 state (whose parameter block is shorter) is refused as
+// such rather than misread.
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '3'};
+constexpr char kStateMagicV2[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
 constexpr char kStateMagicV1[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
 
 // The checkpoint's writer and reader (binary_io.hpp, shared with world files).
@@ -170,6 +174,9 @@ std::string Simulation::SaveState() const {
 }
 
 void Simulation::LoadState(const std::string& data) {
+  if (HasMagic(data, kStateMagicV2))
+    throw InputError("checkpoint: written by an older crowdrecon (state format 2, before the model parameters of "
+                     "November 2026); resume the run with the version that wrote it, or start it again");
   const bool v1 = HasMagic(data, kStateMagicV1);
   StateReader r(data, v1);
   const auto n = r.Get<std::uint64_t>();

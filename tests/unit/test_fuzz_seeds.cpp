@@ -14,6 +14,7 @@
 #include <iterator>
 #include <string>
 
+#include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world_file.hpp"
@@ -43,6 +44,22 @@ TEST(FuzzSeeds, TheWorldAndCheckpointSeedsAreInTheCurrentFormats) {
   sim.LoadState(WithChecksum(Read(kStateSeed)));
   EXPECT_GT(sim.contacts().size(), 0u) << "the seed state has people in contact";
   for (int step = 0; step < 3; ++step) sim.Step();
+}
+
+// A state written before this format (CRSTATE2: a shorter parameter block)
+// is refused as such, with what to do, rather than read as truncated.
+TEST(FuzzSeeds, AStateOfTheFormerFormatIsRefusedAsSuch) {
+  const WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
+  std::string state = Read(kStateSeed);
+  ASSERT_EQ(state.substr(0, 8), "CRSTATE3");
+  state[7] = '2';
+  Simulation sim(world);
+  try {
+    sim.LoadState(WithChecksum(state));
+    ADD_FAILURE() << "a version-2 state was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("written by an older crowdrecon (state format 2"), std::string::npos) << e.what();
+  }
 }
 
 // The checkpoint seed: the world seed's people drawn together (positions 0.7
