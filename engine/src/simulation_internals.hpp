@@ -294,6 +294,10 @@ struct Simulation::Internals {
   std::vector<double> give_way_blocked_s;
   std::vector<double> give_way_left_s;
   std::vector<Vec2> give_way_direction;
+  // UpdateGiveWay's scratch (derived each step, not in the checkpoint):
+  // per body, the people touched and the sum of their desired directions.
+  std::vector<int> give_way_touching;
+  std::vector<Vec2> give_way_their_way;
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.
   // Only the gait jitter (a function of time) reads it.

@@ -70,14 +70,29 @@ Vec2 JitterVelocity(std::uint64_t seed, std::uint32_t id, double t_s, const Mode
 // the shoulders beside, which would make everyone at a door wait for
 // everyone). One pass over the contact list in its order: the same sums on
 // any thread count, and from the restored contacts after a resume.
+// Each walking person's desired direction e_i (zero for the others), for
+// the extensions that need everyone's before the per-person pass.
+void DesiredDirections(const BodyState& bodies, const WorldDef& def,
+                       std::vector<geometry::NavigationField::CellCache>& field_cache, std::vector<Vec2>& desired) {
+  desired.assign(bodies.size(), Vec2{});
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies.state[i] == PersonState::kWalking)
+      desired[i] = def.targets[bodies.target[i]].Direction(bodies.position_m[i], field_cache[i]);
+}
+
+// The facing of a blocked person who turns a shoulder into the way: e
+// rotated by the turn (cos, sin) to whichever side is nearer `orientation`.
+Vec2 ShoulderFacing(Vec2 e, Vec2 turn, Vec2 orientation) {
+  const Vec2 left{e.x * turn.x - e.y * turn.y, e.x * turn.y + e.y * turn.x};
+  const Vec2 right{e.x * turn.x + e.y * turn.y, -e.x * turn.y + e.y * turn.x};
+  return Dot(orientation, left) >= Dot(orientation, right) ? left : right;
+}
+
 void HeldBackByPeopleAhead(const BodyState& bodies, const std::vector<Contact>& contacts, const WorldDef& def,
                            std::vector<geometry::NavigationField::CellCache>& field_cache, std::vector<Vec2>& desired,
                            std::vector<double>& held) {
   held.assign(bodies.size(), 0.0);
-  desired.resize(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i)
-    if (bodies.state[i] == PersonState::kWalking)
-      desired[i] = def.targets[bodies.target[i]].Direction(bodies.position_m[i], field_cache[i]);
+  DesiredDirections(bodies, def, field_cache, desired);
   constexpr double kAheadCosine = 0.70710678118654752;  // cos 45 degrees
   const auto ahead = [](Vec2 arm, Vec2 e) { return Dot(arm, e) >= kAheadCosine * Length(arm); };
   for (const Contact& c : contacts) {
@@ -115,7 +130,7 @@ void Simulation::Drive() {
   if (blocked_known) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
   // The shoulder's turn as a rotation of e_i (cos, sin of the turn angle).
   const double turn_rad = mp.shoulder_turn_angle_deg * (std::numbers::pi / 180.0);
-  const Vec2 turn{std::cos(turn_rad), std::sin(turn_rad)};
+  const Vec2 turn = shoulder_turn ? Vec2{std::cos(turn_rad), std::sin(turn_rad)} : Vec2{};
   const bool jitter = mp.gait_jitter == GaitJitter::kIsotropic && mp.gait_jitter_velocity_m_per_s > 0.0;
   const auto jitter_seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
   const double drive_time_s = in.drive_time_s;
@@ -151,29 +166,20 @@ void Simulation::Drive() {
       if (giving_way && in.give_way_left_s[i] > 0.0) direction[k] = in.give_way_direction[i];
       const double speed = Length(v);
       const Vec2 orientation{in.cos_angle[i], in.sin_angle[i]};
-      if (shoulder_turn && in.held_back_n[i] < 0.0) {
-        // Turning the shoulder (issue 39, off by default): blocked, the
-        // person turns e_i by the turn angle to the nearer side, on purpose
-        // (full gain, not eq. 16's share of the speed).
-        const Vec2 e = direction[k];
-        const Vec2 left{e.x * turn.x - e.y * turn.y, e.x * turn.y + e.y * turn.x};
-        const Vec2 right{e.x * turn.x + e.y * turn.y, -e.x * turn.y + e.y * turn.x};
-        const Vec2 facing = Dot(orientation, left) >= Dot(orientation, right) ? left : right;
-        turning[k] = true;
-        sine[k] = Cross(orientation, facing);
-        cosine[k] = Dot(orientation, facing);
-        gain[k] = 1.0;
-        continue;
-      }
+      // Turning the shoulder (issue 39, off by default): a blocked person
+      // turns e_i by the turn angle to the nearer side, on purpose (full
+      // gain, not eq. 16's share of the speed).
+      const bool turn_shoulder = shoulder_turn && in.held_back_n[i] < 0.0;
       // Only the direction of `facing` matters to the angle (atan2 of two
       // products with it), so the velocity needs no normalising.
-      const Vec2 facing = face_velocity ? v : direction[k];
+      const Vec2 facing = turn_shoulder ? ShoulderFacing(direction[k], turn, orientation)
+                                        : face_velocity ? v : direction[k];
       if (facing.x != 0.0 || facing.y != 0.0) {
         turning[k] = true;
         sine[k] = Cross(orientation, facing);
         cosine[k] = Dot(orientation, facing);
         const double v0 = bodies_.desired_speed_m_per_s[i];
-        gain[k] = v0 > 0.0 ? 1.0 - std::exp(-speed / v0) : 1.0;
+        gain[k] = turn_shoulder ? 1.0 : v0 > 0.0 ? 1.0 - std::exp(-speed / v0) : 1.0;
       }
     }
     // Pass 2: theta_D - theta wrapped to (-pi, pi].
@@ -250,12 +256,11 @@ void Simulation::UpdateGiveWay() {
   // Each walking person's own desired direction, then, per person, the
   // people they touch and the sum of those people's directions.
   std::vector<Vec2>& desired = in.yield_direction;
-  desired.assign(n, {});
-  for (std::size_t i = 0; i < n; ++i)
-    if (bodies_.state[i] == PersonState::kWalking)
-      desired[i] = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], in.field_cache[i]);
-  std::vector<int> touching(n, 0);
-  std::vector<Vec2> their_way(n, Vec2{});
+  DesiredDirections(bodies_, def_, in.field_cache, desired);
+  std::vector<int>& touching = in.give_way_touching;
+  std::vector<Vec2>& their_way = in.give_way_their_way;
+  touching.assign(n, 0);
+  their_way.assign(n, Vec2{});
   std::uint32_t last_a = UINT32_MAX, last_b = UINT32_MAX;
   for (const Contact& c : contacts_) {
     if (c.wall || (c.a == last_a && c.b == last_b)) continue;  // a pair once, whatever its features
