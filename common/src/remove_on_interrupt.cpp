@@ -25,6 +25,9 @@ struct sigaction g_previous_int {}, g_previous_term {};
 extern "C" void RemoveAndDie(int signal) {
   for (int k = 0; k < kSlots; ++k)
     if (g_used[k].load()) unlink(g_paths[k]);
+  // Then the folders, emptied by the first pass (rmdir fails on the rest).
+  for (int k = 0; k < kSlots; ++k)
+    if (g_used[k].load()) rmdir(g_paths[k]);
   std::signal(signal, SIG_DFL);
   std::raise(signal);
 }

@@ -20,6 +20,7 @@
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 #include "crowdrecon/common/sha256.hpp"
+#include "crowdrecon/common/staged_folder.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 #include "crowdrecon/sweep/version.hpp"
@@ -301,26 +302,33 @@ std::string ChromiumFor(const ReportOptions& options) {
   return chromium;
 }
 
-// Writes DIR/report.html and, with a browser, DIR/report.pdf printed from it
-// (each complete or not at all).
-void WritePage(const ReportOptions& options, const std::string& chromium, const std::string& html, ReportSummary* summary) {
-  CreateOutputFolder(options.output_dir);
-  for (const fs::path& left : RemoveLeftovers(options.output_dir, {".chromium-profile", ".chromium.log"}))
+// Writes the report's folder as a whole (common/staged_folder.hpp):
+// people.csv (if given), report.html and, with a browser, report.pdf printed
+// from it. Until all are complete the folder is untouched: a browser that
+// fails, Ctrl-C or a kill leaves the previous report as it was.
+void WriteReportFolder(const ReportOptions& options, const std::string& chromium, const std::string& html,
+                       const std::string* csv, ReportSummary* summary) {
+  StagedFolder staged(options.output_dir, ReportFolderOutput());
+  for (const fs::path& left : staged.removed())
     summary->notes.push_back("removed " + left.string() + ", left by a report that was killed");
-  summary->html = options.output_dir / "report.html";
-  WriteFileAtomically(summary->html, html);
-  if (!options.pdf) return;
-  if (options.progress) options.progress("printing report.pdf with " + chromium);
-  summary->pdf = options.output_dir / "report.pdf";
-  const fs::path partial = PartialPath(summary->pdf);
-  try {
-    PrintPdf(chromium, summary->html, partial);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(partial, ec);
-    throw;
+  // What a report of an earlier version left inside its folder (the folder
+  // is replaced as a whole, but the note says what went).
+  std::error_code ec;
+  if (fs::is_directory(options.output_dir, ec) && ReportFolderOutput().is_previous(options.output_dir))
+    for (const fs::path& left : RemoveLeftovers(options.output_dir, {".chromium-profile", ".chromium.log"}))
+      summary->notes.push_back("removed " + left.string() + ", left by a report that was killed");
+  if (csv) {
+    staged.Write("people.csv", *csv);
+    summary->csv = options.output_dir / "people.csv";
   }
-  fs::rename(partial, summary->pdf);
+  staged.Write("report.html", html);
+  summary->html = options.output_dir / "report.html";
+  if (options.pdf) {
+    if (options.progress) options.progress("printing report.pdf with " + chromium);
+    PrintPdf(chromium, staged.path() / "report.html", staged.path() / "report.pdf");
+    summary->pdf = options.output_dir / "report.pdf";
+  }
+  staged.Commit();
 }
 
 }  // namespace
@@ -346,7 +354,8 @@ OutputKind ReportFolderOutput() {
             std::error_code ec;
             if (!fs::is_regular_file(dir / "report.html", ec)) return false;
             if (ReadInputFile(dir / "report.html", "report").find(kGenerator) == std::string::npos) return false;
-            // With what a killed report leaves (WritePage removes it).
+            // With what a killed report of an earlier version left in it (removed
+            // when the folder is replaced).
             return FolderHoldsOnly(dir, [](const fs::directory_entry& e) {
               const std::string name = e.path().filename().string();
               return name == "report.html" || name == "report.pdf" || name == "people.csv" ||
@@ -471,7 +480,7 @@ ReportSummary WriteEnvelopeReport(const ReportOptions& options) {
        Escape(options.command_line) + "</code>. Rerun the sweep with <code>crowdrecon sweep SWEEP_FILE -o DIR</code> "
        "(identical rows whatever the number of jobs).</p>\n";
   h += SelfCheckScript(figures) + "</body></html>\n";
-  WritePage(options, chromium, h, &summary);
+  WriteReportFolder(options, chromium, h, nullptr, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return summary;
 }
@@ -957,11 +966,8 @@ ReportSummary WriteReport(const ReportOptions& options) {
   h += SelfCheckScript(figures);
   h += "</body></html>\n";
 
-  // --- Files: written complete or not at all --------------------------------
-  CreateOutputFolder(options.output_dir);
-  summary.csv = options.output_dir / "people.csv";
-  WriteFileAtomically(summary.csv, csv);
-  WritePage(options, chromium, h, &summary);
+  // --- Files: the folder replaced as a whole, or not at all -------------------
+  WriteReportFolder(options, chromium, h, &csv, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return summary;
 }

@@ -6,6 +6,8 @@
 // own for those signals (simulate's checkpointing stop), they are left in
 // place and stay in charge. SIGKILL cannot be caught: what it leaves, the
 // next writer of the same output removes (RemoveStalePartialsOf).
+// A folder may be held too (StagedFolder's): it is removed after the files,
+// if they were all it held.
 #pragma once
 
 #include <filesystem>
