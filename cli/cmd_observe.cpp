@@ -136,7 +136,8 @@ void RunTrajectories(const TrajectoryArgs& args) {
   const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
   const observe::Trajectories t = observe::ReadTrajectories(args.file, args.fps, args.unit);
   const observe::Observation obs = observe::ObserveTrajectories(t, spec);
-  observe::WriteObservation(obs, args.output);
+  for (const std::filesystem::path& p : observe::WriteObservation(obs, args.output))
+    std::printf("note: removed %s, left by an observe that was killed\n", p.c_str());
   if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
   if (!args.quiet) {
     std::printf("%zu people, frames %lld-%lld at %s fps\n", t.people, static_cast<long long>(t.first_frame),
@@ -329,7 +330,8 @@ void RunFootage(const FootageArgs& args) {
   observe::FootageSummary summary;
   const observe::Observation obs = observe::ObserveFootage(args.video, h, spec, options, &summary);
   if (options.progress) std::fprintf(stderr, "\n");
-  observe::WriteObservation(obs, args.output);
+  for (const std::filesystem::path& p : observe::WriteObservation(obs, args.output))
+    std::printf("note: removed %s, left by an observe that was killed\n", p.c_str());
   if (!args.figure.empty()) DrawObservationFigure(obs, reference.get(), args.figure);
   if (!args.quiet) {
     if (!h.pairs.empty())

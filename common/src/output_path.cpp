@@ -10,6 +10,8 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <memory>
+#include <utility>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -145,27 +147,46 @@ fs::path PartialPath(const fs::path& file) {
          ("." + file.stem().string() + ".partial-" + std::to_string(::getpid()) + file.extension().string());
 }
 
-void WriteFileAtomically(const fs::path& file, const std::string& text) {
-  const fs::path partial = PartialPath(file);
-  const RemoveOnInterrupt remove_on_interrupt(partial);
-  std::error_code ec;
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(file.string() + ": cannot open a file for writing next to it (" + partial.string() + ")");
+std::vector<fs::path> WriteFileAtomically(const fs::path& file, const std::string& text) {
+  return WriteFilesAtomically({{file, text}});
+}
+
+std::vector<fs::path> WriteFilesAtomically(const std::vector<std::pair<fs::path, std::string>>& files) {
+  std::vector<fs::path> partials, stale;
+  for (const auto& file : files)
+    for (const fs::path& p : RemoveStalePartialsOf(file.first)) stale.push_back(p);
+  std::vector<std::unique_ptr<RemoveOnInterrupt>> remove_on_interrupt;
+  const auto remove_partials = [&partials](std::size_t from) {
+    std::error_code ignored;
+    for (std::size_t k = from; k < partials.size(); ++k) fs::remove(partials[k], ignored);
+  };
+  // Every file complete under its partial name first...
+  for (const auto& [file, text] : files) {
+    partials.push_back(PartialPath(file));
+    remove_on_interrupt.push_back(std::make_unique<RemoveOnInterrupt>(partials.back()));
+    std::ofstream out(partials.back(), std::ios::binary | std::ios::trunc);
+    if (!out) {
+      remove_partials(0);
+      throw InputError(file.string() + ": cannot open a file for writing next to it (" + partials.back().string() + ")");
+    }
     out << text;
     out.flush();
     if (!out) {
       out.close();
-      fs::remove(partial, ec);
+      remove_partials(0);
       throw InputError(file.string() + ": error while writing (disk full?)");
     }
   }
-  fs::rename(partial, file, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(partial, ignored);
-    throw InputError(file.string() + ": cannot write: " + ec.message());
+  // ... then each renamed in place.
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    std::error_code ec;
+    fs::rename(partials[k], files[k].first, ec);
+    if (ec) {
+      remove_partials(k);
+      throw InputError(files[k].first.string() + ": cannot write: " + ec.message());
+    }
   }
+  return stale;
 }
 
 bool FileStartsWith(const fs::path& file, const std::string& magic, std::size_t offset) {
@@ -214,7 +235,14 @@ std::vector<fs::path> RemoveStalePartialsOf(const fs::path& file) {
   const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
   const std::string prefix = "." + file.stem().string() + ".partial-", extension = file.extension().string();
   return RemoveEntries(folder, [&](const fs::path& p) {
-    return p.filename().string().rfind(prefix, 0) == 0 && p.extension().string() == extension && IsStalePartial(p);
+    // ".NAME.partial-PID" + the extension, exactly (a name without one, as
+    // a folder's, has ".partial-PID" for its extension).
+    const std::string name = p.filename().string();
+    if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + extension.size() ||
+        name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
+      return false;
+    const std::string pid = name.substr(prefix.size(), name.size() - prefix.size() - extension.size());
+    return !pid.empty() && pid.find_first_not_of("0123456789") == std::string::npos && IsStalePartial(p);
   });
 }
 

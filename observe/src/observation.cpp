@@ -491,7 +491,7 @@ OutputKind ObservationCsvOutput() {
           [](const std::filesystem::path& file) { return FileStartsWith(file, kCsvHeader); }};
 }
 
-void WriteObservation(const Observation& obs, const std::filesystem::path& json_file) {
+std::vector<std::filesystem::path> WriteObservation(const Observation& obs, const std::filesystem::path& json_file) {
   const std::filesystem::path csv_file = ObservationCsvPath(json_file);
   if (csv_file == json_file) throw InputError(json_file.string() + ": the observation file must end in .json");
   std::ostringstream csv;
@@ -531,9 +531,10 @@ void WriteObservation(const Observation& obs, const std::filesystem::path& json_
                            {"peak_speed_m_per_s", NumberOrNull(e.kind == "surge" ? e.peak_speed_m_per_s : kNaN)},
                            {"rise_time_s", NumberOrNull(e.kind == "surge" ? e.rise_time_s : kNaN)}});
   j["notes"] = obs.notes;
-  // The CSV first: a JSON on disk always names a complete CSV.
-  WriteFileAtomically(csv_file, csv_text);
-  WriteFileAtomically(json_file, j.dump(2) + "\n");
+  // Both complete before either replaces a previous observation (a full disk
+  // leaves the previous pair whole); the CSV renamed first, so a JSON on disk
+  // always names a complete CSV, and its SHA-256 tells a pair apart.
+  return WriteFilesAtomically({{csv_file, csv_text}, {json_file, j.dump(2) + "\n"}});
 }
 
 Observation ReadObservation(const std::filesystem::path& json_file) {

@@ -29,4 +29,15 @@ check report "$d/out/report/people.csv" report "$run" -o "$d/out/report" --no-pd
 check analyze "$d/out/analysis.json" analyze "$run" --json "$d/out/analysis.json"
 check observe "$d/out/observation.json" observe trajectories "$run" --spec "$spec" -o "$d/out/observation.json"
 [[ ! -e $d/out/observation.csv ]] || fail "observe: left observation.csv"
+# Over a previous report made with other options, a full disk leaves that
+# report whole (before: a new people.csv beside the old report.html).
+"$exe" report "$run" -o "$d/out/previous" --no-pdf --label first -q > /dev/null || fail "report: the first report failed"
+before=$(cd "$d/out/previous" && ls -A && sha256sum report.html people.csv)
+# (400 KiB: people.csv, ~15 KiB, and the network picture the report draws
+# first fit; report.html, ~470 KiB, does not)
+( trap '' XFSZ; ulimit -f 400; "$exe" report "$run" -o "$d/out/previous" --no-pdf --label second -q > "$d/msg.txt" 2>&1 ); rc=$?
+echo "report over a previous one: exit $rc: $(grep -m1 'error' "$d/msg.txt")"
+[[ $rc -eq 2 ]] || { cat "$d/msg.txt"; fail "report over a previous one: exit $rc, expected 2"; }
+[[ $(cd "$d/out/previous" && ls -A && sha256sum report.html people.csv) == "$before" ]] || fail "report over a previous one: it changed"
+if compgen -G "$d/out/.*partial*" > /dev/null; then fail "report over a previous one: left $(ls -A "$d"/out/.*partial*)"; fi
 echo "every writer refused cleanly on a full disk"

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -62,7 +63,19 @@ std::string DescribeExisting(const std::filesystem::path& path);
 
 // Writes `text` to a temporary file next to `file` and renames it over `file`,
 // so that an error or a kill never leaves a partial, complete-looking file.
-void WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
+// Removes the partial files of `file` that killed writers left, and returns
+// them (for the command to say so).
+std::vector<std::filesystem::path> WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
+
+// Writes several files that make one output (an observation's JSON and the
+// series CSV it names): each is first written complete under its partial
+// name, and only then are all renamed in place, in the order given; an error
+// (a full disk, a folder that cannot be written) changes none of them. Only a
+// kill between two renames can leave the new first file beside the old
+// second one, which their readers detect (the JSON holds the CSV's SHA-256).
+// Returns the killed writers' partial files it removed, as WriteFileAtomically.
+std::vector<std::filesystem::path> WriteFilesAtomically(
+    const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 
 // Throws InputError naming the second of two entries of `files` that are
 // the same file (also through links): "B: given twice (also as A); " + why.

@@ -133,9 +133,12 @@ Observation ObserveTrajectories(const Trajectories& trajectories, const Observat
 // Writes the observation as JSON (metadata, regions, lines, events, and the
 // series' names) and its series as CSV beside it (same name, .csv): columns
 // time_s, quantity, where, direction, unit, value, uncertainty, samples.
-// The JSON records the CSV's SHA-256. Both are written to temporary names
-// and renamed when complete.
-void WriteObservation(const Observation& observation, const std::filesystem::path& json_file);
+// The JSON records the CSV's SHA-256. Both are written complete to
+// temporary names before either is renamed in place (a full disk leaves a
+// previous pair whole). Returns the partial files of killed writers of the
+// pair that it removed, for the command to say so.
+std::vector<std::filesystem::path> WriteObservation(const Observation& observation,
+                                                    const std::filesystem::path& json_file);
 // Reads what WriteObservation wrote (checks the CSV against its checksum).
 Observation ReadObservation(const std::filesystem::path& json_file);
 // The CSV beside an observation file (same name, .csv).
