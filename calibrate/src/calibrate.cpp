@@ -10,6 +10,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/sweep/sweep_runner.hpp"
 #include "evaluator.hpp"
 #include "fit.hpp"
 #include "outputs.hpp"
@@ -566,8 +567,34 @@ std::string Summary::BriefReport() const {
   s += "  " + std::to_string(sets_evaluated) + " parameter sets, " + std::to_string(runs) + " runs simulated now; wall time " +
        FormatNumber(std::round(wall_s)) + " s\n";
   s += "  outputs: " + json_file.string() + ", " + report_file.string() + "\n";
+  for (const std::string& n : notes) s += "note: " + n + "\n";
   return s;
 }
+
+namespace {
+
+// Partial runs an interrupted calibration left in its batch folders (issue
+// 40): a rerun resumes those of the batches it asks for again, but a rerun
+// with other options (other sets, seeds or bounds) never asks for the rest.
+// Once the calibration is done, whatever partial run is left is such an
+// orphan; it is removed (sweep::RemovePartialRuns), one note per batch.
+std::vector<std::string> RemoveOrphanedRuns(const fs::path& batches) {
+  std::vector<fs::path> folders;
+  std::error_code ec;
+  for (fs::directory_iterator it(batches, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_directory()) folders.push_back(it->path());
+  std::sort(folders.begin(), folders.end());
+  std::vector<std::string> notes;
+  for (const fs::path& batch : folders) {
+    const std::vector<fs::path> removed = sweep::RemovePartialRuns(batch);
+    if (!removed.empty())
+      notes.push_back("removed " + std::to_string(removed.size()) + " partial run file(s) from " +
+                      (batch / "runs").string() + ", left by an interrupted calibration whose batch was not asked for again");
+  }
+  return notes;
+}
+
+}  // namespace
 
 Summary Calibrate(const Options& options) {
   const auto t0 = Clock::now();
@@ -594,7 +621,10 @@ Summary Calibrate(const Options& options) {
   r.summary.runs = evaluator.runs_simulated();
   Summarise(spec, r);
   r.summary.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (r.summary.coordinator) WriteOutputs(options.output_dir, evaluator, &r);
+  if (r.summary.coordinator) {
+    WriteOutputs(options.output_dir, evaluator, &r);
+    r.summary.notes = RemoveOrphanedRuns(options.output_dir / "batches");
+  }
   return r.summary;
 }
 

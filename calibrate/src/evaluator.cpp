@@ -194,14 +194,6 @@ SetResult Evaluator::Load(const std::vector<double>& values, const std::string& 
 
 bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std::vector<std::string>& keys,
                          int attempt) {
-  std::string joined = spec_.fingerprint;  // the build's version among it: a batch folder is one build's
-  for (const std::string& k : keys) joined += k;
-  if (attempt > 0) joined += "attempt " + std::to_string(attempt);
-  const std::string batch = Sha256Hex(joined).substr(0, 16);
-  const fs::path batches = dir_ / "batches";
-  CreateOutputFolder(batches);
-  const fs::path sweep_file = batches / (batch + ".json");
-
   json sweep = {{"format", "crowdrecon-sweep"},
                 {"version", 1},
                 {"name", spec_.name + ": " + std::to_string(sets.size()) + " parameter set(s)"},
@@ -218,6 +210,16 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
     variants.push_back({{"name", keys[s]}, {"set", v}});
   }
   sweep["variants"] = variants;
+  // The batch's folder: named by the build (the fingerprint holds its
+  // version: a batch folder is one build's) and the whole sweep, seeds
+  // included (named by the sets alone, a rerun with other seeds found the
+  // earlier seeds' batch and was refused as "a different sweep").
+  std::string joined = spec_.fingerprint + sweep.dump(1);
+  if (attempt > 0) joined += "attempt " + std::to_string(attempt);
+  const std::string batch = Sha256Hex(joined).substr(0, 16);
+  const fs::path batches = dir_ / "batches";
+  CreateOutputFolder(batches);
+  const fs::path sweep_file = batches / (batch + ".json");
   // Every rank writes the same text; the file is read by every rank.
   if (!fs::exists(sweep_file) || ReadInputFile(sweep_file, "batch") != sweep.dump(1)) WriteFileAtomically(sweep_file, sweep.dump(1));
 

@@ -23,6 +23,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/reports/risk.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
 #include "mpi_transport.hpp"
@@ -147,11 +148,14 @@ struct StopRunsOnError {
   }
 };
 
+// What a run file in runs/ may have beside it.
+constexpr const char* kRunFileSidecars[] = {"-journal", "-wal", "-shm", ".checkpoint", ".checkpoint.tmp",
+                                            ".failed-state", ".failed-state.tmp"};
+
 void RemoveRunFiles(const fs::path& file) {
   std::error_code ec;
-  for (const char* suffix : {"", "-journal", "-wal", "-shm", ".checkpoint", ".checkpoint.tmp", ".failed-state",
-                             ".failed-state.tmp"})
-    fs::remove(file.string() + suffix, ec);
+  fs::remove(file, ec);
+  for (const char* suffix : kRunFileSidecars) fs::remove(file.string() + suffix, ec);
 }
 
 std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
@@ -632,6 +636,41 @@ SweepSummary RunSweep(const SweepOptions& options) {
   }
   if (mpi) transport->RootStatus(s.interrupted ? kInterrupted : kDone);
   return s;
+}
+
+std::vector<fs::path> RemovePartialRuns(const fs::path& sweep_dir) {
+  const fs::path runs = sweep_dir / "runs";
+  std::vector<fs::path> files, removed;
+  std::error_code ec;
+  for (fs::directory_iterator it(runs, ec), end; !ec && it != end; it.increment(ec)) files.push_back(it->path());
+  std::sort(files.begin(), files.end());
+  // A sidecar's run file: its name without the suffix ("" if it is none).
+  const auto run_file_of = [](const fs::path& p) {
+    const std::string name = p.string();
+    for (const char* suffix : kRunFileSidecars) {
+      const std::string s = suffix;
+      if (name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0)
+        return fs::path(name.substr(0, name.size() - s.size()));
+    }
+    return fs::path();
+  };
+  for (const fs::path& p : files) {
+    std::error_code gone;
+    if (p.extension() == ".sqlite") {
+      std::string status;
+      try {
+        status = runfile::RunFileReader(p).RunValue("status");
+      } catch (const std::exception&) {
+        status = "unreadable";  // killed before its first tables were written
+      }
+      if (status.rfind("failed", 0) == 0 || status == "complete") continue;
+      RemoveRunFiles(p);
+      removed.push_back(p);
+    } else if (const fs::path owner = run_file_of(p); !owner.empty() && !fs::exists(owner, gone)) {
+      if (fs::remove(p, gone)) removed.push_back(p);  // (not those removed with their run file above)
+    }
+  }
+  return removed;
 }
 
 }  // namespace crowdrecon::sweep

@@ -92,6 +92,41 @@ print("a fit on the bound: bounded on one side,", p["reason"])
 PY
 fi
 
+# A calibration killed outright (SIGKILL while its first batch runs) leaves
+# partial runs in its batch folder; a rerun that never asks for that batch
+# again (other seeds) removes them when it is done, and says so (issue 40:
+# they stayed for good). A failed run's file stays, for its diagnosis.
+if [ "$mode" = local ]; then
+  "$crowdrecon" calibrate "$d/calibration.json" -o "$d/killed" -q --jobs 1 > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 600); do compgen -G "$d/killed/batches/*/runs/*.sqlite" > /dev/null && break; sleep 0.05; done
+  kill -KILL "$pid"
+  wait "$pid" || true
+  partial=$(compgen -G "$d/killed/batches/*/runs/*" | wc -l)
+  [ "$partial" -gt 0 ] || { echo "FAIL: the killed calibration left no partial run to test with"; exit 1; }
+  failed=$(compgen -G "$d/killed/batches/*/runs" | head -1)/failed.sqlite
+  python3 - "$d/truth.sqlite" "$failed" <<'PY'
+import shutil, sqlite3, sys
+shutil.copy(sys.argv[1], sys.argv[2])
+with sqlite3.connect(sys.argv[2]) as db:
+    db.execute("UPDATE run SET value = 'failed: a test' WHERE key = 'status'")
+PY
+  python3 - "$d/calibration.json" "$d/other-seeds.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["seeds"] = {"first": 5, "count": 2}
+json.dump(c, open(sys.argv[2], "w"))
+PY
+  "$crowdrecon" calibrate "$d/other-seeds.json" -o "$d/killed" -q --jobs 2 > "$d/killed.txt" 2>&1 ||
+    { cat "$d/killed.txt"; echo "FAIL: the rerun after a kill failed"; exit 1; }
+  cat "$d/killed.txt"
+  grep -q "note: removed [0-9]* partial run file(s) from $d/killed/batches/.*/runs, left by an interrupted calibration" "$d/killed.txt" ||
+    { echo "FAIL: the removal was not said"; exit 1; }
+  left=$(compgen -G "$d/killed/batches/*/runs/*" || true)
+  [ "$left" = "$failed" ] || { echo "FAIL: left in the batch folders: $left (expected only $failed)"; exit 1; }
+  echo "a killed calibration: $partial partial file(s) removed by the rerun, the failed run kept"
+fi
+
 if [ "$mode" = mpi ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader OMPI_MCA_rmaps_base_oversubscribe=1
   # Interrupted under MPI (SIGTERM to rank 0 once the first batch runs):

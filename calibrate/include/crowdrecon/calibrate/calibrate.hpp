@@ -68,6 +68,7 @@ struct Summary {
   bool starts_agree = false;
   double wall_s = 0.0;
   std::filesystem::path json_file, report_file;
+  std::vector<std::string> notes;  // what was cleaned up (partial runs of earlier, interrupted calibrations)
 
   std::string BriefReport() const;
 };

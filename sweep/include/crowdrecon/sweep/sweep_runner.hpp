@@ -89,4 +89,13 @@ struct SweepSummary {
 // numerically wrong is a row with status "failed: ...", not an error.
 SweepSummary RunSweep(const SweepOptions& options);
 
+// Removes the partial runs a killed sweep left in DIR/runs: run files of
+// runs that were in progress (status "running" or "interrupted", or
+// unreadable) with their SQLite logs and checkpoints, and such sidecars left
+// without their run file. Only continuing that very sweep would resume them;
+// a caller that will not (a calibration whose batch is no longer asked for)
+// removes them. A failed run's file stays, for its diagnosis. Returns the
+// run files (or lone sidecars) removed.
+std::vector<std::filesystem::path> RemovePartialRuns(const std::filesystem::path& sweep_dir);
+
 }  // namespace crowdrecon::sweep
