@@ -29,6 +29,11 @@ check report "$d/out/report/people.csv" report "$run" -o "$d/out/report" --no-pd
 check analyze "$d/out/analysis.json" analyze "$run" --json "$d/out/analysis.json"
 check observe "$d/out/observation.json" observe trajectories "$run" --spec "$spec" -o "$d/out/observation.json"
 [[ ! -e $d/out/observation.csv ]] || fail "observe: left observation.csv"
+# A video: OpenCV's writer reports no write error (before: a truncated
+# video and "31 frames", exit 0); the container is checked before the rename.
+check synthesize "$d/out/clip.avi" observe synthesize "$run" -o "$d/out/clip.avi" --homography-out "$d/out/h.json"
+[[ ! -e $d/out/h.json ]] || fail "synthesize: left h.json"
+check population "$d/out/people.json" population --mode anthropometric --count 3000 --seed 7 -o "$d/out/people.json"
 # Over a previous report made with other options, a full disk leaves that
 # report whole (before: a new people.csv beside the old report.html).
 "$exe" report "$run" -o "$d/out/previous" --no-pdf --label first -q > /dev/null || fail "report: the first report failed"

@@ -429,6 +429,8 @@ class VideoOut {
   }
   void Close() {
     writer_->Release();
+    if (const std::string wrong = media::IncompleteVideo(PartialPath(final_).string()); !wrong.empty())
+      throw InputError(final_.string() + ": the video could not be written completely (disk full?): it " + wrong);
     std::error_code ec;
     std::filesystem::rename(PartialPath(final_), final_, ec);
     if (ec) throw InputError(final_.string() + ": cannot write video: " + ec.message());

@@ -44,6 +44,13 @@ class VideoWriter {
 std::unique_ptr<VideoReader> MakeVideoReader();
 std::unique_ptr<VideoWriter> MakeVideoWriter();
 
+// A video file as VideoWriter::Release left it, checked for completeness:
+// "" if its container's structure (AVI: RIFF chunks; MP4: ISO boxes) ends
+// exactly at the end of the file, else what is wrong ("ends at 8192 bytes
+// where its RIFF chunk says 412356"). OpenCV's writers report no write
+// error: a full disk gave a truncated video and "31 frames written".
+std::string IncompleteVideo(const std::string& path);
+
 // cv::VideoWriter::fourcc: the four characters of a codec as one int.
 constexpr int FourCc(char a, char b, char c, char d) {
   return (a & 255) + ((b & 255) << 8) + ((c & 255) << 16) + ((d & 255) << 24);
