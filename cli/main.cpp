@@ -46,8 +46,12 @@ int main(int argc, char** argv) {
   crowdrecon::cli::SetCommandLine(argc, argv);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own status (130 / 143: interrupted)
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version: 0; a usage error: 2, as any bad input (CLI11's
+    // own codes, 105-115, said nothing more and differed by kind).
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const crowdrecon::InputError& e) {
     std::fprintf(stderr, "crowdrecon: error: %s\n", e.what());
     return 2;

@@ -3,7 +3,8 @@
 # nothing changed.
 #   expect_refused.sh STATUS REGEX [SETUP...] -- COMMAND [ARGS...]
 # STATUS: "2" (crowdrecon: error ...) or "option" (an option's value refused
-#   by the command-line parser: CLI11's statuses 100 to 127).
+#   by the command-line parser: status 2 too, and the parser's "Run with
+#   --help" line).
 # SETUP, done in a scratch folder before the command:
 #   --nested N NAME     NAME: a scenario whose "name" is N nested arrays
 #   --long-key N NAME   NAME: an outline (points) with an unknown key of N characters
@@ -45,7 +46,8 @@ head -c 4000 "$tmp/log.txt"
 fail() { echo "expect_refused.sh: $*"; exit 1; }
 case "$status" in
   2) [[ $rc -eq 2 ]] || fail "expected exit status 2, got $rc" ;;
-  option) [[ $rc -ge 100 && $rc -le 127 ]] || fail "expected an option error (status 100-127), got $rc" ;;
+  option) [[ $rc -eq 2 ]] && grep -q "Run with --help for more information" "$tmp/log.txt" ||
+            fail "expected an option error (status 2 and the parser's \"Run with --help\"), got $rc" ;;
   *) fail "unknown STATUS $status" ;;
 esac
 grep -q "internal error" "$tmp/log.txt" && fail "the message says \"internal error\""
