@@ -61,6 +61,38 @@ assert all(s["sigma"] is None or s["sigma"] > 0 for s in c["statistics"])
 print("outputs: OK,", len(rows), "parameter sets")
 PY
 
+# The machinery of continuing (calibrate.recovery_cheap's checks, now long):
+# a second invocation on the same folder runs nothing and gives the same
+# result; a copy with the last two sets' runs gone, interrupted by SIGINT
+# (or done before the signal came) and continued, runs only what is missing
+# and gives the same result.
+if [ "$mode" = local ]; then
+  "$crowdrecon" calibrate "$d/calibration.json" -o "$d/local" -q --jobs 2 > "$d/second.txt"
+  grep -q " 0 runs simulated now" "$d/second.txt" || { cat "$d/second.txt"; echo "FAIL: the second invocation ran something"; exit 1; }
+  cp -r "$d/local" "$d/again"
+  rm "$d/again/calibration.json"
+  python3 - "$d/local/calibration.json" "$d/again" <<'PY'
+import json, shutil, sys
+for e in json.load(open(sys.argv[1]))["evaluations"][-2:]:
+    shutil.rmtree(sys.argv[2] + "/cache/" + e["key"])
+PY
+  set +e
+  timeout --preserve-status -s INT 0.3 "$crowdrecon" calibrate "$d/calibration.json" -o "$d/again" -q --jobs 2 > "$d/interrupted.txt" 2>&1
+  rc=$?
+  set -e
+  [ "$rc" = 130 ] || [ "$rc" = 0 ] || { cat "$d/interrupted.txt"; echo "FAIL: the interrupted calibration exited $rc"; exit 1; }
+  "$crowdrecon" calibrate "$d/calibration.json" -o "$d/again" -q --jobs 2 > "$d/continued.txt"
+  grep -Eq " [0-4] runs simulated now" "$d/continued.txt" || { cat "$d/continued.txt"; echo "FAIL: more than the 4 missing runs"; exit 1; }
+  python3 - "$d/local/calibration.json" "$d/again/calibration.json" "$rc" <<'PY'
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+for k in ("wall_s", "runs_simulated_now"):
+    a.pop(k, None); b.pop(k, None)
+assert a == b, "the interrupted and continued calibration differs from the uninterrupted one"
+print("continued (first invocation exit %s): the same calibration.json; a second invocation ran nothing" % sys.argv[3])
+PY
+fi
+
 # A best fit on a bound of the range is not "determined": observations of a
 # crowd walking at 1.5-1.7 m/s against desired speeds of at most 1.0 m/s.
 if [ "$mode" = local ]; then

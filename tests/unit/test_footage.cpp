@@ -11,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "crowdrecon/media/media.hpp"  // imread/imwrite/video through the codecs module (tests start without it)
+
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/observe/footage.hpp"
 #include "crowdrecon/observe/homography.hpp"
@@ -42,9 +44,9 @@ std::filesystem::path SlidingFloor(double speed, int frames, const std::vector<i
   cv::GaussianBlur(other, other, cv::Size(0, 0), 1.5);
   const Homography h = Camera();
   const auto file = ScratchFile("sliding.avi");
-  cv::VideoWriter writer(file.string(), cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                         cv::Size(480, 320), true);
-  writer.set(cv::VIDEOWRITER_PROP_QUALITY, 98);
+  const std::unique_ptr<media::VideoWriter> writer = media::MakeVideoWriter();
+  writer->Open(file.string(), cv::CAP_OPENCV_MJPEG, media::FourCc('M', 'J', 'P', 'G'), fps, cv::Size(480, 320), true);
+  writer->Set(cv::VIDEOWRITER_PROP_QUALITY, 98);
   cv::Mat picture, previous;
   for (int k = 0; k < frames; ++k) {
     // Floor drawing pixel (u, v) shows floor point (u / ppm - 20 + speed t, 5 - v / ppm).
@@ -56,7 +58,7 @@ std::filesystem::path SlidingFloor(double speed, int frames, const std::vector<i
     if (std::find(frozen.begin(), frozen.end(), k) != frozen.end()) picture = previous.clone();
     cv::Mat colour;
     cv::cvtColor(picture, colour, cv::COLOR_GRAY2BGR);
-    writer.write(colour);
+    writer->Write(colour);
     previous = picture.clone();
   }
   return file;

@@ -13,6 +13,8 @@
 #include "scratch.hpp"
 #include <opencv2/imgcodecs.hpp>
 
+#include "crowdrecon/media/media.hpp"  // imread/imwrite/video through the codecs module (tests start without it)
+
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/body.hpp"
@@ -150,7 +152,7 @@ TEST(GeometryLimits, PictureAbovePixelLimitIsRefusedFromItsHeader) {
   // on disk): refused before it is decoded.
   const auto file = ScratchFile("large.png");
   cv::Mat image(10000, 11000, CV_8UC1, cv::Scalar(255));
-  ASSERT_TRUE(cv::imwrite(file.string(), image));
+  ASSERT_TRUE(media::WriteImage(file.string(), image));
   const std::string m = ErrorOf([&] { ReadOutline(file); });
   EXPECT_TRUE(Has(m, "large.png: the picture is 11000 x 10000 pixels (110 megapixels); at most 100 megapixels")) << m;
   std::filesystem::remove(file);

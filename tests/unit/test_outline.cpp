@@ -11,6 +11,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "crowdrecon/media/media.hpp"  // imread/imwrite/video through the codecs module (tests start without it)
+
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/body.hpp"
@@ -35,7 +37,7 @@ std::filesystem::path EllipseImage() {
   cv::Mat image(500, 700, CV_8UC1, cv::Scalar(255));
   cv::ellipse(image, cv::Point(350 * 16, 250 * 16), cv::Size(250 * 16, 150 * 16), 0, 0, 360,
               cv::Scalar(0), cv::FILLED, cv::LINE_8, 4);
-  EXPECT_TRUE(cv::imwrite(file.string(), image));
+  EXPECT_TRUE(media::WriteImage(file.string(), image));
   return file;
 }
 

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowdrecon/common/error.hpp"
@@ -40,6 +41,15 @@ std::string StagedEntries(const fs::path& folder) {
   std::string s;
   for (const std::string& n : names) s += (s.empty() ? "" : " ") + n;
   return s;
+}
+
+// Scratch folder PARENT/name holding `files` (name, text); returns it.
+fs::path FolderWith(const std::string& scratch, const std::string& name,
+                    const std::vector<std::pair<std::string, std::string>>& files) {
+  const fs::path out = testing::ScratchFile(scratch) / name;
+  fs::create_directories(out);
+  for (const auto& [file, text] : files) WriteStaged(out / file, text);
+  return out;
 }
 
 // A folder kind recognised by a marker file, as a report's by its report.html.
@@ -80,11 +90,9 @@ TEST(StagedFolder, ANewFolderAppearsOnlyWhenComplete) {
 }
 
 TEST(StagedFolder, APreviousOutputIsReplacedAsAWhole) {
-  const fs::path parent = testing::ScratchFile("previous"), out = parent / "report";
-  fs::create_directories(out);
-  WriteStaged(out / "report.html", "old page");
-  WriteStaged(out / "report.pdf", "old pdf");
-  WriteStaged(out / "people.csv", "old people");
+  const fs::path out = FolderWith("previous", "report",
+                                  {{"report.html", "old page"}, {"report.pdf", "old pdf"}, {"people.csv", "old people"}});
+  const fs::path parent = out.parent_path();
   {
     // Given with a trailing separator, as a shell completes it.
     StagedFolder staged(out.string() + "/", MarkedStagedKind());
@@ -99,10 +107,8 @@ TEST(StagedFolder, APreviousOutputIsReplacedAsAWhole) {
 }
 
 TEST(StagedFolder, AnErrorBeforeCommitLeavesThePreviousOutputAsItWas) {
-  const fs::path parent = testing::ScratchFile("error"), out = parent / "report";
-  fs::create_directories(out);
-  WriteStaged(out / "report.html", "old page");
-  WriteStaged(out / "people.csv", "old people");
+  const fs::path out = FolderWith("error", "report", {{"report.html", "old page"}, {"people.csv", "old people"}});
+  const fs::path parent = out.parent_path();
   try {
     StagedFolder staged(out, MarkedStagedKind());
     staged.Write("people.csv", "new people");
@@ -115,10 +121,8 @@ TEST(StagedFolder, AnErrorBeforeCommitLeavesThePreviousOutputAsItWas) {
 }
 
 TEST(StagedFolder, AForeignFolderReceivesTheFilesAndKeepsItsOwn) {
-  const fs::path parent = testing::ScratchFile("foreign"), out = parent / "notes";
-  fs::create_directories(out);
-  WriteStaged(out / "mine.txt", "the user's");
-  WriteStaged(out / "people.csv", "old people");
+  const fs::path out = FolderWith("foreign", "notes", {{"mine.txt", "the user's"}, {"people.csv", "old people"}});
+  const fs::path parent = out.parent_path();
   StagedFolder staged(out, MarkedStagedKind());
   staged.Write("people.csv", "new people");
   staged.Write("report.html", "page");
@@ -142,9 +146,8 @@ TEST(StagedFolder, AKilledWritersStagingFolderIsRemovedAndSaid) {
 }
 
 TEST(StagedFolder, CtrlCRemovesTheStagingFolderAndStillEndsTheProgram) {
-  const fs::path parent = testing::ScratchFile("interrupted"), out = parent / "report";
-  fs::create_directories(out);
-  WriteStaged(out / "report.html", "old page");
+  const fs::path out = FolderWith("interrupted", "report", {{"report.html", "old page"}});
+  const fs::path parent = out.parent_path();
   for (int signal : {SIGINT, SIGTERM}) {
     const pid_t pid = fork();
     if (pid == 0) {

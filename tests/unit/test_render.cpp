@@ -12,6 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "crowdrecon/media/media.hpp"  // imread/imwrite/video through the codecs module (tests start without it)
+
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/viz/canvas.hpp"
@@ -126,19 +128,19 @@ TEST(RenderRun, DrawsBodiesWallsAndForcesIntoPngFramesAndAVideo) {
   {
     // The video holds every frame at the picture size (padded to even sizes)
     // and plays at the run's 10 frames per second.
-    cv::VideoCapture video((dir.path() / "run.avi").string());
-    ASSERT_TRUE(video.isOpened());
-    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_COUNT), 21.0);
-    EXPECT_EQ(video.get(cv::CAP_PROP_FPS), 10.0);
-    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_WIDTH), double(summary.width_px + summary.width_px % 2));
-    EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_HEIGHT), double(summary.height_px + summary.height_px % 2));
+    const std::unique_ptr<media::VideoReader> video = media::MakeVideoReader();
+    ASSERT_TRUE(video->Open((dir.path() / "run.avi").string(), cv::CAP_ANY));
+    EXPECT_EQ(video->Get(cv::CAP_PROP_FRAME_COUNT), 21.0);
+    EXPECT_EQ(video->Get(cv::CAP_PROP_FPS), 10.0);
+    EXPECT_EQ(video->Get(cv::CAP_PROP_FRAME_WIDTH), double(summary.width_px + summary.width_px % 2));
+    EXPECT_EQ(video->Get(cv::CAP_PROP_FRAME_HEIGHT), double(summary.height_px + summary.height_px % 2));
   }
 
   for (std::int64_t f = 0; f <= 20; ++f) {
     const std::filesystem::path png = FramePicturePath(options.output_dir, f, ".png");
     ASSERT_TRUE(std::filesystem::exists(png)) << png;
     EXPECT_TRUE(std::filesystem::exists(FramePicturePath(options.output_dir, f, ".svg")));
-    const cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+    const cv::Mat image = media::ReadImage(png.string(), cv::IMREAD_COLOR);
     ASSERT_FALSE(image.empty()) << png;
     EXPECT_EQ(image.cols, summary.width_px);
     EXPECT_EQ(image.rows, summary.height_px);
@@ -151,7 +153,7 @@ TEST(RenderRun, DrawsBodiesWallsAndForcesIntoPngFramesAndAVideo) {
   const runfile::RunFrame frame0 = reader.Frame(0);
   ASSERT_TRUE(frame0.contacts.empty());
   const std::vector<std::uint32_t> groups = reader.PersonGroups();
-  const cv::Mat image = cv::imread(FramePicturePath(options.output_dir, 0, ".png").string(), cv::IMREAD_COLOR);
+  const cv::Mat image = media::ReadImage(FramePicturePath(options.output_dir, 0, ".png").string(), cv::IMREAD_COLOR);
   for (std::size_t i = 0; i < frame0.ids.size(); ++i) {
     const Vec2 inside = frame0.position_m[i] - frame0.orientation[i] * 0.06;
     const Vec2 px = summary.PixelOf(inside);
@@ -181,7 +183,7 @@ TEST(RenderRun, StrongerForcesDrawThickerLines) {
     options.force_n_per_px = n_per_px;
     const RenderSummary summary = RenderRun(run, options);
     EXPECT_DOUBLE_EQ(summary.force_n_per_px, n_per_px);
-    const cv::Mat image = cv::imread(summary.first_picture.string(), cv::IMREAD_COLOR);
+    const cv::Mat image = media::ReadImage(summary.first_picture.string(), cv::IMREAD_COLOR);
     int count = 0;
     for (int y = 0; y < image.rows - static_cast<int>(summary.margin_px); ++y)  // leave out the legend's sample lines
       for (int x = 0; x < image.cols; ++x) {

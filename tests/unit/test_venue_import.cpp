@@ -16,6 +16,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "crowdrecon/media/media.hpp"  // imread/imwrite/video through the codecs module (tests start without it)
+
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/geometry/outline.hpp"
@@ -521,7 +523,7 @@ std::filesystem::path DrawPlan(double ppm) {
   std::vector<cv::Point> corner{px({9, 1}), px({11, 1}), px({11, 3})};
   cv::fillConvexPoly(image, corner, cv::Scalar(0), cv::LINE_8);
   const auto path = TempFile("plan-" + std::to_string(static_cast<int>(ppm)) + ".png");
-  cv::imwrite(path.string(), image);
+  media::WriteImage(path.string(), image);
   return path;
 }
 
@@ -558,7 +560,7 @@ TEST(VenueImport, RasterSeedAndErrors) {
   cv::Mat open(100, 100, CV_8UC1, cv::Scalar(255));
   cv::line(open, {10, 50}, {90, 50}, cv::Scalar(0), 3);
   const auto open_path = TempFile("open.png");
-  cv::imwrite(open_path.string(), open);
+  media::WriteImage(open_path.string(), open);
   RasterImportOptions plain;
   plain.pixels_per_metre = 10;
   m = ErrorOf([&] { ImportRasterPlan(open_path, plain); });
@@ -591,9 +593,9 @@ TEST(VenueImport, PicturesCutShortAreErrors) {
   RasterImportOptions options;
   options.pixels_per_metre = 20;
   const std::string png = Bytes(DrawPlan(20));
-  const cv::Mat plan = cv::imread(DrawPlan(20).string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat plan = media::ReadImage(DrawPlan(20).string(), cv::IMREAD_GRAYSCALE);
   const auto jpeg_path = TempFile("plan-20.jpg");
-  cv::imwrite(jpeg_path.string(), plan, {cv::IMWRITE_JPEG_QUALITY, 95});
+  media::WriteImage(jpeg_path.string(), plan);  // OpenCV's JPEG quality is 95 by default
   const std::string jpeg = Bytes(jpeg_path);
   const double exact = WalkableArea_m2(ImportRasterPlan(jpeg_path, options));
   EXPECT_GT(exact, 35.0);
@@ -602,7 +604,7 @@ TEST(VenueImport, PicturesCutShortAreErrors) {
               1e-12);
   const std::string cut_jpeg = jpeg.substr(0, jpeg.size() * 2 / 3);
   const auto cut_path = WriteBytes("cut.jpg", cut_jpeg);
-  ASSERT_FALSE(cv::imread(cut_path.string(), cv::IMREAD_GRAYSCALE).empty()) << "OpenCV decodes it, as said above";
+  ASSERT_FALSE(media::ReadImage(cut_path.string(), cv::IMREAD_GRAYSCALE).empty()) << "OpenCV decodes it, as said above";
   std::string m = ErrorOf([&] { ImportRasterPlan(cut_path, options); });
   EXPECT_NE(m.find("cut.jpg: JPEG whose image data stops without the end-of-image marker"), std::string::npos) << m;
   EXPECT_NE(m.find("cut short"), std::string::npos) << m;
