@@ -22,7 +22,8 @@ The problem (default): the cheap recovery problem of the tests
 (tests/data/calibration/recovery*.json: a periodic hallway at 3 /m², 30 %
 counter-flow, 10 s; desired speed and restitution; speeds per direction, the
 share standing still, the flow), R recordings per truth (seeds 100001 + ...,
-never run by the calibration), K seeds per parameter set (1 ... K). The prior
+never run by the calibration), K seeds per parameter set (1000 k + 1 ...,
+different for each truth: each truth replicates the whole process). The prior
 is uniform over the box given in PRIOR (default below). Everything is
 deterministic: the truths come from Python's random with --seed.
 
@@ -109,7 +110,11 @@ def calibrate_truth(args, k, truth):
         calibration["observations"].append(dict(template, file=obs))
     calibration["name"] = f"coverage truth {k}"
     calibration["scenario"] = scenario
-    calibration["seeds"] = {"first": 1, "count": args.seeds}
+    # Each truth is a replicate of the whole process: its own recordings and
+    # its own calibration seeds. (With the same seeds 1..K for every truth,
+    # the error of their mean is one draw shared by all truths, and the 20
+    # calibrations are not 20 independent trials of the intervals.)
+    calibration["seeds"] = {"first": 1 + 1000 * k, "count": args.seeds}
     calibration["starts"] = []
     calibration["options"] = {"refinements": 1, "bootstrap": 100, "profile_points": 0}
     json.dump(calibration, open(os.path.join(d, "calibration.json"), "w"), indent=1)
@@ -203,7 +208,7 @@ def main():
     lines = [f"# Coverage of the calibration's intervals ({args.truths} truths)", "",
              f"Problem: tests/data/calibration/recovery*.json (periodic hallway, 3 /m², 30 % counter-flow, 10 s); "
              f"{args.recordings} recordings per truth (seeds never run by the calibration), K = {args.seeds} seeds "
-             f"per parameter set, surrogate approach, bootstrap 100, no profiles. Prior: uniform, "
+             f"per parameter set (their own for each truth), surrogate approach, bootstrap 100, no profiles. Prior: uniform, "
              + "; ".join(f"{p} in [{lo}, {hi}]" for p, (lo, hi) in PRIOR.items())
              + f" (Python random, seed {args.seed}). Wall time of the calibrations run now: {wall:.0f} s.", "",
              "| parameter | inside value ± σ (nominal 0.68) | inside ci95 (0.95) | inside bootstrap 95 % (0.95) | "
