@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Interruptions of `export` and `observe footage` (issue 40), each at
-# several moments by SIGINT, SIGTERM and SIGKILL to its process group, as a
+# two moments by SIGINT, SIGTERM and SIGKILL to its process group, as a
 # terminal's Ctrl-C would send it. Whether the signal lands while the
 # command works or after it is done, it must hold: the exit status is 0 or
 # 128 + the signal; no process of it is left; after SIGINT or SIGTERM
@@ -32,7 +32,7 @@ for kind in export footage; do
   if [[ $kind == export ]]; then out=$d/out.sqlite; cmd=("${export_cmd[@]}" -o "$out"); ref=$export_ref
   else out=$d/out.json; cmd=("${footage_cmd[@]}" -o "$out"); ref=$footage_ref; fi
   for signal in INT TERM KILL; do
-    for at in 0.02 0.1 0.3; do
+    for at in 0.05 0.3; do
       rm -rf "$d/out".* "$d"/.out.*
       "$exe" "${cmd[@]}" > "$d/first.txt" 2>&1 &
       pid=$!
