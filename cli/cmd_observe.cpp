@@ -74,6 +74,12 @@ std::string Definitions(const observe::Observation& obs) {
          "a bin counts with speed 0; flows are means over the bins\n";
 }
 
+// Writes the observation and says which leftovers of killed writers of it went.
+void WriteObservationSayingLeftovers(const observe::Observation& obs, const std::string& output) {
+  for (const std::filesystem::path& p : observe::WriteObservation(obs, output))
+    std::printf("note: removed %s, left by an observe that was killed\n", p.c_str());
+}
+
 void PrintSummary(const observe::Observation& obs) {
   std::printf("observation of %s (%s, by %s): %zu bins of %s s from %s s\n", obs.source_file.c_str(),
               obs.source_format.c_str(), obs.method.c_str(), obs.bins, FormatNumber(obs.bin_s).c_str(),
@@ -136,8 +142,7 @@ void RunTrajectories(const TrajectoryArgs& args) {
   const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
   const observe::Trajectories t = observe::ReadTrajectories(args.file, args.fps, args.unit);
   const observe::Observation obs = observe::ObserveTrajectories(t, spec);
-  for (const std::filesystem::path& p : observe::WriteObservation(obs, args.output))
-    std::printf("note: removed %s, left by an observe that was killed\n", p.c_str());
+  WriteObservationSayingLeftovers(obs, args.output);
   if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
   if (!args.quiet) {
     std::printf("%zu people, frames %lld-%lld at %s fps\n", t.people, static_cast<long long>(t.first_frame),
@@ -330,8 +335,7 @@ void RunFootage(const FootageArgs& args) {
   observe::FootageSummary summary;
   const observe::Observation obs = observe::ObserveFootage(args.video, h, spec, options, &summary);
   if (options.progress) std::fprintf(stderr, "\n");
-  for (const std::filesystem::path& p : observe::WriteObservation(obs, args.output))
-    std::printf("note: removed %s, left by an observe that was killed\n", p.c_str());
+  WriteObservationSayingLeftovers(obs, args.output);
   if (!args.figure.empty()) DrawObservationFigure(obs, reference.get(), args.figure);
   if (!args.quiet) {
     if (!h.pairs.empty())

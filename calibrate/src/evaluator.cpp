@@ -214,14 +214,15 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
   // version: a batch folder is one build's) and the whole sweep, seeds
   // included (named by the sets alone, a rerun with other seeds found the
   // earlier seeds' batch and was refused as "a different sweep").
-  std::string joined = spec_.fingerprint + sweep.dump(1);
+  const std::string sweep_text = sweep.dump(1);
+  std::string joined = spec_.fingerprint + sweep_text;
   if (attempt > 0) joined += "attempt " + std::to_string(attempt);
   const std::string batch = Sha256Hex(joined).substr(0, 16);
   const fs::path batches = dir_ / "batches";
   CreateOutputFolder(batches);
   const fs::path sweep_file = batches / (batch + ".json");
   // Every rank writes the same text; the file is read by every rank.
-  if (!fs::exists(sweep_file) || ReadInputFile(sweep_file, "batch") != sweep.dump(1)) WriteFileAtomically(sweep_file, sweep.dump(1));
+  if (!fs::exists(sweep_file) || ReadInputFile(sweep_file, "batch") != sweep_text) WriteFileAtomically(sweep_file, sweep_text);
 
   sweep::SweepOptions options;
   options.sweep_file = sweep_file;

@@ -147,6 +147,14 @@ fs::path PartialPath(const fs::path& file) {
          ("." + file.stem().string() + ".partial-" + std::to_string(::getpid()) + file.extension().string());
 }
 
+void WriteWholeFile(const fs::path& path, const std::string& text, const fs::path& named) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(named.string() + ": cannot open a file for writing next to it (" + path.string() + ")");
+  out << text;
+  out.flush();
+  if (!out) throw InputError(named.string() + ": error while writing (disk full?)");
+}
+
 std::vector<fs::path> WriteFileAtomically(const fs::path& file, const std::string& text) {
   return WriteFilesAtomically({{file, text}});
 }
@@ -164,17 +172,11 @@ std::vector<fs::path> WriteFilesAtomically(const std::vector<std::pair<fs::path,
   for (const auto& [file, text] : files) {
     partials.push_back(PartialPath(file));
     remove_on_interrupt.push_back(std::make_unique<RemoveOnInterrupt>(partials.back()));
-    std::ofstream out(partials.back(), std::ios::binary | std::ios::trunc);
-    if (!out) {
+    try {
+      WriteWholeFile(partials.back(), text, file);
+    } catch (const InputError&) {
       remove_partials(0);
-      throw InputError(file.string() + ": cannot open a file for writing next to it (" + partials.back().string() + ")");
-    }
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      remove_partials(0);
-      throw InputError(file.string() + ": error while writing (disk full?)");
+      throw;
     }
   }
   // ... then each renamed in place.

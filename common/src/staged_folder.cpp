@@ -6,7 +6,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/remove_on_interrupt.hpp"
@@ -74,11 +73,7 @@ StagedFolder::~StagedFolder() {
 void StagedFolder::Write(const std::string& name, const std::string& text) {
   const fs::path file = staging_ / name;
   remove_on_interrupt_.push_back(std::make_unique<RemoveOnInterrupt>(file));
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError((folder_ / name).string() + ": cannot open a file for writing (" + file.string() + ")");
-  out << text;
-  out.flush();
-  if (!out) throw InputError((folder_ / name).string() + ": error while writing (disk full?)");
+  WriteWholeFile(file, text, folder_ / name);  // (what it leaves goes with the staging folder)
 }
 
 void StagedFolder::Commit() {

@@ -97,4 +97,9 @@ std::string IncompleteVideo(const std::string& path) {
   return "";
 }
 
+void RequireCompleteVideo(const std::string& path, const std::string& video) {
+  if (const std::string wrong = IncompleteVideo(path); !wrong.empty())
+    throw InputError(video + ": the video could not be written completely (disk full?): it " + wrong);
+}
+
 }  // namespace crowdrecon::media

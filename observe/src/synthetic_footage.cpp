@@ -243,10 +243,12 @@ SyntheticFootageSummary RenderSyntheticFootage(const std::filesystem::path& run_
     if (options.progress) options.progress(summary.frames, total);
   }
   writer->Release();
-  if (const std::string wrong = media::IncompleteVideo(partial.string()); !wrong.empty()) {
+  try {
+    media::RequireCompleteVideo(partial.string(), video.string());
+  } catch (const InputError&) {
     std::error_code ignored;
     std::filesystem::remove(partial, ignored);
-    throw InputError(video.string() + ": the video could not be written completely (disk full?): it " + wrong);
+    throw;
   }
   std::filesystem::rename(partial, video);
   WriteFileAtomically(homography_file, HomographyToJson(summary.homography));

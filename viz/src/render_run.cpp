@@ -429,8 +429,7 @@ class VideoOut {
   }
   void Close() {
     writer_->Release();
-    if (const std::string wrong = media::IncompleteVideo(PartialPath(final_).string()); !wrong.empty())
-      throw InputError(final_.string() + ": the video could not be written completely (disk full?): it " + wrong);
+    media::RequireCompleteVideo(PartialPath(final_).string(), final_.string());  // (~VideoOut removes the partial)
     std::error_code ec;
     std::filesystem::rename(PartialPath(final_), final_, ec);
     if (ec) throw InputError(final_.string() + ": cannot write video: " + ec.message());

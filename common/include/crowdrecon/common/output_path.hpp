@@ -67,6 +67,11 @@ std::string DescribeExisting(const std::filesystem::path& path);
 // them (for the command to say so).
 std::vector<std::filesystem::path> WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
 
+// Writes `text` to `path` (a partial or staged name of the output `named`),
+// flushed; throws InputError naming `named` if the file cannot be opened or
+// written (a full disk). The caller removes what it leaves on an error.
+void WriteWholeFile(const std::filesystem::path& path, const std::string& text, const std::filesystem::path& named);
+
 // Writes several files that make one output (an observation's JSON and the
 // series CSV it names): each is first written complete under its partial
 // name, and only then are all renamed in place, in the order given; an error

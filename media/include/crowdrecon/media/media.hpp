@@ -50,6 +50,9 @@ std::unique_ptr<VideoWriter> MakeVideoWriter();
 // where its RIFF chunk says 412356"). OpenCV's writers report no write
 // error: a full disk gave a truncated video and "31 frames written".
 std::string IncompleteVideo(const std::string& path);
+// Throws InputError naming `video` (the output the partial file `path` will
+// become) if IncompleteVideo finds something wrong.
+void RequireCompleteVideo(const std::string& path, const std::string& video);
 
 // cv::VideoWriter::fourcc: the four characters of a codec as one int.
 constexpr int FourCc(char a, char b, char c, char d) {
