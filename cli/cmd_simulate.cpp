@@ -81,6 +81,8 @@ int RunSimulate(const SimulateArgs& args) {
     }
     std::printf("engine time %.2f s: %s\n", total, stages.c_str());
   }
+  if (const std::string steps = engine::StepLevelHistogram(p, s.time_step_s); !steps.empty())
+    std::printf("adaptive step: %s\n", steps.c_str());
   if (s.status != "complete") {
     std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s -o %s --resume\n",
                  s.simulated_s, args.scenario.c_str(), args.output.c_str());

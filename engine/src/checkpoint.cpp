@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <utility>
 
 #include "binary_io.hpp"
 #include "crowdrecon/common/error.hpp"
@@ -27,8 +28,11 @@ namespace {
 // still read (a run without a timeline changes none of it). Version 3: the
 // model parameters of the shoulder's turn and giving way, and giving way's
 // state; a version-2 state (whose parameter block is shorter) is refused as
-// such rather than misread.
-constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '3'};
+// such rather than misread. Version 4: the time step's mode and the adaptive
+// step's parameters, and with the adaptive step its ticks and level (the
+// fixed step's time is written where the step was); version 3 is refused.
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '4'};
+constexpr char kStateMagicV3[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '3'};
 constexpr char kStateMagicV2[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
 constexpr char kStateMagicV1[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
 
@@ -131,7 +135,7 @@ std::string Simulation::SaveState() const {
   w.Put(static_cast<std::uint64_t>(bodies_.size()));
   w.Put(step_count_);
   w.Put(time_s_);
-  w.Put(dt_s_);
+  w.Put(tick_s_);  // (the fixed step; with it, the step)
   w.Put(advance_springs_);
   w.PutVector(bodies_.position_m);
   w.PutVector(bodies_.angle_rad);
@@ -170,13 +174,24 @@ std::string Simulation::SaveState() const {
   w.PutVector(in_->group_lambda);
   PutParameters(w, def_.parameters);
   w.PutVector(wall_enabled_);
+  // Only with the adaptive step (the definition says which): the time in
+  // ticks and the next step's level.
+  if (max_level_ > 0) {
+    w.Put(tick_count_);
+    w.Put(static_cast<std::uint8_t>(level_));
+    w.Put(approach_memory_m_per_s_);
+    w.Put(approach_age_s_);
+    w.Put(approach_speed_m_per_s_);
+  }
   return w.Finish();
 }
 
 void Simulation::LoadState(const std::string& data) {
-  if (HasMagic(data, kStateMagicV2))
-    throw InputError("checkpoint: written by an older crowdrecon (state format 2, before the model parameters of "
-                     "November 2026); resume the run with the version that wrote it, or start it again");
+  for (const auto& [magic, format] : {std::pair{kStateMagicV2, "2"}, std::pair{kStateMagicV3, "3"}})
+    if (HasMagic(data, magic))
+      throw InputError(std::string("checkpoint: written by an older crowdrecon (state format ") + format +
+                       ", before the model parameters of November 2026); resume the run with the version that "
+                       "wrote it, or start it again");
   const bool v1 = HasMagic(data, kStateMagicV1);
   StateReader r(data, v1);
   const auto n = r.Get<std::uint64_t>();
@@ -187,9 +202,12 @@ void Simulation::LoadState(const std::string& data) {
   time_s_ = r.Get<double>();
   in_->drive_time_s = time_s_;
   const double dt = r.Get<double>();
-  if (dt != dt_s_)
+  if (dt != tick_s_)
     throw InputError("checkpoint: time step " + FormatNumber(dt) + " s differs from this run's " +
-                     FormatNumber(dt_s_) + " s (different scenario or parameters?)");
+                     FormatNumber(tick_s_) + " s (different scenario or parameters?)");
+  tick_count_ = step_count_;  // (the fixed step; the adaptive one's ticks follow below)
+  level_ = next_level_ = 0;
+  last_step_ticks_ = 0;
   advance_springs_ = r.Get<bool>();
   r.GetVector(bodies_.position_m, n);
   r.GetVector(bodies_.angle_rad, n);
@@ -233,6 +251,21 @@ void Simulation::LoadState(const std::string& data) {
     r.GetVector(wall_enabled_);
     if (!wall_enabled_.empty() && wall_enabled_.size() != def_.walls.size())
       throw InputError("checkpoint: damaged wall switches");
+    if (max_level_ > 0) {
+      tick_count_ = r.Get<std::uint64_t>();
+      const int level = r.Get<std::uint8_t>();
+      approach_memory_m_per_s_ = r.Get<double>();
+      approach_age_s_ = r.Get<double>();
+      approach_speed_m_per_s_ = r.Get<double>();
+      for (double x : {approach_memory_m_per_s_, approach_age_s_, approach_speed_m_per_s_})
+        if (!(x >= 0.0 && std::isfinite(x)))
+          throw InputError("checkpoint: damaged adaptive step (a remembered approach of " + FormatNumber(x) + ")");
+      if (level > max_level_ || tick_count_ % (std::uint64_t{1} << level) != 0 || tick_count_ < step_count_ ||
+          static_cast<double>(tick_count_) * tick_s_ != time_s_)
+        throw InputError("checkpoint: damaged adaptive step (level " + std::to_string(level) + " at tick " +
+                         std::to_string(tick_count_) + ")");
+      level_ = next_level_ = level;
+    }
     in_->restitution_factor = RestitutionDampingFactor(p.restitution);
     in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
     for (std::size_t i = 0; i < n; ++i) {
@@ -244,6 +277,7 @@ void Simulation::LoadState(const std::string& data) {
           in_->family_geometry[in_->shape_family[s]].core_radius_m * in_->shape_scale[s] * (1.0 + 1e-12);
     }
   }
+  dt_s_ = next_dt_s_ = std::ldexp(tick_s_, level_);
   // What the steps rely on (the body arrays' lengths were checked as read).
   if (!std::isfinite(time_s_)) throw InputError("checkpoint: damaged state: the time is not a finite number");
   RequireFinite(bodies_.position_m, "position");

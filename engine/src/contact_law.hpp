@@ -35,6 +35,9 @@ struct ContactLaw {
   // What of the spring a step keeps: exp(-dt / T) for TangentialSpring::kCreeping
   // (issue 39), 1 otherwise (then the product below is the spring itself, bit for bit).
   double spring_keep = 1.0;
+  // The step after this evaluation (the leading fraction's half step): dt
+  // itself with the fixed step; with the adaptive step, the one chosen for it.
+  double dt_next = 0.0;
 
   // Restitution per pair. A pair touching at several points (a flat face) acts
   // as one spring of stiffness k_eff kn along the normal, and the pair's
@@ -99,7 +102,7 @@ struct ContactLaw {
       // The last leading kick already covered the time it expected the contact to last beyond its half step.
       c.trailing_fraction = previous.leading_fraction > 1.0 ? 2.0 - previous.leading_fraction : 1.0;
     }
-    const double until_end = vn > 0.0 ? 2.0 * c.overlap_m / (vn * dt) : 2.0;
+    const double until_end = vn > 0.0 ? 2.0 * c.overlap_m / (vn * dt_next) : 2.0;
     c.leading_fraction = until_end < 2.0 ? until_end : 1.0;
   }
 };

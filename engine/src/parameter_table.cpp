@@ -18,6 +18,7 @@ using Kind = ParameterInfo::Kind;
 constexpr const char* kTangentialDampingChoices[] = {"from_restitution", "equal_to_normal", "fixed"};
 constexpr const char* kFacingChoices[] = {"velocity", "desired_direction"};
 constexpr const char* kIntegratorChoices[] = {"velocity_verlet", "gear5"};
+constexpr const char* kTimeStepModeChoices[] = {"fixed", "adaptive"};
 constexpr const char* kBackForceTriggerChoices[] = {"velocity", "averaged_velocity"};
 constexpr const char* kTangentialSpringChoices[] = {"history", "none", "creeping"};
 constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
@@ -118,6 +119,17 @@ auto MakeTable() {
              "time step; 0: chosen by the engine from every stiffness and the lightest body"),
       Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
              "the engine's step as a fraction of the integrator's stability limit"),
+      Choice<&P::time_step_mode>("time_step_mode", kTimeStepModeChoices, "issue 42",
+             "fixed: one step for the whole run; adaptive: the step doubled (up to adaptive_max_safety of the "
+             "stability limit) while no pair approaches fast enough for its restitution to suffer (velocity "
+             "Verlet only)"),
+      Number("adaptive_max_safety", &P::adaptive_max_safety, "", 1e-4, 0.5, "issue 42 (docs/decisions.md)",
+             "the largest adaptive step as a fraction of the stability limit (a jam's contact network is up "
+             "to ~2.5 times stiffer than one pair)"),
+      Number("adaptive_reference_speed_m_per_s", &P::adaptive_reference_speed_m_per_s, "m/s", 0.0, 20.0,
+             "issue 42 (docs/decisions.md)",
+             "collisions up to this speed keep the fixed step's restitution accuracy, slower ones its absolute "
+             "velocity error; 0: the fastest desired speed of the people"),
       // --- Extensions beyond the paper (issue 39; off by default) ---
       Choice<&P::gait_jitter>("gait_jitter", kGaitJitterChoices, "issue 39; Wuppertal trajectories",
              "none: eq. 3 as printed; isotropic: eq. 3's desired velocity plus a band-limited random velocity "
@@ -230,6 +242,10 @@ bool ModelParameters::IsValid(std::string* error) const {
         return false;
       }
     }
+  }
+  if (time_step_mode == TimeStepMode::kAdaptive && integrator != Integrator::kVelocityVerlet) {
+    if (error) *error = "time_step_mode = adaptive needs integrator = velocity_verlet (Gear's history assumes one step)";
+    return false;
   }
   if (gait_jitter_band_high_hz < gait_jitter_band_low_hz) {
     if (error)

@@ -42,6 +42,8 @@ bool FromString(const std::string& s, Integrator* t) {
   return true;
 }
 
+const char* ToString(TimeStepMode m) { return m == TimeStepMode::kFixed ? "fixed" : "adaptive"; }
+
 const char* ToString(ComputeDevice d) { return d == ComputeDevice::kCpu ? "cpu" : "cuda"; }
 bool FromString(const std::string& s, ComputeDevice* d) {
   if (s == "cpu") *d = ComputeDevice::kCpu;

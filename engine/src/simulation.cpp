@@ -85,6 +85,9 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
       !unstable.empty())
     throw InputError("time_step_s: " + unstable);
   dt_s_ = dt_estimate_.chosen_s;
+  tick_s_ = dt_s_;
+  next_dt_s_ = dt_s_;
+  SetUpAdaptiveStep();
 
   if (def_.device == ComputeDevice::kCuda)
     in_->cuda = std::make_unique<cuda::Collider>(in_->family_geometry, in_->shape_family, in_->shape_scale,
@@ -265,9 +268,11 @@ void Simulation::ComputeForces() {
 void Simulation::Step() {
   in_->previous_contacts.swap(contacts_);
   advance_springs_ = true;
-  in_->drive_time_s = static_cast<double>(step_count_ + 1) * dt_s_;  // the forces are evaluated at the step's end
+  const std::uint64_t step_ticks = std::uint64_t{1} << level_;
+  in_->drive_time_s = static_cast<double>(tick_count_ + step_ticks) * tick_s_;  // the forces are evaluated at the step's end
   if (def_.parameters.integrator == Integrator::kVelocityVerlet) {
     VerletKickDrift();
+    if (max_level_ > 0) ChooseStep(tick_count_ + step_ticks);
     ComputeForces();
     VerletKick();
   } else {
@@ -275,11 +280,16 @@ void Simulation::Step() {
     ComputeForces();
     GearCorrect();
   }
-  time_s_ = static_cast<double>(step_count_ + 1) * dt_s_;
+  tick_count_ += step_ticks;
+  time_s_ = static_cast<double>(tick_count_) * tick_s_;
   ++step_count_;
+  ++profile_.steps_at_level[static_cast<std::size_t>(level_)];
+  last_step_ticks_ = step_ticks;
   in_->drive_time_s = time_s_;
-  AverageBackForceTrigger();
+  AverageBackForceTrigger();  // (these two with the step just taken)
   UpdateGiveWay();
+  level_ = next_level_;
+  dt_s_ = next_dt_s_;
   Check();
 }
 
@@ -360,10 +370,10 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
     probe.shapes = {def_.shapes[p.shape]};
     probe.people = {p};
     probe.people[0].shape = 0;
-    if (const TimeStepEstimate e = EstimateTimeStep(probe); dt_s_ > e.stability_limit_s)
+    if (const TimeStepEstimate e = EstimateTimeStep(probe); LargestStep() > e.stability_limit_s)
       throw InputError("spawn into slot " + std::to_string(slot) + ": this person (" + FormatNumber(p.mass_kg) +
                        " kg) needs a time step below " + FormatNumber(e.stability_limit_s) + " s, the run's is " +
-                       FormatNumber(dt_s_) + " s (choose the step for every arrival)");
+                       FormatNumber(LargestStep()) + " s (choose the step for every arrival)");
   }
   LoadPerson(slot, p, id);
   bodies_.force_n[slot] = {};
@@ -445,17 +455,22 @@ void Simulation::SetParameters(const ModelParameters& parameters) {
   ModelParameters p = parameters;
   p.time_step_s = def_.parameters.time_step_s;
   if (p.integrator != def_.parameters.integrator || p.back_force_trigger != def_.parameters.back_force_trigger ||
-      p.tangential_spring != def_.parameters.tangential_spring)
-    throw InputError("model parameters: the integrator, the back force's trigger and the tangential spring are "
-                     "fixed for a run; only numbers may change during it");
+      p.tangential_spring != def_.parameters.tangential_spring || p.time_step_mode != def_.parameters.time_step_mode ||
+      p.time_step_safety != def_.parameters.time_step_safety ||
+      p.adaptive_max_safety != def_.parameters.adaptive_max_safety ||
+      p.adaptive_reference_speed_m_per_s != def_.parameters.adaptive_reference_speed_m_per_s)
+    throw InputError("model parameters: the integrator, the back force's trigger, the tangential spring and the "
+                     "time step's settings are fixed for a run; only the model's numbers may change during it");
   const TimeStepEstimate estimate = EstimateTimeStep(ProbeWorld(p));
-  if (dt_s_ > estimate.stability_limit_s)
-    throw InputError("model parameters: the run's time step " + FormatNumber(dt_s_) +
+  if (LargestStep() > estimate.stability_limit_s)
+    throw InputError("model parameters: the run's time step " + FormatNumber(LargestStep()) +
                      " s is above the stability limit " + FormatNumber(estimate.stability_limit_s) +
                      " s of the new parameters (limited by " + estimate.limited_by + ")");
   def_.parameters = p;
   in_->restitution_factor = RestitutionDampingFactor(p.restitution);
   in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
+  if (max_level_ > 0)  // the restitution errors at each level for the new parameters (the levels stay)
+    level_speed_ = AdaptiveLevelSpeeds(def_, tick_s_, max_level_, reference_speed_m_per_s_);
   Drive();
 }
 
@@ -488,10 +503,10 @@ void Simulation::SetGroupDrive(std::uint32_t group, double back_force_gamma, dou
   if (!std::isnan(torsion_stiffness_lambda)) {
     ModelParameters p = def_.parameters;
     p.torsion_stiffness_lambda = torsion_stiffness_lambda;
-    if (dt_s_ > EstimateTimeStep(ProbeWorld(p)).stability_limit_s) {
+    if (LargestStep() > EstimateTimeStep(ProbeWorld(p)).stability_limit_s) {
       in.group_lambda[group] = nan;
       throw InputError("group " + std::to_string(group) + ": torsion stiffness " + FormatNumber(torsion_stiffness_lambda) +
-                       " needs a shorter time step than the run's " + FormatNumber(dt_s_) + " s");
+                       " needs a shorter time step than the run's " + FormatNumber(LargestStep()) + " s");
     }
   }
   Drive();

@@ -202,7 +202,8 @@ void Simulation::Collide() {
                        mp.tangential_spring != TangentialSpring::kNone,
                        mp.tangential_spring == TangentialSpring::kCreeping
                            ? std::exp(-dt_s_ / mp.tangential_spring_relaxation_time_s)
-                           : 1.0};
+                           : 1.0,
+                       next_dt_s_};
   ContactLaw wall_law = law;
   wall_law.damping_factor = in.wall_restitution_factor;
   const PairCollider collider(bodies_, in, def_.periodic, law, wall_law);

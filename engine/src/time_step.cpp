@@ -3,6 +3,9 @@
 // "ERRATA 12: time step").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
 #include <string>
 
 #include "crowdrecon/common/error.hpp"
@@ -79,6 +82,7 @@ double RestitutionErrorAtStep(const WorldDef& def, double time_step_s) {
   WorldDef scene;
   scene.parameters = def.parameters;
   scene.parameters.ground_reaction = false;
+  scene.parameters.time_step_mode = TimeStepMode::kFixed;  // (measured at this one step)
   scene.parameters.time_step_s = std::min(time_step_s, world.stability_limit_s);
   scene.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
   BodyShape face;
@@ -114,6 +118,48 @@ double RestitutionErrorAtStep(const WorldDef& def, double time_step_s) {
     worst = std::max(worst, std::abs(restitution / def.parameters.restitution - 1.0));
   }
   return worst;
+}
+
+int AdaptiveStepLevels(const ModelParameters& p) {
+  if (p.time_step_mode != TimeStepMode::kAdaptive) return 0;
+  int levels = 0;
+  while (levels + 1 < kMaxStepLevels && std::ldexp(p.time_step_safety, levels + 1) <= p.adaptive_max_safety * (1.0 + 1e-12))
+    ++levels;
+  return levels;
+}
+
+std::vector<double> AdaptiveLevelSpeeds(const WorldDef& def, double tick_s, int levels, double reference_speed_m_per_s) {
+  std::vector<double> speeds(static_cast<std::size_t>(levels) + 1, std::numeric_limits<double>::infinity());
+  if (levels == 0) return speeds;
+  const double error_at_tick = RestitutionErrorAtStep(def, tick_s);
+  for (int l = 1; l <= levels; ++l) {
+    const double error = RestitutionErrorAtStep(def, std::ldexp(tick_s, l));
+    speeds[static_cast<std::size_t>(l)] = error > 0.0 ? reference_speed_m_per_s * error_at_tick / error
+                                                      : std::numeric_limits<double>::infinity();
+  }
+  return speeds;
+}
+
+std::string StepLevelHistogram(const Profile& profile, double tick_s) {
+  std::uint64_t steps = 0, ticks = 0;
+  for (std::size_t l = 0; l < profile.steps_at_level.size(); ++l) {
+    steps += profile.steps_at_level[l];
+    ticks += profile.steps_at_level[l] << l;
+  }
+  if (steps == profile.steps_at_level[0]) return "";
+  std::string text;
+  for (std::size_t l = 0; l < profile.steps_at_level.size(); ++l) {
+    if (profile.steps_at_level[l] == 0) continue;
+    char part[96];
+    std::snprintf(part, sizeof part, "%s%llu h: %llu steps (%.1f %%)", text.empty() ? "" : ", ", 1ull << l,
+                  static_cast<unsigned long long>(profile.steps_at_level[l]),
+                  100.0 * static_cast<double>(profile.steps_at_level[l]) / static_cast<double>(steps));
+    text += part;
+  }
+  const double mean = static_cast<double>(ticks) / static_cast<double>(steps);
+  char tail[96];
+  std::snprintf(tail, sizeof tail, "; mean step %.2f h = %.3g s", mean, mean * tick_s);
+  return text + tail;
 }
 
 std::string TimeStepAboveLimit(double time_step_s, Integrator integrator, const TimeStepEstimate& estimate) {

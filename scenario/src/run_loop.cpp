@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -69,11 +71,17 @@ void RunLoop::Run(std::int64_t first_frame, std::int64_t last_frame) {
         step_systems_s += spent;
       }
     };
-    for (std::int64_t k = 0; k < options_.steps_per_frame; ++k) {
+    // steps_per_frame fixed steps: with the adaptive step, fewer and longer
+    // ones, which land on the frame (the runner makes frames a multiple of
+    // the largest step).
+    const std::uint64_t frame_end = sim_.tick_count() + static_cast<std::uint64_t>(options_.steps_per_frame);
+    while (sim_.tick_count() < frame_end) {
       run_step_systems(&RunSystem::BeforeStep);
       options_.step(sim_);
       run_step_systems(&RunSystem::AfterStep);
     }
+    if (sim_.tick_count() != frame_end)
+      throw std::logic_error("internal error: a step of the adaptive step straddled frame " + std::to_string(frame));
     summary_.engine_s += Since(steps_start) - step_systems_s;
     // The per-frame systems, in order.
     FrameContext context{sim_, frame, last_frame,

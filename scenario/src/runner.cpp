@@ -231,7 +231,11 @@ std::string ChooseTimeStep(const Scenario& scenario, BuiltWorld& built, std::int
           engine::TimeStepAboveLimit(scenario.model.time_step_s, scenario.model.integrator, estimate);
       !unstable.empty())
     throw InputError(scenario.file.string() + ": /model/time_step_s: " + unstable);
-  const double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
+  double steps = std::ceil(frame_dt / estimate.chosen_s - 1e-9);
+  // The adaptive step's largest step lands on every frame: frames a multiple
+  // of 2^L fixed steps apart (the fixed step then a little shorter).
+  const double largest = std::ldexp(1.0, engine::AdaptiveStepLevels(built.world.parameters));
+  steps = std::ceil(steps / largest) * largest;
   built.world.parameters.time_step_s = frame_dt / steps;
   *steps_per_frame = static_cast<std::int64_t>(std::llround(frame_dt / built.world.parameters.time_step_s));
   return TimeStepWarning(scenario, built.world, estimate);
@@ -270,7 +274,7 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
   header.venue_json = geometry::VenueToJson(scenario.venue);
   header.walkable_wkt = built.walkable_wkt;
   header.output_fps = scenario.run.output_fps;
-  header.time_step_s = sim.time_step_s();
+  header.time_step_s = sim.tick_s();
   header.seed = scenario.population.seed;
   if (!scenario.timeline.enabled) return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
   // A timeline's people: those of the start, then every arrival the schedule
@@ -353,7 +357,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   RunSummary summary;
   summary.people = timeline ? built.timeline.initial_people : sim.bodies().size();
   summary.slots = timeline ? sim.bodies().size() : 0;
-  summary.time_step_s = sim.time_step_s();
+  summary.time_step_s = sim.tick_s();
   const auto start = Clock::now();
   const double start_sim = sim.time_s();
 

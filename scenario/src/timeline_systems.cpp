@@ -218,13 +218,13 @@ class ExitSystem : public RunSystem {
   }
   std::string_view name() const override { return "exits"; }
   bool acts_every_step() const override { return !removing_.empty(); }
-  // Every kCheckSteps steps and at every frame (so that no frame shows
+  // Every kCheckSteps fixed steps (ticks) and at every frame (so that no frame shows
   // anyone beyond an open exit): the straight path of each walking person's
   // centre since the last check (a few millimetres: 10 steps of ~0.5 ms at
   // walking speed; a person is removed at most that late), for a tenth of
   // the cost of a check every step.
   void AfterStep(engine::Simulation& sim) override {
-    if (sim.step_count() % kCheckSteps == 0) Check(sim);
+    if (sim.LastStepReached(kCheckSteps)) Check(sim);
   }
   void AtFrame(FrameContext& c) override { Check(c.sim); }
   std::string SaveState() const override {
@@ -283,9 +283,9 @@ class FallSystem : public RunSystem {
   std::string_view name() const override { return "falls"; }
   bool acts_every_step() const override { return spec_.criterion != FallSpec::Criterion::kNone; }
   void AfterStep(engine::Simulation& sim) override {
-    if (every_ == 0) {  // the sampling in steps, from the run's step
-      every_ = std::max<std::int64_t>(1, std::llround(spec_.sample_s / sim.time_step_s()));
-      const double sample = static_cast<double>(every_) * sim.time_step_s();
+    if (every_ == 0) {  // the sampling in fixed steps (ticks), from the run's step
+      every_ = std::max<std::int64_t>(1, std::llround(spec_.sample_s / sim.tick_s()));
+      const double sample = static_cast<double>(every_) * sim.tick_s();
       depth_ = static_cast<std::size_t>(std::max<long long>(1, std::llround(spec_.window_s / sample)));
     }
     const engine::BodyState& b = sim.bodies();
@@ -303,8 +303,8 @@ class FallSystem : public RunSystem {
     // Tripping: the impulse of the fallen's hold, every step (none to count
     // until someone has fallen).
     if (spec_.trip_over_fallen && s_.fallen > 0) AddImpulseOfTheFallen(sim);
-    if (static_cast<std::int64_t>(sim.step_count()) % every_ != 0) return;
-    const double sample_s = static_cast<double>(every_) * sim.time_step_s();
+    if (!sim.LastStepReached(static_cast<std::uint64_t>(every_))) return;
+    const double sample_s = static_cast<double>(every_) * sim.tick_s();
     if (spec_.criterion == FallSpec::Criterion::kLoad) PersonChestLoads(sim, &load_);
     for (std::uint32_t i = 0; i < n; ++i) {
       if (b.state[i] != engine::PersonState::kWalking) continue;
@@ -404,7 +404,7 @@ class FallSystem : public RunSystem {
   // fallen person to the walking one's account.
   void AddImpulseOfTheFallen(const engine::Simulation& sim) {
     const engine::BodyState& b = sim.bodies();
-    const double dt = sim.time_step_s();
+    const double dt = sim.last_step_s();
     for (const engine::Contact& c : sim.contacts()) {
       if (c.wall) continue;
       const engine::PersonState sa = b.state[c.a], sb = b.state[c.b];

@@ -285,6 +285,7 @@ Relaxation GrowAndRelax(const engine::WorldDef& def, Placement& placement, doubl
     // The placement is not part of the dynamics: relax with velocity Verlet
     // whatever the run's integrator (Gear's step is ten times shorter).
     relax.parameters.integrator = engine::Integrator::kVelocityVerlet;
+    relax.parameters.time_step_mode = engine::TimeStepMode::kFixed;  // (the same placement with either step)
     for (engine::BodyShape& s : relax.shapes) {
       for (Vec2& v : s.vertices) v *= scale;
       s.radius_m *= scale;

@@ -138,7 +138,7 @@ std::string LoadError(const std::string& data, const std::string& origin) {
 TEST(WorldFile, RoundTripGivesTheSameBytes) {
   const WorldDef def = EveryKindOfWorld();
   const std::string bytes = SaveWorld(def);
-  ASSERT_EQ(bytes.substr(0, 8), "CRWORLD5");
+  ASSERT_EQ(bytes.substr(0, 8), "CRWORLD6");
   const WorldDef loaded = LoadWorld(bytes, "memory");
   EXPECT_EQ(SaveWorld(loaded), bytes);
 
@@ -300,10 +300,11 @@ TEST(WorldFile, DamagedDataIsRefusedWithItsOrigin) {
   // parameters (the parameter table's order): 5 doubles, tangential_damping,
   // a double, tangential_spring, 2 flags, 2 doubles (tau, Gamma),
   // back_force_trigger, 3 doubles, facing_target, a double, integrator, 2
-  // doubles, gait_jitter, 4 doubles, yielding, 2 doubles, shoulder_turn, a
-  // double, give_way, 4 doubles; then the shape count.
+  // doubles, time_step_mode, 2 doubles, gait_jitter, 4 doubles, yielding, 2
+  // doubles, shoulder_turn, a double, give_way, 4 doubles; then the shape count.
   const std::size_t integrator_at = 8 + 5 * 8 + 1 + 8 + 1 + 2 + 2 * 8 + 1 + 3 * 8 + 1 + 1 * 8;
-  const std::size_t shape_count_at = integrator_at + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8;
+  const std::size_t shape_count_at =
+      integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8;
   ASSERT_EQ(static_cast<unsigned char>(good[integrator_at]), static_cast<unsigned>(Integrator::kGear5));
   std::string bad_enum = good;
   bad_enum[integrator_at] = 7;

@@ -89,6 +89,15 @@ enum class Integrator {
 const char* ToString(Integrator t);
 bool FromString(const std::string& s, Integrator* t);
 
+// How the step is chosen during a run (issue 42; docs/decisions.md, "An
+// adaptive step").
+enum class TimeStepMode {
+  kFixed,     // one step for the whole run (default; the paper's model as before, bit for bit)
+  kAdaptive,  // velocity Verlet only: each step a power-of-two multiple of the fixed step, as long as
+              // slow approaches allow (restitution error bounded in absolute terms)
+};
+const char* ToString(TimeStepMode m);
+
 struct ModelParameters {
   // --- Contact forces (eqs. 7-14, 19; Table 1) -------------------------
   double normal_stiffness_n_per_m = 1e5;      // k_n, Table 1 (thorax deformation data [21])
@@ -178,6 +187,18 @@ struct ModelParameters {
   // collision within a step, and within 0.5% at half that step
   // (tests/unit/test_engine_physics.cpp; docs/model.md).
   double time_step_safety = 0.08;
+  // Adaptive step (TimeStepMode::kAdaptive): the step is the fixed step h
+  // (above) times 2^l, l = 0..L, L the largest with 2^L time_step_safety <=
+  // adaptive_max_safety. A step 2^l h is taken only while every pair that may
+  // touch within two of the largest steps approaches at most as fast as
+  // adaptive_reference_speed_m_per_s * err(h) / err(2^l h), err the measured
+  // restitution error of a collision at that step (RestitutionErrorAtStep):
+  // no collision's velocity error exceeds what the fixed step gives a
+  // collision at the reference speed. 0: the fastest desired speed of the
+  // world's people.
+  TimeStepMode time_step_mode = TimeStepMode::kFixed;
+  double adaptive_max_safety = 0.32;
+  double adaptive_reference_speed_m_per_s = 0.0;
 
   // Returns false and fills *error with "name = value, expected in [min,
   // max]" if a value is outside its range in the parameter table

@@ -94,7 +94,32 @@ class Simulation {
 
   double time_s() const { return time_s_; }
   std::uint64_t step_count() const { return step_count_; }
+  // The step the next Step() takes. With TimeStepMode::kAdaptive it is
+  // tick_s() times a power of two that changes between steps; with the fixed
+  // step it is tick_s() throughout.
   double time_step_s() const { return dt_s_; }
+  // The time counts in ticks of the fixed step: time_s() = tick_count() *
+  // tick_s() (with the fixed step one tick per step, so this is step_count()
+  // * time_step_s() as it always was). A step of level l advances 2^l ticks
+  // and starts at a multiple of 2^l ticks, so that a run whose frames are a
+  // multiple of 2^max_step_level() ticks apart lands on every frame exactly.
+  double tick_s() const { return tick_s_; }
+  std::uint64_t tick_count() const { return tick_count_; }
+  int step_level() const { return level_; }          // of the next step
+  int max_step_level() const { return max_level_; }  // 0 with the fixed step
+  // The length of the step just taken (before the first, time_step_s()).
+  double last_step_s() const { return last_step_ticks_ == 0 ? dt_s_ : tick_s_ * static_cast<double>(last_step_ticks_); }
+  // True when the step just taken reached or passed a multiple of `every`
+  // ticks: "every k steps" of the fixed step, whatever the steps' lengths.
+  bool LastStepReached(std::uint64_t every) const {
+    return every != 0 && last_step_ticks_ != 0 && (tick_count_ - last_step_ticks_) / every != tick_count_ / every;
+  }
+  // The largest approach speed the adaptive step allows at each level
+  // (level 0: infinite); one entry with the fixed step.
+  const std::vector<double>& step_level_speeds() const { return level_speed_; }
+  // The approach speed the last choice of step was made for (the fastest pair
+  // that may touch, or a recent collision's, decayed); 0 with the fixed step.
+  double step_approach_speed() const { return approach_speed_m_per_s_; }
   const TimeStepEstimate& time_step_estimate() const { return dt_estimate_; }
   const WorldDef& definition() const { return def_; }
   // Changes the number of worker threads from the next step on (1..1024).
@@ -206,6 +231,12 @@ class Simulation {
   void GearPredict();
   void GearCorrect();
   void Check();
+  // The adaptive step: its levels and the approach speed each allows (at
+  // construction and when the parameters change), and the next step's level
+  // (stage choose_step, after the drift: positions at the step's end).
+  void SetUpAdaptiveStep();
+  void ChooseStep(std::uint64_t ticks_after);
+  double LargestStep() const { return tick_s_ * static_cast<double>(std::uint64_t{1} << max_level_); }
 
   WorldDef def_;
   BodyState bodies_;
@@ -213,9 +244,24 @@ class Simulation {
   std::unique_ptr<Internals> in_;
   Profile profile_;
   TimeStepEstimate dt_estimate_;
-  double dt_s_ = 0.0;
+  double dt_s_ = 0.0;       // the next step
+  double next_dt_s_ = 0.0;  // the step after it, decided during the next (the contact law's leading fractions)
+  double tick_s_ = 0.0;
   double time_s_ = 0.0;
   std::uint64_t step_count_ = 0;
+  std::uint64_t tick_count_ = 0;
+  std::uint64_t last_step_ticks_ = 0;
+  int level_ = 0, next_level_ = 0, max_level_ = 0;
+  std::vector<double> level_speed_;
+  double reference_speed_m_per_s_ = 0.0;
+  // The fastest approach of the recent past, held for collision_s_ (the
+  // longest collision) and then decaying over it: a collision keeps its
+  // impact speed's step until it is over, though its relative speed passes
+  // through zero at the turning point. Its age, since it was seen.
+  double approach_memory_m_per_s_ = 0.0;
+  double approach_age_s_ = 0.0;
+  double collision_s_ = 0.0;
+  double approach_speed_m_per_s_ = 0.0;  // what the last choice was made for
   bool advance_springs_ = false;
   std::string device_fallback_;
   // Per wall: 0 while switched off (SetWallEnabled); empty while all are on.
@@ -228,6 +274,15 @@ bool CudaAvailable(std::string* why = nullptr);
 
 // Time-step estimate for a world (used by the constructor; exposed for tests).
 TimeStepEstimate EstimateTimeStep(const WorldDef& def);
+// The number of doublings of the fixed step the adaptive step may use:
+// the largest L (at most kMaxStepLevels - 1) with 2^L time_step_safety <=
+// adaptive_max_safety; 0 with the fixed step. A runner that lands on frames
+// makes them a multiple of 2^L ticks apart.
+int AdaptiveStepLevels(const ModelParameters& parameters);
+// The largest approach speed each level 0..levels of the adaptive step allows
+// (level 0: infinite): reference_speed * err(tick) / err(2^l tick), err the
+// restitution error RestitutionErrorAtStep measures at that step.
+std::vector<double> AdaptiveLevelSpeeds(const WorldDef& def, double tick_s, int levels, double reference_speed_m_per_s);
 // "" if `time_step_s` is within the integrator's stability limit, else why
 // not ("0.02 s is above the stability limit of the velocity_verlet
 // integrator ...; give a smaller step, or 0 ..."): the one message of the
