@@ -24,9 +24,13 @@ void RegisterObserveCommands(CLI::App& app);  // observe trajectories / footage 
 void RegisterExportCommand(CLI::App& app);  // export (a run's trajectories for tools unaware of periodic boxes)
 void RegisterCalibrateCommand(CLI::App& app);  // calibrate (scenario values fitted to observations)
 
-// The command line as given (for the records of reports), set by main.
+// The command line as given (for the records of reports), set by RunCommandLine.
 const std::string& CommandLine();
 void SetCommandLine(int argc, char** argv);
+// Parses and runs the command line with the commands registered in `app`, and
+// returns the exit status (README, "Exit status"; cli/run_app.cpp): the one
+// way of crowdrecon and of the lean crowdrecon-simulate.
+int RunCommandLine(CLI::App& app, int argc, char** argv);
 
 // The --force flag of every command that writes: replace a file, or write into
 // a folder, that is not a previous output of the command (see
