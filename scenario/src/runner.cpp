@@ -468,6 +468,11 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     writer.SetRunValue("timeline_exit_counts", exits + "}");
   }
   if (options.show_progress) std::fprintf(stderr, "\n");
+  if (sim.max_step_level() > 0) {  // the adaptive step's steps by length (issue 42)
+    const std::string steps = engine::StepLevelHistogram(sim.profile(), sim.tick_s());
+    writer.SetRunValue("adaptive_steps", (steps.empty() ? "every step 1 h (the fixed step)" : steps) +
+                                             (options.resume ? " (since the resume)" : ""));
+  }
   writer.SetStatus(status);
   if (status == "complete") {
     std::error_code ec;

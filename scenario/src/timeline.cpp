@@ -26,7 +26,9 @@ constexpr double kMaxRate_per_s = 1e3;  // persons per second at one entry
 bool ChangeableParameter(const std::string& name) {
   if (name == "desired_speed_m_per_s") return true;
   const engine::ParameterInfo* info = engine::FindModelParameter(name);
-  return info && info->kind == engine::ParameterInfo::Kind::kNumber && name != "time_step_s";
+  // (The step's settings are chosen once for the run: Simulation::SetParameters.)
+  return info && info->kind == engine::ParameterInfo::Kind::kNumber && name != "time_step_s" &&
+         name != "time_step_safety" && name != "adaptive_max_safety" && name != "adaptive_reference_speed_m_per_s";
 }
 
 bool GroupParameter(const std::string& name) {

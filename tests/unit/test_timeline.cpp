@@ -352,6 +352,9 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"events": [{"time_s": 1, "close_exit": "door"}]})", "/timeline/events/0/close_exit: the venue has no exit \"door\"");
   refuse(R"({"events": [{"time_s": 1, "set": {"restitution": 0.5}, "group": "main"}]})", "is the same for everyone");
   refuse(R"({"events": [{"time_s": 1, "set": {"integrator": 1}}]})", "cannot change during a run");
+  // The step's settings are chosen once for the run (issue 42).
+  for (const char* step : {"time_step_s", "time_step_safety", "adaptive_max_safety", "adaptive_reference_speed_m_per_s"})
+    refuse(std::string(R"({"events": [{"time_s": 1, "set": {")") + step + R"(": 0.1}}]})", "cannot change during a run");
   refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
   refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
   refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
