@@ -42,6 +42,41 @@ inline WorldDef PassiveWorld() {
   return def;
 }
 
+// A disk that cannot roll (inertia 1e12) resting on a long wall along y = 0
+// (friction scenes).
+inline WorldDef DiskOnWall(WorldDef def = PassiveWorld()) {
+  def.shapes.push_back(DiskShape(0.2));
+  PersonDef p;
+  SetMassFromShape(def.shapes.back(), 1000.0, p);
+  p.shape = static_cast<std::uint32_t>(def.shapes.size() - 1);
+  p.inertia_kg_m2 = 1e12;
+  p.position_m = {0.0, 0.2};
+  def.people = {p};
+  def.walls.push_back({{{-50.0, 0.0}, {50.0, 0.0}}, false, 0.0});
+  return def;
+}
+
+// The disk of DiskOnWall(def) pressed onto the wall by Fn = 500 N and pushed
+// sideways by Ft = fraction mu Fn (loaded gradually, so that the spring does
+// not overshoot): its displacement along the wall during the second second
+// of pushing, after the tangential spring has loaded.
+// `profile`, if given, receives the engine's profile (its steps by length).
+inline double SlideDuringSecondSecond(const WorldDef& def, double push_fraction_of_mu_fn, Profile* profile = nullptr) {
+  Simulation sim(def);
+  const double fn = 500.0, mu = def.parameters.friction_coefficient;
+  sim.SetExternalForce(0, {0.0, -fn});
+  sim.AdvanceTo(1.0);  // settle onto the wall
+  for (int k = 1; k <= 100; ++k) {
+    sim.SetExternalForce(0, {push_fraction_of_mu_fn * mu * fn * k / 100.0, -fn});
+    sim.AdvanceTo(1.0 + 0.01 * k);
+  }
+  sim.AdvanceTo(5.0);
+  const double x0 = sim.bodies().position_m[0].x;
+  sim.AdvanceTo(6.0);
+  if (profile) *profile = sim.profile();
+  return sim.bodies().position_m[0].x - x0;
+}
+
 // N thorax-like bodies on a jittered lattice in [0, L]^2 with random
 // velocities and spins (no two overlapping at the start).
 inline WorldDef RandomGas(int per_side, double spacing_m, unsigned seed, bool periodic) {

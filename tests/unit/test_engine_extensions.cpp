@@ -254,18 +254,11 @@ TEST(Yielding, OffOrAFullShareIsThePapersModelBitForBit) {
 //   v = F_t / (kt T + m gamma_t).
 TEST(TangentialSpringCreep, AHeldContactSlidesAtTheMaxwellElementsVelocity) {
   for (double relaxation_s : {0.5, 2.0, 8.0}) {
-    WorldDef def;
-    def.parameters.ground_reaction = false;
+    WorldDef def = testing::PassiveWorld();
     def.parameters.tangential_spring = TangentialSpring::kCreeping;
     def.parameters.tangential_spring_relaxation_time_s = relaxation_s;
-    def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
-    def.shapes.push_back(testing::DiskShape(0.2));
-    PersonDef p;
-    SetMassFromShape(def.shapes[0], 1000.0, p);
-    p.inertia_kg_m2 = 1e12;  // no rolling: isolates sliding
-    p.position_m = {0.0, 0.2};
-    def.people = {p};
-    def.walls.push_back({{{-50.0, 0.0}, {50.0, 0.0}}, false, 0.0});
+    def = testing::DiskOnWall(def);  // (no rolling: isolates sliding)
+    const PersonDef& p = def.people[0];
     Simulation sim(def);
     const double fn = 500.0, ft = 0.5 * def.parameters.friction_coefficient * fn;  // half the Coulomb limit
     sim.SetExternalForce(0, {0.0, -fn});
@@ -283,16 +276,7 @@ TEST(TangentialSpringCreep, AHeldContactSlidesAtTheMaxwellElementsVelocity) {
   // The paper's spring holds the same push: it only rings down from the
   // sudden load (tens of micrometres), where the slowest creep above slides
   // 2.5 mm in the same 2 s.
-  WorldDef def;
-  def.parameters.ground_reaction = false;
-  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
-  def.shapes.push_back(testing::DiskShape(0.2));
-  PersonDef p;
-  SetMassFromShape(def.shapes[0], 1000.0, p);
-  p.inertia_kg_m2 = 1e12;
-  p.position_m = {0.0, 0.2};
-  def.people = {p};
-  def.walls.push_back({{{-50.0, 0.0}, {50.0, 0.0}}, false, 0.0});
+  const WorldDef def = testing::DiskOnWall();
   Simulation sim(def);
   sim.SetExternalForce(0, {0.0, -500.0});
   sim.AdvanceTo(1.0);

@@ -13,10 +13,12 @@
 namespace crowdrecon::engine {
 namespace {
 
+using testing::DiskOnWall;
 using testing::DiskShape;
 using testing::PassiveWorld;
 using testing::RandomGas;
 using testing::SetMassFromShape;
+using testing::SlideDuringSecondSecond;
 using testing::ThoraxLikeShape;
 
 // Two bodies approach head-on along x; returns the measured restitution
@@ -75,36 +77,9 @@ TEST(EnginePhysics, HeadOnCollisionsHaveTheConfiguredRestitution) {
     }
 }
 
-// A body pressed onto a wall by Fn and pushed sideways by Ft = fraction mu Fn.
-// Returns its displacement along the wall during the second second of pushing
-// (after the tangential spring has loaded).
-double SlideDuringSecondSecond(double push_fraction_of_mu_fn) {
-  WorldDef def = PassiveWorld();
-  def.shapes.push_back(DiskShape(0.2));
-  PersonDef p;
-  SetMassFromShape(def.shapes[0], 1000.0, p);
-  p.inertia_kg_m2 = 1e12;  // no rolling: isolates sliding friction
-  p.position_m = {0.0, 0.2};
-  def.people = {p};
-  def.walls.push_back({{{-50.0, 0.0}, {50.0, 0.0}}, false, 0.0});
-  Simulation sim(def);
-  const double fn = 500.0, mu = def.parameters.friction_coefficient;
-  sim.SetExternalForce(0, {0.0, -fn});
-  sim.AdvanceTo(1.0);  // settle onto the wall
-  // Load the tangential force gradually so that the spring does not overshoot.
-  for (int k = 1; k <= 100; ++k) {
-    sim.SetExternalForce(0, {push_fraction_of_mu_fn * mu * fn * k / 100.0, -fn});
-    sim.AdvanceTo(1.0 + 0.01 * k);
-  }
-  sim.AdvanceTo(5.0);
-  const double x0 = sim.bodies().position_m[0].x;
-  sim.AdvanceTo(6.0);
-  return sim.bodies().position_m[0].x - x0;
-}
-
 TEST(EnginePhysics, FrictionSticksBelowMuFnAndSlidesAbove) {
-  const double stick = SlideDuringSecondSecond(0.95);
-  const double slide = SlideDuringSecondSecond(1.05);
+  const double stick = SlideDuringSecondSecond(DiskOnWall(), 0.95);
+  const double slide = SlideDuringSecondSecond(DiskOnWall(), 1.05);
   EXPECT_LT(std::abs(stick), 1e-6) << stick;  // static: the spring holds
   // Sliding: the elastic part is capped at mu Fn; the excess 0.05 mu Fn = 10 N
   // drives steady sliding against the tangential dashpot only.
