@@ -181,7 +181,6 @@ std::string Simulation::SaveState() const {
     w.Put(static_cast<std::uint8_t>(level_));
     w.Put(approach_memory_m_per_s_);
     w.Put(approach_age_s_);
-    w.Put(approach_speed_m_per_s_);
   }
   return w.Finish();
 }
@@ -256,8 +255,7 @@ void Simulation::LoadState(const std::string& data) {
       const int level = r.Get<std::uint8_t>();
       approach_memory_m_per_s_ = r.Get<double>();
       approach_age_s_ = r.Get<double>();
-      approach_speed_m_per_s_ = r.Get<double>();
-      for (double x : {approach_memory_m_per_s_, approach_age_s_, approach_speed_m_per_s_})
+      for (double x : {approach_memory_m_per_s_, approach_age_s_})
         if (!(x >= 0.0 && std::isfinite(x)))
           throw InputError("checkpoint: damaged adaptive step (a remembered approach of " + FormatNumber(x) + ")");
       if (level > max_level_ || tick_count_ % (std::uint64_t{1} << level) != 0 || tick_count_ < step_count_ ||

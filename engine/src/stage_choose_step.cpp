@@ -100,7 +100,7 @@ void Simulation::ChooseStep(std::uint64_t ticks_after) {
       }
   }
   // The recent past's fastest approach: held for a collision's length, then fading.
-  approach_age_s_ += std::ldexp(tick_s_, level_);  // (the step just taken)
+  approach_age_s_ += dt_s_;  // (the step being taken)
   const double remembered = approach_age_s_ <= collision_s_
                                 ? approach_memory_m_per_s_
                                 : approach_memory_m_per_s_ * std::exp(-(approach_age_s_ - collision_s_) / collision_s_);
@@ -110,7 +110,6 @@ void Simulation::ChooseStep(std::uint64_t ticks_after) {
   } else {
     fastest = remembered;
   }
-  approach_speed_m_per_s_ = fastest;
   // The largest level whose speed allows the fastest approach, and up only
   // onto the grid of its own step.
   int level = 0;

@@ -117,9 +117,6 @@ class Simulation {
   // The largest approach speed the adaptive step allows at each level
   // (level 0: infinite); one entry with the fixed step.
   const std::vector<double>& step_level_speeds() const { return level_speed_; }
-  // The approach speed the last choice of step was made for (the fastest pair
-  // that may touch, or a recent collision's, decayed); 0 with the fixed step.
-  double step_approach_speed() const { return approach_speed_m_per_s_; }
   const TimeStepEstimate& time_step_estimate() const { return dt_estimate_; }
   const WorldDef& definition() const { return def_; }
   // Changes the number of worker threads from the next step on (1..1024).
@@ -261,7 +258,6 @@ class Simulation {
   double approach_memory_m_per_s_ = 0.0;
   double approach_age_s_ = 0.0;
   double collision_s_ = 0.0;
-  double approach_speed_m_per_s_ = 0.0;  // what the last choice was made for
   bool advance_springs_ = false;
   std::string device_fallback_;
   // Per wall: 0 while switched off (SetWallEnabled); empty while all are on.
