@@ -6,17 +6,18 @@ parameter sets from a stated prior, makes synthetic recordings at each (runs
 of seeds the calibration never runs), calibrates each with a small, fast
 problem, and reports per parameter:
 
-  - coverage: the fraction of truths inside the reported 68 % interval
-    (value ± sigma, the seeds' covariance), the 95 % interval (`ci95`) and the
-    bootstrap's 95 % interval (`bootstrap_ci95`), each with its binomial
-    standard error; an interval is right when its coverage matches the
-    nominal level within that uncertainty;
+  - coverage: the fraction of truths inside the posterior's central 68 % and
+    95 % intervals (a flat prior over the bounds, the quadratic over every set
+    evaluated with its lack of fit counted; docs/calibration.md, "The
+    posterior"), each with its binomial standard error; an interval is right
+    when its coverage matches the nominal level within that uncertainty. For
+    comparison, the same for the older intervals: value ± sigma and `ci95`
+    (Ceres' covariance of the local quadratic) and the bootstrap's 95 %;
   - the rank histogram (Talts et al. 2018, "Validating Bayesian inference
-    algorithms with simulation-based calibration"): the calibration reports a
-    Gaussian interval, not posterior draws, so the rank of the truth is its
-    probability integral transform u = Phi((truth - value) / sigma), uniform on
-    [0, 1] when the intervals are right; a U shape means intervals too narrow
-    (too confident), a hump too wide, a slope a bias.
+    algorithms with simulation-based calibration"): the rank of the truth
+    among the posterior's samples (posterior.csv), u = the share of samples
+    below it, uniform on [0, 1] when the posterior is right; a U shape means
+    intervals too narrow (too confident), a hump too wide, a slope a bias.
 
 The problem (default): the cheap recovery problem of the tests
 (tests/data/calibration/recovery*.json: a periodic hallway at 3 /m², 30 %
@@ -50,9 +51,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DATA = os.path.join(ROOT, "tests", "data", "calibration")
 SPEC = os.path.join(ROOT, "venues", "madrid-arena", "observations", "hallway.json")
 
-# The prior: uniform over these boxes, inside the calibration's bounds
-# (recovery.json: desired speed 0.6-1.8 m/s, restitution 0.1-0.8), kept off
-# the bounds so that a truth is not a bound.
+# The prior: uniform over these boxes, which are also the calibration's bounds
+# (recovery.json's are replaced by them): the posterior's flat prior is then
+# the prior the truths are drawn from, as simulation-based calibration asks.
 PRIOR = {
     "population.desired_speed_m_per_s": (0.8, 1.6),
     "model.restitution": (0.15, 0.7),
@@ -108,6 +109,8 @@ def calibrate_truth(args, k, truth):
         run([args.crowdrecon, "observe", "trajectories", os.path.join(d, "truth", "runs", r), "--spec", SPEC,
              "-o", obs, "-q"], log)
         calibration["observations"].append(dict(template, file=obs))
+    for par in calibration["parameters"]:
+        par["min"], par["max"] = PRIOR[par["path"]]
     calibration["name"] = f"coverage truth {k}"
     calibration["scenario"] = scenario
     # Each truth is a replicate of the whole process: its own recordings and
@@ -124,6 +127,16 @@ def calibrate_truth(args, k, truth):
     shutil.rmtree(os.path.join(d, "calibration", "batches"), ignore_errors=True)
     shutil.rmtree(os.path.join(d, "truth", "runs"), ignore_errors=True)
     return json.load(open(result)), time.time() - t0
+
+
+def posterior_rank(d, path, truth):
+    """The share of the posterior's samples below the truth (NaN: none)."""
+    f = os.path.join(d, "calibration", "posterior.csv")
+    if not os.path.exists(f):
+        return math.nan
+    with open(f) as fh:
+        values = [float(r[path]) for r in csv.DictReader(fh)]
+    return sum(1 for v in values if v < truth) / len(values) if values else math.nan
 
 
 def rank_svg(rows, paths, bins, file):
@@ -155,7 +168,7 @@ def rank_svg(rows, paths, bins, file):
         for b in range(bins + 1):
             svg.append(f'<text x="{x0 + b * bw:.1f}" y="{y(0) + 15:.1f}" text-anchor="middle">{b / bins:g}</text>')
         svg.append(f'<text x="{x0 + (w - 2 * pad) / 2}" y="{h + 12}" text-anchor="middle">'
-                   f'rank u = Φ((truth − value)/σ)</text>')
+                   f'rank u: the share of posterior samples below the truth</text>')
         svg.append(f'<text x="{x0 + (w - 2 * pad) / 2}" y="18" text-anchor="middle" font-weight="bold">'
                    f'{path} ({n} truths)</text>')
     svg.append(f'<text x="8" y="{h + 34}" fill="#555">bars: truths per bin; dashed: the uniform expectation; '
@@ -175,8 +188,8 @@ def main():
     p.add_argument("--bins", type=int, default=5)
     p.add_argument("--crowdrecon", default=os.path.join(ROOT, "build", "release", "cli", "crowdrecon"))
     p.add_argument("--check", action="store_true",
-                   help="exit 1 unless every parameter's coverage matches its nominal level within two binomial "
-                        "standard errors of that level (68 %% and both 95 %% intervals)")
+                   help="exit 1 unless every parameter's posterior intervals (68 %% and 95 %%) cover their nominal "
+                        "share within two binomial standard errors of it")
     args = p.parse_args()
     args.crowdrecon = os.path.abspath(args.crowdrecon)
     args.out = os.path.abspath(args.out)
@@ -190,15 +203,25 @@ def main():
             t, v, s = truth[par["path"]], par["value"], par["sigma"]
             lo95, hi95 = par["ci95"] if par.get("ci95") else (math.nan, math.nan)
             blo, bhi = par["bootstrap_ci95"] if par.get("bootstrap_ci95") else (math.nan, math.nan)
-            u = phi((t - v) / s) if s and math.isfinite(s) and s > 0 else math.nan
+            s = s if s is not None else math.nan
+            post = par.get("posterior") or {}
+            plo68, phi68 = [math.nan if x is None else x for x in (post.get("ci68") or [None, None])]
+            plo95, phi95 = [math.nan if x is None else x for x in (post.get("ci95") or [None, None])]
+            u = posterior_rank(os.path.join(args.out, f"truth-{k:02d}"), par["path"], t)
             rows.append({"truth": k, "path": par["path"], "true": t, "value": v, "sigma": s,
                          "ci95_low": lo95, "ci95_high": hi95, "bootstrap95_low": blo, "bootstrap95_high": bhi,
+                         "posterior_median": post.get("median"), "posterior68_low": plo68, "posterior68_high": phi68,
+                         "posterior95_low": plo95, "posterior95_high": phi95,
                          "determination": par["determination"],
+                         "inside_posterior68": int(plo68 <= t <= phi68) if math.isfinite(plo68) else "",
+                         "inside_posterior95": int(plo95 <= t <= phi95) if math.isfinite(plo95) else "",
                          "inside68": int(abs(t - v) <= s) if math.isfinite(s) else "",
-                         "inside95": int(lo95 <= t <= hi95), "inside_bootstrap95": int(blo <= t <= bhi),
+                         "inside95": int(lo95 <= t <= hi95) if lo95 is not None and math.isfinite(s) else "",
+                         "inside_bootstrap95": int(blo <= t <= bhi) if blo is not None else "",
                          "rank_u": u, "bin": min(args.bins - 1, int(u * args.bins)) if math.isfinite(u) else -1})
-        print(f"truth {k:2d}: " + ", ".join(f"{r['path'].split('.')[-1]} {r['true']:.3f} -> {r['value']:.3f} "
-                                            f"± {r['sigma']:.3f} ({r['determination']})"
+        print(f"truth {k:2d}: " + ", ".join(f"{r['path'].split('.')[-1]} {r['true']:.3f} -> posterior 68 % "
+                                            f"[{r['posterior68_low']:.3f}, {r['posterior68_high']:.3f}], 95 % "
+                                            f"[{r['posterior95_low']:.3f}, {r['posterior95_high']:.3f}], u {r['rank_u']:.2f}"
                                             for r in rows if r["truth"] == k), flush=True)
     with open(os.path.join(args.out, "coverage.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
@@ -208,12 +231,13 @@ def main():
     lines = [f"# Coverage of the calibration's intervals ({args.truths} truths)", "",
              f"Problem: tests/data/calibration/recovery*.json (periodic hallway, 3 /m², 30 % counter-flow, 10 s); "
              f"{args.recordings} recordings per truth (seeds never run by the calibration), K = {args.seeds} seeds "
-             f"per parameter set (their own for each truth), surrogate approach, bootstrap 100, no profiles. Prior: uniform, "
+             f"per parameter set (their own for each truth), surrogate approach, bootstrap 100, no profiles, posterior 4 × 20000 steps. Prior: uniform, "
              + "; ".join(f"{p} in [{lo}, {hi}]" for p, (lo, hi) in PRIOR.items())
              + f" (Python random, seed {args.seed}). Wall time of the calibrations run now: {wall:.0f} s.", "",
-             "| parameter | inside value ± σ (nominal 0.68) | inside ci95 (0.95) | inside bootstrap 95 % (0.95) | "
-             "rank u: mean (uniform 0.5), χ² of the histogram (dof " + str(args.bins - 1) + ") |",
-             "| --- | --- | --- | --- | --- |"]
+             "| parameter | inside the posterior's 68 % (nominal 0.68) | inside its 95 % (0.95) | "
+             "rank u: mean (uniform 0.5), χ² of the histogram (dof " + str(args.bins - 1) + ") | "
+             "for comparison: inside value ± σ (0.68) | inside ci95 (0.95) | inside bootstrap 95 % (0.95) |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
     for path in paths:
         rs = [r for r in rows if r["path"] == path]
         n = len(rs)
@@ -226,10 +250,12 @@ def main():
         counts = [sum(1 for r in rs if r["bin"] == b) for b in range(args.bins)]
         e = len(us) / args.bins
         chi2 = sum((c - e) ** 2 / e for c in counts) if e > 0 else math.nan
-        lines.append(f"| {path} | {frac('inside68')} | {frac('inside95')} | {frac('inside_bootstrap95')} | "
-                     f"{sum(us) / len(us):.2f}; {chi2:.1f} (bins {counts}) |")
-    lines += ["", "Each fraction's ± is its binomial standard error. Rank u = Φ((truth − value)/σ): uniform when the "
-              "intervals are right; piled at 0 and 1 when they are too narrow.", ""]
+        mean_u = sum(us) / len(us) if us else math.nan
+        lines.append(f"| {path} | {frac('inside_posterior68')} | {frac('inside_posterior95')} | "
+                     f"{mean_u:.2f}; {chi2:.1f} (bins {counts}) | "
+                     f"{frac('inside68')} | {frac('inside95')} | {frac('inside_bootstrap95')} |")
+    lines += ["", "Each fraction's ± is its binomial standard error. Rank u: the share of the truth's posterior "
+              "samples below it: uniform when the posterior is right; piled at 0 and 1 when it is too narrow.", ""]
     open(os.path.join(args.out, "coverage.md"), "w").write("\n".join(lines))
     rank_svg(rows, paths, args.bins, os.path.join(args.out, "ranks.svg"))
     print("\n".join(lines))
@@ -237,7 +263,7 @@ def main():
         failures = []
         for path in paths:
             rs = [r for r in rows if r["path"] == path]
-            for key, nominal in (("inside68", 0.68), ("inside95", 0.95), ("inside_bootstrap95", 0.95)):
+            for key, nominal in (("inside_posterior68", 0.68), ("inside_posterior95", 0.95)):
                 m = sum(1 for r in rs if r[key] != "")
                 q = sum(r[key] for r in rs if r[key] != "") / m
                 se = math.sqrt(nominal * (1 - nominal) / m)

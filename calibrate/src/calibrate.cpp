@@ -31,6 +31,18 @@ struct Interrupted {};
 
 using Point = std::vector<double>;  // unit coordinates
 
+// The k-th point's i-th coordinate (i < 8) of the Halton sequence in [0, 1).
+double Halton(std::size_t k, std::size_t i) {
+  static const std::size_t primes[] = {2, 3, 5, 7, 11, 13, 17, 19};
+  const std::size_t base = primes[i % 8];
+  double f = 1.0, r = 0.0;
+  for (std::size_t x = k; x > 0; x /= base) {
+    f /= static_cast<double>(base);
+    r += f * static_cast<double>(x % base);
+  }
+  return r;
+}
+
 // The face-centred central composite design in the box centre +- half (each
 // coordinate clamped to [0, 1]): corners, face centres, centre; for more than
 // four parameters a Halton design of twice the quadratic's terms instead.
@@ -57,17 +69,11 @@ std::vector<Point> Design(const Point& centre, double half) {
         add(u);
       }
   } else {
-    static const int primes[] = {2, 3, 5, 7, 11, 13, 17, 19};
     const std::size_t n = 2 * (1 + p + p * (p + 1) / 2);
     for (std::size_t k = 1; k <= n; ++k) {
       Point u(p);
       for (std::size_t i = 0; i < p; ++i) {
-        double f = 1.0, r = 0.0;
-        for (std::size_t x = k; x > 0; x /= static_cast<std::size_t>(primes[i])) {
-          f /= primes[i];
-          r += f * static_cast<double>(x % static_cast<std::size_t>(primes[i]));
-        }
-        u[i] = centre[i] - half + 2.0 * half * r;
+        u[i] = centre[i] - half + 2.0 * half * Halton(k, i);
       }
       add(u);
     }
@@ -94,6 +100,7 @@ class Calibration {
     else SearchWithGradients();
     Uncertainty();
     Profiles();
+    Posterior();
   }
 
  private:
@@ -416,6 +423,72 @@ class Calibration {
     }
   }
 
+  // 6. The posterior: a flat prior over the box and the likelihood of a
+  //    quadratic over every set evaluated (the search's, the uncertainty's
+  //    and the profiles'), its lack of fit beyond the seeds' S / K added to
+  //    the simulated means' error; four Metropolis chains, from the best fit
+  //    and three Halton points of the box. No runs: the surrogate alone.
+  void Posterior() {
+    if (spec_.options.posterior_steps <= 0) return;
+    const std::size_t p = spec_.parameters.size();
+    auto& post = r_.posterior;
+    std::vector<Point> units;
+    std::vector<std::vector<double>> means;
+    for (const SetResult* s : ev_.All()) {
+      units.push_back(ev_.ToUnit(s->values));
+      means.push_back(s->mean);
+    }
+    Quadratic whole;
+    if (!whole.Fit(units, means, Point(p, 0.5), 0.5)) {
+      post.note = "too few parameter sets for a quadratic over the whole box";
+      return;
+    }
+    Objective o = r_.objective;
+    const std::size_t n = o.statistics.size();
+    o.surrogate_variance.assign(n, 0.0);
+    post.lack_of_fit_sd.assign(n, kNaN);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double var = whole.residual_variance[j];
+      if (!std::isfinite(var)) continue;
+      const double seeds = o.seed_covariance[j * n + j] / o.seeds;
+      o.surrogate_variance[j] = std::max(0.0, var - seeds);
+      post.lack_of_fit_sd[j] = std::sqrt(o.surrogate_variance[j]);
+    }
+    o.Reobserve();
+    std::vector<Point> starts{ev_.ToUnit(r_.best)};
+    for (std::size_t c = 1; c <= 3; ++c) {
+      Point u(p);
+      for (std::size_t i = 0; i < p; ++i) u[i] = 0.1 + 0.8 * Halton(c, i);
+      starts.push_back(u);
+    }
+    // Overdispersion: where the best fit's chi2 per degree of freedom
+    // exceeds 1, the statistics scatter more than the seeds' covariance
+    // allows (a recording with a jam the runs rarely make), and the
+    // likelihood is widened by that ratio (never narrowed).
+    std::size_t used = 0;
+    for (double sigma : o.sigma) used += std::isfinite(sigma) ? 1 : 0;
+    const double freedom = static_cast<double>(used) - static_cast<double>(p);
+    post.scale = freedom > 0.0 ? std::max(1.0, r_.best_simulated_chi2 / freedom) : 1.0;
+    const SurrogateLikelihood likelihood(whole, o, post.scale);
+    if (likelihood.empty()) {
+      post.note = "no statistic could be fitted by the quadratic over the whole box";
+      return;
+    }
+    const PosteriorSamples ps =
+        SamplePosterior([&](const Point& u) { return likelihood(u); }, starts, spec_.options.posterior_steps, 20121104);
+    post.samples.clear();
+    for (const Point& u : ps.u) post.samples.push_back(ev_.FromUnit(u));
+    post.chains = ps.chains;
+    post.acceptance = ps.acceptance;
+    post.r_hat = ps.r_hat;
+    post.surrogate_form = whole.form;
+    post.sets = units.size();
+    double worst = 0.0;
+    for (double r : ps.r_hat) worst = std::max(worst, std::isfinite(r) ? r : 0.0);
+    Say("posterior: " + std::to_string(post.samples.size()) + " samples of " + std::to_string(ps.chains) +
+        " chains, acceptance " + Fixed(ps.acceptance, 2) + ", largest R-hat " + Fixed(worst, 4));
+  }
+
   const CalibrationSpec& spec_;
   Evaluator& ev_;
   CalibrationResult& r_;
@@ -452,6 +525,23 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
       std::tie(pr.bootstrap_lo95, pr.bootstrap_hi95) = Percentiles95(v);
     } else {
       pr.bootstrap_sigma = pr.bootstrap_lo95 = pr.bootstrap_hi95 = kNaN;
+    }
+    if (!r.posterior.samples.empty()) {
+      std::vector<double> w;
+      for (const auto& x : r.posterior.samples) w.push_back(x[i]);
+      std::sort(w.begin(), w.end());
+      double mean = 0.0, ss = 0.0;
+      for (double x : w) mean += x / static_cast<double>(w.size());
+      for (double x : w) ss += (x - mean) * (x - mean);
+      pr.posterior_sd = std::sqrt(ss / static_cast<double>(w.size() - 1));
+      pr.posterior_median = Quantile(w, 0.5);
+      pr.posterior_lo68 = Quantile(w, 0.15865);
+      pr.posterior_hi68 = Quantile(w, 0.84135);
+      pr.posterior_lo95 = Quantile(w, 0.025);
+      pr.posterior_hi95 = Quantile(w, 0.975);
+    } else {
+      pr.posterior_median = pr.posterior_sd = pr.posterior_lo68 = pr.posterior_hi68 = pr.posterior_lo95 =
+          pr.posterior_hi95 = kNaN;
     }
     // Determination: the covariance, the bootstrap and the profile each may
     // say that the observations leave the parameter free.

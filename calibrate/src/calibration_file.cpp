@@ -385,6 +385,9 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
     if (x.profile_points == 1) o->At("profile_points").Fail("1 point is no profile; expected 0 (none) or at least 2");
     x.measure_noise = o->Bool("measure_noise", x.measure_noise);
     x.noise_step = o->Number("noise_step", x.noise_step, 1e-6, 0.2);
+    x.posterior_steps = static_cast<int>(o->Integer("posterior_steps", x.posterior_steps, 0, 10000000));
+    if (x.posterior_steps > 0 && x.posterior_steps < 1000)
+      o->At("posterior_steps").Fail("expected 0 (no posterior) or at least 1000 steps per chain");
     o->Finish();
   }
   root.Finish();

@@ -105,6 +105,7 @@ std::vector<double> Objective::Covariance(const std::vector<std::size_t>& rows, 
       const double s = seed_covariance[j * n + i];
       double v = statistics[j].observation == statistics[i].observation ? s : 0.0;
       if (shared) v += s / seeds;
+      if (shared && !surrogate_variance.empty() && lead[j] == lead[i]) v += surrogate_variance[lead[j]];
       if (a == b) v += statistics[j].observed_sigma * statistics[j].observed_sigma;
       c[a * m + b] = v;
     }
@@ -395,6 +396,7 @@ bool Quadratic::Fit(const std::vector<std::vector<double>>& points, const std::v
   const std::size_t statistics = values.empty() ? 0 : values[0].size();
   coefficients_.assign(statistics, {});
   rms.assign(statistics, kNaN);
+  residual_variance.assign(statistics, kNaN);
   const std::size_t m = Basis(points[0]).size();
   for (std::size_t j = 0; j < statistics; ++j) {
     std::vector<std::size_t> rows;
@@ -415,9 +417,11 @@ bool Quadratic::Fit(const std::vector<std::vector<double>>& points, const std::v
     coefficients_[j].assign(x.data(), x.data() + x.size());
     const Eigen::VectorXd e = a * x - y;
     rms[j] = std::sqrt(e.squaredNorm() / static_cast<double>(rows.size()));
+    if (rows.size() > m) residual_variance[j] = e.squaredNorm() / static_cast<double>(rows.size() - m);
   }
   return true;
 }
+
 
 double Quadratic::Value(std::size_t statistic, const std::vector<double>& u) const {
   const std::vector<double> b = Basis(u);
@@ -435,8 +439,13 @@ std::vector<double> Quadratic::Gradient(std::size_t statistic, const std::vector
 }
 
 std::vector<double> Quadratic::Values(const std::vector<double>& u) const {
+  const std::vector<double> b = Basis(u);  // (once for every statistic)
   std::vector<double> v(coefficients_.size());
-  for (std::size_t j = 0; j < v.size(); ++j) v[j] = Value(j, u);
+  for (std::size_t j = 0; j < v.size(); ++j) {
+    double x = 0.0;
+    for (std::size_t c = 0; c < b.size(); ++c) x += coefficients_[j][c] * b[c];
+    v[j] = x;
+  }
   return v;
 }
 
@@ -644,6 +653,118 @@ bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const s
   covariance->assign(p * p, 0.0);
   cov.GetCovarianceBlock(x.data(), x.data(), covariance->data());
   return true;
+}
+
+// --- The posterior -----------------------------------------------------------
+
+double Quantile(const std::vector<double>& sorted, double q) {
+  const double at = std::clamp(q, 0.0, 1.0) * static_cast<double>(sorted.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(at));
+  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+}
+
+SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale)
+    : mean_(mean), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale) {
+  if (!rows_.empty()) white_ = objective.Whiten(rows_);
+}
+
+double SurrogateLikelihood::operator()(const std::vector<double>& u) const {
+  constexpr double kNone = -std::numeric_limits<double>::infinity();
+  if (rows_.empty()) return kNone;
+  const std::vector<double> all = mean_.Values(u);
+  std::vector<double> value(rows_.size()), residuals(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) value[r] = all[lead_[rows_[r]]];
+  white_.Apply(value.data(), 1, true, residuals.data());
+  double chi2 = 0.0;
+  for (double r : residuals) chi2 += r * r;
+  return std::isfinite(chi2) ? -0.5 * chi2 / scale_ : kNone;
+}
+
+PosteriorSamples SamplePosterior(const LogDensity& density, const std::vector<std::vector<double>>& starts, int steps,
+                                 std::uint64_t seed) {
+  PosteriorSamples out;
+  if (starts.empty() || steps < 8) return out;
+  const std::size_t p = starts[0].size();
+  const auto pi = static_cast<Eigen::Index>(p);
+  const auto log_density = [&](const Eigen::VectorXd& u) {
+    for (Eigen::Index i = 0; i < pi; ++i)
+      if (!(u(i) >= 0.0 && u(i) <= 1.0)) return -std::numeric_limits<double>::infinity();
+    return density(std::vector<double>(u.data(), u.data() + pi));
+  };
+  const int burn = std::max(steps / 4, 1);
+  const int keep = steps - burn;
+  const double scale = 2.38 * 2.38 / static_cast<double>(p);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::size_t accepted = 0;
+  std::vector<std::vector<Eigen::VectorXd>> chains;
+  for (const std::vector<double>& start : starts) {
+    Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(start.data(), pi);
+    for (Eigen::Index i = 0; i < pi; ++i) x(i) = std::clamp(x(i), 0.0, 1.0);
+    double lx = log_density(x);
+    Eigen::MatrixXd chol = Eigen::MatrixXd::Identity(pi, pi) * 0.1;  // the first proposal: 0.1 of each range
+    std::vector<Eigen::VectorXd> kept;
+    std::vector<Eigen::VectorXd> burnt;
+    for (int step = 0; step < steps; ++step) {
+      if (step < burn && step > 0 && step % 200 == 0 && burnt.size() >= 2 * p + 2) {
+        // Adapt to the spread of the chain's second half so far (past its
+        // walk from the start).
+        const std::size_t from = burnt.size() / 2, n = burnt.size() - from;
+        Eigen::VectorXd mean = Eigen::VectorXd::Zero(pi);
+        for (std::size_t k = from; k < burnt.size(); ++k) mean += burnt[k] / static_cast<double>(n);
+        Eigen::MatrixXd c = Eigen::MatrixXd::Zero(pi, pi);
+        for (std::size_t k = from; k < burnt.size(); ++k) c += (burnt[k] - mean) * (burnt[k] - mean).transpose();
+        c = c / static_cast<double>(n - 1) * scale;
+        c.diagonal().array() += 1e-8;
+        const Eigen::LLT<Eigen::MatrixXd> llt(c);
+        if (llt.info() == Eigen::Success) chol = llt.matrixL();
+      }
+      Eigen::VectorXd z(pi);
+      for (Eigen::Index i = 0; i < pi; ++i) z(i) = normal(rng);
+      const Eigen::VectorXd y = x + chol * z;
+      const double ly = log_density(y);
+      const double a = uniform(rng);
+      const bool accept = std::isfinite(ly) && (ly >= lx || a < std::exp(ly - lx));
+      if (accept) {
+        x = y;
+        lx = ly;
+      }
+      if (step < burn) {
+        burnt.push_back(x);
+      } else {
+        kept.push_back(x);
+        accepted += accept ? 1 : 0;
+      }
+    }
+    chains.push_back(std::move(kept));
+  }
+  out.chains = chains.size();
+  out.acceptance = static_cast<double>(accepted) / static_cast<double>(chains.size() * static_cast<std::size_t>(keep));
+  for (const auto& chain : chains)
+    for (const Eigen::VectorXd& x : chain) out.u.emplace_back(x.data(), x.data() + x.size());
+  // Gelman and Rubin: between-chain against within-chain variance.
+  out.r_hat.assign(p, kNaN);
+  const double m = static_cast<double>(chains.size()), n = static_cast<double>(keep);
+  if (chains.size() >= 2 && keep >= 2)
+    for (std::size_t i = 0; i < p; ++i) {
+      std::vector<double> means, vars;
+      for (const auto& chain : chains) {
+        double mean = 0.0, ss = 0.0;
+        for (const Eigen::VectorXd& x : chain) mean += x(static_cast<Eigen::Index>(i)) / n;
+        for (const Eigen::VectorXd& x : chain) ss += (x(static_cast<Eigen::Index>(i)) - mean) * (x(static_cast<Eigen::Index>(i)) - mean);
+        means.push_back(mean);
+        vars.push_back(ss / (n - 1.0));
+      }
+      double grand = 0.0, w = 0.0, b = 0.0;
+      for (double x : means) grand += x / m;
+      for (double x : means) b += n * (x - grand) * (x - grand) / (m - 1.0);
+      for (double v : vars) w += v / m;
+      const double v = (n - 1.0) / n * w + b / n;
+      out.r_hat[i] = w > 0.0 ? std::sqrt(v / w) : kNaN;
+    }
+  return out;
 }
 
 }  // namespace crowdrecon::calibrate

@@ -41,6 +41,12 @@ struct Objective {
   std::vector<double> seed_covariance;
   std::vector<double> seed_sd;
   double seeds = 1.0;
+  // The error of a surrogate of the simulated means beyond the seeds' S / K
+  // (per statistic, indexed like the statistics, read at each statistic's
+  // lead; empty: none): shared by every recording's statistics of one
+  // simulated value, as S / K is. Set by the posterior (its quadratic over
+  // the whole box has a lack of fit); call Reobserve() after setting it.
+  std::vector<double> surrogate_variance;
 
   // Sets lead from the statistics' simulated values.
   void Group();
@@ -69,6 +75,9 @@ struct Objective {
     void Apply(const double* x, std::size_t stride, bool minus_b, double* out) const;
   };
   Whitening WhiteningOf(const std::vector<std::size_t>& rows) const;
+  // The same, computed now (after the covariance changed; WhiteningOf may
+  // return the whitening of every statistic used as it was last computed).
+  Whitening Whiten(const std::vector<std::size_t>& rows) const;
   // One draw of the observed values' errors (C's part of one recording:
   // S within recordings plus observed_sigma^2), from `normal` draws, one per
   // statistic; zero for statistics left out.
@@ -76,7 +85,6 @@ struct Objective {
 
  private:
   std::vector<double> Covariance(const std::vector<std::size_t>& rows, bool shared) const;
-  Whitening Whiten(const std::vector<std::size_t>& rows) const;  // (WhiteningOf without the cache)
   Whitening used_;                  // over every statistic used
   std::vector<double> realisation_; // Cholesky factor of one recording's part, over used_.rows
 };
@@ -137,6 +145,9 @@ class Quadratic {
   std::vector<double> Values(const std::vector<double>& u) const;
   // Root mean square of the fit's residuals per statistic, and the terms used.
   std::vector<double> rms;
+  // The residuals' variance per statistic with the fit's terms counted
+  // (sum of squares / (points - terms); NaN with no point to spare).
+  std::vector<double> residual_variance;
   std::string form;  // "full quadratic", "quadratic without cross terms", "linear"
   std::vector<double> centre;
   double half_width = 1.0;
@@ -179,5 +190,43 @@ Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const
 // rank deficient (a combination of parameters leaves every statistic unchanged).
 bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
                          std::vector<double>* covariance, std::string* reason, std::vector<int>* without_effect);
+
+// The posterior's log-likelihood at u (docs/calibration.md, "The
+// posterior"): -chi2 / (2 scale) over the statistics `mean` fits, the
+// simulated means read from `mean`, chi2 the objective's generalised one;
+// `scale` >= 1 widens it where the best fit's chi2 per degree of freedom
+// says the statistics scatter more than their covariance allows.
+class SurrogateLikelihood {
+ public:
+  SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0);
+  double operator()(const std::vector<double>& u) const;  // -inf where undefined
+  bool empty() const { return rows_.empty(); }
+
+ private:
+  const Quadratic& mean_;
+  std::vector<std::size_t> lead_;
+  std::vector<std::size_t> rows_;
+  Objective::Whitening white_;
+  double scale_;
+};
+
+// Samples of a density over the unit box: random-walk Metropolis, one chain
+// from each of `starts`; the first quarter of `steps` burns in (the proposal
+// adapted to the chain's own spread every 200 steps, scaled by 2.38^2 / p),
+// the rest is kept. Proposals outside the box are refused (the prior is 0
+// there). Deterministic for a seed.
+struct PosteriorSamples {
+  std::vector<std::vector<double>> u;  // kept samples, chain after chain
+  std::size_t chains = 0;
+  double acceptance = 0.0;             // of the kept steps, over every chain
+  std::vector<double> r_hat;           // per coordinate: Gelman and Rubin's potential scale reduction (NaN: one chain)
+};
+using LogDensity = std::function<double(const std::vector<double>& u)>;
+PosteriorSamples SamplePosterior(const LogDensity& log_density, const std::vector<std::vector<double>>& starts,
+                                 int steps, std::uint64_t seed);
+
+// The q-quantile (0 <= q <= 1) of `sorted` (ascending, non-empty), linear
+// between order statistics.
+double Quantile(const std::vector<double>& sorted, double q);
 
 }  // namespace crowdrecon::calibrate

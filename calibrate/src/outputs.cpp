@@ -28,6 +28,9 @@ std::string Fixed(double v, int digits) {
 
 namespace {
 
+// Every how many posterior samples one goes into posterior.csv.
+constexpr std::size_t kPosteriorFileEvery = 5;
+
 json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 json Values(const CalibrationSpec& spec, const std::vector<double>& v) {
@@ -54,6 +57,9 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                       {"ci95", {Num(p.lo95), Num(p.hi95)}}, {"bootstrap_sigma", Num(p.bootstrap_sigma)},
                       {"bootstrap_ci95", {Num(p.bootstrap_lo95), Num(p.bootstrap_hi95)}},
                       {"relative_half_width_95", Num(p.RelativeHalfWidth95())},
+                      {"posterior", {{"median", Num(p.posterior_median)}, {"sd", Num(p.posterior_sd)},
+                                     {"ci68", {Num(p.posterior_lo68), Num(p.posterior_hi68)}},
+                                     {"ci95", {Num(p.posterior_lo95), Num(p.posterior_hi95)}}}},
                       {"determination", p.determination}, {"reason", p.reason}});
   }
   j["parameters"] = params;
@@ -69,6 +75,20 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   j["chi2"] = Num(s.chi2);
   j["degrees_of_freedom"] = s.degrees_of_freedom;
   j["surrogate"] = {{"form", r.surrogate_form}};
+  {
+    const auto& post = r.posterior;
+    json rh = json::array();
+    for (double v : post.r_hat) rh.push_back(Num(v));
+    j["posterior"] = {{"prior", "flat over each parameter's bounds"},
+                      {"surrogate", post.samples.empty() ? json(nullptr) : json(post.surrogate_form + " over every set evaluated")},
+                      {"sets", post.sets}, {"overdispersion_scale", post.scale},
+                      {"chains", post.chains},
+                      {"steps_per_chain", spec.options.posterior_steps},
+                      {"samples", post.samples.size()}, {"acceptance", Num(post.acceptance)}, {"r_hat", rh},
+                      {"samples_file", post.samples.empty() ? json(nullptr) : json("posterior.csv")},
+                      {"samples_file_every", kPosteriorFileEvery},
+                      {"note", post.note}};
+  }
   json starts = json::array();
   for (const StartResult& st : r.starts)
     starts.push_back({{"start", Values(spec, st.start)}, {"found", Values(spec, st.found)},
@@ -92,7 +112,10 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                      {"sigma", Num(r.objective.sigma[k])}, {"simulated_at_best", Num(r.best_set.mean[k])},
                      {"simulated_sd_at_best", Num(r.best_set.sd[k])},
                      {"residual_at_best", Num((r.best_set.mean[k] - st.observed) / r.objective.sigma[k])},
-                     {"surrogate_rms", k < r.surrogate_rms.size() ? Num(r.surrogate_rms[k]) : json(nullptr)}});
+                     {"surrogate_rms", k < r.surrogate_rms.size() ? Num(r.surrogate_rms[k]) : json(nullptr)},
+                     {"posterior_lack_of_fit_sd", k < r.posterior.lack_of_fit_sd.size()
+                                                      ? Num(r.posterior.lack_of_fit_sd[r.objective.lead[k]])
+                                                      : json(nullptr)}});
   }
   j["statistics"] = stats;
   json profiles = json::object();
@@ -135,6 +158,21 @@ std::string Report(const CalibrationResult& r) {
     }
     if (!p.reason.empty()) o << " (" << p.reason << ")";
     o << "\n";
+  }
+  if (!r.posterior.samples.empty()) {
+    o << "\nPosterior (a flat prior over the bounds; " << r.posterior.surrogate_form << " over all "
+      << r.posterior.sets << " sets, its lack of fit counted; chi2 divided by "
+      << Fixed(r.posterior.scale, 3) << " for overdispersion; " << r.posterior.chains << " chains, "
+      << r.posterior.samples.size() << " samples, acceptance " << Fixed(r.posterior.acceptance, 2)
+      << "): median, 68 % and 95 % intervals\n";
+    for (std::size_t i = 0; i < s.parameters.size(); ++i) {
+      const ParameterResult& p = s.parameters[i];
+      o << "  " << p.path << " = " << Fixed(p.posterior_median, 4) << "   68 % [" << Fixed(p.posterior_lo68) << ", "
+        << Fixed(p.posterior_hi68) << "]   95 % [" << Fixed(p.posterior_lo95) << ", " << Fixed(p.posterior_hi95)
+        << "]   R-hat " << Fixed(i < r.posterior.r_hat.size() ? r.posterior.r_hat[i] : std::nan(""), 4) << "\n";
+    }
+  } else if (!r.posterior.note.empty()) {
+    o << "\nNo posterior: " << r.posterior.note << "\n";
   }
   if (s.parameters.size() > 1 && r.covariance_ok) {
     o << "\nCorrelations:\n";
@@ -186,8 +224,8 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
                         std::string("chi2 along each parameter, ") +
                             (r.profiles_refitted ? "the others re-fitted at each point"
                                                  : "the others held at the best fit") +
-                            "; grey band: 95 % of the seeds' redraws; shaded: the covariance's 95 % interval; "
-                            "green dashes: the bootstrap's");
+                            "; grey: the seeds' redraws; 95 % intervals: shaded the covariance's, "
+                            "green dashes the bootstrap's, orange the posterior's");
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const Parameter& p = spec.parameters[i];
     const ParameterResult& pr = r.summary.parameters[i];
@@ -228,6 +266,10 @@ void DrawProfiles(const fs::path& file, const CalibrationResult& r) {
     if (std::isfinite(pr.bootstrap_lo95)) {
       panel.Mark(pr.bootstrap_lo95, viz::ChartColor(2), "", true);
       panel.Mark(pr.bootstrap_hi95, viz::ChartColor(2), "", true);
+    }
+    if (std::isfinite(pr.posterior_lo95)) {
+      panel.Mark(pr.posterior_lo95, viz::ChartColor(4), "", false);
+      panel.Mark(pr.posterior_hi95, viz::ChartColor(4), "", false);
     }
     if (!x.empty()) panel.Line(x, y, viz::ChartColor(0), 2.0, "simulated (profile)");
     panel.Points(x, y, viz::ChartColor(0), 3.0);
@@ -349,6 +391,21 @@ void WriteOutputs(const fs::path& dir, const Evaluator& ev, CalibrationResult* r
     csv << "," << sweep::ExactNumber(r->objective.Chi2(e->mean)) << "," << e->failures.size() << "\n";
   }
   WriteFileAtomically(dir / "evaluations.csv", csv.str());
+  // The posterior's samples (chain after chain, every kPosteriorFileEvery-th),
+  // for corner plots and checks.
+  if (!r->posterior.samples.empty()) {
+    std::ostringstream post;
+    post << "chain";
+    for (const Parameter& p : r->spec->parameters) post << "," << p.path;
+    post << "\n";
+    const std::size_t per_chain = r->posterior.samples.size() / std::max<std::size_t>(r->posterior.chains, 1);
+    for (std::size_t k = 0; k < r->posterior.samples.size(); k += kPosteriorFileEvery) {
+      post << k / per_chain;
+      for (double v : r->posterior.samples[k]) post << "," << sweep::ExactNumber(v);
+      post << "\n";
+    }
+    WriteFileAtomically(dir / "posterior.csv", post.str());
+  }
   WriteFileAtomically(r->summary.report_file, Report(*r));
   for (const char* ext : {".png", ".svg"}) {
     if (!r->profiles.empty() && !r->profiles[0].empty()) DrawProfiles(dir / (std::string("profiles") + ext), *r);

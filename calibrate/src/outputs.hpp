@@ -65,6 +65,19 @@ struct CalibrationResult {
   std::vector<double> covariance;  // values' units, row-major
   std::vector<int> without_effect;  // parameters no statistic depends on at the best fit
   std::vector<std::vector<double>> bootstrap;  // replicates' values
+  // The posterior (fit.hpp, SamplePosterior): its samples' values, and how
+  // they were had.
+  struct Posterior {
+    std::vector<std::vector<double>> samples;  // values, chain after chain
+    std::size_t chains = 0;
+    double acceptance = 0.0;
+    std::vector<double> r_hat;            // per parameter
+    std::string surrogate_form;           // the quadratic over every set evaluated
+    std::size_t sets = 0;                 // ... of this many sets
+    std::vector<double> lack_of_fit_sd;   // per statistic: the surrogate's error beyond the seeds' (NaN: not fitted)
+    double scale = 1.0;                   // the likelihood's widening: max(1, chi2 at the best fit / degrees of freedom)
+    std::string note;                     // why there is none
+  } posterior;
   std::vector<std::vector<ProfilePoint>> profiles;
   bool profiles_refitted = false;  // the others re-fitted at each point (else held at the best fit)
   Summary summary;

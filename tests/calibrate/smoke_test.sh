@@ -46,7 +46,7 @@ PY
 
 "$crowdrecon" calibrate "$d/calibration.json" -o "$d/local" -q --jobs 2 | tee "$d/local.txt"
 grep -q "model.back_force_gamma = " "$d/local.txt"
-for f in calibration.json report.txt evaluations.csv profiles.png profiles.svg fit.png fit.svg; do
+for f in calibration.json report.txt evaluations.csv posterior.csv profiles.png profiles.svg fit.png fit.svg; do
   test -s "$d/local/$f" || { echo "FAIL: no $f"; exit 1; }
 done
 python3 - "$d/local/calibration.json" "$d/local/evaluations.csv" <<'PY'
@@ -58,7 +58,15 @@ assert len(c["parameters"]) == 1 and c["parameters"][0]["determination"] in ("de
 assert len(c["starts"]) == 2 and len(c["profiles"]["model.back_force_gamma"]) == 3
 assert len(rows) == len(c["evaluations"]) == c["sets_evaluated"], (len(rows), len(c["evaluations"]))
 assert all(s["sigma"] is None or s["sigma"] > 0 for s in c["statistics"])
-print("outputs: OK,", len(rows), "parameter sets")
+# The posterior (issue 41): its intervals nest inside the bounds, its samples
+# (every fifth in posterior.csv) lie inside them too.
+post, par = c["posterior"], c["parameters"][0]
+lo95, hi95 = par["posterior"]["ci95"]; lo68, hi68 = par["posterior"]["ci68"]
+assert par["min"] <= lo95 <= lo68 <= par["posterior"]["median"] <= hi68 <= hi95 <= par["max"], par["posterior"]
+assert post["chains"] == 4 and post["samples"] == 4 * 15000 and post["overdispersion_scale"] >= 1, post
+samples = list(csv.DictReader(open(sys.argv[2].replace("evaluations.csv", "posterior.csv"))))
+assert len(samples) == post["samples"] // 5 and all(par["min"] <= float(r["model.back_force_gamma"]) <= par["max"] for r in samples)
+print("outputs: OK,", len(rows), "parameter sets; posterior 95 %", round(lo95, 3), "to", round(hi95, 3))
 PY
 
 # The machinery of continuing (calibrate.recovery_cheap's checks, now long):

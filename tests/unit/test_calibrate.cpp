@@ -7,6 +7,7 @@
 // JSON path, the value and what was expected.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -190,6 +191,122 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   ASSERT_TRUE(g.Fit(pts, sum, {0.5, 0.5}, 0.5));
   EXPECT_FALSE(SurrogateCovariance(g, ObjectiveObserving({1.0, 2.0}, {0.1, 0.1}), {0.5, 0.5}, &cov, &reason, &without_effect));
   EXPECT_NE(reason.find("rank deficient"), std::string::npos) << reason;
+}
+
+// The posterior's sampler against the analytic posterior: linear statistics
+// m = A u with Gaussian errors give a Gaussian posterior of covariance
+// (JᵀJ)⁻¹ about the least-squares solution (far inside the box, the flat
+// prior's edges do not matter); a surrogate's variance shared by the
+// statistics widens it as the generalised chi2 says; a coordinate nothing
+// depends on comes out uniform over the box; the same seed, the same samples.
+TEST(Posterior, MatchesTheAnalyticPosteriorOfALinearProblem) {
+  const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
+  std::vector<std::vector<double>> pts, vals;
+  for (double x : {0.0, 1.0})
+    for (double y : {0.0, 1.0}) {
+      pts.push_back({x, y});
+      vals.push_back({a[0][0] * x + a[0][1] * y, a[1][0] * x + a[1][1] * y, a[2][0] * x + a[2][1] * y});
+    }
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  const std::vector<double> truth{0.45, 0.55};
+  std::vector<double> observed;
+  for (const auto& row : a) observed.push_back(row[0] * truth[0] + row[1] * truth[1]);
+  const double sd = 0.04;
+  Objective o = ObjectiveObserving(observed, {sd, sd, sd});
+  // Each coordinate's mean, standard deviation and central 68 % interval.
+  struct Marginal {
+    double mean, sd, lo68, hi68;
+  };
+  const auto marginals = [](const PosteriorSamples& ps) {
+    std::vector<Marginal> out;
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::vector<double> v;
+      for (const auto& u : ps.u) v.push_back(u[i]);
+      std::sort(v.begin(), v.end());
+      double mean = 0.0, ss = 0.0;
+      for (double x : v) mean += x / static_cast<double>(v.size());
+      for (double x : v) ss += (x - mean) * (x - mean);
+      out.push_back({mean, std::sqrt(ss / static_cast<double>(v.size() - 1)), Quantile(v, 0.15865), Quantile(v, 0.84135)});
+    }
+    return out;
+  };
+  const auto analytic_sd = [&](double var) {
+    double jtj[2][2] = {{0, 0}, {0, 0}};
+    for (const auto& row : a)
+      for (int i = 0; i < 2; ++i)
+        for (int k = 0; k < 2; ++k) jtj[i][k] += row[i] * row[k] / var;
+    const double det = jtj[0][0] * jtj[1][1] - jtj[0][1] * jtj[1][0];
+    return std::vector<double>{std::sqrt(jtj[1][1] / det), std::sqrt(jtj[0][0] / det)};
+  };
+  const std::vector<std::vector<double>> starts{{0.5, 0.5}, {0.2, 0.8}, {0.8, 0.3}, {0.3, 0.3}};
+  const auto sample = [&](const Objective& obj, const Quadratic& mean, std::uint64_t seed) {
+    const SurrogateLikelihood l(mean, obj);
+    return SamplePosterior([&](const std::vector<double>& u) { return l(u); }, starts, 40000, seed);
+  };
+  const PosteriorSamples ps = sample(o, q, 7);
+  ASSERT_EQ(ps.u.size(), 4u * 30000u);
+  EXPECT_EQ(ps.chains, 4u);
+  EXPECT_GT(ps.acceptance, 0.15);
+  EXPECT_LT(ps.acceptance, 0.6);
+  const std::vector<Marginal> m = marginals(ps);
+  const std::vector<double> expected = analytic_sd(sd * sd);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_LT(ps.r_hat[i], 1.01);
+    EXPECT_NEAR(m[i].mean, truth[i], 0.1 * expected[i]) << i;
+    EXPECT_NEAR(m[i].sd, expected[i], 0.05 * expected[i]) << i;
+    EXPECT_NEAR(m[i].lo68, truth[i] - expected[i], 0.1 * expected[i]) << i;
+    EXPECT_NEAR(m[i].hi68, truth[i] + expected[i], 0.1 * expected[i]) << i;
+  }
+  // The same seed: the same samples.
+  EXPECT_EQ(sample(o, q, 7).u, ps.u);
+
+  // A surrogate's variance, shared by the three statistics (one simulated
+  // value each here, so it adds to each diagonal): sd² + v.
+  o.surrogate_variance.assign(3, 0.03 * 0.03);
+  o.Reobserve();
+  const std::vector<Marginal> wider = marginals(sample(o, q, 7));
+  const std::vector<double> expected_wider = analytic_sd(sd * sd + 0.03 * 0.03);
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_NEAR(wider[i].sd, expected_wider[i], 0.05 * expected_wider[i]) << i;
+
+  // Statistics of u[0] alone: u[1] is uniform over the box.
+  std::vector<std::vector<double>> flat;
+  for (const auto& p : pts) flat.push_back({2.0 * p[0], -p[0]});
+  Quadratic f;
+  ASSERT_TRUE(f.Fit(pts, flat, {0.5, 0.5}, 0.5));
+  const PosteriorSamples free = sample(ObjectiveObserving({1.0, -0.5}, {0.1, 0.1}), f, 8);
+  std::vector<double> v;
+  for (const auto& u : free.u) v.push_back(u[1]);
+  std::sort(v.begin(), v.end());
+  EXPECT_NEAR(Quantile(v, 0.025), 0.025, 0.02);
+  EXPECT_NEAR(Quantile(v, 0.5), 0.5, 0.03);
+  EXPECT_NEAR(Quantile(v, 0.975), 0.975, 0.02);
+  // Nothing to sample: no start.
+  EXPECT_TRUE(SamplePosterior([](const std::vector<double>&) { return 0.0; }, {}, 40000, 8).u.empty());
+}
+
+// The likelihood: -chi2 / 2 of the generalised chi2, divided by the
+// overdispersion scale.
+TEST(Posterior, TheLikelihoodIsTheScaledChi2) {
+  Objective o = ObjectiveObserving({0.5}, {0.1});
+  o.WeighCovariance({0.04}, 3.0);
+  Quadratic mean;
+  ASSERT_TRUE(mean.Fit({{0.0}, {1.0}}, {{0.0}, {1.0}}, {0.5}, 0.5));
+  const SurrogateLikelihood plain(mean, o), wider(mean, o, 2.5);
+  const double c = 0.01 + 0.04 * (1.0 + 1.0 / 3.0);
+  for (double u : {0.2, 0.5, 0.9}) {
+    EXPECT_NEAR(plain({u}), -0.5 * (u - 0.5) * (u - 0.5) / c, 1e-12) << u;
+    EXPECT_NEAR(wider({u}), -0.5 * (u - 0.5) * (u - 0.5) / c / 2.5, 1e-12) << u;
+  }
+}
+
+TEST(Posterior, QuantilesInterpolateBetweenOrderStatistics) {
+  const std::vector<double> v{0.0, 1.0, 2.0, 3.0};
+  EXPECT_EQ(Quantile(v, 0.0), 0.0);
+  EXPECT_EQ(Quantile(v, 1.0), 3.0);
+  EXPECT_DOUBLE_EQ(Quantile(v, 0.5), 1.5);
+  EXPECT_DOUBLE_EQ(Quantile(v, 0.25), 0.75);
+  EXPECT_EQ(Quantile({4.0}, 0.3), 4.0);
 }
 
 // Recordings of one simulated value share its error (seed_sd^2 / K): their

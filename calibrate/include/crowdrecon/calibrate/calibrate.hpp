@@ -45,6 +45,11 @@ struct ParameterResult {
   // covariance could not be computed) and the bootstrap's percentiles.
   double sigma = 0.0, lo95 = 0.0, hi95 = 0.0;
   double bootstrap_sigma = 0.0, bootstrap_lo95 = 0.0, bootstrap_hi95 = 0.0;
+  // The posterior's median, standard deviation and central 68 % and 95 %
+  // intervals (a flat prior over the bounds; NaN: no posterior). The
+  // intervals whose coverage is checked (docs/calibration.md, "The posterior").
+  double posterior_median = 0.0, posterior_sd = 0.0;
+  double posterior_lo68 = 0.0, posterior_hi68 = 0.0, posterior_lo95 = 0.0, posterior_hi95 = 0.0;
   // The covariance's 95 % half-width as a fraction of the value (NaN where
   // either is unknown or the value is 0): how precisely "determined".
   double RelativeHalfWidth95() const { return value != 0.0 ? 1.96 * sigma / std::abs(value) : std::numeric_limits<double>::quiet_NaN(); }

@@ -26,7 +26,8 @@
 //     "approach": "surrogate",                                   (or "gradient")
 //     "starts": [{"model.back_force_gamma": 3.0}],               (more starting points)
 //     "options": {"refinements": 2, "shrink": 0.5, "gradient_step": 0.1, "max_iterations": 8,
-//                 "bootstrap": 200, "profile_points": 7, "measure_noise": false}
+//                 "bootstrap": 200, "profile_points": 7, "measure_noise": false,
+//                 "posterior_steps": 20000}
 //   }
 //
 // "scenario", "set" and "seeds" mean what they mean in a sweep file (they are
@@ -132,6 +133,8 @@ struct CalibrationOptions {
   // Measure the objective's noise along each parameter at small steps first.
   bool measure_noise = false;
   double noise_step = 0.01;  // fraction of the range
+  // Steps of each of the posterior's four Metropolis chains (0: no posterior).
+  int posterior_steps = 20000;
 };
 
 struct CalibrationSpec {
