@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -86,9 +87,12 @@ void RunCheck(const CheckArgs& args) {
                                              : "exit \"" + t.exit_id + "\"").c_str()
                                                    : ("direction " + VecText(t.direction)).c_str());
   if (v.slope)
-    std::printf("  slope: gradient %s (%s %%) downhill toward %s, %s\n", FormatNumber(v.slope->gradient).c_str(),
-                FormatFixed(100.0 * v.slope->gradient, 1).c_str(), VecText(v.slope->direction).c_str(),
-                v.slope->enabled ? "enabled" : "disabled");
+    std::printf("  slope: gradient %s (%s %%, %s degrees) downhill toward %s, %s, %s\n", FormatNumber(v.slope->gradient).c_str(),
+                FormatFixed(100.0 * v.slope->gradient, 1).c_str(),
+                FormatFixed(std::atan(v.slope->gradient) * 180.0 / std::numbers::pi, 1).c_str(),
+                VecText(v.slope->direction).c_str(), v.slope->enabled ? "enabled" : "disabled",
+                v.slope->region.empty() ? "the whole floor"
+                                        : ("inside a region of " + std::to_string(v.slope->region.size()) + " points").c_str());
   else
     std::printf("  slope: none (level floor)\n");
   const geo::Capacity capacity = geo::VenueCapacity(v);

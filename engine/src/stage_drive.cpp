@@ -105,6 +105,16 @@ void HeldBackByPeopleAhead(const BodyState& bodies, const std::vector<Contact>& 
   }
 }
 
+// Whether p lies inside the polygon `ring` (even-odd rule; the slope's region).
+bool InsideRing(const std::vector<Vec2>& ring, Vec2 p) {
+  bool inside = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Vec2 a = ring[i], b = ring[j];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x)) inside = !inside;
+  }
+  return inside;
+}
+
 }  // namespace
 
 void Simulation::Drive() {
@@ -123,6 +133,7 @@ void Simulation::Drive() {
       def_.slope.gradient > 0.0 ? mp.gravity_m_per_s2 * def_.slope.gradient / std::sqrt(1.0 + def_.slope.gradient * def_.slope.gradient)
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
+  const std::vector<Vec2>& slope_region = def_.slope.region;  // (empty: the whole floor)
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
   const bool shoulder_turn = mp.shoulder_turn == ShoulderTurn::kWhenBlocked;
   const bool blocked_known = yielding || shoulder_turn;
@@ -216,7 +227,7 @@ void Simulation::Drive() {
         if (turning[k]) torque += torsion * inertia * gain[k] * angle[k];
         // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
         torque -= inertia * rotation_damping * bodies_.angular_velocity_rad_per_s[i];
-        force += slope_acceleration * m;
+        if (slope_region.empty() || InsideRing(slope_region, bodies_.position_m[i])) force += slope_acceleration * m;
       }
       bodies_.force_n[i] = force;
       bodies_.torque_n_m[i] = torque;

@@ -32,7 +32,7 @@ namespace {
 // Version 4: issue 39's parameters (gait jitter, yielding, creep of the tangential spring) at the table's end.
 // Version 5: and the shoulder's turn and giving way after them.
 // Version 6: the time step's mode and the adaptive step's parameters (issue 42), after time_step_safety.
-constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', '6'};
+constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', '7'};
 
 // The bytes are the machine's; the development machine and the GPU machines
 // are little-endian, so a file moves between them unchanged. A big-endian
@@ -46,7 +46,7 @@ static_assert(sizeof(Vec2) == 2 * sizeof(double));
 static_assert(sizeof(ModelParameters) == 288, "ModelParameters changed: update the parameter table (parameter_table.cpp) and the magic");
 static_assert(sizeof(PersonDef) == 96, "PersonDef changed: update PersonFields and the magic");
 static_assert(sizeof(PeriodicBox) == 40, "PeriodicBox changed: update the world file and the magic");
-static_assert(sizeof(FloorSlope) == 24, "FloorSlope changed: update the world file and the magic");
+static_assert(sizeof(FloorSlope) == 48, "FloorSlope changed: update the world file and the magic");
 
 class WorldWriter : public detail::BinaryWriter {
  public:
@@ -191,6 +191,7 @@ template <typename Io, typename P>
 void SlopeFields(Io& io, P& s) {
   io.Field(s.downhill);
   io.Field(s.gradient);
+  io.Field(s.region);
 }
 
 // Bytes that one element of a list takes at the least (as the writer writes

@@ -289,6 +289,9 @@ class VenueReader {
       // (building codes allow about 0.08), so larger values are input errors.
       slope.gradient = s->Number("gradient", 0.0, 1.0);
       slope.enabled = s->Bool("enabled", true);
+      // A region: the floor slopes there only (an alley between level
+      // streets); elsewhere it is level.
+      if (auto region = s->Find("region")) slope.region = ReadRing(*region);
       s->Finish();
       v.slope = slope;
     }
@@ -536,6 +539,7 @@ std::string VenueToJson(const Venue& v) {
     root["slope"] = Json{{"direction", PointJson(v.slope->direction)},
                          {"gradient", v.slope->gradient},
                          {"enabled", v.slope->enabled}};
+    if (!v.slope->region.empty()) root["slope"]["region"] = PointsJson(v.slope->region);
   }
   std::string out;
   Emit(root, 0, &out);

@@ -79,6 +79,18 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     }
   }
 
+  // "slope": the venue's floor slope with another gradient (or switched on
+  // or off): a figure the sources disagree on is a parameter of the
+  // scenario, while its direction and region stay the venue's.
+  if (auto slope = root.Find("slope")) {
+    if (!slope->IsObject()) slope->Fail("expected an object {\"gradient\": g, \"enabled\": true}, found " + slope->ValueText());
+    if (!s.venue.slope)
+      slope->Fail("the venue " + s.venue_file.string() + " has no slope (its direction and region come from the venue)");
+    s.venue.slope->gradient = slope->Number("gradient", s.venue.slope->gradient, 0.0, 1.0);
+    s.venue.slope->enabled = slope->Bool("enabled", s.venue.slope->enabled);
+    slope->Finish();
+  }
+
   {
     const JsonReader pop = root.At("population");
     PopulationSpec& p = s.population;

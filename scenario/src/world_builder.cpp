@@ -543,7 +543,7 @@ BuiltWorld BuildWorld(const Scenario& scenario, int threads,
                        FormatNumber(d.direction.y) + ") is not along x or y; the engine supports axis-aligned periods");
     }
   }
-  if (venue.slope && venue.slope->enabled) def.slope = {venue.slope->direction, venue.slope->gradient};
+  if (venue.slope && venue.slope->enabled) def.slope = {venue.slope->direction, venue.slope->gradient, venue.slope->region};
   built.walkable_wkt = WalkableAreaWkt(venue);
   // A timeline's doors: a wall across every exit, switched off while the
   // exit is open (engine::Simulation::SetWallEnabled).

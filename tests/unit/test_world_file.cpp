@@ -88,6 +88,7 @@ WorldDef EveryKindOfWorld() {
   def.targets = {NavigationField::Constant({1.0, 1.0}), GridTowardLine()};
   def.slope.downhill = Normalized(Vec2{1.0, 0.3});
   def.slope.gradient = 0.025;
+  def.slope.region = {{0.5, 0.0}, {3.0, 0.0}, {3.0, 2.0}, {0.5, 2.0}};
   def.threads = 2;
 
   ModelParameters& m = def.parameters;
@@ -138,7 +139,7 @@ std::string LoadError(const std::string& data, const std::string& origin) {
 TEST(WorldFile, RoundTripGivesTheSameBytes) {
   const WorldDef def = EveryKindOfWorld();
   const std::string bytes = SaveWorld(def);
-  ASSERT_EQ(bytes.substr(0, 8), "CRWORLD6");
+  ASSERT_EQ(bytes.substr(0, 8), "CRWORLD7");
   const WorldDef loaded = LoadWorld(bytes, "memory");
   EXPECT_EQ(SaveWorld(loaded), bytes);
 
@@ -172,6 +173,8 @@ TEST(WorldFile, RoundTripGivesTheSameBytes) {
   EXPECT_FALSE(loaded.periodic.y);
   EXPECT_TRUE(SameBits(loaded.periodic.max_m, def.periodic.max_m));
   EXPECT_TRUE(SameBits(loaded.slope.downhill, def.slope.downhill));
+  ASSERT_EQ(loaded.slope.region.size(), def.slope.region.size());
+  for (std::size_t k = 0; k < def.slope.region.size(); ++k) EXPECT_TRUE(SameBits(loaded.slope.region[k], def.slope.region[k]));
   EXPECT_EQ(loaded.threads, 2);
   EXPECT_EQ(loaded.device, ComputeDevice::kCpu);
   WorldDef on_cuda = def;

@@ -63,6 +63,7 @@ using crowdrecon::PeriodicBox;
 struct FloorSlope {
   Vec2 downhill;          // unit vector (0, 0 = flat)
   double gradient = 0.0;  // rise over run (e.g. 0.30 m / 12 m = 0.025)
+  std::vector<Vec2> region;  // the polygon where the floor slopes (a person's centre inside); empty: everywhere
 };
 
 // Where the narrow phase and contact law of person pairs run. The results

@@ -7,7 +7,7 @@
 //
 // The format, in the machine's byte order (little-endian on every machine the
 // project runs on; world_file.cpp refuses to build elsewhere):
-//   "CRWORLD5"
+//   "CRWORLD7"
 //   the model parameters, in the order of the parameter table (parameter_table.hpp)
 //     (doubles; enums as uint8; bools as uint8 0 or 1)
 //   shapes  (count; per shape: vertices, radius_m, core_radius_m)
@@ -15,12 +15,12 @@
 //   walls   (count; per wall: points, closed, radius_m)
 //   targets (count; per field: constant flag, then the direction, or the
 //            grid: origin, spacing, nx, ny, distances, directions)
-//   periodic box, floor slope, threads (int32)
+//   periodic box, floor slope (downhill, gradient, region), threads (int32)
 //   FNV-1a 64-bit checksum of everything before it, as in checkpoints.
 // Counts are uint64; a list of numbers or points is its count followed by
 // the values. Each field is written on its own (no structs with padding), so
 // the bytes depend only on the world: SaveWorld(LoadWorld(SaveWorld(d))) ==
-// SaveWorld(d). A change of WorldDef needs a new magic ("CRWORLD5").
+// SaveWorld(d). A change of WorldDef needs a new magic ("CRWORLD7").
 #pragma once
 
 #include <filesystem>

@@ -117,6 +117,7 @@ struct Slope {
   Vec2 direction;         // downhill, unit vector
   double gradient = 0.0;  // dimensionless, in [0, 1]
   bool enabled = true;    // a slope may be documented but switched off
+  Ring region;            // where the floor slopes (empty: the whole floor)
 };
 
 struct Venue {
