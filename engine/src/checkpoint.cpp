@@ -31,7 +31,8 @@ namespace {
 // such rather than misread. Version 4: the time step's mode and the adaptive
 // step's parameters, and with the adaptive step its ticks and level (the
 // fixed step's time is written where the step was); version 3 is refused.
-constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '4'};
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '5'};
+constexpr char kStateMagicV4[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '4'};
 constexpr char kStateMagicV3[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '3'};
 constexpr char kStateMagicV2[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
 constexpr char kStateMagicV1[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '1'};
@@ -186,7 +187,8 @@ std::string Simulation::SaveState() const {
 }
 
 void Simulation::LoadState(const std::string& data) {
-  for (const auto& [magic, format] : {std::pair{kStateMagicV2, "2"}, std::pair{kStateMagicV3, "3"}})
+  for (const auto& [magic, format] :
+       {std::pair{kStateMagicV2, "2"}, std::pair{kStateMagicV3, "3"}, std::pair{kStateMagicV4, "4"}})
     if (HasMagic(data, magic))
       throw InputError(std::string("checkpoint: written by an older crowdrecon (state format ") + format +
                        ", before the model parameters of November 2026); resume the run with the version that "

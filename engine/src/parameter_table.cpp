@@ -25,6 +25,7 @@ constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
 // Yielding and ShoulderTurn: what a person does when blocked.
 constexpr const char* kWhenBlockedChoices[] = {"none", "when_blocked"};
 constexpr const char* kGiveWayChoices[] = {"none", "where_room"};
+constexpr const char* kSlopeResponseChoices[] = {"body_force", "held"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -112,6 +113,11 @@ auto MakeTable() {
       // --- Floor ---
       Number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", 0.0, 100.0, "physics",
              "g, for the body force of a sloping floor"),
+      Choice<&P::slope_response>("slope_response", kSlopeResponseChoices,
+             "issue 43; Tobler 1993 (hiking function, from Imhof's walking data)",
+             "body_force: m g sin(theta) downhill on walking people, held by eq. 3 alone (a person wanting to stand "
+             "drifts at tau g sin(theta)); held: the legs hold it, and the desired speed is scaled by Tobler's "
+             "exp(-3.5 abs(s + 0.05)) / exp(-3.5 x 0.05) of the grade s along the desired direction"),
       // --- Time integration ---
       Choice<&P::integrator>("integrator", kIntegratorChoices, "ERRATA 12",
              "velocity Verlet (default) or Gear's fifth-order predictor-corrector (the paper's code)"),

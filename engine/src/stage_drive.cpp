@@ -117,6 +117,11 @@ bool InsideRing(const std::vector<Vec2>& ring, Vec2 p) {
 
 }  // namespace
 
+double SlopeWalkingFactor(double grade) {
+  // Tobler (1993): W = 6 exp(-3.5 |s + 0.05|) km/h, relative to the level's.
+  return std::exp(-3.5 * (std::abs(grade + 0.05) - 0.05));
+}
+
 void Simulation::Drive() {
   ScopedTimer timer(profile_.stage_s[Index(Stage::kDrive)]);
   const Internals& in = *in_;
@@ -134,6 +139,7 @@ void Simulation::Drive() {
                                 : 0.0;
   const Vec2 slope_acceleration = def_.slope.downhill * slope_force_per_kg;
   const std::vector<Vec2>& slope_region = def_.slope.region;  // (empty: the whole floor)
+  const bool slope_held = mp.slope_response == SlopeResponse::kHeld && slope_force_per_kg > 0.0;
   const bool yielding = mp.yielding == Yielding::kWhenBlocked;
   const bool shoulder_turn = mp.shoulder_turn == ShoulderTurn::kWhenBlocked;
   const bool blocked_known = yielding || shoulder_turn;
@@ -208,7 +214,11 @@ void Simulation::Drive() {
         const Vec2 e = direction[k];
         // Yielding (issue 39, off by default): held up by the people ahead,
         // the person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
-        const double pace = yielding && in.held_back_n[i] < 0.0 ? v0 * mp.yielding_push_share : v0;
+        double pace = yielding && in.held_back_n[i] < 0.0 ? v0 * mp.yielding_push_share : v0;
+        const bool on_slope = slope_region.empty() || InsideRing(slope_region, bodies_.position_m[i]);
+        // A held slope (issue 43, off by default): the legs hold its pull,
+        // and the pace follows the grade along e (Tobler's hiking function).
+        if (slope_held && on_slope) pace *= SlopeWalkingFactor(-def_.slope.gradient * Dot(e, def_.slope.downhill));
         force += (e * pace - v) * (m * inverse_tau);  // eq. (3)
         // Gait jitter (issue 39, off by default): eq. (3)'s desired velocity plus u_i(t).
         if (jitter) force += JitterVelocity(jitter_seed, bodies_.id[i], drive_time_s, mp) * (m * inverse_tau);
@@ -227,7 +237,7 @@ void Simulation::Drive() {
         if (turning[k]) torque += torsion * inertia * gain[k] * angle[k];
         // Rotational damping, eq. (17), with its own relaxation time (ERRATA 8).
         torque -= inertia * rotation_damping * bodies_.angular_velocity_rad_per_s[i];
-        if (slope_region.empty() || InsideRing(slope_region, bodies_.position_m[i])) force += slope_acceleration * m;
+        if (!slope_held && on_slope) force += slope_acceleration * m;
       }
       bodies_.force_n[i] = force;
       bodies_.torque_n_m[i] = torque;

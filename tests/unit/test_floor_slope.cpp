@@ -98,5 +98,31 @@ TEST(FloorSlope, TheFloorIsLevelOutsideTheSlopesRegion) {
   EXPECT_NEAR(-everywhere.bodies().velocity_m_per_s[0].y, 1.2 + drift, 1e-4);
 }
 
+// The held slope (issue 43, slope_response = held): the legs hold the
+// slope's pull, and the desired speed follows Tobler's hiking function of the
+// grade along the walking direction. Alone, a person walks uphill at 0.61 v0
+// and downhill at 0.87 v0 at 8 degrees, and standing, stands; across the
+// slope (no grade along the walk) at v0; on the level beyond the region at v0.
+TEST(FloorSlope, AHeldSlopeSlowsWalkersAsToblersFunctionAndLetsPeopleStand) {
+  EXPECT_NEAR(SlopeWalkingFactor(0.0), 1.0, 1e-15);
+  EXPECT_NEAR(SlopeWalkingFactor(kGradient), std::exp(-3.5 * kGradient), 1e-12);
+  EXPECT_NEAR(SlopeWalkingFactor(kGradient), 0.611, 1e-3);
+  EXPECT_NEAR(SlopeWalkingFactor(-kGradient), 0.868, 1e-3);
+  EXPECT_NEAR(SlopeWalkingFactor(-0.05), std::exp(0.175), 1e-12);  // Tobler's fastest: slightly downhill
+  const double v0 = 1.2;
+  for (const auto& [name, direction, speed, want] :
+       {std::tuple{"uphill", Vec2{0.0, 1.0}, v0, Vec2{0.0, v0 * SlopeWalkingFactor(kGradient)}},
+        std::tuple{"downhill", Vec2{0.0, -1.0}, v0, Vec2{0.0, -v0 * SlopeWalkingFactor(-kGradient)}},
+        std::tuple{"across", Vec2{1.0, 0.0}, v0, Vec2{v0, 0.0}},
+        std::tuple{"standing", Vec2{0.0, 1.0}, 0.0, Vec2{0.0, 0.0}}}) {
+    WorldDef def = OnePersonOnASlope(direction, speed, {0.0, 0.0});
+    def.parameters.slope_response = SlopeResponse::kHeld;
+    Simulation sim(def);
+    sim.AdvanceTo(12.0 * def.parameters.relaxation_time_s);
+    EXPECT_NEAR(sim.bodies().velocity_m_per_s[0].x, want.x, 1e-4) << name;
+    EXPECT_NEAR(sim.bodies().velocity_m_per_s[0].y, want.y, 1e-4) << name;
+  }
+}
+
 }  // namespace
 }  // namespace crowdrecon::engine

@@ -51,7 +51,7 @@ TEST(FuzzSeeds, TheWorldAndCheckpointSeedsAreInTheCurrentFormats) {
 TEST(FuzzSeeds, AStateOfTheFormerFormatIsRefusedAsSuch) {
   const WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
   std::string state = Read(kStateSeed);
-  ASSERT_EQ(state.substr(0, 8), "CRSTATE4");
+  ASSERT_EQ(state.substr(0, 8), "CRSTATE5");
   state[7] = '2';
   Simulation sim(world);
   try {

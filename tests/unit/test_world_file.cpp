@@ -302,10 +302,11 @@ TEST(WorldFile, DamagedDataIsRefusedWithItsOrigin) {
   // Offsets in the format (world_file.hpp): the magic (8), then the
   // parameters (the parameter table's order): 5 doubles, tangential_damping,
   // a double, tangential_spring, 2 flags, 2 doubles (tau, Gamma),
-  // back_force_trigger, 3 doubles, facing_target, a double, integrator, 2
-  // doubles, time_step_mode, 2 doubles, gait_jitter, 4 doubles, yielding, 2
-  // doubles, shoulder_turn, a double, give_way, 4 doubles; then the shape count.
-  const std::size_t integrator_at = 8 + 5 * 8 + 1 + 8 + 1 + 2 + 2 * 8 + 1 + 3 * 8 + 1 + 1 * 8;
+  // back_force_trigger, 3 doubles, facing_target, a double (g),
+  // slope_response, integrator, 2 doubles, time_step_mode, 2 doubles,
+  // gait_jitter, 4 doubles, yielding, 2 doubles, shoulder_turn, a double,
+  // give_way, 4 doubles; then the shape count.
+  const std::size_t integrator_at = 8 + 5 * 8 + 1 + 8 + 1 + 2 + 2 * 8 + 1 + 3 * 8 + 1 + 1 * 8 + 1;
   const std::size_t shape_count_at =
       integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8;
   ASSERT_EQ(static_cast<unsigned char>(good[integrator_at]), static_cast<unsigned>(Integrator::kGear5));

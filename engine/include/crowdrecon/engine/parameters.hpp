@@ -82,6 +82,12 @@ enum class GiveWay {
                // heading against e_i: walk their way for give_way_duration_s
 };
 
+// How a sloping floor acts on walking people (issue 43; docs/itaewon.md).
+enum class SlopeResponse {
+  kBodyForce,  // issue 19: m g sin(theta) downhill on every walking person (default; eq. 3 alone holds it)
+  kHeld,       // the legs hold the slope's pull; the desired speed follows Tobler's hiking function of the grade
+};
+
 enum class Integrator {
   kVelocityVerlet,  // second order, symplectic for conservative forces; default
   kGear5,           // fifth-order Gear predictor-corrector, as in the paper's SPOLY code
@@ -174,6 +180,7 @@ struct ModelParameters {
 
   // --- Floor --------------------------------------------------------------
   double gravity_m_per_s2 = 9.81;  // for the optional floor slope body force
+  SlopeResponse slope_response = SlopeResponse::kBodyForce;
 
   // --- Time integration ---------------------------------------------------
   Integrator integrator = Integrator::kVelocityVerlet;

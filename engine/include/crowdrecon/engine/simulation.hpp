@@ -292,6 +292,12 @@ std::string TimeStepAboveLimit(double time_step_s, Integrator integrator, const 
 // omega_max (engine/src/time_step.cpp). About 0.02 at the engine's own step.
 double RestitutionErrorAtStep(const WorldDef& def, double time_step_s);
 
+// The walking speed on a grade s (rise over run along the walking direction,
+// uphill positive) relative to the level's: Tobler's hiking function
+// exp(-3.5 |s + 0.05|) / exp(-3.5 x 0.05) (0.61 at +0.14, 0.87 at -0.14).
+// The desired speed of SlopeResponse::kHeld.
+double SlopeWalkingFactor(double grade);
+
 // Throws SimulationError if the straight path of a person's centre from
 // `centres_before` (positions at an earlier time) to now crosses a wall's
 // core line: a safety net behind the contact check (a core vertex crossing a
