@@ -233,6 +233,18 @@ class Calibration {
     }
   }
 
+  // A quadratic over the whole box fitted to every set evaluated so far
+  // (the profiles' and the posterior's); false with too few sets.
+  bool FitWhole(Quadratic* q) const {
+    std::vector<Point> units;
+    std::vector<std::vector<double>> means;
+    for (const SetResult* s : ev_.All()) {
+      units.push_back(ev_.ToUnit(s->values));
+      means.push_back(s->mean);
+    }
+    return q->Fit(units, means, Point(spec_.parameters.size(), 0.5), 0.5);
+  }
+
   // Evaluates a design in the box and fits a quadratic to every set
   // evaluated inside it.
   Quadratic FitLocal(const Point& c, double half, const std::string& stage) {
@@ -373,14 +385,8 @@ class Calibration {
     r_.profiles.assign(p, {});
     if (n < 2) return;
     const Point best = ev_.ToUnit(r_.best);
-    std::vector<Point> all_units;
-    std::vector<std::vector<double>> all_means;
-    for (const SetResult* s : ev_.All()) {
-      all_units.push_back(ev_.ToUnit(s->values));
-      all_means.push_back(s->mean);
-    }
     Quadratic whole;
-    const bool refit = whole.Fit(all_units, all_means, Point(p, 0.5), 0.5);
+    const bool refit = FitWhole(&whole);
     std::vector<Point> pts;
     std::vector<double> surrogate_chi2;
     for (std::size_t i = 0; i < p; ++i)
@@ -432,14 +438,8 @@ class Calibration {
     if (spec_.options.posterior_steps <= 0) return;
     const std::size_t p = spec_.parameters.size();
     auto& post = r_.posterior;
-    std::vector<Point> units;
-    std::vector<std::vector<double>> means;
-    for (const SetResult* s : ev_.All()) {
-      units.push_back(ev_.ToUnit(s->values));
-      means.push_back(s->mean);
-    }
     Quadratic whole;
-    if (!whole.Fit(units, means, Point(p, 0.5), 0.5)) {
+    if (!FitWhole(&whole)) {
       post.note = "too few parameter sets for a quadratic over the whole box";
       return;
     }
@@ -482,7 +482,7 @@ class Calibration {
     post.acceptance = ps.acceptance;
     post.r_hat = ps.r_hat;
     post.surrogate_form = whole.form;
-    post.sets = units.size();
+    post.sets = ev_.All().size();
     double worst = 0.0;
     for (double r : ps.r_hat) worst = std::max(worst, std::isfinite(r) ? r : 0.0);
     Say("posterior: " + std::to_string(post.samples.size()) + " samples of " + std::to_string(ps.chains) +

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "crowdrecon/calibrate/calibration_file.hpp"
@@ -148,17 +149,26 @@ TEST(GradientSearch, FindsMinimaInsideAndOnTheEdgeWithFewJacobians) {
   }
 }
 
+// Three statistics linear in two unit coordinates, m = A u, and their
+// quadratic fitted at the box's corners (exact).
+struct LinearProblem {
+  const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
+  std::vector<std::vector<double>> corners{{0.0, 0.0}, {0.0, 1.0}, {1.0, 0.0}, {1.0, 1.0}};
+  Quadratic q;
+  LinearProblem() {
+    std::vector<std::vector<double>> vals;
+    for (const auto& u : corners)
+      vals.push_back({a[0][0] * u[0] + a[0][1] * u[1], a[1][0] * u[0] + a[1][1] * u[1], a[2][0] * u[0] + a[2][1] * u[1]});
+    if (!q.Fit(corners, vals, {0.5, 0.5}, 0.5)) throw std::logic_error("the linear problem's fit");
+  }
+};
+
 TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
   // Linear statistics m = A u + b with sigma 0.5: covariance (JᵀJ)⁻¹, J = A / 0.5.
-  const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
-  std::vector<std::vector<double>> pts, vals;
-  for (double x : {0.0, 1.0})
-    for (double y : {0.0, 1.0}) {
-      pts.push_back({x, y});
-      vals.push_back({a[0][0] * x + a[0][1] * y, a[1][0] * x + a[1][1] * y, a[2][0] * x + a[2][1] * y});
-    }
-  Quadratic q;
-  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  const LinearProblem linear;
+  const auto& a = linear.a;
+  const auto& pts = linear.corners;
+  const Quadratic& q = linear.q;
   const Objective o = ObjectiveObserving({0.5, 0.5, 0.5}, {0.5, 0.5, 0.5});
   std::vector<double> cov;
   std::string reason;
@@ -200,15 +210,10 @@ TEST(Surrogate, CovarianceIsTheInverseOfJtJAndAFreeParameterIsReported) {
 // statistics widens it as the generalised chi2 says; a coordinate nothing
 // depends on comes out uniform over the box; the same seed, the same samples.
 TEST(Posterior, MatchesTheAnalyticPosteriorOfALinearProblem) {
-  const double a[3][2] = {{1.0, 0.5}, {-0.3, 2.0}, {0.7, 0.7}};
-  std::vector<std::vector<double>> pts, vals;
-  for (double x : {0.0, 1.0})
-    for (double y : {0.0, 1.0}) {
-      pts.push_back({x, y});
-      vals.push_back({a[0][0] * x + a[0][1] * y, a[1][0] * x + a[1][1] * y, a[2][0] * x + a[2][1] * y});
-    }
-  Quadratic q;
-  ASSERT_TRUE(q.Fit(pts, vals, {0.5, 0.5}, 0.5));
+  const LinearProblem linear;
+  const auto& a = linear.a;
+  const auto& pts = linear.corners;
+  const Quadratic& q = linear.q;
   const std::vector<double> truth{0.45, 0.55};
   std::vector<double> observed;
   for (const auto& row : a) observed.push_back(row[0] * truth[0] + row[1] * truth[1]);
