@@ -57,6 +57,18 @@ void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
   for (const geometry::Obstacle& o : venue.obstacles) rings.push_back(o.polygon);
   canvas.FillRings(rings, kFloor);
 
+  // The floor slope's region (issue 43): tinted brown, an arrow downhill at
+  // its centre (a slope over the whole floor: the subtitle says it).
+  if (venue.slope && !venue.slope->region.empty()) {
+    const Color brown = Color::Hex(0x8c510a);
+    canvas.FillPolygon(venue.slope->region, Color::Hex(0x8c510a, 0.10));
+    Vec2 c;
+    for (Vec2 q : venue.slope->region) c += q;
+    c = c / static_cast<double>(venue.slope->region.size());
+    const Vec2 d = venue.slope->direction * (0.06 * extent);
+    canvas.Arrow(c - d, c + d, brown, 2.5);
+    canvas.Text(c + d + Vec2{0.01 * extent, 0.0}, "downhill", 12, brown);
+  }
   for (const geometry::MeasurementArea& m : venue.measurement_areas) {
     canvas.FillPolygon(m.polygon, Color{kMeasure.r, kMeasure.g, kMeasure.b, 0.12});
     std::vector<Vec2> closed = m.polygon;
@@ -139,7 +151,7 @@ void DrawVenue(const geometry::Venue& venue, const std::filesystem::path& file,
   if (venue.slope)
     subtitle += "; slope " + FormatFixed(100.0 * venue.slope->gradient, 1) + " % toward (" +
                 FormatNumber(venue.slope->direction.x) + ", " + FormatNumber(venue.slope->direction.y) + ")" +
-                (venue.slope->enabled ? "" : " (disabled)");
+                (venue.slope->region.empty() ? "" : " in the tinted region") + (venue.slope->enabled ? "" : " (disabled)");
   canvas.TextPx(56.0, 44.0, subtitle, 12, Color::Hex(0x444444));
   canvas.ScaleBar(NiceLength(hi.x - lo.x));
   std::string legend = "walls: black   exits: green   entries: blue   obstacles: grey";
