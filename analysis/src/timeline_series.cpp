@@ -68,6 +68,10 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   if (venue.empty()) throw InputError(run_file.string() + ": the run file holds no venue (written before format 2)");
   const geometry::Venue stored = geometry::ParseVenue(venue, run_file.string() + ": run value venue");
   s.area_m2 = geometry::WalkableArea_m2(stored);
+  for (const geometry::MeasurementArea& m : stored.measurement_areas) {
+    s.area_names.push_back(m.id);
+    s.area_m2_each.push_back(std::abs(geometry::RingSignedArea_m2(m.polygon)));
+  }
   for (const geometry::Exit& e : stored.exits) {
     s.exit_names.push_back(e.id);
     s.exit_width_m.push_back(stored.FreeWidth_m(e));  // between the jambs: flows per metre of opening
@@ -81,6 +85,7 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   runfile::PersonFrame frame;
   for (const runfile::FrameTime& ft : times) s.time_s.push_back(ft.time_s);
   s.density_per_m2.assign(times.size(), 0.0);  // a frame nobody is in has no rows
+  s.area_density_per_m2.assign(s.area_names.size(), std::vector<double>(times.size(), 0.0));
   s.counter_fraction.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
   std::size_t k = 0;
   while (stream.Next(&frame)) {
@@ -91,6 +96,11 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
       if (p < group.size() && group[p] == 1) ++counter;
     const std::size_t present = frame.person.size();
     s.density_per_m2[k] = static_cast<double>(present) / s.area_m2;
+    for (std::size_t a = 0; a < s.area_names.size(); ++a) {
+      std::size_t inside = 0;
+      for (Vec2 x : frame.position_m) inside += geometry::PointInRing(stored.measurement_areas[a].polygon, x) ? 1 : 0;
+      if (s.area_m2_each[a] > 0.0) s.area_density_per_m2[a][k] = static_cast<double>(inside) / s.area_m2_each[a];
+    }
     if (present > 0) s.counter_fraction[k] = static_cast<double>(counter) / static_cast<double>(present);
   }
   s.queued.assign(s.time_s.size(), 0.0);
@@ -108,6 +118,7 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   };
   s.time_s.resize(n);
   s.density_per_m2.resize(n);
+  for (std::vector<double>& area : s.area_density_per_m2) area.resize(n);
   s.counter_fraction.resize(n);
   s.queued.resize(n);
   for (const std::vector<double>& g : a.series.group_mean_speed_m_per_s) s.group_speed_m_per_s.push_back(fit(g));

@@ -18,6 +18,7 @@ constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
 const Color kRecorded = Color::Hex(0xe6550d), kFatal = Color::Hex(0xb2182b), kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
+const Color kArea[] = {Color::Hex(0x8c510a), Color::Hex(0x35978f), Color::Hex(0xe08214), Color::Hex(0x4d4d4d)};  // measurement areas (dashed)
 
 // Pixels from the top-left corner on a canvas of one world unit per pixel.
 struct Sheet {
@@ -55,10 +56,10 @@ void DrawFrame(Sheet& s, const Panel& p, const std::string& label) {
 
 // A series as a polyline, broken where it is NaN.
 void DrawSeries(Sheet& s, const Panel& p, const std::vector<double>& t, const std::vector<double>& v, Color c,
-                double width) {
+                double width, bool dashed = false) {
   std::vector<Vec2> run;
   const auto flush = [&] {
-    if (run.size() >= 2) s.canvas.StrokePolyline(run, c, width);
+    if (run.size() >= 2) s.canvas.StrokePolyline(run, c, width, dashed);
     run.clear();
   };
   // At most ~2 points per pixel column.
@@ -105,7 +106,10 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   const std::vector<double> density = smooth(ts.density_per_m2), share = smooth(ts.counter_fraction),
                             forward = smooth(ts.flow_forward_per_m_s), backward = smooth(ts.flow_backward_per_m_s),
                             queued = smooth(ts.queued);
+  std::vector<std::vector<double>> area_density;  // the measurement areas' (dashed on the density panel)
+  for (const auto& a : ts.area_density_per_m2) area_density.push_back(smooth(a));
   p[0].hi = std::ceil(Max(density, 1.0));
+  for (const auto& a : area_density) p[0].hi = std::max(p[0].hi, std::ceil(Max(a, 1.0)));
   p[1].hi = 100.0;
   std::vector<std::vector<double>> speeds;
   double v_lo = 0.0, v_hi = 0.5;
@@ -137,6 +141,8 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   std::vector<double> shares(share.size());
   for (std::size_t i = 0; i < share.size(); ++i) shares[i] = 100.0 * share[i];
   DrawSeries(s, p[0], ts.time_s, density, kSeries[0], 2.0);
+  for (std::size_t a = 0; a < area_density.size(); ++a)
+    DrawSeries(s, p[0], ts.time_s, area_density[a], kArea[a % 4], 1.6, true);
   DrawSeries(s, p[1], ts.time_s, shares, kSeries[1], 2.0);
   s.canvas.Line(s.P(kLeft, p[2].Y(0.0)), s.P(kRight, p[2].Y(0.0)), kInk, 0.8);
   for (std::size_t g = 0; g < speeds.size(); ++g) DrawSeries(s, p[2], ts.time_s, speeds[g], kSeries[g % 4], 2.0);
@@ -177,6 +183,11 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
     s.canvas.TextPxAligned(lx + 32, ly + 6, text, 12, 0.0, 0.5, kInk, 0.0, false, kWidth - lx - 40);
     ly += 22;
   };
+  entry(kSeries[0], "density over the venue", false);
+  for (std::size_t a = 0; a < ts.area_names.size(); ++a)
+    entry(kArea[a % 4], "density in " + ts.area_names[a] + " (" + Number(std::round(ts.area_m2_each[a] * 10.0) / 10.0) + " m2)",
+          true);
+  ly += 8;
   for (std::size_t g = 0; g < ts.group_names.size() && g < speeds.size(); ++g) entry(kSeries[g % 4], ts.group_names[g], false);
   ly += 8;
   entry(kSeries[0], "flow along group 0's direction", false);

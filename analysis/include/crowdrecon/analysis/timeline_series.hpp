@@ -37,6 +37,12 @@ struct TimelineSeries {
   double area_m2 = 0.0;
   std::vector<double> time_s;
   std::vector<double> density_per_m2;
+  // Per measurement area of the venue (its id, its area) the people whose
+  // centre lies inside it per square metre, by frame (an alley's own density
+  // inside a street network's).
+  std::vector<std::string> area_names;
+  std::vector<double> area_m2_each;
+  std::vector<std::vector<double>> area_density_per_m2;  // [area][frame]
   std::vector<double> counter_fraction;  // NaN where nobody is present
   std::vector<double> queued;            // waiting at the entries (0 without a census)
   std::vector<std::string> group_names;
