@@ -14,6 +14,7 @@
 #include "crowdrecon/reports/risk.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/canvas.hpp"
+#include "crowdrecon/viz/chart.hpp"
 
 namespace crowdrecon::reports {
 
@@ -98,6 +99,9 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   for (const analysis::TimelineMark& f : s.falls) r.fall_s.push_back(f.time_s);
   r.time_s = s.time_s;
   r.density_per_m2 = analysis::MovingMean(s.time_s, s.density_per_m2, options.smooth_s);
+  r.area_names = s.area_names;
+  for (const std::vector<double>& a : s.area_density_per_m2)
+    r.area_density_per_m2.push_back(analysis::MovingMean(s.time_s, a, options.smooth_s));
   r.recorded = s.recorded;
   r.clog_for_good_s = ClogForGood(s, options);
   RiskOptions risk;
@@ -254,7 +258,9 @@ const viz::Color kRecorded = viz::Color::Hex(0xe6550d), kFatal = viz::Color::Hex
 
 void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, const std::filesystem::path& file) {
   const std::size_t n = score.runs.size();
-  const double rows_top = kTop + kDensity + 30;
+  // The density panel grows with the legend's lines for measurement areas.
+  const double density_h = kDensity + 22.0 * static_cast<double>(score.runs.front().area_names.size());
+  const double rows_top = kTop + density_h + 30;
   const double height = rows_top + static_cast<double>(n) * kRow + 70;
   viz::Canvas canvas(file, {0, 0}, {kWidth, height}, 1.0, 0.0);
   const auto P = [&](double x, double y) { return Vec2{x, height - y}; };
@@ -272,11 +278,15 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
                        12, 0.0, 0.5, viz::Color::Hex(0x555555), 0.0, false, kWidth - kLeft - 20);
   // Density panel.
   double d_hi = 1.0;
-  for (const EnsembleRun& r : score.runs)
+  for (const EnsembleRun& r : score.runs) {
     for (double d : r.density_per_m2)
       if (!std::isnan(d)) d_hi = std::max(d_hi, d);
+    for (const std::vector<double>& area : r.area_density_per_m2)
+      for (double d : area)
+        if (!std::isnan(d)) d_hi = std::max(d_hi, d);
+  }
   d_hi = std::ceil(d_hi / 2.0) * 2.0;
-  const double top = kTop, bottom = kTop + kDensity;
+  const double top = kTop, bottom = kTop + density_h;
   const auto Y = [&](double v) { return bottom - std::clamp(v / d_hi, 0.0, 1.0) * (bottom - top); };
   const double d_step = d_hi <= 6 ? 1.0 : d_hi <= 12 ? 2.0 : d_hi <= 30 ? 5.0 : 10.0;
   for (double v = 0.0; v <= d_hi + 1e-9; v += d_step) {
@@ -303,6 +313,13 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
     for (std::size_t i = 0; i < r.time_s.size(); ++i)
       if (!std::isnan(r.density_per_m2[i])) line.push_back(P(X(r.time_s[i]), Y(r.density_per_m2[i])));
     if (line.size() >= 2) canvas.StrokePolyline(line, viz::Color::Hex(0x2166ac, 0.55), 1.4);
+    // Each measurement area's own density (dashed, one colour per area).
+    for (std::size_t a = 0; a < r.area_density_per_m2.size(); ++a) {
+      std::vector<Vec2> dashed;
+      for (std::size_t i = 0; i < r.time_s.size() && i < r.area_density_per_m2[a].size(); ++i)
+        if (!std::isnan(r.area_density_per_m2[a][i])) dashed.push_back(P(X(r.time_s[i]), Y(r.area_density_per_m2[a][i])));
+      if (dashed.size() >= 2) canvas.StrokePolyline(dashed, viz::AreaColor(a), 1.2, true);
+    }
   }
   canvas.StrokePolygon({P(kLeft, top), P(kRight, top), P(kRight, bottom), P(kLeft, bottom)}, kInk, 1.0);
   // Recorded marks' labels over the density panel.
@@ -367,6 +384,10 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
   };
   canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::Color::Hex(0x2166ac, 0.55), 2.0);
   text("density, one line per run");
+  for (std::size_t a = 0; a < score.runs.front().area_names.size(); ++a) {
+    canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::AreaColor(a), 2.0, true);
+    text("density in " + score.runs.front().area_names[a]);
+  }
   canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kRecorded, 2.0, true);
   text("recorded avalanche");
   canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kFatal, 2.5);

@@ -22,6 +22,11 @@ Color ChartColor(int index) {
   return Color::Hex(kPalette[static_cast<unsigned>(index) % 8]);
 }
 
+Color AreaColor(std::size_t index) {
+  static const unsigned kPalette[] = {0x8c510a, 0x35978f, 0xe08214, 0x4d4d4d};
+  return Color::Hex(kPalette[index % 4]);
+}
+
 void ChartPanel::Line(const std::vector<double>& x, const std::vector<double>& y, Color color, double width_px,
                       const std::string& legend, bool dashed) {
   items_.push_back(std::make_shared<Item>(Item{Item::Kind::kLine, x, y, {}, {}, {}, color, width_px, legend, dashed}));

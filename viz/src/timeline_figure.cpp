@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "crowdrecon/viz/canvas.hpp"
+#include "crowdrecon/viz/chart.hpp"
 #include "ticks.hpp"
 
 namespace crowdrecon::viz {
@@ -18,7 +19,6 @@ constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
 const Color kRecorded = Color::Hex(0xe6550d), kFatal = Color::Hex(0xb2182b), kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
-const Color kArea[] = {Color::Hex(0x8c510a), Color::Hex(0x35978f), Color::Hex(0xe08214), Color::Hex(0x4d4d4d)};  // measurement areas (dashed)
 
 // Pixels from the top-left corner on a canvas of one world unit per pixel.
 struct Sheet {
@@ -142,7 +142,7 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   for (std::size_t i = 0; i < share.size(); ++i) shares[i] = 100.0 * share[i];
   DrawSeries(s, p[0], ts.time_s, density, kSeries[0], 2.0);
   for (std::size_t a = 0; a < area_density.size(); ++a)
-    DrawSeries(s, p[0], ts.time_s, area_density[a], kArea[a % 4], 1.6, true);
+    DrawSeries(s, p[0], ts.time_s, area_density[a], AreaColor(a), 1.6, true);
   DrawSeries(s, p[1], ts.time_s, shares, kSeries[1], 2.0);
   s.canvas.Line(s.P(kLeft, p[2].Y(0.0)), s.P(kRight, p[2].Y(0.0)), kInk, 0.8);
   for (std::size_t g = 0; g < speeds.size(); ++g) DrawSeries(s, p[2], ts.time_s, speeds[g], kSeries[g % 4], 2.0);
@@ -185,7 +185,7 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   };
   entry(kSeries[0], "density over the venue", false);
   for (std::size_t a = 0; a < ts.area_names.size(); ++a)
-    entry(kArea[a % 4], "density in " + ts.area_names[a] + " (" + Number(std::round(ts.area_m2_each[a] * 10.0) / 10.0) + " m2)",
+    entry(AreaColor(a), "density in " + ts.area_names[a] + " (" + Number(std::round(ts.area_m2_each[a] * 10.0) / 10.0) + " m2)",
           true);
   ly += 8;
   for (std::size_t g = 0; g < ts.group_names.size() && g < speeds.size(); ++g) entry(kSeries[g % 4], ts.group_names[g], false);

@@ -60,6 +60,8 @@ struct EnsembleRun {
   std::vector<double> rise_time_s;  // their rise times (NaN where the event gives none)
   std::vector<double> fall_s;       // its falls
   std::vector<double> time_s, density_per_m2;  // smoothed density, for the figure
+  std::vector<std::string> area_names;         // the venue's measurement areas
+  std::vector<std::vector<double>> area_density_per_m2;  // [area][frame], smoothed (an alley's own density)
   double clog_for_good_s = std::numeric_limits<double>::quiet_NaN();  // NaN: never
   std::size_t danger_peak = 0;  // most people above danger_n at once (1-s smoothed chest load)
   double danger_peak_time_s = std::numeric_limits<double>::quiet_NaN();

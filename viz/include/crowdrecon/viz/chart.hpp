@@ -20,6 +20,9 @@ namespace crowdrecon::viz {
 
 // A palette of distinguishable colours (index wraps).
 Color ChartColor(int index);
+// The colour of a venue's measurement area `index` in the timeline figures
+// (its own density, dashed: brown, teal, orange, grey, then again).
+Color AreaColor(std::size_t index);
 
 class ChartPanel {
  public:
