@@ -465,10 +465,8 @@ class Calibration {
     // exceeds 1, the statistics scatter more than the seeds' covariance
     // allows (a recording with a jam the runs rarely make), and the
     // likelihood is widened by that ratio (never narrowed).
-    std::size_t used = 0;
-    for (double sigma : o.sigma) used += std::isfinite(sigma) ? 1 : 0;
-    const double freedom = static_cast<double>(used) - static_cast<double>(p);
-    post.scale = freedom > 0.0 ? std::max(1.0, r_.best_simulated_chi2 / freedom) : 1.0;
+    const int freedom = o.DegreesOfFreedom(p);
+    post.scale = freedom > 0 ? std::max(1.0, r_.best_simulated_chi2 / freedom) : 1.0;
     const SurrogateLikelihood likelihood(whole, o, post.scale);
     if (likelihood.empty()) {
       post.note = "no statistic could be fitted by the quadratic over the whole box";
@@ -500,9 +498,7 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
   const std::size_t p = spec.parameters.size();
   Summary& s = r.summary;
   s.chi2 = r.best_simulated_chi2;
-  std::size_t used = 0;
-  for (double sigma : r.objective.sigma) used += std::isfinite(sigma) ? 1 : 0;
-  s.degrees_of_freedom = static_cast<int>(used) - static_cast<int>(p);
+  s.degrees_of_freedom = r.objective.DegreesOfFreedom(p);
   s.parameters.clear();
   for (std::size_t i = 0; i < p; ++i) {
     const Parameter& par = spec.parameters[i];
@@ -518,10 +514,7 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
     for (const auto& rep : r.bootstrap) v.push_back(rep[i]);
     if (v.size() >= 2) {
       std::sort(v.begin(), v.end());
-      double mean = 0.0, ss = 0.0;
-      for (double x : v) mean += x / static_cast<double>(v.size());
-      for (double x : v) ss += (x - mean) * (x - mean);
-      pr.bootstrap_sigma = std::sqrt(ss / static_cast<double>(v.size() - 1));
+      pr.bootstrap_sigma = SampleSd(v);
       std::tie(pr.bootstrap_lo95, pr.bootstrap_hi95) = Percentiles95(v);
     } else {
       pr.bootstrap_sigma = pr.bootstrap_lo95 = pr.bootstrap_hi95 = kNaN;
@@ -530,10 +523,7 @@ void Summarise(const CalibrationSpec& spec, CalibrationResult& r) {
       std::vector<double> w;
       for (const auto& x : r.posterior.samples) w.push_back(x[i]);
       std::sort(w.begin(), w.end());
-      double mean = 0.0, ss = 0.0;
-      for (double x : w) mean += x / static_cast<double>(w.size());
-      for (double x : w) ss += (x - mean) * (x - mean);
-      pr.posterior_sd = std::sqrt(ss / static_cast<double>(w.size() - 1));
+      pr.posterior_sd = SampleSd(w);
       pr.posterior_median = Quantile(w, 0.5);
       pr.posterior_lo68 = Quantile(w, 0.15865);
       pr.posterior_hi68 = Quantile(w, 0.84135);

@@ -180,6 +180,12 @@ double Objective::Chi2(const std::vector<double>& mean) const {
   return chi2;
 }
 
+int Objective::DegreesOfFreedom(std::size_t parameters) const {
+  int used = 0;
+  for (double s : sigma) used += std::isfinite(s) ? 1 : 0;
+  return used - static_cast<int>(parameters);
+}
+
 SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vector<double>>*>& sets,
                                     const std::vector<std::size_t>& lead) {
   const std::size_t n = lead.size();
@@ -422,13 +428,13 @@ bool Quadratic::Fit(const std::vector<std::vector<double>>& points, const std::v
   return true;
 }
 
-
-double Quadratic::Value(std::size_t statistic, const std::vector<double>& u) const {
-  const std::vector<double> b = Basis(u);
+double Quadratic::ValueAt(std::size_t statistic, const std::vector<double>& basis) const {
   double v = 0.0;
-  for (std::size_t c = 0; c < b.size(); ++c) v += coefficients_[statistic][c] * b[c];
+  for (std::size_t c = 0; c < basis.size(); ++c) v += coefficients_[statistic][c] * basis[c];
   return v;
 }
+
+double Quadratic::Value(std::size_t statistic, const std::vector<double>& u) const { return ValueAt(statistic, Basis(u)); }
 
 std::vector<double> Quadratic::Gradient(std::size_t statistic, const std::vector<double>& u) const {
   const auto g = BasisGradient(u);
@@ -441,11 +447,7 @@ std::vector<double> Quadratic::Gradient(std::size_t statistic, const std::vector
 std::vector<double> Quadratic::Values(const std::vector<double>& u) const {
   const std::vector<double> b = Basis(u);  // (once for every statistic)
   std::vector<double> v(coefficients_.size());
-  for (std::size_t j = 0; j < v.size(); ++j) {
-    double x = 0.0;
-    for (std::size_t c = 0; c < b.size(); ++c) x += coefficients_[j][c] * b[c];
-    v[j] = x;
-  }
+  for (std::size_t j = 0; j < v.size(); ++j) v[j] = ValueAt(j, b);
   return v;
 }
 
@@ -656,6 +658,13 @@ bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const s
 }
 
 // --- The posterior -----------------------------------------------------------
+
+double SampleSd(const std::vector<double>& v) {
+  double mean = 0.0, ss = 0.0;
+  for (double x : v) mean += x / static_cast<double>(v.size());
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / static_cast<double>(v.size() - 1));
+}
 
 double Quantile(const std::vector<double>& sorted, double q) {
   const double at = std::clamp(q, 0.0, 1.0) * static_cast<double>(sorted.size() - 1);

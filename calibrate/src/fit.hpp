@@ -62,7 +62,9 @@ struct Objective {
   // statistics used with a finite simulated mean (whitened among those
   // alone), NaN elsewhere.
   std::vector<double> Residuals(const std::vector<double>& mean) const;
-  double Chi2(const std::vector<double>& mean) const;  // +inf where a statistic used has no simulated mean
+  double Chi2(const std::vector<double>& mean) const;
+  // chi2's degrees of freedom: the statistics used less the parameters fitted.
+  int DegreesOfFreedom(std::size_t parameters) const;  // +inf where a statistic used has no simulated mean
 
   // The whitening of `rows` (statistics used, ascending): residuals
   // w * (simulated values of rows) - b.
@@ -154,6 +156,7 @@ class Quadratic {
 
  private:
   std::vector<double> Basis(const std::vector<double>& u) const;
+  double ValueAt(std::size_t statistic, const std::vector<double>& basis) const;
   std::vector<std::vector<double>> BasisGradient(const std::vector<double>& u) const;
   std::size_t dims_ = 0;
   int terms_ = 2;  // 0 linear, 1 squares, 2 full
@@ -224,6 +227,9 @@ struct PosteriorSamples {
 using LogDensity = std::function<double(const std::vector<double>& u)>;
 PosteriorSamples SamplePosterior(const LogDensity& log_density, const std::vector<std::vector<double>>& starts,
                                  int steps, std::uint64_t seed);
+
+// The sample standard deviation of v (at least two values).
+double SampleSd(const std::vector<double>& v);
 
 // The q-quantile (0 <= q <= 1) of `sorted` (ascending, non-empty), linear
 // between order statistics.

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "crowdrecon/common/fast_math.hpp"
+#include "crowdrecon/common/polygon.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -103,16 +104,6 @@ void HeldBackByPeopleAhead(const BodyState& bodies, const std::vector<Contact>& 
     if (ahead(c.point_m - xa, desired[c.a])) held[c.a] += std::min(0.0, Dot(f, desired[c.a]));
     if (ahead(c.point_m - xb, desired[c.b])) held[c.b] += std::min(0.0, -Dot(f, desired[c.b]));
   }
-}
-
-// Whether p lies inside the polygon `ring` (even-odd rule; the slope's region).
-bool InsideRing(const std::vector<Vec2>& ring, Vec2 p) {
-  bool inside = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Vec2 a = ring[i], b = ring[j];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x)) inside = !inside;
-  }
-  return inside;
 }
 
 }  // namespace
@@ -215,7 +206,7 @@ void Simulation::Drive() {
         // Yielding (issue 39, off by default): held up by the people ahead,
         // the person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
         double pace = yielding && in.held_back_n[i] < 0.0 ? v0 * mp.yielding_push_share : v0;
-        const bool on_slope = slope_region.empty() || InsideRing(slope_region, bodies_.position_m[i]);
+        const bool on_slope = slope_region.empty() || PointInPolygon(slope_region, bodies_.position_m[i]);
         // A held slope (issue 43, off by default): the legs hold its pull,
         // and the pace follows the grade along e (Tobler's hiking function).
         if (slope_held && on_slope) pace *= SlopeWalkingFactor(-def_.slope.gradient * Dot(e, def_.slope.downhill));

@@ -13,6 +13,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/polygon.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "venue_internal.hpp"
 
@@ -38,20 +39,7 @@ double RingPerimeter_m(const Ring& ring) {
   return length;
 }
 
-bool PointInRing(const Ring& ring, Vec2 p) {
-  // Crossing number with the half-open rule (an edge counts when one endpoint
-  // is strictly above p and the other not), so vertices are not counted twice.
-  bool inside = false;
-  const std::size_t n = ring.size();
-  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
-    const Vec2 a = ring[i], b = ring[j];
-    if ((a.y > p.y) != (b.y > p.y)) {
-      const double x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-      if (p.x < x) inside = !inside;
-    }
-  }
-  return inside;
-}
+bool PointInRing(const Ring& ring, Vec2 p) { return PointInPolygon(ring, p); }
 
 double DistanceToRing(const Ring& ring, Vec2 p) {
   double d = std::numeric_limits<double>::infinity();
