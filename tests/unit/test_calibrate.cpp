@@ -799,6 +799,10 @@ TEST(CalibrationFile, BadFilesAreRefusedWithThePathAndTheValue) {
          "/starts/0/model.restitution: \"model.restitution\" is not one of the parameters to fit");
   expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "options": {"profile_points": 1})"),
          "/options/profile_points");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "options": {"posterior_steps": 500})"),
+         "/options/posterior_steps: expected 0 (no posterior) or at least 1000 steps per chain");
+  expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "options": {"posterior_steps": -1})"),
+         "/options/posterior_steps");
   expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "extra": 1)"), "unknown key");
   expect(Calibration("/nonexistent/obs.json", R"([{"path": "model.back_force_gamma"}])"),
          "/observations/0/file: cannot use the observation");
