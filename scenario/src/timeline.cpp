@@ -76,6 +76,16 @@ RateSchedule ReadRate(const JsonReader& inflow, const std::filesystem::path& bas
     }
   }
   rate.linear = inflow.Choice("interpolation", "step", {"step", "linear"}) == "linear";
+  if (auto scale = inflow.Find("rate_scale")) {
+    const double k = scale->AsNumber(0.0, 10.0);
+    for (auto& point : rate.points) {
+      point.second *= k;
+      if (point.second > kMaxRate_per_s)
+        scale->Fail("scales the rate " + FormatNumber(point.second / k) + " persons/s at " + FormatNumber(point.first) +
+                    " s beyond " + FormatNumber(kMaxRate_per_s) + " persons/s");
+    }
+  }
+  if (auto cap = inflow.Find("max_rate_per_s")) rate.Cap(cap->AsNumber(0.0, kMaxRate_per_s));
   rate.Prepare();
   return rate;
 }
@@ -91,6 +101,23 @@ double RateSchedule::RateAt(double t) const {
   if (!linear) return r0;
   const auto& [t1, r1] = *next;
   return r0 + (r1 - r0) * (t - t0) / (t1 - t0);
+}
+
+void RateSchedule::Cap(double cap) {
+  std::vector<std::pair<double, double>> capped;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (linear && k > 0) {  // where a linear piece crosses the cap, a point at the crossing keeps it exact
+      const auto& [t0, r0] = points[k - 1];
+      const auto& [t1, r1] = points[k];
+      if ((r0 < cap && r1 > cap) || (r0 > cap && r1 < cap)) {
+        const double tc = t0 + (cap - r0) * (t1 - t0) / (r1 - r0);
+        if (tc > t0 && tc < t1) capped.emplace_back(tc, cap);
+      }
+    }
+    capped.emplace_back(points[k].first, std::min(points[k].second, cap));
+  }
+  points = std::move(capped);
+  Prepare();
 }
 
 void RateSchedule::Prepare() {

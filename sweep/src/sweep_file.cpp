@@ -154,20 +154,36 @@ bool ValidName(const std::string& name) {
 }
 
 // Puts `value` at dotted `path` in `doc`, creating objects on the way.
+// The element a path's part names in a list: a decimal index below its size
+// ("timeline.inflows.0.max_rate_per_s" is the first inflow's cap).
+json& Element(json& list, const std::string& part, const std::string& prefix, const std::string& path,
+              const std::string& where) {
+  const bool digits = !part.empty() && part.size() <= 6 &&
+                      std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (!digits || std::stoul(part) >= list.size())
+    throw InputError(where + ": cannot set \"" + path + "\": \"" + prefix + "\" is a list of " +
+                     std::to_string(list.size()) + " in the scenario; expected an index 0.." +
+                     (list.empty() ? std::string("(none)") : std::to_string(list.size() - 1)) + ", not \"" + part + "\"");
+  return list[std::stoul(part)];
+}
+
 void Apply(json& doc, const std::string& path, json value, const std::string& where) {
   const std::vector<std::string> parts = SplitPath(path);
   json* node = &doc;
   std::string prefix;
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    json& next = node->is_array() ? Element(*node, parts[i], prefix, path, where) : (*node)[parts[i]];
     prefix += (i ? "." : "") + parts[i];
-    json& next = (*node)[parts[i]];
     if (next.is_null()) next = json::object();
-    if (!next.is_object())
+    if (!next.is_object() && !next.is_array())
       throw InputError(where + ": cannot set \"" + path + "\": \"" + prefix + "\" is " + next.dump() +
-                       " in the scenario, not an object");
+                       " in the scenario, not an object or a list");
     node = &next;
   }
-  (*node)[parts.back()] = std::move(value);
+  if (node->is_array())
+    Element(*node, parts.back(), prefix, path, where) = std::move(value);
+  else
+    (*node)[parts.back()] = std::move(value);
 }
 
 // Makes relative file paths inside an override value relative to `dir`

@@ -7,6 +7,8 @@
 #include <limits>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
@@ -157,6 +159,31 @@ TEST(SweepFile, OverrideThroughANonObject) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("test.json: run 0 (variant base, seed 1): cannot set \"population.seed.x\": "
                                          "\"population.seed\" is 1 in the scenario, not an object"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A part of a path that is a number names an element of a list: an axis over
+// one inflow's cap ("timeline.inflows.0.max_rate_per_s"); an index beyond the
+// list is refused with the list's size.
+TEST(SweepFile, ANumberInAPathNamesAListsElement) {
+  const SweepSpec s = Parse("{" + kHead + R"(,
+    "set": {"timeline": {"inflows": [{"entry": "a", "rate_per_s": 1}, {"entry": "b", "rate_per_s": 2}]}},
+    "axes": [{"path": "timeline.inflows.1.max_rate_per_s", "values": [0.5, 1.5]}]})");
+  const std::vector<RunPlan> runs = ExpandRuns(s);
+  const nlohmann::json doc = nlohmann::json::parse(RunScenarioJson(s, runs.at(1)));
+  EXPECT_EQ(doc["timeline"]["inflows"][1]["max_rate_per_s"], 1.5);
+  EXPECT_EQ(doc["timeline"]["inflows"][1]["rate_per_s"], 2);
+  EXPECT_FALSE(doc["timeline"]["inflows"][0].contains("max_rate_per_s"));
+  try {
+    const SweepSpec beyond = Parse("{" + kHead + R"(,
+      "set": {"timeline": {"inflows": [{"entry": "a", "rate_per_s": 1}]}, "timeline.inflows.2.rate_scale": 2}})");
+    (void)RunScenarioJson(beyond, ExpandRuns(beyond).at(0));
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot set \"timeline.inflows.2.rate_scale\": \"timeline.inflows\" is a list "
+                                         "of 1 in the scenario; expected an index 0..0, not \"2\""),
               std::string::npos)
         << e.what();
   }

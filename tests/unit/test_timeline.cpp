@@ -98,6 +98,34 @@ TEST(RateSchedule, StepAndLinearIntegralsAreExact) {
   EXPECT_EQ(ArrivalsDue(late, 7.25), 4u);
 }
 
+// An inflow held back ("max_rate_per_s", issue 43's design question): the
+// rate is min(schedule, cap) at every time, and the people due are its exact
+// integral: a linear ramp 1 -> 3 persons/s over 10 s capped at 2 delivers
+// 1.5 x 5 (the ramp up to the crossing at 5 s) + 2 x 5.
+TEST(RateSchedule, ACapHoldsTheRateAtMostThereExactly) {
+  RateSchedule ramp;
+  ramp.points = {{0.0, 1.0}, {10.0, 3.0}, {20.0, 0.5}};
+  ramp.linear = true;
+  ramp.Cap(2.0);
+  ASSERT_EQ(ramp.points.size(), 5u);  // crossings at 5 s (up) and 14 s (down)
+  EXPECT_DOUBLE_EQ(ramp.points[1].first, 5.0);
+  EXPECT_DOUBLE_EQ(ramp.points[3].first, 14.0);
+  for (double t = 0.0; t <= 25.0; t += 0.25) {
+    const double uncapped = t < 10.0 ? 1.0 + 0.2 * t : t < 20.0 ? 3.0 - 0.25 * (t - 10.0) : 0.5;
+    EXPECT_NEAR(ramp.RateAt(t), std::min(uncapped, 2.0), 1e-12) << t;
+  }
+  EXPECT_NEAR(ramp.Integral(0.0, 10.0), 7.5 + 10.0, 1e-12);
+  EXPECT_NEAR(ramp.Integral(10.0, 20.0), 2.0 * 4.0 + 0.5 * (2.0 + 0.5) * 6.0, 1e-12);
+  RateSchedule step;  // a step schedule: each point's rate capped, no new points
+  step.points = {{0.0, 1.0}, {10.0, 3.0}};
+  step.Cap(2.0);
+  ASSERT_EQ(step.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(step.Integral(0.0, 20.0), 10.0 + 20.0);
+  RateSchedule below = step;  // a cap above every rate changes nothing
+  below.Cap(5.0);
+  EXPECT_EQ(below.points, step.points);
+}
+
 TEST(RateSchedule, CsvIsReadAndBadRowsNameTheLine) {
   const auto file = crowdrecon::testing::ScratchFile("rate.csv");
   {
@@ -335,6 +363,25 @@ TEST(Timeline, ThreadCountDoesNotChangeATimeline) {
   }
 }
 
+// "rate_scale" multiplies the schedule (the inflow's scale, a calibration's
+// nuisance parameter), then "max_rate_per_s" holds it back; without them the
+// schedule is read unchanged.
+TEST(Timeline, AnInflowsScaleAndCapShapeItsSchedule) {
+  const auto schedule = [](const std::string& extra) {
+    const Scenario s = ParseScenario(
+        Hallway(R"({"count": 10, "target": "to_exit"})", R"({"duration_s": 10})",
+                R"({"inflows": [{"entry": "from_court", "rate_per_s": [[0, 1], [10, 3]], "interpolation": "linear")" +
+                    extra + "}]}"),
+        "scaled.json", kSource);
+    return s.timeline.inflows.at(0).rate.points;
+  };
+  using Points = std::vector<std::pair<double, double>>;
+  EXPECT_EQ(schedule(""), (Points{{0.0, 1.0}, {10.0, 3.0}}));
+  EXPECT_EQ(schedule(R"(, "rate_scale": 1.5)"), (Points{{0.0, 1.5}, {10.0, 4.5}}));
+  EXPECT_EQ(schedule(R"(, "rate_scale": 2, "max_rate_per_s": 4)"), (Points{{0.0, 2.0}, {5.0, 4.0}, {10.0, 4.0}}));
+  EXPECT_EQ(schedule(R"(, "max_rate_per_s": 0.5)"), (Points{{0.0, 0.5}, {10.0, 0.5}}));
+}
+
 TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   const auto refuse = [](const std::string& timeline, const std::string& expected) {
     try {
@@ -349,6 +396,10 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": [[5, 1], [2, 1]]}]})", "/timeline/inflows/0/rate_per_s: times must increase");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": -1}]})", "/timeline/inflows/0/rate_per_s");
   refuse(R"({"inflows": [{"entry": "from_court", "group": "staff", "rate_per_s": 1}]})", "group \"staff\" needs a \"target\"");
+  refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 1, "rate_scale": -0.5}]})", "/timeline/inflows/0/rate_scale: value -0.5 is out of range");
+  refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 200, "rate_scale": 8}]})",
+         "/timeline/inflows/0/rate_scale: scales the rate 200 persons/s at 0 s beyond 1000 persons/s");
+  refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 1, "max_rate_per_s": "slow"}]})", "/timeline/inflows/0/max_rate_per_s");
   refuse(R"({"events": [{"time_s": 1, "close_exit": "door"}]})", "/timeline/events/0/close_exit: the venue has no exit \"door\"");
   refuse(R"({"events": [{"time_s": 1, "set": {"restitution": 0.5}, "group": "main"}]})", "is the same for everyone");
   refuse(R"({"events": [{"time_s": 1, "set": {"integrator": 1}}]})", "cannot change during a run");

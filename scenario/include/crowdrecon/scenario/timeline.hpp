@@ -59,6 +59,10 @@ struct RateSchedule {
 
   // Fills `prefix` (after the points change).
   void Prepare();
+  // The rate held back to at most `cap` (an inflow's "max_rate_per_s"):
+  // min(rate, cap) at every time, exactly (a linear piece that crosses the
+  // cap gets a point where it does).
+  void Cap(double cap);
   double RateAt(double t_s) const;
   // The integral of the rate from -infinity to t (people due by t if always
   // on), exact for both kinds.
