@@ -101,6 +101,7 @@ class Calibration {
     Uncertainty();
     Profiles();
     Posterior();
+    Footage();
   }
 
  private:
@@ -342,6 +343,12 @@ class Calibration {
     r_.best_set = Eval({best}, "the best fit")[0];
     r_.best_simulated_chi2 = r_.objective.Chi2(r_.best_set.mean);
 
+    const std::size_t n = r_.objective.statistics.size();
+    r_.jacobian.assign(n * p, kNaN);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::vector<double> g = local.Gradient(j, best);
+      for (std::size_t i = 0; i < p; ++i) r_.jacobian[j * p + i] = g[i] / spec_.parameters[i].Range();
+    }
     std::vector<double> cov_u;
     r_.covariance_ok = SurrogateCovariance(local, r_.objective, best, &cov_u, &r_.covariance_reason, &r_.without_effect);
     if (r_.covariance_ok) {
@@ -485,6 +492,17 @@ class Calibration {
     for (double r : ps.r_hat) worst = std::max(worst, std::isfinite(r) ? r : 0.0);
     Say("posterior: " + std::to_string(post.samples.size()) + " samples of " + std::to_string(ps.chains) +
         " chains, acceptance " + Fixed(ps.acceptance, 2) + ", largest R-hat " + Fixed(worst, 4));
+  }
+
+  // 7. What the recordings determine, and what more would: each
+  //    parameter's expected interval for N recordings of T seconds of the
+  //    first recording's kind, from the seeds' covariance and the Jacobian
+  //    at the best fit (footage.hpp). No runs.
+  void Footage() {
+    r_.footage = DesignFootage(r_.objective, r_.jacobian, r_.best, FootageOptions{});
+    if (r_.footage.note.empty())
+      Say("footage: the design over " + std::to_string(r_.footage.kinds.size()) + " kinds of statistics of " +
+          FormatNumber(r_.footage.recording_s) + "-s recordings");
   }
 
   const CalibrationSpec& spec_;

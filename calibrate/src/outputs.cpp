@@ -39,6 +39,33 @@ json Values(const CalibrationSpec& spec, const std::vector<double>& v) {
   return o;
 }
 
+// A value per parameter, by path.
+json ByParameter(const CalibrationSpec& spec, const std::vector<double>& v) {
+  json o = json::object();
+  for (std::size_t i = 0; i < spec.parameters.size() && i < v.size(); ++i) o[spec.parameters[i].path] = Num(v[i]);
+  return o;
+}
+
+json FootageJson(const CalibrationSpec& spec, const FootageDesign& f) {
+  if (!f.note.empty()) return {{"note", f.note}};
+  json rows = json::array();
+  for (const FootageRow& row : f.rows) rows.push_back({{"recordings", row.recordings}, {"length_s", row.length_s}, {"sd", ByParameter(spec, row.sd)}});
+  json needed = json::array();
+  const std::vector<double> targets = FootageOptions{}.targets;
+  for (std::size_t t = 0; t < f.one_recording_s.size(); ++t)
+    needed.push_back({{"half_width_95_fraction", targets[t]},
+                      {"one_recording_s", ByParameter(spec, f.one_recording_s[t])},
+                      {"recordings_of_this_length", ByParameter(spec, f.recordings_needed[t])}});
+  json kinds = json::array();
+  for (std::size_t g = 0; g < f.kinds.size(); ++g)
+    kinds.push_back({{"kind", f.kinds[g]}, {"precision_lost_without", ByParameter(spec, f.share_lost[g])},
+                     {"information_share_alone", ByParameter(spec, f.information_share[g])}});
+  return {{"window_s", f.window_s}, {"recording_s", f.recording_s}, {"windows", f.windows},
+          {"seeds", "enough (the footage alone limits)"}, {"kinds", kinds}, {"left_out", f.left_out},
+          {"designs", rows}, {"needed", needed},
+          {"this_calibration", {{"recordings", f.recordings_now}, {"sd", ByParameter(spec, f.sd_now)}}}};
+}
+
 json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   const CalibrationSpec& spec = *r.spec;
   const Summary& s = r.summary;
@@ -128,6 +155,7 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
     profiles[spec.parameters[i].path] = pts;
   }
   j["profiles"] = profiles;
+  j["footage"] = FootageJson(spec, r.footage);
   j["profiles_refitted"] = r.profiles_refitted;
   json evals = json::array();
   for (const SetResult* e : ev.All())
@@ -138,6 +166,65 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   j["runs_simulated_now"] = s.runs;
   j["wall_s"] = s.wall_s;
   return j;
+}
+
+// A percentage for a reader: whole percents from 10 on (not "2.7e+02").
+std::string Percent(double percent) {
+  return percent >= 10.0 ? std::to_string(std::lround(percent)) : Fixed(percent, 2);
+}
+
+// A duration for a reader: seconds, minutes or hours.
+std::string Duration(double seconds) {
+  if (!std::isfinite(seconds)) return "more than any footage";
+  if (seconds < 120.0) return Fixed(seconds, 2) + " s";
+  if (seconds < 7200.0) return Fixed(seconds / 60.0, 2) + " min";
+  return Fixed(seconds / 3600.0, 2) + " h";
+}
+
+// "How much footage": what the calibrated kind of recording determines, and
+// how much of it each parameter needs.
+std::string FootageReport(const CalibrationSpec& spec, const CalibrationResult& r) {
+  const FootageDesign& f = r.footage;
+  std::ostringstream o;
+  if (!f.note.empty()) {
+    o << "\nHow much footage: no design (" << f.note << ")\n";
+    return o.str();
+  }
+  const std::vector<double> targets = FootageOptions{}.targets;
+  o << "\nHow much footage (expected 95 % half-widths, linearised at the best fit, for recordings of the first one's kind: "
+    << FormatNumber(f.recording_s) << " s in " << f.windows << " windows of " << FormatNumber(f.window_s)
+    << " s; with enough seeds that the footage alone limits; docs/calibration.md, \"How much footage\"):\n";
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+    const std::string& path = spec.parameters[i].path;
+    const double value = r.best[i];
+    const double now = f.rows.empty() ? std::nan("") : [&] {
+      for (const FootageRow& row : f.rows)
+        if (row.recordings == 1 && std::abs(row.length_s - f.recording_s) < 1e-9) return row.sd[i];
+      return std::nan("");
+    }();
+    o << "  " << path << ": one recording like this one gives +-"
+      << (std::isfinite(now) && value != 0.0 ? Percent(100.0 * 1.96 * now / std::abs(value)) + " %" : std::string("- (undetermined)"));
+    if (std::isfinite(now) && 1.96 * now > 0.5 * spec.parameters[i].Range())
+      o << " (wider than its range: the bounds, not the footage, hold it)";
+    for (std::size_t t = 0; t < targets.size() && t < f.one_recording_s.size(); ++t) {
+      const double one = f.one_recording_s[t][i], many = f.recordings_needed[t][i];
+      o << "; to know it within +-" << std::lround(100.0 * targets[t]) << " %: " << Duration(one)
+        << " of one recording";
+      if (std::isfinite(many))
+        o << ", or " << FormatNumber(many) << (many == 1.0 ? " recording" : " recordings") << " like this one ("
+          << Duration(many * f.recording_s) << ")";
+    }
+    o << "\n";
+  }
+  o << "  What carries the information (the share of each parameter's precision lost without that kind of statistic):\n";
+  for (std::size_t g = 0; g < f.kinds.size(); ++g) {
+    o << "    " << f.kinds[g] << ":";
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      o << " " << spec.parameters[i].name << " " << Percent(100.0 * f.share_lost[g][i]) << " %";
+    o << "\n";
+  }
+  for (const std::string& why : f.left_out) o << "  Left out of the design: " << why << "\n";
+  return o.str();
 }
 
 std::string Report(const CalibrationResult& r) {
@@ -153,8 +240,7 @@ std::string Report(const CalibrationResult& r) {
       << Fixed(p.bootstrap_lo95) << ", " << Fixed(p.bootstrap_hi95) << "]   range [" << FormatNumber(p.min) << ", "
       << FormatNumber(p.max) << "]: " << p.determination;
     if (p.determination != "undetermined" && std::isfinite(p.RelativeHalfWidth95())) {
-      const double percent = 100.0 * p.RelativeHalfWidth95();  // (whole percents from 10 on: not "1.3e+02")
-      o << " to +-" << (percent >= 10.0 ? std::to_string(std::lround(percent)) : Fixed(percent, 2)) << " % (95 %)";
+      o << " to +-" << Percent(100.0 * p.RelativeHalfWidth95()) << " % (95 %)";
     }
     if (!p.reason.empty()) o << " (" << p.reason << ")";
     o << "\n";
@@ -174,6 +260,7 @@ std::string Report(const CalibrationResult& r) {
   } else if (!r.posterior.note.empty()) {
     o << "\nNo posterior: " << r.posterior.note << "\n";
   }
+  o << FootageReport(spec, r);
   if (s.parameters.size() > 1 && r.covariance_ok) {
     o << "\nCorrelations:\n";
     for (std::size_t i = 0; i < s.parameters.size(); ++i) {
@@ -376,6 +463,52 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
 
 }  // namespace
 
+// Each parameter's expected 95 % half-width against the footage, for one
+// recording made longer and for more recordings of the calibrated length.
+void DrawFootage(const fs::path& file, const CalibrationResult& r) {
+  const CalibrationSpec& spec = *r.spec;
+  const FootageDesign& f = r.footage;
+  viz::ChartSheet sheet(file, 1000, "How much footage: " + spec.name,
+                        "expected 95 % half-width (linearised at the best fit), recordings of " +
+                            FormatNumber(f.recording_s) + " s like the first; enough seeds");
+  double x1 = 0.0;  // the longest footage drawn: one recording made longest, or the most recordings
+  for (const FootageRow& row : f.rows)
+    if (row.recordings == 1 || std::abs(row.length_s - f.recording_s) < 1e-9)
+      x1 = std::max(x1, row.recordings * row.length_s / 60.0);
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+    const double value = std::abs(r.best[i]);
+    std::vector<double> lx, ly, nx, ny;
+    double y1 = 25.0;
+    for (const FootageRow& row : f.rows) {
+      const double percent = 100.0 * 1.96 * row.sd[i] / value;
+      if (!std::isfinite(percent)) continue;
+      if (row.recordings == 1) {
+        lx.push_back(row.length_s / 60.0);
+        ly.push_back(percent);
+        y1 = std::max(y1, percent);
+      }
+      if (std::abs(row.length_s - f.recording_s) < 1e-9) {
+        nx.push_back(row.recordings * row.length_s / 60.0);
+        ny.push_back(percent);
+        y1 = std::max(y1, percent);
+      }
+    }
+    y1 = std::min(y1 * 1.05, 300.0);
+    viz::ChartPanel& panel = sheet.AddPanel("footage, minutes (all recordings together)",
+                                            spec.parameters[i].name + " +-% of " + Fixed(r.best[i], 3),
+                                            0.0, x1, 0.0, y1, 260);
+    for (std::size_t t = 0; t < FootageOptions{}.targets.size(); ++t) {
+      const double target = 100.0 * FootageOptions{}.targets[t];
+      panel.Line({0.0, x1}, {target, target}, viz::Color::Black(), 1.0, t == 0 ? "+-20 % and +-10 %" : "", true);
+    }
+    if (!lx.empty()) panel.Line(lx, ly, viz::ChartColor(0), 2.0, "one recording, longer");
+    panel.Points(lx, ly, viz::ChartColor(0), 3.0);
+    if (!nx.empty()) panel.Line(nx, ny, viz::ChartColor(1), 2.0, "more recordings of this length");
+    panel.Points(nx, ny, viz::ChartColor(1), 3.0);
+  }
+  sheet.Finish();
+}
+
 void WriteOutputs(const fs::path& dir, const Evaluator& ev, CalibrationResult* r) {
   r->summary.json_file = dir / "calibration.json";
   r->summary.report_file = dir / "report.txt";
@@ -406,10 +539,28 @@ void WriteOutputs(const fs::path& dir, const Evaluator& ev, CalibrationResult* r
     }
     WriteFileAtomically(dir / "posterior.csv", post.str());
   }
+  if (r->footage.note.empty()) {  // the footage design: one row per N recordings of T seconds
+    std::ostringstream fc;
+    fc << "recordings,length_s,footage_min";
+    for (const Parameter& p : r->spec->parameters) fc << "," << p.path << "_sd," << p.path << "_half_width_95_percent";
+    fc << "\n";
+    for (const FootageRow& row : r->footage.rows) {
+      fc << row.recordings << "," << sweep::ExactNumber(row.length_s) << ","
+         << sweep::ExactNumber(row.recordings * row.length_s / 60.0);
+      for (std::size_t i = 0; i < row.sd.size(); ++i) {
+        const double half = 100.0 * 1.96 * row.sd[i] / std::abs(r->best[i]);
+        fc << "," << (std::isfinite(row.sd[i]) ? sweep::ExactNumber(row.sd[i]) : "") << ","
+           << (std::isfinite(half) ? sweep::ExactNumber(half) : "");
+      }
+      fc << "\n";
+    }
+    WriteFileAtomically(dir / "footage.csv", fc.str());
+  }
   WriteFileAtomically(r->summary.report_file, Report(*r));
   for (const char* ext : {".png", ".svg"}) {
     if (!r->profiles.empty() && !r->profiles[0].empty()) DrawProfiles(dir / (std::string("profiles") + ext), *r);
     DrawFit(dir / (std::string("fit") + ext), *r);
+    if (r->footage.note.empty() && !r->footage.rows.empty()) DrawFootage(dir / (std::string("footage") + ext), *r);
   }
 }
 

@@ -11,6 +11,7 @@
 #include "crowdrecon/calibrate/calibrate.hpp"
 #include "evaluator.hpp"
 #include "fit.hpp"
+#include "footage.hpp"
 
 namespace crowdrecon::calibrate {
 
@@ -78,6 +79,11 @@ struct CalibrationResult {
     double scale = 1.0;                   // the likelihood's widening: max(1, chi2 at the best fit / degrees of freedom)
     std::string note;                     // why there is none
   } posterior;
+  // d (simulated mean of statistic j) / d (parameter i) at the best fit, from
+  // the local quadratic (statistics x parameters, row-major, the parameters'
+  // units; NaN: not fitted), and what it says about more footage.
+  std::vector<double> jacobian;
+  FootageDesign footage;
   std::vector<std::vector<ProfilePoint>> profiles;
   bool profiles_refitted = false;  // the others re-fitted at each point (else held at the best fit)
   Summary summary;

@@ -46,7 +46,7 @@ PY
 
 "$crowdrecon" calibrate "$d/calibration.json" -o "$d/local" -q --jobs 2 | tee "$d/local.txt"
 grep -q "model.back_force_gamma = " "$d/local.txt"
-for f in calibration.json report.txt evaluations.csv posterior.csv profiles.png profiles.svg fit.png fit.svg; do
+for f in calibration.json report.txt evaluations.csv posterior.csv footage.csv footage.png footage.svg profiles.png profiles.svg fit.png fit.svg; do
   test -s "$d/local/$f" || { echo "FAIL: no $f"; exit 1; }
 done
 python3 - "$d/local/calibration.json" "$d/local/evaluations.csv" <<'PY'
@@ -66,6 +66,20 @@ assert par["min"] <= lo95 <= lo68 <= par["posterior"]["median"] <= hi68 <= hi95 
 assert post["chains"] == 4 and post["samples"] == 4 * 15000 and post["overdispersion_scale"] >= 1, post
 samples = list(csv.DictReader(open(sys.argv[2].replace("evaluations.csv", "posterior.csv"))))
 assert len(samples) == post["samples"] // 5 and all(par["min"] <= float(r["model.back_force_gamma"]) <= par["max"] for r in samples)
+# The footage design (issue 41, point 4): one row per design; more footage
+# never knows less (sd falls with N at a length, and with the length for one
+# recording); the report says it.
+f = c["footage"]
+assert "note" not in f, f
+fr = list(csv.DictReader(open(sys.argv[2].replace("evaluations.csv", "footage.csv"))))
+assert len(fr) == len(f["designs"]) > 0, (len(fr), len(f["designs"]))
+col = "model.back_force_gamma_sd"
+sd = {(int(r["recordings"]), float(r["length_s"])): float(r[col]) for r in fr if r[col]}
+for (n, t), v in sd.items():
+    assert all(v >= w - 1e-12 for (n2, t2), w in sd.items() if (n2 >= n and t2 == t) or (n2 == n and t2 >= t)), (n, t)
+assert f["this_calibration"]["recordings"] == 1 and f["kinds"], f
+report = open(sys.argv[1].replace("calibration.json", "report.txt")).read()
+assert "How much footage" in report and "to know it within +-20 %" in report, report
 print("outputs: OK,", len(rows), "parameter sets; posterior 95 %", round(lo95, 3), "to", round(hi95, 3))
 PY
 

@@ -20,6 +20,7 @@
 #include "crowdrecon/calibrate/statistics.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "fit.hpp"
+#include "footage.hpp"
 #include "scratch.hpp"
 
 namespace crowdrecon::calibrate {
@@ -815,6 +816,104 @@ TEST(CalibrationFile, BadFilesAreRefusedWithThePathAndTheValue) {
          "(variant max-density_per_m2, seed 1): the scenario with this run's overrides is not valid");
   // "width" for a value that is not a range.
   expect(Calibration(obs, R"([{"path": "model.back_force_gamma", "width": 0.2}])"), "\"width\" is for ranges");
+}
+
+// A recording's statistics for the footage design: `windows` windows of
+// `window_s` of one series (speed) whose seeds' values correlate as AR(1)
+// from window to window (variance s2, correlation rho^lag) and move with the
+// parameters by `slope` (one row per parameter), plus, optionally, a count.
+Objective FootageObjective(std::size_t windows, double window_s, double s2, double rho, std::vector<double> slope,
+                           std::vector<double>* jacobian, bool with_count = false, double count_var = 4.0,
+                           std::vector<double> count_slope = {}) {
+  Objective o;
+  const std::size_t p = slope.size();
+  for (std::size_t w = 0; w < windows; ++w) {
+    Statistic st;
+    st.name = "speed " + std::to_string(w);
+    st.quantity = "speed";
+    st.where = "hallway";
+    st.direction = "forward";
+    st.sim_from_s = static_cast<double>(w) * window_s;
+    st.sim_to_s = st.sim_from_s + window_s;
+    o.statistics.push_back(st);
+    jacobian->insert(jacobian->end(), slope.begin(), slope.end());
+  }
+  if (with_count) {
+    Statistic st;
+    st.name = "stops";
+    st.quantity = "stop";
+    st.where = "hallway";
+    st.direction = "forward";
+    st.is_count = true;
+    st.sim_to_s = static_cast<double>(windows) * window_s;
+    o.statistics.push_back(st);
+    jacobian->insert(jacobian->end(), count_slope.begin(), count_slope.end());
+  }
+  const std::size_t n = o.statistics.size();
+  o.seed_covariance.assign(n * n, 0.0);
+  for (std::size_t a = 0; a < windows; ++a)
+    for (std::size_t b = 0; b < windows; ++b)
+      o.seed_covariance[a * n + b] = s2 * std::pow(rho, std::abs(static_cast<double>(a) - static_cast<double>(b)));
+  if (with_count) o.seed_covariance[n * n - 1] = count_var;
+  (void)p;
+  return o;
+}
+
+// The design against the analytic information of an AR(1) series: m
+// windows of unit-variance correlation rho^|a-b| carry 1ᵀR⁻¹1 =
+// (m(1 - rho) + 2 rho) / (1 + rho) windows' worth; beyond the recording each
+// window adds (1 - rho) / (1 + rho) (the long-run variance, up to the
+// Bartlett weights' bias); N recordings divide the variance by N, K seeds
+// add 1/K; a count's information grows with the length; a statistic that
+// moves with one parameter only informs that one.
+TEST(Footage, MatchesTheInformationOfACorrelatedSeries) {
+  const double rho = 0.5, s2 = 0.04, g = 0.8;
+  std::vector<double> jac;
+  const Objective o = FootageObjective(40, 5.0, s2, rho, {g}, &jac);
+  const auto var = [&](int n, double m, double k) { return FootageCovariance(o, jac, 1, n, m, k)[0]; };
+  const auto analytic = [&](double m) { return s2 / (g * g) * (1.0 + rho) / (m * (1.0 - rho) + 2.0 * rho); };
+  for (double m : {1.0, 2.0, 10.0, 40.0}) EXPECT_NEAR(var(1, m, 0.0), analytic(m), 1e-9 * analytic(m)) << m;
+  for (double m : {80.0, 160.0, 1000.0}) EXPECT_NEAR(var(1, m, 0.0), analytic(m), 0.05 * analytic(m)) << m;
+  EXPECT_NEAR(var(4, 10.0, 0.0), analytic(10.0) / 4.0, 1e-9);
+  EXPECT_NEAR(var(4, 10.0, 8.0), analytic(10.0) * (1.0 / 4.0 + 1.0 / 8.0), 1e-9);
+
+  // The design's table and the footage it asks for.
+  FootageOptions options;
+  options.recordings = {1, 4};
+  options.targets = {0.2};
+  const FootageDesign d = DesignFootage(o, jac, {1.0}, options);
+  ASSERT_TRUE(d.note.empty()) << d.note;
+  EXPECT_EQ(d.windows, 40u);
+  EXPECT_DOUBLE_EQ(d.recording_s, 200.0);
+  ASSERT_EQ(d.rows.size(), 2u * 7u);
+  EXPECT_NEAR(d.rows[1].sd[0], std::sqrt(analytic(40.0)), 1e-9);  // one recording, its own length
+  EXPECT_NEAR(d.rows[7 + 1].sd[0], std::sqrt(analytic(40.0) / 4.0), 1e-9);
+  // 95 % half-width 0.2: sd 0.2 / 1.96; analytic windows m, in seconds, within a window.
+  const double want = 0.2 / 1.96;
+  const double m = ((1.0 + rho) * s2 / (g * g) / (want * want) - 2.0 * rho) / (1.0 - rho);
+  EXPECT_NEAR(d.one_recording_s[0][0], m * 5.0, 0.05 * m * 5.0 + 5.0);
+  EXPECT_DOUBLE_EQ(d.recordings_needed[0][0], std::ceil(analytic(40.0) / (want * want)));
+  ASSERT_EQ(d.share_lost.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.share_lost[0][0], 1.0);  // without its only statistic, undetermined
+
+  // A count informs the second parameter alone, the series the first: each
+  // kind carries all of its parameter's information.
+  std::vector<double> jac2;
+  const Objective two = FootageObjective(10, 5.0, s2, rho, {g, 0.0}, &jac2, true, 4.0, {0.0, 3.0});
+  const FootageDesign d2 = DesignFootage(two, jac2, {1.0, 2.0}, options);
+  ASSERT_EQ(d2.kinds.size(), 2u);
+  EXPECT_EQ(d2.kinds[1], "stop hallway forward (count)");
+  EXPECT_NEAR(d2.share_lost[0][0], 1.0, 1e-12);
+  EXPECT_NEAR(d2.share_lost[0][1], 0.0, 1e-12);
+  EXPECT_NEAR(d2.share_lost[1][1], 1.0, 1e-12);
+  EXPECT_NEAR(d2.information_share[1][1], 1.0, 1e-12);
+  // The count over f times the recording: mean slope f * 3, variance f * 4
+  // (and the observed count's own 0.25, not grown).
+  const auto count_var = [&](double f) { return (4.0 * f) / (9.0 * f * f); };
+  for (double f : {0.5, 1.0, 3.0}) {
+    const std::vector<double> c = FootageCovariance(two, jac2, 2, 1, 10.0 * f, 0.0);
+    EXPECT_NEAR(c[3], count_var(f), 1e-9 * count_var(f)) << f;
+  }
 }
 
 }  // namespace

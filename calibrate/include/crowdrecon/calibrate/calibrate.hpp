@@ -12,7 +12,8 @@
 // every start (a quadratic surrogate over a design, refined; or Ceres with
 // central differences); 4. uncertainty at the best fit (a local design,
 // Ceres' covariance, the seed-and-observation bootstrap); 5. profiles; 6. the
-// outputs. Every parameter set is K runs (the same seeds at every set: common
+// posterior; 7. the footage design (what more recordings would determine);
+// 8. the outputs. Every parameter set is K runs (the same seeds at every set: common
 // random numbers) run through the sweep machinery (sweep/): on the local
 // cores or over MPI ranks, each set cached in DIR/cache/ once run, so an
 // interrupted calibration resumes where it stopped and repeats nothing.
