@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <random>
 #include <tuple>
 
@@ -23,6 +24,9 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The posterior's surrogate bandwidths (fractions of the box; inf: the
+// quadratic over the whole box), chosen among by leave-one-out error.
+const std::vector<double> kBandwidths{0.15, 0.25, 0.4, 0.7, std::numeric_limits<double>::infinity()};
 constexpr double kChi2At95 = 3.841458820694124;  // chi-square, one degree of freedom, 95 %
 
 // An evaluation was interrupted (Ctrl-C, SIGTERM): the calibration stops
@@ -452,13 +456,30 @@ class Calibration {
     }
     Objective o = r_.objective;
     const std::size_t n = o.statistics.size();
+    // The surrogate: a quadratic over the whole box, or one fitted around
+    // each point (the bandwidth whose leave-one-out predictions of the sets'
+    // means, each over its seeds' error S_jj / K, err least).
+    std::vector<Point> units;
+    std::vector<std::vector<double>> means;
+    for (const SetResult* s : ev_.All()) {
+      units.push_back(ev_.ToUnit(s->values));
+      means.push_back(s->mean);
+    }
+    std::vector<double> noise(n);
+    for (std::size_t j = 0; j < n; ++j) noise[j] = o.seed_covariance[j * n + j] / o.seeds;
+    post.bandwidth = ChooseBandwidth(units, means, noise, kBandwidths, &post.bandwidth_scores);
+    std::optional<LocalQuadratic> local;
+    std::vector<double> misfit = whole.residual_variance;  // beyond the seeds' noise: the surrogate's own error
+    if (std::isfinite(post.bandwidth)) {
+      local.emplace(units, means, post.bandwidth);
+      misfit = local->LeaveOneOutVariance(noise, nullptr);
+    }
     o.surrogate_variance.assign(n, 0.0);
     post.lack_of_fit_sd.assign(n, kNaN);
     for (std::size_t j = 0; j < n; ++j) {
-      const double var = whole.residual_variance[j];
+      const double var = misfit[j];
       if (!std::isfinite(var)) continue;
-      const double seeds = o.seed_covariance[j * n + j] / o.seeds;
-      o.surrogate_variance[j] = std::max(0.0, var - seeds);
+      o.surrogate_variance[j] = std::max(0.0, var - noise[j]);
       post.lack_of_fit_sd[j] = std::sqrt(o.surrogate_variance[j]);
     }
     o.Reobserve();
@@ -474,7 +495,7 @@ class Calibration {
     // likelihood is widened by that ratio (never narrowed).
     const int freedom = o.DegreesOfFreedom(p);
     post.scale = freedom > 0 ? std::max(1.0, r_.best_simulated_chi2 / freedom) : 1.0;
-    const SurrogateLikelihood likelihood(whole, o, post.scale);
+    const SurrogateLikelihood likelihood(whole, o, post.scale, local ? &*local : nullptr);
     if (likelihood.empty()) {
       post.note = "no statistic could be fitted by the quadratic over the whole box";
       return;
@@ -486,7 +507,9 @@ class Calibration {
     post.chains = ps.chains;
     post.acceptance = ps.acceptance;
     post.r_hat = ps.r_hat;
-    post.surrogate_form = whole.form;
+    post.surrogate_form = local ? "quadratic fitted around each point (Gaussian weights, bandwidth " +
+                                      FormatNumber(post.bandwidth) + " of the box)"
+                                : whole.form;
     post.sets = ev_.All().size();
     double worst = 0.0;
     for (double r : ps.r_hat) worst = std::max(worst, std::isfinite(r) ? r : 0.0);

@@ -673,15 +673,113 @@ double Quantile(const std::vector<double>& sorted, double q) {
   return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
 }
 
-SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale)
-    : mean_(mean), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale) {
+LocalQuadratic::LocalQuadratic(std::vector<std::vector<double>> points, std::vector<std::vector<double>> values,
+                               double bandwidth)
+    : points_(std::move(points)), values_(std::move(values)), h_(bandwidth) {}
+
+std::vector<double> LocalQuadratic::Values(const std::vector<double>& u, std::size_t skip) const {
+  const std::size_t n = points_.size(), p = u.size();
+  const std::size_t statistics = values_.empty() ? 0 : values_[0].size();
+  const std::size_t m = 1 + p + p * (p + 1) / 2;
+  std::vector<double> out(statistics, kNaN);
+  // The weighted design: rows sqrt(w) [1, d, d_i d_k], d = point - u; the
+  // value at u is the intercept.
+  Eigen::MatrixXd a(n, m);
+  Eigen::VectorXd sw(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    double d2 = 0.0;
+    for (std::size_t k = 0; k < p; ++k) d2 += (points_[i][k] - u[k]) * (points_[i][k] - u[k]);
+    const double w = i == skip ? 0.0 : std::isinf(h_) ? 1.0 : std::exp(-0.5 * d2 / (h_ * h_));
+    sw(static_cast<Eigen::Index>(i)) = std::sqrt(w);
+    Eigen::Index c = 0;
+    const auto ii = static_cast<Eigen::Index>(i);
+    a(ii, c++) = 1.0;
+    for (std::size_t k = 0; k < p; ++k) a(ii, c++) = points_[i][k] - u[k];
+    for (std::size_t k = 0; k < p; ++k)
+      for (std::size_t l = k; l < p; ++l) a(ii, c++) = (points_[i][k] - u[k]) * (points_[i][l] - u[l]);
+    a.row(ii) *= sw(ii);
+  }
+  // Statistics with a value at every point share one factorisation.
+  std::vector<std::size_t> complete, partial;
+  for (std::size_t j = 0; j < statistics; ++j) {
+    bool all = true;
+    for (std::size_t i = 0; i < n; ++i) all = all && (i == skip || std::isfinite(values_[i][j]));
+    (all ? complete : partial).push_back(j);
+  }
+  const std::size_t used = n - (skip < n ? 1 : 0);
+  if (!complete.empty() && used >= m) {
+    Eigen::MatrixXd y(n, complete.size());
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < complete.size(); ++c) {
+        const double v = values_[i][complete[c]];
+        y(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = i == skip ? 0.0 : v * sw(static_cast<Eigen::Index>(i));
+      }
+    const Eigen::MatrixXd x = a.colPivHouseholderQr().solve(y);
+    for (std::size_t c = 0; c < complete.size(); ++c) out[complete[c]] = x(0, static_cast<Eigen::Index>(c));
+  }
+  for (std::size_t j : partial) {
+    std::vector<Eigen::Index> rows;
+    for (std::size_t i = 0; i < n; ++i)
+      if (i != skip && std::isfinite(values_[i][j])) rows.push_back(static_cast<Eigen::Index>(i));
+    if (rows.size() < m) continue;
+    Eigen::MatrixXd aj(rows.size(), m);
+    Eigen::VectorXd yj(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      aj.row(static_cast<Eigen::Index>(r)) = a.row(rows[r]);
+      yj(static_cast<Eigen::Index>(r)) = values_[static_cast<std::size_t>(rows[r])][j] * sw(rows[r]);
+    }
+    out[j] = aj.colPivHouseholderQr().solve(yj)(0);
+  }
+  return out;
+}
+
+std::vector<double> LocalQuadratic::LeaveOneOutVariance(const std::vector<double>& scale, double* score) const {
+  const std::size_t statistics = values_.empty() ? 0 : values_[0].size();
+  std::vector<double> sum(statistics, 0.0);
+  std::vector<std::size_t> count(statistics, 0);
+  double total = 0.0;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    const std::vector<double> v = Values(points_[i], i);
+    for (std::size_t j = 0; j < statistics; ++j) {
+      const double e = v[j] - values_[i][j];
+      if (!std::isfinite(e)) continue;
+      sum[j] += e * e;
+      ++count[j];
+      if (j < scale.size() && scale[j] > 0.0 && std::isfinite(scale[j])) total += e * e / scale[j];
+    }
+  }
+  for (std::size_t j = 0; j < statistics; ++j) sum[j] = count[j] > 0 ? sum[j] / static_cast<double>(count[j]) : kNaN;
+  if (score) *score = total;
+  return sum;
+}
+
+double ChooseBandwidth(const std::vector<std::vector<double>>& points, const std::vector<std::vector<double>>& values,
+                       const std::vector<double>& scale, const std::vector<double>& candidates,
+                       std::vector<double>* scores) {
+  double best = std::numeric_limits<double>::infinity(), best_score = best;
+  if (scores) scores->clear();
+  for (double h : candidates) {
+    double score = 0.0;
+    LocalQuadratic(points, values, h).LeaveOneOutVariance(scale, &score);
+    if (scores) scores->push_back(score);
+    if (score < best_score) {
+      best_score = score;
+      best = h;
+    }
+  }
+  return best;
+}
+
+SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale,
+                                         const LocalQuadratic* local)
+    : mean_(mean), local_(local), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale) {
   if (!rows_.empty()) white_ = objective.Whiten(rows_);
 }
 
 double SurrogateLikelihood::operator()(const std::vector<double>& u) const {
   constexpr double kNone = -std::numeric_limits<double>::infinity();
   if (rows_.empty()) return kNone;
-  const std::vector<double> all = mean_.Values(u);
+  const std::vector<double> all = local_ ? local_->Values(u) : mean_.Values(u);
   std::vector<double> value(rows_.size()), residuals(rows_.size());
   for (std::size_t r = 0; r < rows_.size(); ++r) value[r] = all[lead_[rows_[r]]];
   white_.Apply(value.data(), 1, true, residuals.data());

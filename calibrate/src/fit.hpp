@@ -194,6 +194,37 @@ Minimum MinimiseFunction(const ResidualFunction& f, std::size_t residuals, const
 bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const std::vector<double>& u,
                          std::vector<double>* covariance, std::string* reason, std::vector<int>* without_effect);
 
+// Each statistic's mean at u from a quadratic fitted around u to every
+// set, each weighted by exp(-d^2 / (2 h^2)), d its distance from u in the
+// unit box (locally weighted regression, Cleveland and Devlin 1988, with a
+// Gaussian kernel): follows a statistic that a quadratic over the whole box
+// cannot (the restitution's effect, steep at one end and flat at the
+// other). The bandwidth h is chosen among candidates by leave-one-out
+// prediction error, the global quadratic (h = inf) among them.
+class LocalQuadratic {
+ public:
+  // points: unit coordinates; values[point][statistic] (NaN: left out).
+  LocalQuadratic(std::vector<std::vector<double>> points, std::vector<std::vector<double>> values, double bandwidth);
+  // The means at u (NaN where a statistic has too few values); `skip`: a
+  // point left out (leave-one-out), SIZE_MAX none.
+  std::vector<double> Values(const std::vector<double>& u, std::size_t skip = static_cast<std::size_t>(-1)) const;
+  // Per statistic, the mean square of the leave-one-out errors over the
+  // points (NaN: none), and their sum over statistics each divided by
+  // `scale` (its seeds' variance; statistics without one left out).
+  std::vector<double> LeaveOneOutVariance(const std::vector<double>& scale, double* score) const;
+  double bandwidth() const { return h_; }
+
+ private:
+  std::vector<std::vector<double>> points_, values_;
+  double h_;
+};
+
+// The bandwidth (of `candidates`, inf for the global quadratic) whose
+// leave-one-out errors, each over its statistic's `scale`, sum least.
+double ChooseBandwidth(const std::vector<std::vector<double>>& points, const std::vector<std::vector<double>>& values,
+                       const std::vector<double>& scale, const std::vector<double>& candidates,
+                       std::vector<double>* scores = nullptr);
+
 // The posterior's log-likelihood at u (docs/calibration.md, "The
 // posterior"): -chi2 / (2 scale) over the statistics `mean` fits, the
 // simulated means read from `mean`, chi2 the objective's generalised one;
@@ -201,12 +232,14 @@ bool SurrogateCovariance(const Quadratic& q, const Objective& objective, const s
 // says the statistics scatter more than their covariance allows.
 class SurrogateLikelihood {
  public:
-  SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0);
+  SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0,
+                      const LocalQuadratic* local = nullptr);
   double operator()(const std::vector<double>& u) const;  // -inf where undefined
   bool empty() const { return rows_.empty(); }
 
  private:
   const Quadratic& mean_;
+  const LocalQuadratic* local_;  // the means from it where given (mean_ then says which statistics are fitted)
   std::vector<std::size_t> lead_;
   std::vector<std::size_t> rows_;
   Objective::Whitening white_;

@@ -109,6 +109,12 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
     j["posterior"] = {{"prior", "flat over each parameter's bounds"},
                       {"surrogate", post.samples.empty() ? json(nullptr) : json(post.surrogate_form + " over every set evaluated")},
                       {"sets", post.sets}, {"overdispersion_scale", post.scale},
+                      {"bandwidth", std::isfinite(post.bandwidth) ? json(post.bandwidth) : json("whole box")},
+                      {"bandwidth_leave_one_out_scores", [&] {
+                         json a = json::array();
+                         for (double v : post.bandwidth_scores) a.push_back(Num(v));
+                         return a;
+                       }()},
                       {"chains", post.chains},
                       {"steps_per_chain", spec.options.posterior_steps},
                       {"samples", post.samples.size()}, {"acceptance", Num(post.acceptance)}, {"r_hat", rh},

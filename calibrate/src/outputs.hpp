@@ -77,6 +77,8 @@ struct CalibrationResult {
     std::size_t sets = 0;                 // ... of this many sets
     std::vector<double> lack_of_fit_sd;   // per statistic: the surrogate's error beyond the seeds' (NaN: not fitted)
     double scale = 1.0;                   // the likelihood's widening: max(1, chi2 at the best fit / degrees of freedom)
+    double bandwidth = 0.0;               // the surrogate's (fraction of the box; inf: the quadratic over the whole box)
+    std::vector<double> bandwidth_scores; // leave-one-out error of each candidate
     std::string note;                     // why there is none
   } posterior;
   // d (simulated mean of statistic j) / d (parameter i) at the best fit, from

@@ -291,6 +291,58 @@ TEST(Posterior, MatchesTheAnalyticPosteriorOfALinearProblem) {
   EXPECT_TRUE(SamplePosterior([](const std::vector<double>&) { return 0.0; }, {}, 40000, 8).u.empty());
 }
 
+// The posterior's local surrogate: with an infinite bandwidth it is the
+// quadratic over the whole box; a statistic steep at one end and flat at the
+// other (1 - exp(-u / 0.1), as the restitution acts) is followed by a
+// quadratic fitted around each point where the global one cannot, the
+// leave-one-out error says so, and the bandwidth chosen is finite; for a
+// quadratic statistic the global fit is exact and chosen.
+TEST(Posterior, ALocalQuadraticFollowsWhatAGlobalOneCannot) {
+  std::vector<std::vector<double>> pts;
+  for (int i = 0; i <= 6; ++i)
+    for (int k = 0; k <= 6; ++k) pts.push_back({i / 6.0, k / 6.0});
+  const auto steep = [](const std::vector<double>& u) { return 1.0 - std::exp(-u[0] / 0.1) + 0.3 * u[1]; };
+  const auto quad = [](const std::vector<double>& u) { return 0.5 + u[0] - 0.7 * u[0] * u[1] + 0.2 * u[1] * u[1]; };
+  std::vector<std::vector<double>> values;
+  for (const auto& u : pts) values.push_back({steep(u), quad(u)});
+  Quadratic global;
+  ASSERT_TRUE(global.Fit(pts, values, {0.5, 0.5}, 0.5));
+  const LocalQuadratic whole(pts, values, std::numeric_limits<double>::infinity());
+  for (const std::vector<double>& u : {std::vector<double>{0.1, 0.3}, std::vector<double>{0.77, 0.9}}) {
+    const std::vector<double> a = whole.Values(u), b = global.Values(u);
+    EXPECT_NEAR(a[0], b[0], 1e-9);
+    EXPECT_NEAR(a[1], b[1], 1e-9);
+  }
+  const LocalQuadratic near(pts, values, 0.15);
+  double global_error = 0.0, local_error = 0.0;
+  for (double x = 0.02; x < 1.0; x += 0.05) {
+    const std::vector<double> u{x, 0.4};
+    global_error = std::max(global_error, std::abs(whole.Values(u)[0] - steep(u)));
+    local_error = std::max(local_error, std::abs(near.Values(u)[0] - steep(u)));
+    EXPECT_NEAR(near.Values(u)[1], quad(u), 1e-9);  // a quadratic is exact at any bandwidth
+  }
+  EXPECT_GT(global_error, 0.05);
+  EXPECT_LT(local_error, 0.5 * global_error);
+  std::vector<double> scores;
+  const double h = ChooseBandwidth(pts, values, {1e-4, 1e-4}, {0.15, 0.4, std::numeric_limits<double>::infinity()}, &scores);
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_TRUE(std::isfinite(h)) << h;
+  EXPECT_LT(scores[0], scores[2]);
+  // The quadratic statistic alone: every bandwidth is exact; the first of
+  // the best is kept, and its leave-one-out error is round-off.
+  std::vector<std::vector<double>> only;
+  for (const auto& v : values) only.push_back({v[1]});
+  double score = 1.0;
+  const std::vector<double> loo = LocalQuadratic(pts, only, 0.4).LeaveOneOutVariance({1e-4}, &score);
+  EXPECT_LT(loo[0], 1e-20);
+  EXPECT_LT(score, 1e-14);
+  // Left out: the point's own value does not enter its prediction.
+  std::vector<std::vector<double>> bumped = values;
+  bumped[24][0] += 10.0;
+  EXPECT_NEAR(LocalQuadratic(pts, bumped, 0.15).Values(pts[24], 24)[0], near.Values(pts[24], 24)[0], 1e-9);
+  EXPECT_GT(std::abs(LocalQuadratic(pts, bumped, 0.15).Values(pts[24])[0] - near.Values(pts[24])[0]), 0.1);
+}
+
 // The likelihood: -chi2 / 2 of the generalised chi2, divided by the
 // overdispersion scale.
 TEST(Posterior, TheLikelihoodIsTheScaledChi2) {
