@@ -43,7 +43,17 @@ void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geomet
   double top = 1.0;
   for (const auto& m : maps) top = std::max(top, m.max_per_m2);
   top = std::ceil(top / 4.0) * 4.0;  // whole ticks at its quarters
-  c.TextPx(20, 30, title, 20);
+  // The title on one line where it fits the sheet (about 0.56 of the font
+  // size per character), else on two, broken at a space.
+  const std::size_t fits = static_cast<std::size_t>(1300.0 / (0.56 * 20.0));
+  if (title.size() <= fits) {
+    c.TextPx(20, 30, title, 20);
+  } else {
+    std::size_t cut = title.rfind(' ', fits);
+    if (cut == std::string::npos || cut < fits / 2) cut = fits;
+    c.TextPx(20, 28, title.substr(0, cut), 18);
+    c.TextPx(20, 52, title.substr(cut + (title[cut] == ' ' ? 1 : 0)), 18);
+  }
   for (std::size_t k = 0; k < maps.size(); ++k) {
     const analysis::DensityMap& m = maps[k];
     const double ox = double(k % columns) * (w + gap);
