@@ -500,13 +500,29 @@ class Calibration {
       post.note = "no statistic could be fitted by the quadratic over the whole box";
       return;
     }
-    const PosteriorSamples ps =
-        SamplePosterior([&](const Point& u) { return likelihood(u); }, starts, spec_.options.posterior_steps, 20121104);
+    // The seeds' mean is uncertain as a function, not only in its level:
+    // their K surfaces' spread, as K standard normal weights sampled with
+    // the parameters (each coordinate z of the box beyond the parameters is
+    // a weight w = Phi^-1(z): uniform z, normal w).
+    std::vector<std::vector<std::vector<double>>> per_set_seed;
+    for (const SetResult* s : ev_.All()) per_set_seed.push_back(s->per_seed);
+    SeedSurfaces surfaces;
+    const std::size_t k = surfaces.Fit(units, per_set_seed, ev_.ToUnit(r_.best)) ? surfaces.seeds() : 0;
+    post.seed_functions = k;
+    for (Point& start : starts) start.resize(p + k, 0.5);
+    const auto density = [&](const Point& x) {
+      if (k == 0) return likelihood(x);
+      const Point u(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(p));
+      std::vector<double> w(k);
+      for (std::size_t s = 0; s < k; ++s) w[s] = NormalQuantile(x[p + s]);
+      return likelihood.WithOffset(u, surfaces.Offset(u, w));
+    };
+    const PosteriorSamples ps = SamplePosterior(density, starts, spec_.options.posterior_steps, 20121104);
     post.samples.clear();
-    for (const Point& u : ps.u) post.samples.push_back(ev_.FromUnit(u));
+    for (const Point& x : ps.u) post.samples.push_back(ev_.FromUnit(Point(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(p))));
     post.chains = ps.chains;
     post.acceptance = ps.acceptance;
-    post.r_hat = ps.r_hat;
+    post.r_hat.assign(ps.r_hat.begin(), ps.r_hat.begin() + static_cast<std::ptrdiff_t>(std::min(p, ps.r_hat.size())));
     post.surrogate_form = local ? "quadratic fitted around each point (Gaussian weights, bandwidth " +
                                       FormatNumber(post.bandwidth) + " of the box)"
                                 : whole.form;

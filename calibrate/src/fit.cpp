@@ -776,16 +776,91 @@ SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective&
   if (!rows_.empty()) white_ = objective.Whiten(rows_);
 }
 
-double SurrogateLikelihood::operator()(const std::vector<double>& u) const {
+double SurrogateLikelihood::operator()(const std::vector<double>& u) const { return WithOffset(u, {}); }
+
+double SurrogateLikelihood::WithOffset(const std::vector<double>& u, const std::vector<double>& offset) const {
   constexpr double kNone = -std::numeric_limits<double>::infinity();
   if (rows_.empty()) return kNone;
-  const std::vector<double> all = local_ ? local_->Values(u) : mean_.Values(u);
+  std::vector<double> all = local_ ? local_->Values(u) : mean_.Values(u);
+  for (std::size_t j = 0; j < offset.size() && j < all.size(); ++j) all[j] += offset[j];
   std::vector<double> value(rows_.size()), residuals(rows_.size());
   for (std::size_t r = 0; r < rows_.size(); ++r) value[r] = all[lead_[rows_[r]]];
   white_.Apply(value.data(), 1, true, residuals.data());
   double chi2 = 0.0;
   for (double r : residuals) chi2 += r * r;
   return std::isfinite(chi2) ? -0.5 * chi2 / scale_ : kNone;
+}
+
+bool SeedSurfaces::Fit(const std::vector<std::vector<double>>& points,
+                       const std::vector<std::vector<std::vector<double>>>& per_set_seed, const std::vector<double>& anchor) {
+  surfaces_.clear();
+  if (per_set_seed.empty() || per_set_seed[0].size() < 2) return false;
+  const std::size_t k = per_set_seed[0].size();
+  for (std::size_t s = 0; s < k; ++s) {
+    std::vector<std::vector<double>> values;
+    for (const auto& set : per_set_seed) values.push_back(s < set.size() ? set[s] : std::vector<double>(set[0].size(), kNaN));
+    Quadratic q;
+    if (!q.Fit(points, values, std::vector<double>(anchor.size(), 0.5), 0.5)) {
+      surfaces_.clear();
+      return false;
+    }
+    surfaces_.push_back(std::move(q));
+  }
+  anchor_ = anchor;
+  at_anchor_.clear();
+  for (const Quadratic& q : surfaces_) at_anchor_.push_back(q.Values(anchor));
+  return true;
+}
+
+std::vector<double> SeedSurfaces::Offset(const std::vector<double>& u, const std::vector<double>& w) const {
+  const std::size_t k = surfaces_.size();
+  std::vector<std::vector<double>> d;
+  for (std::size_t s = 0; s < k; ++s) {
+    std::vector<double> v = surfaces_[s].Values(u);
+    for (std::size_t j = 0; j < v.size(); ++j) v[j] -= at_anchor_[s][j];  // each seed's change from the anchor
+    d.push_back(std::move(v));
+  }
+  const std::size_t n = d.empty() ? 0 : d[0].size();
+  std::vector<double> out(n, 0.0);
+  const double norm = 1.0 / std::sqrt(static_cast<double>(k) * static_cast<double>(k - 1));
+  for (std::size_t j = 0; j < n; ++j) {
+    double mean = 0.0;
+    for (std::size_t s = 0; s < k; ++s) mean += d[s][j] / static_cast<double>(k);
+    for (std::size_t s = 0; s < k; ++s) out[j] += w[s] * (d[s][j] - mean) * norm;
+    if (!std::isfinite(out[j])) out[j] = 0.0;  // a statistic some seed has no surface for: no slope error known
+  }
+  return out;
+}
+
+double NormalQuantile(double p) {
+  if (!(p > 0.0)) return -std::numeric_limits<double>::infinity();
+  if (!(p < 1.0)) return std::numeric_limits<double>::infinity();
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  double x;
+  if (p < 0.02425) {
+    const double q = std::sqrt(-2.0 * std::log(p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  } else if (p > 1.0 - 0.02425) {
+    const double q = std::sqrt(-2.0 * std::log1p(-p));
+    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  } else {
+    const double q = p - 0.5, r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+  }
+  // One Newton step on Phi(x) = p.
+  const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
+  const double u = e * std::sqrt(2.0 * 3.14159265358979323846) * std::exp(0.5 * x * x);
+  return x - u / (1.0 + 0.5 * x * u);
 }
 
 PosteriorSamples SamplePosterior(const LogDensity& density, const std::vector<std::vector<double>>& starts, int steps,

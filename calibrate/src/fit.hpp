@@ -235,6 +235,8 @@ class SurrogateLikelihood {
   SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0,
                       const LocalQuadratic* local = nullptr);
   double operator()(const std::vector<double>& u) const;  // -inf where undefined
+  // The same with `offset` (per statistic) added to the simulated means.
+  double WithOffset(const std::vector<double>& u, const std::vector<double>& offset) const;
   bool empty() const { return rows_.empty(); }
 
  private:
@@ -245,6 +247,36 @@ class SurrogateLikelihood {
   Objective::Whitening white_;
   double scale_;
 };
+
+// The error of a mean of K seeds as a function of the parameters (common
+// random numbers make it smooth, not constant: the same seeds at every set
+// move together, and their mean's slope is as uncertain as its level): the
+// K seeds' own quadratics q_s over every set, and their spread about their
+// mean as random functions. Offset(u, w) = sum_s w_s (d_s(u) - d_s(anchor)) /
+// sqrt(K (K - 1)), d_s = q_s - mean of the q_s, w ~ N(0, I_K): zero at the
+// anchor (the best fit, where the objective's S / K already counts the
+// level), with the sample covariance of the seeds' surfaces over K as its
+// covariance elsewhere. The posterior samples w with the parameters
+// (docs/calibration.md, "The posterior").
+class SeedSurfaces {
+ public:
+  // per_set_seed[set][seed][statistic] (NaN: none), points: the sets' unit
+  // coordinates; false with fewer than 2 seeds or too few sets.
+  bool Fit(const std::vector<std::vector<double>>& points,
+           const std::vector<std::vector<std::vector<double>>>& per_set_seed, const std::vector<double>& anchor);
+  std::size_t seeds() const { return surfaces_.size(); }
+  // The offset per statistic at u for standard normal weights w (K of them).
+  std::vector<double> Offset(const std::vector<double>& u, const std::vector<double>& w) const;
+
+ private:
+  std::vector<Quadratic> surfaces_;
+  std::vector<double> anchor_;
+  std::vector<std::vector<double>> at_anchor_;  // [seed][statistic] - the mean there
+};
+
+// The standard normal's quantile (Acklam's rational approximation refined
+// by a Newton step: relative error below 1e-12 on (0, 1)); +-inf at 0 and 1.
+double NormalQuantile(double p);
 
 // Samples of a density over the unit box: random-walk Metropolis, one chain
 // from each of `starts`; the first quarter of `steps` burns in (the proposal

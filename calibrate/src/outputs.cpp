@@ -110,6 +110,7 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                       {"surrogate", post.samples.empty() ? json(nullptr) : json(post.surrogate_form + " over every set evaluated")},
                       {"sets", post.sets}, {"overdispersion_scale", post.scale},
                       {"bandwidth", std::isfinite(post.bandwidth) ? json(post.bandwidth) : json("whole box")},
+                      {"seed_functions", post.seed_functions},
                       {"bandwidth_leave_one_out_scores", [&] {
                          json a = json::array();
                          for (double v : post.bandwidth_scores) a.push_back(Num(v));

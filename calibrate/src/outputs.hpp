@@ -78,6 +78,7 @@ struct CalibrationResult {
     std::vector<double> lack_of_fit_sd;   // per statistic: the surrogate's error beyond the seeds' (NaN: not fitted)
     double scale = 1.0;                   // the likelihood's widening: max(1, chi2 at the best fit / degrees of freedom)
     double bandwidth = 0.0;               // the surrogate's (fraction of the box; inf: the quadratic over the whole box)
+    std::size_t seed_functions = 0;       // the seeds' surfaces sampled as the means' error (0: none)
     std::vector<double> bandwidth_scores; // leave-one-out error of each candidate
     std::string note;                     // why there is none
   } posterior;

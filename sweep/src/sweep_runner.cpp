@@ -184,6 +184,17 @@ const std::map<std::string, std::size_t>& MetricColumnOf() {
   return column_of;
 }
 
+// The group a per-group metric belongs to ("mean_speed_g2_m_per_s",
+// "passages_g2": 2), or -1 for a metric of the whole run.
+int GroupOfMetric(const std::string& name) {
+  for (std::size_t at = name.find("_g"); at != std::string::npos; at = name.find("_g", at + 1)) {
+    std::size_t end = at + 2;
+    while (end < name.size() && name[end] >= '0' && name[end] <= '9') ++end;
+    if (end > at + 2 && (end == name.size() || name[end] == '_')) return std::stoi(name.substr(at + 2, end - at - 2));
+  }
+  return -1;
+}
+
 ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
   const std::map<std::string, std::size_t>& column_of = MetricColumnOf();
   ResultRow row;
@@ -194,6 +205,10 @@ ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
   row.metrics.assign(MetricColumns().size(), std::numeric_limits<double>::quiet_NaN());
   for (const analysis::SummaryValue& v : a.SummaryTable()) {
     const auto it = column_of.find(v.name);
+    // The table holds the main flow's and the counter-flow's columns (groups
+    // 0 and 1); a scenario's further groups (an inflow's own) are in the
+    // run's own analysis, not here.
+    if (it == column_of.end() && GroupOfMetric(v.name) >= 2) continue;
     if (it == column_of.end())
       throw std::logic_error("sweep: the analysis reports \"" + v.name + "\", which has no results column");
     row.metrics[it->second] = v.value;

@@ -343,6 +343,83 @@ TEST(Posterior, ALocalQuadraticFollowsWhatAGlobalOneCannot) {
   EXPECT_GT(std::abs(LocalQuadratic(pts, bumped, 0.15).Values(pts[24])[0] - near.Values(pts[24])[0]), 0.1);
 }
 
+// The seeds' mean as an uncertain function: K seeds whose surfaces differ
+// in slope (common random numbers: smooth, zero difference at the anchor)
+// give the means an error that grows away from the anchor; sampled with the
+// parameters (weights w = Phi^-1(z)), the posterior of u is the marginal one,
+// y ~ N(a u, sigma^2 + v (u - anchor)^2), computed here on a grid.
+TEST(Posterior, TheSeedsSurfacesWidenItAsTheirSlopesDiffer) {
+  EXPECT_NEAR(NormalQuantile(0.5), 0.0, 1e-14);
+  EXPECT_NEAR(NormalQuantile(0.975), 1.959963984540054, 1e-12);
+  EXPECT_NEAR(NormalQuantile(1e-10), -6.361340902404056, 1e-9);
+  EXPECT_NEAR(NormalQuantile(0.3) + NormalQuantile(0.7), 0.0, 1e-14);
+  EXPECT_TRUE(std::isinf(NormalQuantile(0.0)) && std::isinf(NormalQuantile(1.0)));
+
+  const std::vector<double> slopes{-0.3, -0.1, 0.1, 0.3};  // per seed, about the anchor 0.5
+  std::vector<std::vector<double>> pts;
+  std::vector<std::vector<std::vector<double>>> per_set_seed;
+  std::vector<std::vector<double>> means;
+  for (int i = 0; i <= 10; ++i) {
+    const double u = i / 10.0;
+    pts.push_back({u});
+    means.push_back({u});
+    std::vector<std::vector<double>> seeds;
+    for (double c : slopes) seeds.push_back({u + c * (u - 0.5)});
+    per_set_seed.push_back(seeds);
+  }
+  SeedSurfaces surfaces;
+  ASSERT_TRUE(surfaces.Fit(pts, per_set_seed, {0.5}));
+  EXPECT_EQ(surfaces.seeds(), 4u);
+  EXPECT_NEAR(surfaces.Offset({0.5}, {1.0, -2.0, 0.5, 3.0})[0], 0.0, 1e-12);  // nothing at the anchor
+  const double v = (0.09 + 0.01 + 0.01 + 0.09) / 3.0 / 4.0;                 // the slopes' sample variance / K
+  // The offset is linear in w: its variance over w ~ N(0, I) is the sum of its squared coefficients.
+  double var = 0.0;
+  for (std::size_t s = 0; s < 4; ++s) {
+    std::vector<double> w(4, 0.0);
+    w[s] = 1.0;
+    const double o = surfaces.Offset({0.9}, w)[0];
+    var += o * o;
+  }
+  EXPECT_NEAR(var, v * 0.16, 1e-12);
+
+  Quadratic q;
+  ASSERT_TRUE(q.Fit(pts, means, {0.5}, 0.5));
+  const double sigma = 0.05, truth = 0.8;
+  const Objective o = ObjectiveObserving({truth}, {sigma});
+  const SurrogateLikelihood l(q, o);
+  const auto sample = [&](bool with_seeds) {
+    std::vector<std::vector<double>> starts{{0.5}, {0.3}, {0.7}, {0.9}};
+    if (with_seeds)
+      for (auto& x : starts) x.resize(5, 0.5);
+    const PosteriorSamples ps = SamplePosterior(
+        [&](const std::vector<double>& x) {
+          if (!with_seeds) return l(x);
+          std::vector<double> w;
+          for (std::size_t s = 1; s < 5; ++s) w.push_back(NormalQuantile(x[s]));
+          return l.WithOffset({x[0]}, surfaces.Offset({x[0]}, w));
+        },
+        starts, 60000, 11);
+    std::vector<double> u;
+    for (const auto& x : ps.u) u.push_back(x[0]);
+    return SampleSd(u);
+  };
+  const auto grid_sd = [&](double slope_var) {
+    double z = 0.0, m1 = 0.0, m2 = 0.0;
+    for (double u = 0.00005; u < 1.0; u += 0.0001) {
+      const double s2 = sigma * sigma + slope_var * (u - 0.5) * (u - 0.5);
+      const double d = std::exp(-0.5 * (truth - u) * (truth - u) / s2) / std::sqrt(s2);
+      z += d;
+      m1 += d * u;
+      m2 += d * u * u;
+    }
+    return std::sqrt(m2 / z - (m1 / z) * (m1 / z));
+  };
+  const double plain = sample(false), wider = sample(true);
+  EXPECT_NEAR(plain, grid_sd(0.0), 0.05 * grid_sd(0.0));
+  EXPECT_NEAR(wider, grid_sd(v), 0.05 * grid_sd(v));
+  EXPECT_GT(grid_sd(v), 1.1 * grid_sd(0.0));
+}
+
 // The likelihood: -chi2 / 2 of the generalised chi2, divided by the
 // overdispersion scale.
 TEST(Posterior, TheLikelihoodIsTheScaledChi2) {

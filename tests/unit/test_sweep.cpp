@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <string>
 
@@ -12,6 +13,8 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
+#include "crowdrecon/sweep/sweep_runner.hpp"
+#include "scratch.hpp"
 
 namespace crowdrecon::sweep {
 namespace {
@@ -187,6 +190,42 @@ TEST(SweepFile, ANumberInAPathNamesAListsElement) {
               std::string::npos)
         << e.what();
   }
+}
+
+// A scenario with a third group (an inflow's own: the Itaewon envelope's
+// people walking along the food street) runs in a sweep; the table keeps the
+// first two groups' columns (it stopped the sweep with an internal error).
+TEST(SweepRunner, AThirdGroupsMetricsStayOutOfTheTable) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-three-groups");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string source = CROWDRECON_SOURCE_DIR;
+  {
+    std::ofstream f(dir / "scenario.json");
+    f << R"({"format": "crowdrecon-scenario", "version": 1, "venue": ")" << source
+      << R"(/venues/madrid-arena/hallway-open.json",
+      "population": {"count": 12, "counter_flow_fraction": 0.5, "target": "to_exit", "counter_target": "to_court",
+                     "body": {"mode": "circle"}, "seed": 4},
+      "run": {"duration_s": 2, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false},
+      "timeline": {"inflows": [{"entry": "from_court", "group": "along", "target": "to_exit", "rate_per_s": 2}]}})";
+  }
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": "scenario.json", "seeds": [1]})";
+  }
+  SweepOptions options;
+  options.sweep_file = dir / "sweep.json";
+  options.output_dir = dir / "out";
+  options.jobs = 1;
+  const SweepSummary summary = RunSweep(options);
+  EXPECT_EQ(summary.failed, 0u);
+  std::ifstream csv(dir / "out" / "results.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_NE(header.find("mean_speed_g1_m_per_s"), std::string::npos);
+  EXPECT_EQ(header.find("_g2"), std::string::npos) << header;
+  EXPECT_NE(row.find("complete"), std::string::npos) << row;
 }
 
 TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
