@@ -183,9 +183,10 @@ std::string Percent(double percent) {
 // A duration for a reader: seconds, minutes or hours.
 std::string Duration(double seconds) {
   if (!std::isfinite(seconds)) return "more than any footage";
-  if (seconds < 120.0) return Fixed(seconds, 2) + " s";
-  if (seconds < 7200.0) return Fixed(seconds / 60.0, 2) + " min";
-  return Fixed(seconds / 3600.0, 2) + " h";
+  const auto number = [](double v) { return v >= 10.0 ? std::to_string(std::lround(v)) : Fixed(v, 2); };
+  if (seconds < 120.0) return number(seconds) + " s";
+  if (seconds < 7200.0) return number(seconds / 60.0) + " min";
+  return number(seconds / 3600.0) + " h";
 }
 
 // "How much footage": what the calibrated kind of recording determines, and
