@@ -24,6 +24,7 @@ Chromium where it is installed.
 import argparse
 import csv
 import json
+import math
 import os
 import shutil
 import sqlite3
@@ -162,6 +163,14 @@ def main():
                        check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
+def nice_ceiling(v):
+    """The smallest of 1, 2, 4, 5, 8 x 10^k at or above v (quarters of it are round numbers)."""
+    if v <= 0:
+        return 1.0
+    k = 10 ** math.floor(math.log10(v))
+    return next(m * k for m in (1, 2, 4, 5, 8, 10) if m * k >= v)
+
+
 def draw(table, designs, file):
     """Two bar panels: the alley's peak density (top area) and the most people above 400 N at once, per design,
     one dot per seed on a bar at the median."""
@@ -176,14 +185,16 @@ def draw(table, designs, file):
     colours = {"two-way": "#3a6ea5", "one-way-up": "#d9822b"}
     for k, (key, label) in enumerate(panels):
         x0 = left + k * (pw + gap)
-        vmax = max(t[key] for t in table) * 1.1 or 1.0
+        vmax = nice_ceiling(max(t[key] for t in table) * 1.05)
         out.append(f'<rect x="{x0}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="#333"/>')
         out.append(f'<text x="{x0 + pw / 2}" y="{top + ph + 70}" font-size="14" text-anchor="middle">{label}</text>')
         for g in range(5):
             v = vmax * g / 4
             y = top + ph - ph * g / 4
             out.append(f'<line x1="{x0}" x2="{x0 + pw}" y1="{y}" y2="{y}" stroke="#ddd"/>')
-            out.append(f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">{v:.1f}</text>')
+            out.append(f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">'
+                       f'{v:.0f}</text>' if vmax >= 10 else
+                       f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">{v:.1f}</text>')
         bw = pw / (len(designs) + 1)
         for i, (v, c) in enumerate(designs):
             ts = [t[key] for t in table if t["variant"] == v and t["station_cap_per_s"] == c]
