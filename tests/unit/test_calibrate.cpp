@@ -995,7 +995,7 @@ Objective FootageObjective(std::size_t windows, double window_s, double s2, doub
 // Bartlett weights' bias); N recordings divide the variance by N, K seeds
 // add 1/K; a count's information grows with the length; a statistic that
 // moves with one parameter only informs that one.
-TEST(Footage, MatchesTheInformationOfACorrelatedSeries) {
+TEST(FootageDesign, MatchesTheInformationOfACorrelatedSeries) {
   const double rho = 0.5, s2 = 0.04, g = 0.8;
   std::vector<double> jac;
   const Objective o = FootageObjective(40, 5.0, s2, rho, {g}, &jac);
