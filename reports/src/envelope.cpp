@@ -49,8 +49,9 @@ Envelope ReadEnvelope(const fs::path& dir, const std::string& metric, double lev
     Statement s(db, "SELECT * FROM runs LIMIT 0");
     for (int c = 0; c < s.ColumnCount(); ++c) columns.insert(s.ColumnName(c));
   }
+  // A sweep of one axis (its diagram has no y): one row of cells.
   for (const std::string& c : {e.x_axis, e.y_axis})
-    if (!columns.count(c))
+    if (!(c.empty() && &c != &e.x_axis) && !columns.count(c))
       throw InputError(e.results.string() + ": table runs has no column \"" + c + "\" (the diagram's axis)");
   if (!columns.count(metric)) {
     // A sweep that records injury risk has people_danger: then the metric is
@@ -65,8 +66,8 @@ Envelope ReadEnvelope(const fs::path& dir, const std::string& metric, double lev
   }
   std::map<std::string, std::map<std::pair<double, double>, std::vector<double>>> cells;
   std::set<double> xs, ys;
-  Statement s(db, "SELECT variant, " + Quoted(e.x_axis) + ", " + Quoted(e.y_axis) + ", status, " + Quoted(metric) +
-                      " FROM runs ORDER BY run_index");
+  Statement s(db, "SELECT variant, " + Quoted(e.x_axis) + ", " + (e.y_axis.empty() ? "0" : Quoted(e.y_axis)) +
+                      ", status, " + Quoted(metric) + " FROM runs ORDER BY run_index");
   while (s.Next()) {
     ++e.runs;
     const double x = s.Double(1), y = s.Double(2);
@@ -136,7 +137,8 @@ std::string EnvelopeSvg(const Envelope& e, const std::string& variant) {
       s += "<rect x=\"" + svg::Short(X(ix), 6) + "\" y=\"" + svg::Short(Y(iy), 6) + "\" width=\"" + svg::Short(kCell, 6) +
            "\" height=\"" + svg::Short(kCell, 6) + "\" fill=\"" + (have ? colour(c->median) : "#dddddd") +
            "\" stroke=\"#ffffff\"><title>" +
-           svg::Escape(e.x_axis + " " + svg::Short(e.xs[ix]) + ", " + e.y_axis + " " + svg::Short(e.ys[iy]) +
+           svg::Escape(e.x_axis + " " + svg::Short(e.xs[ix]) +
+                       (e.y_axis.empty() ? std::string() : ", " + e.y_axis + " " + svg::Short(e.ys[iy])) +
                        (have ? ": median " + svg::Short(c->median) + ", range " + svg::Short(c->low) + "–" +
                                    svg::Short(c->high) + " over " + std::to_string(c->values.size()) + " seeds"
                              : ": no complete run")) +
@@ -177,7 +179,7 @@ std::string EnvelopeSvg(const Envelope& e, const std::string& variant) {
   for (std::size_t ix = 0; ix < nx; ++ix)
     s += "<text x=\"" + svg::Short(X(ix) + kCell / 2, 6) + "\" y=\"" + svg::Short(kTop + double(ny) * kCell + 16, 6) +
          "\" text-anchor=\"middle\">" + svg::Short(e.xs[ix]) + "</text>\n";
-  for (std::size_t iy = 0; iy < ny; ++iy)
+  for (std::size_t iy = 0; iy < ny && !e.y_axis.empty(); ++iy)
     s += "<text x=\"" + svg::Short(kLeft - 6, 6) + "\" y=\"" + svg::Short(Y(iy) + kCell / 2 + 4, 6) +
          "\" text-anchor=\"end\">" + svg::Short(e.ys[iy]) + "</text>\n";
   s += "<text x=\"" + svg::Short(kLeft + double(nx) * kCell / 2, 6) + "\" y=\"" + svg::Short(height - 14, 6) +

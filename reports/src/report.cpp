@@ -443,7 +443,9 @@ ReportSummary WriteEnvelopeReport(const ReportOptions& options) {
        " runs (" + std::to_string(e.failed) + " failed, " + std::to_string(e.without_metric) + " without " +
        Escape(e.metric) + "), made by crowdrecon " + Escape(e.crowdrecon_version) + "; this report: crowdrecon " +
        Escape(CROWDRECON_GIT_VERSION) + ".</p>\n";
-  h += "<p>Where in the sweep's plane (" + Escape(e.x_axis) + " × " + Escape(e.y_axis) + ") the median over seeds of <b>" +
+  h += "<p>Where in the sweep's " +
+       (e.y_axis.empty() ? "axis (" + Escape(e.x_axis) + ")" : "plane (" + Escape(e.x_axis) + " × " + Escape(e.y_axis) + ")") +
+       " the median over seeds of <b>" +
        Escape(e.metric) + "</b> stays at or below <b>" + Short(e.level) +
        "</b>: inside the blue edge. Each cell shows the median and, in brackets, the smallest and largest seed; a "
        "dashed square marks a cell whose seeds lie on both sides of the level, where the edge is uncertain. Risk "
@@ -469,11 +471,14 @@ ReportSummary WriteEnvelopeReport(const ReportOptions& options) {
           if (!broken_all) all_seeds = x;
         }
       rows.push_back({Short(y), std::isnan(reach) ? "none" : Short(reach), std::isnan(all_seeds) ? "none" : Short(all_seeds)});
-      summary.envelope_lines.push_back(variant + ": " + e.y_axis + " " + Short(y) + ": inside up to " + e.x_axis + " " +
+      summary.envelope_lines.push_back(variant + (e.y_axis.empty() ? std::string() : ": " + e.y_axis + " " + Short(y)) +
+                                       ": inside up to " + e.x_axis + " " +
                                        (std::isnan(reach) ? std::string("none") : Short(reach)) + " (every seed: " +
                                        (std::isnan(all_seeds) ? std::string("none") : Short(all_seeds)) + ")");
     }
-    h += Table({Escape(e.y_axis), "inside up to " + Escape(e.x_axis) + " (median)", "every seed inside up to"}, rows);
+    h += Table({e.y_axis.empty() ? std::string("(one axis)") : Escape(e.y_axis), "inside up to " + Escape(e.x_axis) + " (median)",
+                "every seed inside up to"},
+               rows);
   }
   h += "<h2>Reproducibility</h2>\n<p>Sweep file <code>" + Escape(e.sweep_file) + "</code>; results <code>" +
        Escape(e.results.string()) + "</code>, SHA-256 <code>" + Sha256OfFile(e.results) + "</code>; command <code>" +
