@@ -114,7 +114,7 @@ def main():
             sys.exit(f"itaewon-envelope: run {r['run_id']} did not complete: {r['status']}")
         run = os.path.join(args.sweep, "runs", r["run_id"] + ".sqlite")
         m = run_metrics(run, areas, venue["slope"]["region"])
-        m.update({"run_id": r["run_id"], "variant": r["variant"], "station_cap_per_s": float(r[cap]),
+        m.update({"run_id": r["run_id"], "variant": r["variant"], "station_cap_per_s": float(r.get(cap) or "nan"),
                   "seed": int(r["seed"]), "max_load_n": float(r["max_load_n"]),
                   "people_ever_above_400n": int(float(r["people_ever_above_load"])),
                   "longest_above_400n_s": float(r["longest_above_load_s"] or 0),
@@ -128,7 +128,12 @@ def main():
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         w.writerows(table)
-    designs = sorted({(t["variant"], t["station_cap_per_s"]) for t in table}, key=lambda d: (d[0] != "two-way", -d[1]))
+    # (A sweep without the cap axis, e.g. the arrival ranges: one design per variant, cap "-".)
+    designs = []
+    for t in table:
+        if not any(d[0] == t["variant"] and same(d[1], t["station_cap_per_s"]) for d in designs):
+            designs.append((t["variant"], t["station_cap_per_s"]))
+    designs.sort(key=lambda d: (d[0] != "two-way", -d[1] if d[1] == d[1] else 0))
 
     def cell(ts, key, digits=1):
         v = [t[key] for t in ts]
@@ -142,8 +147,8 @@ def main():
              "peak local density, /m² | fallen |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for v, c in designs:
-        ts = [t for t in table if t["variant"] == v and t["station_cap_per_s"] == c]
-        lines.append(f"| {v} | {c:g} | {cell(ts, 'alley_foot_peak_per_m2')} / {cell(ts, 'alley_middle_peak_per_m2')} / "
+        ts = [t for t in table if t["variant"] == v and same(t["station_cap_per_s"], c)]
+        lines.append(f"| {v} | {'-' if c != c else f'{c:g}'} | {cell(ts, 'alley_foot_peak_per_m2')} / {cell(ts, 'alley_middle_peak_per_m2')} / "
                      f"{cell(ts, 'alley_top_peak_per_m2')} | {cell(ts, 'junction_peak_per_m2')} | "
                      f"{cell(ts, 'alley_up', 0)} / {cell(ts, 'alley_down', 0)} | {cell(ts, 'most_above_400n_at_once', 0)} | "
                      f"{cell(ts, 'above_400n_in_alley_at_worst', 0)} | "
@@ -161,6 +166,11 @@ def main():
                         f"--screenshot={os.path.abspath(os.path.join(args.out, 'envelope.png'))}", "--window-size=980,560",
                         "file://" + os.path.abspath(os.path.join(args.out, "envelope.svg"))],
                        check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def same(a, b):
+    """Equal caps, NaN (no cap axis) equal to NaN."""
+    return a == b or (a != a and b != b)
 
 
 def nice_ceiling(v):
@@ -197,14 +207,15 @@ def draw(table, designs, file):
                        f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">{v:.1f}</text>')
         bw = pw / (len(designs) + 1)
         for i, (v, c) in enumerate(designs):
-            ts = [t[key] for t in table if t["variant"] == v and t["station_cap_per_s"] == c]
+            ts = [t[key] for t in table if t["variant"] == v and same(t["station_cap_per_s"], c)]
             med = statistics.median(ts)
             cx = x0 + bw * (i + 1)
             out.append(f'<rect x="{cx - bw * 0.35}" y="{top + ph - ph * med / vmax}" width="{bw * 0.7}" '
                        f'height="{ph * med / vmax}" fill="{colours.get(v, "#888")}" opacity="0.75"/>')
             for t in ts:
                 out.append(f'<circle cx="{cx}" cy="{top + ph - ph * t / vmax}" r="3.5" fill="black"/>')
-            out.append(f'<text x="{cx}" y="{top + ph + 18}" font-size="11" text-anchor="middle">{c:g}/s</text>')
+            out.append(f'<text x="{cx}" y="{top + ph + 18}" font-size="11" text-anchor="middle">'
+                       f'{"" if c != c else f"{c:g}/s"}</text>')
             out.append(f'<text x="{cx}" y="{top + ph + 34}" font-size="10" text-anchor="middle" fill="#555">'
                        f'{"two-way" if v == "two-way" else "one-way"}</text>')
     out.append("</svg>")
