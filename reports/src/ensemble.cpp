@@ -322,13 +322,20 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
     }
   }
   canvas.StrokePolygon({P(kLeft, top), P(kRight, top), P(kRight, bottom), P(kLeft, bottom)}, kInk, 1.0);
-  // Recorded marks' labels over the density panel.
-  int stagger = 0;
-  for (const analysis::TimelineMark& m : score.runs.front().recorded) {
-    if (m.time_s < t0 || m.time_s > t1) continue;
-    canvas.TextPxAligned(X(m.time_s) + 3, top - 4 - 11.0 * (stagger++ % 2), m.label, 10, 0.0, 1.0,
-                         m.kind == "fatal" ? kFatal : kRecorded);
-  }
+  // Recorded marks' labels over the density panel, in rows where they would overlap.
+  std::vector<const analysis::TimelineMark*> shown;
+  std::vector<double> at;
+  std::vector<std::string> labels;
+  for (const analysis::TimelineMark& m : score.runs.front().recorded)
+    if (m.time_s >= t0 && m.time_s <= t1) {
+      shown.push_back(&m);
+      at.push_back(X(m.time_s) + 3);
+      labels.push_back(m.label);
+    }
+  const std::vector<int> rows = viz::LabelRows(at, labels, 10, 3);
+  for (std::size_t k = 0; k < shown.size(); ++k)
+    canvas.TextPxAligned(at[k], top - 4 - 11.0 * rows[k], labels[k], 10, 0.0, 1.0,
+                         shown[k]->kind == "fatal" ? kFatal : kRecorded);
   // One row per run.
   for (std::size_t k = 0; k < n; ++k) {
     const EnsembleRun& r = score.runs[k];

@@ -17,6 +17,7 @@
 #include "test_util.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/viz/canvas.hpp"
+#include "crowdrecon/viz/chart.hpp"
 #include "crowdrecon/viz/render_run.hpp"
 #include "render_scene.hpp"
 
@@ -54,6 +55,22 @@ std::filesystem::path WriteRun(const std::filesystem::path& dir, int frames, boo
   const std::filesystem::path file = dir / "run.sqlite";
   engine::testing::WriteCorridorRun(file, sim, scene, frames, 10.0, record_periodic_box);
   return file;
+}
+
+// The recorded marks' labels over a timeline: each in the first row where it
+// does not overlap the row's last label (0.56 of the size per character and
+// a 6-px gap), at most the rows given (then the row that ends first). The
+// Itaewon marks at 156, 180 and 204 s of 270 overlapped with two rows taken
+// in turn.
+TEST(LabelRows, ALabelGoesWhereItDoesNotOverlap) {
+  const std::vector<std::string> labels{"22:11 last police call before the crush (/10)", "22:15 swept down (/10)",
+                                        "22:19 first rescue team (/10)", "22:43 (/10)"};
+  // 10-px text: the first is 45 characters, 252 px (+6) wide.
+  EXPECT_EQ(LabelRows({100, 200, 300, 400}, labels, 10, 3), (std::vector<int>{0, 1, 2, 0}));
+  EXPECT_EQ(LabelRows({100, 400, 700, 900}, labels, 10, 3), (std::vector<int>{0, 0, 0, 0}));
+  // No row free: the one whose last label ends first.
+  EXPECT_EQ(LabelRows({100, 110, 120}, {"aaaaaaaaaa", "bbbbbbbbbbbbbbbbbbbb", "c"}, 10, 2), (std::vector<int>{0, 1, 0}));
+  EXPECT_TRUE(LabelRows({}, {}, 10, 3).empty());
 }
 
 TEST(RenderFrameSelection, ParsesEveryForm) {

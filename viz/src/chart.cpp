@@ -43,6 +43,20 @@ void ChartPanel::Band(const std::vector<double>& x, const std::vector<double>& l
   items_.push_back(std::make_shared<Item>(Item{Item::Kind::kBand, x, {}, lo, hi, {}, color, 1.0, "", false}));
 }
 
+std::vector<int> LabelRows(const std::vector<double>& x_px, const std::vector<std::string>& labels, double size_px,
+                           int rows) {
+  std::vector<double> end(static_cast<std::size_t>(std::max(rows, 1)), -1e300);
+  std::vector<int> out;
+  for (std::size_t k = 0; k < x_px.size() && k < labels.size(); ++k) {
+    std::size_t row = 0;
+    while (row < end.size() && end[row] > x_px[k]) ++row;
+    if (row == end.size()) row = static_cast<std::size_t>(std::min_element(end.begin(), end.end()) - end.begin());
+    end[row] = x_px[k] + 0.56 * size_px * static_cast<double>(labels[k].size()) + 6.0;
+    out.push_back(static_cast<int>(row));
+  }
+  return out;
+}
+
 void ChartPanel::Mark(double x, Color color, const std::string& label, bool dashed) {
   items_.push_back(std::make_shared<Item>(Item{Item::Kind::kMark, {x}, {}, {}, {}, {}, color, 1.4, label, dashed}));
 }

@@ -212,13 +212,20 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   s.canvas.Line(s.P(lx + 8, ly + 1), s.P(lx + 18, ly + 11), kFatal, 2.0);
   s.canvas.Line(s.P(lx + 8, ly + 11), s.P(lx + 18, ly + 1), kFatal, 2.0);
   s.canvas.TextPxAligned(lx + 32, ly + 6, "fall in the run (" + std::to_string(ts.falls.size()) + ")", 12, 0.0, 0.5, kInk);
-  // Recorded marks' labels, staggered over the first panel.
-  int row = 0;
-  for (const analysis::TimelineMark& m : ts.recorded) {
-    if (m.time_s < t0 || m.time_s > t1) continue;
-    s.canvas.TextPxAligned(p[0].X(m.time_s) + 3, p[0].top - 4 - 11.0 * (row++ % 2), m.label, 10, 0.0, 1.0,
-                           m.kind == "fatal" ? kFatal : kRecorded);
-  }
+  // Recorded marks' labels over the first panel, in rows where they would overlap.
+  std::vector<const analysis::TimelineMark*> shown;
+  std::vector<double> at;
+  std::vector<std::string> text;
+  for (const analysis::TimelineMark& m : ts.recorded)
+    if (m.time_s >= t0 && m.time_s <= t1) {
+      shown.push_back(&m);
+      at.push_back(p[0].X(m.time_s) + 3);
+      text.push_back(m.label);
+    }
+  const std::vector<int> rows = LabelRows(at, text, 10, 3);
+  for (std::size_t k = 0; k < shown.size(); ++k)
+    s.canvas.TextPxAligned(at[k], p[0].top - 4 - 11.0 * rows[k], text[k], 10, 0.0, 1.0,
+                           shown[k]->kind == "fatal" ? kFatal : kRecorded);
   s.canvas.Finish();
 }
 

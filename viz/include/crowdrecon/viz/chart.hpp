@@ -24,6 +24,14 @@ Color ChartColor(int index);
 // (its own density, dashed: brown, teal, orange, grey, then again).
 Color AreaColor(std::size_t index);
 
+// Rows (0, 1, ...) for labels drawn left-aligned from x_px, so that no two
+// in one row overlap (a label's width taken as 0.56 of the font size per
+// character, plus a gap): each in the first row where it fits, at most
+// `rows` rows (where none is free, the row whose last label ends first).
+// For the recorded marks' labels over the timeline figures.
+std::vector<int> LabelRows(const std::vector<double>& x_px, const std::vector<std::string>& labels, double size_px,
+                           int rows);
+
 class ChartPanel {
  public:
   void Line(const std::vector<double>& x, const std::vector<double>& y, Color color, double width_px,
