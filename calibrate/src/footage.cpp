@@ -260,6 +260,10 @@ FootageDesign DesignFootage(const Objective& objective, const std::vector<double
                             const std::vector<double>& best, const FootageOptions& options) {
   FootageDesign d;
   const std::size_t p = best.size();
+  if (p == 0 || jacobian.size() != objective.statistics.size() * p || objective.seed_covariance.empty()) {
+    d.note = "no Jacobian at a best fit, or no seeds' covariance";
+    return d;
+  }
   const Layout l = LayoutOf(objective, jacobian, p);
   d.left_out = l.left_out;
   d.note = l.note;
