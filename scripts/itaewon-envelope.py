@@ -159,7 +159,9 @@ def main():
               f"({len(table)} runs, {statistics.mean(t['wall_s'] for t in table):.0f} s each on average)."]
     open(os.path.join(args.out, "envelope.md"), "w").write("\n".join(lines) + "\n")
     print("\n".join(lines))
-    draw(table, designs, os.path.join(args.out, "envelope.svg"))
+    name = sqlite3.connect(f"file:{os.path.join(args.sweep, 'results.sqlite')}?mode=ro", uri=True).execute(
+        "select value from sweep where key = 'name'").fetchone()[0]
+    draw(table, designs, os.path.join(args.out, "envelope.svg"), name)
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
     if browser:  # the PNG: the SVG as a headless browser draws it
         subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
@@ -174,25 +176,31 @@ def same(a, b):
 
 
 def nice_ceiling(v):
-    """The smallest of 1, 2, 4, 5, 8 x 10^k at or above v (quarters of it are round numbers)."""
+    """The smallest of 1, 1.2, 1.6, 2, 3, 4, 5, 6, 8 x 10^k at or above v (its quarters are short numbers)."""
     if v <= 0:
         return 1.0
     k = 10 ** math.floor(math.log10(v))
-    return next(m * k for m in (1, 2, 4, 5, 8, 10) if m * k >= v)
+    return next(m * k for m in (1, 1.2, 1.6, 2, 3, 4, 5, 6, 8, 10) if m * k >= v)
 
 
-def draw(table, designs, file):
+def draw(table, designs, file, name):
     """Two bar panels: the alley's peak density (top area) and the most people above 400 N at once, per design,
     one dot per seed on a bar at the median."""
+    palette = ["#3a6ea5", "#d9822b", "#5a9e4b", "#8e5ea2", "#c44e52"]
+    variants = []
+    for v, _ in designs:
+        if v not in variants:
+            variants.append(v)
+    colours = {v: palette[i % len(palette)] for i, v in enumerate(variants)}
+    title = name if len(name) <= 118 else name[:115] + "..."
     w, h, left, top, pw, ph, gap = 980, 560, 90, 70, 380, 380, 110
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="DejaVu Sans, sans-serif">',
            '<rect width="100%" height="100%" fill="white"/>',
-           '<text x="20" y="30" font-size="18" font-weight="bold">Itaewon alley, the design envelope (shortened evening)</text>',
-           '<text x="20" y="52" font-size="13" fill="#555">bars: median over seeds; dots: each seed. '
-           'Blue: two-way (as it was); orange: one-way up. Station inflow held to 0.5, 1, 2 persons/s.</text>']
+           f'<text x="20" y="30" font-size="14" font-weight="bold">{title}</text>',
+           '<text x="20" y="52" font-size="13" fill="#555">bars: median over seeds; dots: each seed; '
+           'under each bar its variant and, where the sweep holds it back, the station inflow\'s cap.</text>']
     panels = [("alley_top_peak_per_m2", "the alley's top: peak density, /m²"),
               ("most_above_400n_at_once", "people above 400 N at once (most)")]
-    colours = {"two-way": "#3a6ea5", "one-way-up": "#d9822b"}
     for k, (key, label) in enumerate(panels):
         x0 = left + k * (pw + gap)
         vmax = nice_ceiling(max(t[key] for t in table) * 1.05)
@@ -202,9 +210,7 @@ def draw(table, designs, file):
             v = vmax * g / 4
             y = top + ph - ph * g / 4
             out.append(f'<line x1="{x0}" x2="{x0 + pw}" y1="{y}" y2="{y}" stroke="#ddd"/>')
-            out.append(f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">'
-                       f'{v:.0f}</text>' if vmax >= 10 else
-                       f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">{v:.1f}</text>')
+            out.append(f'<text x="{x0 - 6}" y="{y + 4}" font-size="11" text-anchor="end">{round(v, 6):g}</text>')
         bw = pw / (len(designs) + 1)
         for i, (v, c) in enumerate(designs):
             ts = [t[key] for t in table if t["variant"] == v and same(t["station_cap_per_s"], c)]
@@ -216,8 +222,8 @@ def draw(table, designs, file):
                 out.append(f'<circle cx="{cx}" cy="{top + ph - ph * t / vmax}" r="3.5" fill="black"/>')
             out.append(f'<text x="{cx}" y="{top + ph + 18}" font-size="11" text-anchor="middle">'
                        f'{"" if c != c else f"{c:g}/s"}</text>')
-            out.append(f'<text x="{cx}" y="{top + ph + 34}" font-size="10" text-anchor="middle" fill="#555">'
-                       f'{"two-way" if v == "two-way" else "one-way"}</text>')
+            out.append(f'<text x="{cx}" y="{top + ph + 34}" font-size="8.5" text-anchor="middle" fill="#555">'
+                       f'{v}</text>')
     out.append("</svg>")
     open(file, "w").write("\n".join(out) + "\n")
 
