@@ -243,11 +243,16 @@ class Calibration {
   bool FitWhole(Quadratic* q) const {
     std::vector<Point> units;
     std::vector<std::vector<double>> means;
-    for (const SetResult* s : ev_.All()) {
-      units.push_back(ev_.ToUnit(s->values));
-      means.push_back(s->mean);
-    }
+    EvaluatedSets(&units, &means);
     return q->Fit(units, means, Point(spec_.parameters.size(), 0.5), 0.5);
+  }
+
+  // Every set evaluated so far: its unit coordinates and its seeds' means.
+  void EvaluatedSets(std::vector<Point>* units, std::vector<std::vector<double>>* means) const {
+    for (const SetResult* s : ev_.All()) {
+      units->push_back(ev_.ToUnit(s->values));
+      means->push_back(s->mean);
+    }
   }
 
   // Evaluates a design in the box and fits a quadratic to every set
@@ -461,10 +466,7 @@ class Calibration {
     // means, each over its seeds' error S_jj / K, err least).
     std::vector<Point> units;
     std::vector<std::vector<double>> means;
-    for (const SetResult* s : ev_.All()) {
-      units.push_back(ev_.ToUnit(s->values));
-      means.push_back(s->mean);
-    }
+    EvaluatedSets(&units, &means);
     std::vector<double> noise(n);
     for (std::size_t j = 0; j < n; ++j) noise[j] = o.seed_covariance[j * n + j] / o.seeds;
     post.bandwidth = ChooseBandwidth(units, means, noise, kBandwidths, &post.bandwidth_scores);

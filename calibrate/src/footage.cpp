@@ -272,6 +272,7 @@ FootageDesign DesignFootage(const Objective& objective, const std::vector<double
     d.note = "no series of the first recording (counts alone): no window to measure footage in";
     return d;
   }
+  d.targets = options.targets;
   d.window_s = l.window_s;
   d.windows = l.windows;
   d.recording_s = static_cast<double>(l.windows) * l.window_s;

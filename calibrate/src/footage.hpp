@@ -40,6 +40,7 @@ struct FootageDesign {
   // its K seeds: the spread its fitted values should have over replicates.
   int recordings_now = 1;
   std::vector<double> sd_now;
+  std::vector<double> targets;  // the 95 % half-widths (fractions of the value) said for, as asked
   // Per target, per parameter: the seconds of one recording, and the number
   // of recordings of the calibrated length, that give that 95 % half-width
   // (inf: never, with these statistics; NaN: no value to be relative to).

@@ -51,9 +51,8 @@ json FootageJson(const CalibrationSpec& spec, const FootageDesign& f) {
   json rows = json::array();
   for (const FootageRow& row : f.rows) rows.push_back({{"recordings", row.recordings}, {"length_s", row.length_s}, {"sd", ByParameter(spec, row.sd)}});
   json needed = json::array();
-  const std::vector<double> targets = FootageOptions{}.targets;
   for (std::size_t t = 0; t < f.one_recording_s.size(); ++t)
-    needed.push_back({{"half_width_95_fraction", targets[t]},
+    needed.push_back({{"half_width_95_fraction", f.targets[t]},
                       {"one_recording_s", ByParameter(spec, f.one_recording_s[t])},
                       {"recordings_of_this_length", ByParameter(spec, f.recordings_needed[t])}});
   json kinds = json::array();
@@ -198,7 +197,7 @@ std::string FootageReport(const CalibrationSpec& spec, const CalibrationResult& 
     o << "\nHow much footage: no design (" << f.note << ")\n";
     return o.str();
   }
-  const std::vector<double> targets = FootageOptions{}.targets;
+  const std::vector<double>& targets = f.targets;
   o << "\nHow much footage (expected 95 % half-widths, linearised at the best fit, for recordings of the first one's kind: "
     << FormatNumber(f.recording_s) << " s in " << f.windows << " windows of " << FormatNumber(f.window_s)
     << " s; with enough seeds that the footage alone limits; docs/calibration.md, \"How much footage\"):\n";
@@ -505,8 +504,8 @@ void DrawFootage(const fs::path& file, const CalibrationResult& r) {
     viz::ChartPanel& panel = sheet.AddPanel("footage, minutes (all recordings together)",
                                             spec.parameters[i].name + " +-% of " + Fixed(r.best[i], 3),
                                             0.0, x1, 0.0, y1, 260);
-    for (std::size_t t = 0; t < FootageOptions{}.targets.size(); ++t) {
-      const double target = 100.0 * FootageOptions{}.targets[t];
+    for (std::size_t t = 0; t < f.targets.size(); ++t) {
+      const double target = 100.0 * f.targets[t];
       panel.Line({0.0, x1}, {target, target}, viz::Color::Black(), 1.0, t == 0 ? "+-20 % and +-10 %" : "", true);
     }
     if (!lx.empty()) panel.Line(lx, ly, viz::ChartColor(0), 2.0, "one recording, longer");

@@ -206,7 +206,9 @@ void Simulation::Drive() {
         // Yielding (issue 39, off by default): held up by the people ahead,
         // the person drives toward a share of v0 (eq. 3's v0 e_i, scaled).
         double pace = yielding && in.held_back_n[i] < 0.0 ? v0 * mp.yielding_push_share : v0;
-        const bool on_slope = slope_region.empty() || PointInPolygon(slope_region, bodies_.position_m[i]);
+        // (The region is looked up only where the floor slopes at all.)
+        const bool on_slope =
+            slope_region.empty() || (slope_force_per_kg > 0.0 && PointInPolygon(slope_region, bodies_.position_m[i]));
         // A held slope (issue 43, off by default): the legs hold its pull,
         // and the pace follows the grade along e (Tobler's hiking function).
         if (slope_held && on_slope) pace *= SlopeWalkingFactor(-def_.slope.gradient * Dot(e, def_.slope.downhill));

@@ -15,6 +15,7 @@
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/canvas.hpp"
 #include "crowdrecon/viz/chart.hpp"
+#include "crowdrecon/viz/timeline_figure.hpp"
 
 namespace crowdrecon::reports {
 
@@ -251,7 +252,7 @@ namespace {
 
 constexpr double kWidth = 1400, kLeft = 150, kRight = 1130, kTop = 96, kDensity = 170, kRow = 34;
 const viz::Color kInk = viz::Color::Hex(0x222222), kGrid = viz::Color::Hex(0xe3e3e3);
-const viz::Color kRecorded = viz::Color::Hex(0xe6550d), kFatal = viz::Color::Hex(0xb2182b),
+const viz::Color kRecorded = viz::RecordedMarkColor(false), kFatal = viz::RecordedMarkColor(true),
                  kDetected = viz::Color::Hex(0x6a3d9a), kClog = viz::Color::Hex(0x525252);
 
 }  // namespace
@@ -322,20 +323,8 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
     }
   }
   canvas.StrokePolygon({P(kLeft, top), P(kRight, top), P(kRight, bottom), P(kLeft, bottom)}, kInk, 1.0);
-  // Recorded marks' labels over the density panel, in rows where they would overlap.
-  std::vector<const analysis::TimelineMark*> shown;
-  std::vector<double> at;
-  std::vector<std::string> labels;
-  for (const analysis::TimelineMark& m : score.runs.front().recorded)
-    if (m.time_s >= t0 && m.time_s <= t1) {
-      shown.push_back(&m);
-      at.push_back(X(m.time_s) + 3);
-      labels.push_back(m.label);
-    }
-  const std::vector<int> rows = viz::LabelRows(at, labels, 10, 3);
-  for (std::size_t k = 0; k < shown.size(); ++k)
-    canvas.TextPxAligned(at[k], top - 4 - 11.0 * rows[k], labels[k], 10, 0.0, 1.0,
-                         shown[k]->kind == "fatal" ? kFatal : kRecorded);
+  // Recorded marks' labels over the density panel.
+  viz::DrawRecordedMarkLabels(canvas, score.runs.front().recorded, t0, t1, X, top);
   // One row per run.
   for (std::size_t k = 0; k < n; ++k) {
     const EnsembleRun& r = score.runs[k];

@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 150, kGap = 26;
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
-const Color kRecorded = Color::Hex(0xe6550d), kFatal = Color::Hex(0xb2182b), kDetected = Color::Hex(0x6a3d9a);
+const Color kRecorded = RecordedMarkColor(false), kFatal = RecordedMarkColor(true), kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
 
 // Pixels from the top-left corner on a canvas of one world unit per pixel.
@@ -212,21 +212,25 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   s.canvas.Line(s.P(lx + 8, ly + 1), s.P(lx + 18, ly + 11), kFatal, 2.0);
   s.canvas.Line(s.P(lx + 8, ly + 11), s.P(lx + 18, ly + 1), kFatal, 2.0);
   s.canvas.TextPxAligned(lx + 32, ly + 6, "fall in the run (" + std::to_string(ts.falls.size()) + ")", 12, 0.0, 0.5, kInk);
-  // Recorded marks' labels over the first panel, in rows where they would overlap.
+  DrawRecordedMarkLabels(s.canvas, ts.recorded, t0, t1, [&](double t) { return p[0].X(t); }, p[0].top);
+  s.canvas.Finish();
+}
+
+void DrawRecordedMarkLabels(Canvas& canvas, const std::vector<analysis::TimelineMark>& marks, double t0, double t1,
+                            const std::function<double(double)>& x_px, double top_px) {
   std::vector<const analysis::TimelineMark*> shown;
   std::vector<double> at;
   std::vector<std::string> text;
-  for (const analysis::TimelineMark& m : ts.recorded)
+  for (const analysis::TimelineMark& m : marks)
     if (m.time_s >= t0 && m.time_s <= t1) {
       shown.push_back(&m);
-      at.push_back(p[0].X(m.time_s) + 3);
+      at.push_back(x_px(m.time_s) + 3);
       text.push_back(m.label);
     }
   const std::vector<int> rows = LabelRows(at, text, 10, 3);
   for (std::size_t k = 0; k < shown.size(); ++k)
-    s.canvas.TextPxAligned(at[k], p[0].top - 4 - 11.0 * rows[k], text[k], 10, 0.0, 1.0,
-                           shown[k]->kind == "fatal" ? kFatal : kRecorded);
-  s.canvas.Finish();
+    canvas.TextPxAligned(at[k], top_px - 4 - 11.0 * rows[k], text[k], 10, 0.0, 1.0,
+                         RecordedMarkColor(shown[k]->kind == "fatal"));
 }
 
 }  // namespace crowdrecon::viz
