@@ -22,7 +22,6 @@ usage: adaptive-step-ensembles.py CROWDRECON OUT [--seeds K] [--duration S]
        [--points 3:0.3,5:0.3,6.5:0.4] [--threads T]
 """
 import argparse
-import itertools
 import json
 import math
 import pathlib
@@ -31,6 +30,9 @@ import sqlite3
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from ensemble_stats import mean_sd, permutation_p  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE = ROOT / "venues/madrid-arena/scenarios/hallway-5pm2-30cf.json"
@@ -79,20 +81,6 @@ def statistics(run, duration):
         "load_mean": sum(loads) / len(loads),
         "load_p99": loads[int(0.99 * (len(loads) - 1))],
     }
-
-
-def permutation_p(a, b):
-    pooled = a + b
-    k = len(a)
-    observed = abs(sum(a) / k - sum(b) / len(b))
-    count = total = 0
-    for chosen in itertools.combinations(range(len(pooled)), k):
-        s = set(chosen)
-        x = [pooled[i] for i in chosen]
-        y = [pooled[i] for i in range(len(pooled)) if i not in s]
-        total += 1
-        count += abs(sum(x) / len(x) - sum(y) / len(y)) >= observed - 1e-12
-    return count / total
 
 
 def main():
@@ -148,11 +136,7 @@ def main():
         for key in keys:
             fx = [r[key] for r in rows if r["density"] == density and r["counter"] == counter and r["mode"] == "fixed"]
             ad = [r[key] for r in rows if r["density"] == density and r["counter"] == counter and r["mode"] == "adaptive"]
-            def ms(v):
-                m = sum(v) / len(v)
-                sd = math.sqrt(sum((x - m) ** 2 for x in v) / max(1, len(v) - 1))
-                return m, sd
-            (mf, sf), (ma, sa) = ms(fx), ms(ad)
+            (mf, sf), (ma, sa) = mean_sd(fx), mean_sd(ad)
             pv = permutation_p(fx, ad)
             judged = key not in ("mean_step_h", "wall_s")
             lines.append(f"| {density:g} /m², {counter:g} | {key} | {mf:.4g} ± {sf:.2g} | {ma:.4g} ± {sa:.2g} | "

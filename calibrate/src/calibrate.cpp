@@ -131,7 +131,7 @@ class Calibration {
     for (const SetResult& s : sets) per_seed.push_back(&s.per_seed);
     const SeedCovariance c = PooledSeedCovariance(per_seed, r_.objective.lead);
     r_.objective.WeighCovariance(c.covariance, static_cast<double>(spec_.base.seeds.size()));
-    r_.seed_correlation = {c.shrinkage, c.effective_values, c.values, sets.size()};
+    r_.seed_correlation = {c.shrinkage, c.effective_values, c.values, sets.size(), c.freedom};
     Say("the seeds' covariance of " + std::to_string(c.values) + " simulated values from " +
         std::to_string(sets.size()) + " sets: correlations shrunk by " + FormatNumber(c.shrinkage) +
         ", as many as " + FormatNumber(c.effective_values) + " independent values");
@@ -497,7 +497,14 @@ class Calibration {
     // likelihood is widened by that ratio (never narrowed).
     const int freedom = o.DegreesOfFreedom(p);
     post.scale = freedom > 0 ? std::max(1.0, r_.best_simulated_chi2 / freedom) : 1.0;
-    const SurrogateLikelihood likelihood(whole, o, post.scale, local ? &*local : nullptr);
+    // S is estimated from the design's runs: the likelihood that accounts
+    // for that (fit.hpp, EstimatedCovariance), not the Gaussian that takes
+    // it as known.
+    EstimatedCovariance estimate;
+    if (r_.seed_correlation.freedom > 0)
+      estimate = {r_.seed_correlation.freedom, static_cast<double>(r_.seed_correlation.values), static_cast<double>(p)};
+    post.likelihood_power = estimate.known() ? 0.0 : estimate.Power();
+    const SurrogateLikelihood likelihood(whole, o, post.scale, local ? &*local : nullptr, estimate);
     if (likelihood.empty()) {
       post.note = "no statistic could be fitted by the quadratic over the whole box";
       return;

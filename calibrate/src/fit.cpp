@@ -198,7 +198,7 @@ SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vec
     if (lead[j] == j) values.push_back(j);
   const std::size_t g = values.size();
   std::vector<std::vector<double>> dev;  // [row][value], NaN: none
-  std::vector<double> var_sum(g, 0.0), var_sets(g, 0.0);
+  std::vector<double> var_sum(g, 0.0), var_sets(g, 0.0), freedom(g, 0.0);
   std::vector<std::vector<double>> row_weight;  // n / (n - 1) of the row's set, per value
   for (const auto* set : sets) {
     const std::size_t k = set->size();
@@ -226,6 +226,7 @@ SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vec
       if (count[a] >= 2) {
         var_sum[a] += ss[a] / (count[a] - 1.0);
         var_sets[a] += 1.0;
+        freedom[a] += count[a] - 1.0;
       }
   }
   std::vector<double> sd(g, 0.0);
@@ -238,6 +239,8 @@ SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vec
     if (sd[a] > 0) live.push_back(a);
   const std::size_t h = live.size();
   out.values = h;
+  out.freedom = h ? std::numeric_limits<double>::infinity() : 0.0;
+  for (std::size_t a : live) out.freedom = std::min(out.freedom, freedom[a]);
   Matrix r = Matrix::Identity(static_cast<Eigen::Index>(h), static_cast<Eigen::Index>(h));
   double noise = 0.0, signal = 0.0;
   for (std::size_t x = 0; x < h; ++x)
@@ -770,9 +773,18 @@ double ChooseBandwidth(const std::vector<std::vector<double>>& points, const std
   return best;
 }
 
+double EstimatedCovariance::Power() const {
+  const double runs = freedom + 1.0, d = dimension, p = parameters;
+  if (freedom <= d + 3.0) return p + 3.0;  // B below grows without bound as runs - d - 4 -> 0
+  const double b = (runs - d - 2.0) / ((runs - d - 1.0) * (runs - d - 4.0));
+  const double bd = b * std::max(0.0, d - p);
+  return p + 2.0 + (runs - 1.0 + bd) / (1.0 + bd);
+}
+
 SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale,
-                                         const LocalQuadratic* local)
-    : mean_(mean), local_(local), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale) {
+                                         const LocalQuadratic* local, EstimatedCovariance covariance)
+    : mean_(mean), local_(local), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale),
+      covariance_(covariance), power_(covariance.known() ? 0.0 : covariance.Power()) {
   if (!rows_.empty()) white_ = objective.Whiten(rows_);
 }
 
@@ -788,7 +800,9 @@ double SurrogateLikelihood::WithOffset(const std::vector<double>& u, const std::
   white_.Apply(value.data(), 1, true, residuals.data());
   double chi2 = 0.0;
   for (double r : residuals) chi2 += r * r;
-  return std::isfinite(chi2) ? -0.5 * chi2 / scale_ : kNone;
+  if (!std::isfinite(chi2)) return kNone;
+  if (covariance_.known()) return -0.5 * chi2 / scale_;
+  return -0.5 * power_ * std::log1p(chi2 / (scale_ * covariance_.freedom));
 }
 
 bool SeedSurfaces::Fit(const std::vector<std::vector<double>>& points,

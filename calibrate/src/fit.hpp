@@ -3,8 +3,10 @@
 // surrogate of every statistic, and Ceres minimising it, with its covariance.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -103,6 +105,7 @@ struct SeedCovariance {
   double shrinkage = 0.0;          // 0: the sample correlations, 1: none kept
   double effective_values = 0.0;   // (sum eigenvalues)^2 / sum eigenvalues^2 of the correlation used
   std::size_t values = 0;          // distinct simulated values with a spread
+  double freedom = 0.0;            // degrees of freedom of the estimate: the fewest over the values of sum over sets (K - 1)
 };
 SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vector<double>>*>& sets,
                                     const std::vector<std::size_t>& lead);
@@ -225,15 +228,37 @@ double ChooseBandwidth(const std::vector<std::vector<double>>& points, const std
                        const std::vector<double>& scale, const std::vector<double>& candidates,
                        std::vector<double>* scores = nullptr);
 
+// A seeds' covariance S estimated from a finite number of runs, as the
+// likelihood must treat it (docs/calibration.md, "The posterior"): a
+// Gaussian likelihood with S taken as known gives intervals that cover less
+// than they claim (an S of 8 values on 15 degrees of freedom: a "95 %"
+// interval covers about 67 %). With S estimated on `freedom` degrees of
+// freedom over `dimension` simulated values and `parameters` fitted, the
+// likelihood (1 + chi2 / freedom)^(-m/2) with the power m of Percival et al.
+// (2022, MNRAS 510, 3207: "Matching Bayesian and frequentist coverage
+// probabilities when using an approximate data covariance matrix") gives
+// posterior intervals whose coverage matches their level; Sellentin &
+// Heavens' (2016) marginal over S is m = freedom + 1.
+struct EstimatedCovariance {
+  double freedom = std::numeric_limits<double>::infinity();  // inf: S known (the Gaussian likelihood)
+  double dimension = 0.0;
+  double parameters = 0.0;
+  bool known() const { return !std::isfinite(freedom) || freedom <= 0.0; }
+  // m; where freedom <= dimension + 3 (too few runs for the formula), its
+  // limit for few runs, parameters + 3.
+  double Power() const;
+};
+
 // The posterior's log-likelihood at u (docs/calibration.md, "The
 // posterior"): -chi2 / (2 scale) over the statistics `mean` fits, the
 // simulated means read from `mean`, chi2 the objective's generalised one;
 // `scale` >= 1 widens it where the best fit's chi2 per degree of freedom
-// says the statistics scatter more than their covariance allows.
+// says the statistics scatter more than their covariance allows. With an
+// estimated covariance: -(m / 2) log(1 + chi2 / (scale freedom)).
 class SurrogateLikelihood {
  public:
   SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0,
-                      const LocalQuadratic* local = nullptr);
+                      const LocalQuadratic* local = nullptr, EstimatedCovariance covariance = {});
   double operator()(const std::vector<double>& u) const;  // -inf where undefined
   // The same with `offset` (per statistic) added to the simulated means.
   double WithOffset(const std::vector<double>& u, const std::vector<double>& offset) const;
@@ -246,6 +271,8 @@ class SurrogateLikelihood {
   std::vector<std::size_t> rows_;
   Objective::Whitening white_;
   double scale_;
+  EstimatedCovariance covariance_;
+  double power_;
 };
 
 // The error of a mean of K seeds as a function of the parameters (common

@@ -110,6 +110,10 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
                       {"sets", post.sets}, {"overdispersion_scale", post.scale},
                       {"bandwidth", std::isfinite(post.bandwidth) ? json(post.bandwidth) : json("whole box")},
                       {"seed_functions", post.seed_functions},
+                      {"likelihood", post.likelihood_power > 0
+                                         ? json{{"form", "(1 + chi2 / freedom)^(-power/2): the seeds' covariance estimated (Percival et al. 2022)"},
+                                                {"freedom", Num(r.seed_correlation.freedom)}, {"power", Num(post.likelihood_power)}}
+                                         : json{{"form", "exp(-chi2/2): the seeds' covariance taken as known"}}},
                       {"bandwidth_leave_one_out_scores", [&] {
                          json a = json::array();
                          for (double v : post.bandwidth_scores) a.push_back(Num(v));
@@ -136,7 +140,8 @@ json ToJson(const Evaluator& ev, const CalibrationResult& r) {
   j["noise"] = noise;
   j["seed_correlation"] = {{"values", r.seed_correlation.values}, {"pooled_over_sets", r.seed_correlation.sets},
                            {"shrinkage", Num(r.seed_correlation.shrinkage)},
-                           {"effective_independent_values", Num(r.seed_correlation.effective_values)}};
+                           {"effective_independent_values", Num(r.seed_correlation.effective_values)},
+                           {"degrees_of_freedom", Num(r.seed_correlation.freedom)}};
   json stats = json::array();
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];
@@ -255,7 +260,13 @@ std::string Report(const CalibrationResult& r) {
   if (!r.posterior.samples.empty()) {
     o << "\nPosterior (a flat prior over the bounds; " << r.posterior.surrogate_form << " over all "
       << r.posterior.sets << " sets, its lack of fit counted; chi2 divided by "
-      << Fixed(r.posterior.scale, 3) << " for overdispersion; " << r.posterior.chains << " chains, "
+      << Fixed(r.posterior.scale, 3) << " for overdispersion; "
+      << (r.posterior.likelihood_power > 0
+              ? "the seeds' covariance estimated on " + Fixed(r.seed_correlation.freedom) +
+                    " degrees of freedom: likelihood (1 + chi2/" + Fixed(r.seed_correlation.freedom) + ")^(-" +
+                    Fixed(r.posterior.likelihood_power) + "/2); "
+              : std::string())
+      << r.posterior.chains << " chains, "
       << r.posterior.samples.size() << " samples, acceptance " << Fixed(r.posterior.acceptance, 2)
       << "): median, 68 % and 95 % intervals\n";
     for (std::size_t i = 0; i < s.parameters.size(); ++i) {
@@ -297,7 +308,8 @@ std::string Report(const CalibrationResult& r) {
     o << "\nThe seeds' covariance (pooled over " << r.seed_correlation.sets << " sets): "
       << r.seed_correlation.values << " simulated values, their correlations shrunk by "
       << Fixed(r.seed_correlation.shrinkage, 2) << ", as informative as "
-      << Fixed(r.seed_correlation.effective_values, 2) << " independent ones; chi2 is the generalised one\n";
+      << Fixed(r.seed_correlation.effective_values, 2) << " independent ones, estimated on "
+      << Fixed(r.seed_correlation.freedom) << " degrees of freedom; chi2 is the generalised one\n";
   o << "\nStatistics at the best fit (observed +- its sigma | simulated mean +- seed sd | residual alone):\n";
   for (std::size_t k = 0; k < r.objective.statistics.size(); ++k) {
     const Statistic& st = r.objective.statistics[k];

@@ -54,6 +54,7 @@ struct CalibrationResult {
     double effective_values = 0.0;  // independent simulated values they amount to
     std::size_t values = 0;         // distinct simulated values with a spread
     std::size_t sets = 0;           // pooled over
+    double freedom = 0.0;           // its degrees of freedom (0: not estimated)
   } seed_correlation;
   std::vector<StartResult> starts;
   std::vector<double> best;  // values
@@ -79,6 +80,7 @@ struct CalibrationResult {
     double scale = 1.0;                   // the likelihood's widening: max(1, chi2 at the best fit / degrees of freedom)
     double bandwidth = 0.0;               // the surrogate's (fraction of the box; inf: the quadratic over the whole box)
     std::size_t seed_functions = 0;       // the seeds' surfaces sampled as the means' error (0: none)
+    double likelihood_power = 0.0;        // m of the estimated covariance's likelihood (fit.hpp, EstimatedCovariance; 0: Gaussian)
     std::vector<double> bandwidth_scores; // leave-one-out error of each candidate
     std::string note;                     // why there is none
   } posterior;
