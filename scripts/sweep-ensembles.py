@@ -51,8 +51,8 @@ def runs_of(folder, variant, metrics):
             if "timeline_removed" in meta:
                 r["timeline_removed"] = float(meta["timeline_removed"])
                 r["timeline_queued"] = float(meta["timeline_queued"])
-                r["inside_at_end"] = float(meta["timeline_entered"]) - float(meta["timeline_removed"]) + float(
-                    meta.get("people", 0))
+                # (entered counts the people placed at the start too)
+                r["inside_at_end"] = float(meta["timeline_entered"]) - float(meta["timeline_removed"])
         out[int(seed)] = r
     return out
 
