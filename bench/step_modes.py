@@ -108,7 +108,10 @@ def main():
                          if mode == "adaptive" else ""])
     table = bc.markdown_table(["scenario", "step", "median (range)", "unit", "budget", "", "fixed / adaptive"], rows)
     header = bc.header_lines(bc.command_line(), started, load_before, load_after,
-                             [f"- {args.rounds} rounds, the steps in turn (order alternating), {args.threads} thread(s)"])
+                             [f"- {args.rounds} rounds, the steps in turn (order alternating), {args.threads} thread(s)",
+                              f"- evacuation: its first {args.duration:g} s only, a slice of the budget's run (the crowd "
+                              "at the exits densifies later); \"met\" says this slice is inside the budget, not the run",
+                              "- box-10000: a difference of two runs (6 s and 4 s), so its spread is wide"])
     print(header + "\n\n" + table)
     stamp = started
     path = bc.default_json_path("step-modes", stamp, args.label)
