@@ -99,6 +99,11 @@ def parse_summary(stdout):
         out["stages_percent"] = {name: float(v) for name, v in re.findall(r"(\w+) ([0-9.]+) %", m[2])}
         r = re.search(r"\((\d+) rebuilds\)", m[2])
         out["pair_rebuilds"] = int(r[1]) if r else None
+    # The adaptive step (model.time_step_mode) says how many steps of each
+    # length it took; the fixed step takes simulated / time step.
+    m = re.search(r"adaptive step: (.*?); mean step", stdout)
+    if m:
+        out["steps"] = sum(int(n) for n in re.findall(r"(\d+) steps", m[1]))
     return out
 
 
@@ -140,7 +145,7 @@ def run_once(exe, scenario, threads, workdir, device="cpu"):
         bc.fail(f"{' '.join(cmd)} failed with status {proc.returncode}:\n{proc.stdout}{proc.stderr}")
     result = parse_summary(proc.stdout)
     result.update(parse_time_v(time_file.read_text()))
-    result["steps"] = round(result["simulated_s"] / result["time_step_s"])
+    result.setdefault("steps", round(result["simulated_s"] / result["time_step_s"]))
     agent_steps = result["people"] * result["steps"]
     result["agent_steps"] = agent_steps
     for key, seconds in (("engine", result.get("engine_s")), ("loop", result["loop_wall_s"]),

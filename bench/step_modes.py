@@ -37,12 +37,12 @@ import run_benchmarks as rb  # noqa: E402
 MODES = ("fixed", "adaptive")
 
 
-def with_mode(scenario, mode, folder):
-    d = json.loads(pathlib.Path(scenario).read_text())
+def with_mode(copy, mode):
+    """The scenario copy (rb.scenario_copy's, in this run's folder) with its step's mode set, in place."""
+    d = json.loads(copy.read_text())
     d.setdefault("model", {})["time_step_mode"] = mode
-    out = pathlib.Path(folder) / f"{pathlib.Path(scenario).stem}-{mode}.json"
-    out.write_text(json.dumps(d, indent=2))
-    return out
+    copy.write_text(json.dumps(d, indent=2))
+    return copy
 
 
 def measure(name, mode, work, args):
@@ -50,16 +50,16 @@ def measure(name, mode, work, args):
     folder.mkdir(exist_ok=True)
     if name == "evacuation":
         source = bc.ROOT / "venues/madrid-arena/scenarios/evacuation-6800-demo.json"
-        scenario = with_mode(rb.scenario_copy(source, args.duration, folder), mode, folder)
+        scenario = with_mode(rb.scenario_copy(source, args.duration, folder), mode)
         r = rb.run_once(args.exe, scenario, args.threads, folder)
         return {"figure": r["loop_wall_s"] / r["simulated_s"], "unit": "min of wall per simulated min",
                 "budget": 4.0, "better": "lower", "run": r}
     if name == "box-10000":
         source = bc.ROOT / "bench/scenarios/box-10000.json"
-        first = with_mode(rb.scenario_copy(source, 4.0, folder), mode, folder)
+        first = with_mode(rb.scenario_copy(source, 4.0, folder), mode)
         whole_folder = folder / "whole"
         whole_folder.mkdir(exist_ok=True)
-        whole = with_mode(rb.scenario_copy(source, 6.0, whole_folder), mode, whole_folder)
+        whole = with_mode(rb.scenario_copy(source, 6.0, whole_folder), mode)
         r = rb.steady_difference(rb.run_once(args.exe, first, args.threads, folder),
                                  rb.run_once(args.exe, whole, args.threads, folder))
         return {"figure": r["real_time_factor"], "unit": "real-time factor", "budget": 1.0, "better": "higher",
