@@ -53,7 +53,7 @@ def scenario(density, counter, seed, mode, duration, path):
 
 
 def statistics(run, duration):
-    c = sqlite3.connect(run)
+    c = sqlite3.connect(f"file:{run}?mode=ro", uri=True)
     frames = c.execute("SELECT MAX(frame) FROM frame_time").fetchone()[0]
     first = frames // 2
     groups = dict(c.execute("SELECT id, grp FROM person").fetchall())

@@ -45,14 +45,15 @@ DATA = os.path.join(ROOT, '..', 'shared', 'data', 'juelich-bottleneck', '040_c_5
 AREA = (-0.4, 0.4, 0.5, 1.3)
 AREA_M2 = 0.8 * 0.8
 
-# A variant is BODY[+jitter|+jitter=SIGMA][+face-desired][+no-spring|+creep=T][+yield=SHARE][+turn|+turn=DEG]: the
+# A variant is BODY[+jitter|+jitter=SIGMA][+face-desired][+no-spring|+creep=T][+yield=SHARE][+turn|+turn=DEG][+lag=T]: the
 # body mode (paper, anthropometric, circle), then options of the model
 # (docs/decisions.md, "Issue 39"): the gait jitter at its measured strength
 # and band (the parameter table's defaults) or at SIGMA m/s, the motive
 # torque turning people to their desired direction (ERRATA 5's option),
 # contacts without the tangential spring (issue 19's option) or with a
 # spring that creeps over T seconds, yielding with the given push share,
-# a blocked person turning a shoulder into the way (by 90 degrees or DEG).
+# a blocked person turning a shoulder into the way (by 90 degrees or DEG),
+# a reaction time of the drive (its velocity perceived with a lag of T s).
 DEFAULT_VARIANTS = ['paper', 'anthropometric', 'circle', 'paper+jitter', 'anthropometric+jitter', 'circle+jitter']
 
 
@@ -81,9 +82,12 @@ def parse_variant(name):
             model['shoulder_turn'] = 'when_blocked'
             if part.startswith('turn='):
                 model['shoulder_turn_angle_deg'] = float(part[len('turn='):])
+        elif part.startswith('lag='):
+            model['drive_reaction'] = 'lagged'
+            model['drive_reaction_time_s'] = float(part[len('lag='):])
         else:
             raise ValueError(f'variant {name!r}: {part!r}; expected jitter, jitter=SIGMA, face-desired, no-spring, '
-                             'creep=T, yield=SHARE, turn or turn=DEG')
+                             'creep=T, yield=SHARE, turn, turn=DEG or lag=T')
     return body, model
 
 

@@ -35,7 +35,7 @@ METRIC = "NULL"
 
 
 def load(folder):
-    con = sqlite3.connect(os.path.join(folder, "results.sqlite"))
+    con = sqlite3.connect(f"file:{os.path.join(folder, 'results.sqlite')}?mode=ro", uri=True)  # never creates one
     meta = dict(con.execute("SELECT key, value FROM sweep").fetchall())
     sweep = {"name": meta.get("name", folder)}
     x, y = meta["diagram_x"], meta["diagram_y"]

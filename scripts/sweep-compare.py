@@ -22,7 +22,7 @@ import sys
 
 def load(spec, metric):
     folder, variant = spec.rsplit(":", 1)
-    con = sqlite3.connect(f"{folder}/results.sqlite")
+    con = sqlite3.connect(f"file:{folder}/results.sqlite?mode=ro", uri=True)  # never creates one
     meta = dict(con.execute("SELECT key, value FROM sweep"))
     x, y = meta["diagram_x"], meta["diagram_y"]
     rows = con.execute(

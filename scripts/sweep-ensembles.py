@@ -35,7 +35,7 @@ COST = {"wall_s"}
 
 
 def runs_of(folder, variant, metrics):
-    con = sqlite3.connect(folder / "results.sqlite")
+    con = sqlite3.connect(f"file:{folder / 'results.sqlite'}?mode=ro", uri=True)  # never creates one
     cols = ", ".join(f'"{m}"' for m in metrics)
     rows = con.execute(f"SELECT seed, run_id, duration_s, {cols} FROM runs WHERE variant = ? AND status = 'complete' "
                        "ORDER BY seed", (variant,)).fetchall()
@@ -47,7 +47,7 @@ def runs_of(folder, variant, metrics):
         r.update({m: (float(v) if v is not None else math.nan) for m, v in zip(metrics, values)})
         run = folder / "runs" / f"{run_id}.sqlite"
         if run.exists():
-            meta = dict(sqlite3.connect(run).execute("SELECT key, value FROM run"))
+            meta = dict(sqlite3.connect(f'file:{run}?mode=ro', uri=True).execute("SELECT key, value FROM run"))
             if "timeline_removed" in meta:
                 r["timeline_removed"] = float(meta["timeline_removed"])
                 r["timeline_queued"] = float(meta["timeline_queued"])

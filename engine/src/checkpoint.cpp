@@ -159,6 +159,8 @@ std::string Simulation::SaveState() const {
   // Only with BackForceTrigger::kAveragedVelocity (the definition, which the
   // checkpoint is restored into, says which).
   if (!in_->averaged_along.empty()) w.PutVector(in_->averaged_along);
+  // Only with DriveReaction::kLagged (the same).
+  if (!in_->perceived_velocity.empty()) w.PutVector(in_->perceived_velocity);
   // Only with GiveWay::kWhereRoom (the same).
   if (!in_->give_way_along.empty()) {
     w.PutVector(in_->give_way_along);
@@ -229,6 +231,7 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
   if (!in_->averaged_along.empty()) r.GetVector(in_->averaged_along, n);
+  if (!in_->perceived_velocity.empty()) r.GetVector(in_->perceived_velocity, n);
   if (!in_->give_way_along.empty()) {
     r.GetVector(in_->give_way_along, n);
     r.GetVector(in_->give_way_blocked_s, n);
@@ -293,6 +296,7 @@ void Simulation::LoadState(const std::string& data) {
   RequireFinite(bodies_.mass_kg, "mass");
   RequireFinite(bodies_.inertia_kg_m2, "moment of inertia");
   RequireFinite(in_->averaged_along, "averaged velocity");
+  RequireFinite(in_->perceived_velocity, "perceived velocity");
   RequireFinite(in_->give_way_along, "give-way velocity");
   RequireFinite(in_->give_way_blocked_s, "give-way blocked time");
   RequireFinite(in_->give_way_left_s, "give-way time left");

@@ -26,6 +26,7 @@ constexpr const char* kGaitJitterChoices[] = {"none", "isotropic"};
 constexpr const char* kWhenBlockedChoices[] = {"none", "when_blocked"};
 constexpr const char* kGiveWayChoices[] = {"none", "where_room"};
 constexpr const char* kSlopeResponseChoices[] = {"body_force", "held"};
+constexpr const char* kDriveReactionChoices[] = {"instant", "lagged"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -180,6 +181,13 @@ auto MakeTable() {
              "how long a person who gives way walks with the people against them"),
       Number("give_way_max_contacts", &P::give_way_max_contacts, "", 0.0, 20.0, "issue 39 (candidate b)",
              "whole number: a person touching more people than this has no room to turn and does not give way"),
+      Choice<&P::drive_reaction>("drive_reaction", kDriveReactionChoices,
+             "issue 39; Juelich corridors (scripts/reaction-time-from-data.py)",
+             "instant: eq. 3 as printed, from this step's velocity; lagged: eq. 3 from the velocity perceived "
+             "with a first-order lag of drive_reaction_time_s (a reaction time)"),
+      Number("drive_reaction_time_s", &P::drive_reaction_time_s, "s", 0.01, 10.0,
+             "Juelich corridors (scripts/reaction-time-from-data.py)",
+             "T of drive_reaction = lagged: the time constant (and mean delay) of the perceived velocity"),
   };
 }
 

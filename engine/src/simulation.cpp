@@ -140,6 +140,8 @@ void Simulation::LoadBodies() {
   in_->cos_angle.assign(n, 1.0);
   // People are placed at rest: u_i = 0, no back force until pushed back.
   if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
+  // A reaction time: people perceive the velocity they are placed with.
+  if (def_.parameters.drive_reaction == DriveReaction::kLagged) in_->perceived_velocity = bodies_.velocity_m_per_s;
   if (def_.parameters.give_way == GiveWay::kWhereRoom) {
     in_->give_way_along.assign(n, 0.0);
     in_->give_way_blocked_s.assign(n, 0.0);
@@ -286,7 +288,8 @@ void Simulation::Step() {
   ++profile_.steps_at_level[static_cast<std::size_t>(level_)];
   last_step_ticks_ = step_ticks;
   in_->drive_time_s = time_s_;
-  AverageBackForceTrigger();  // (these two with the step just taken)
+  AverageBackForceTrigger();  // (these three with the step just taken)
+  UpdatePerceivedVelocity();
   UpdateGiveWay();
   level_ = next_level_;
   dt_s_ = next_dt_s_;
@@ -300,6 +303,7 @@ void Simulation::AdvanceTo(double end_time_s) {
 void Simulation::Quench() {
   std::fill(bodies_.velocity_m_per_s.begin(), bodies_.velocity_m_per_s.end(), Vec2{});
   std::fill(bodies_.angular_velocity_rad_per_s.begin(), bodies_.angular_velocity_rad_per_s.end(), 0.0);
+  std::fill(in_->perceived_velocity.begin(), in_->perceived_velocity.end(), Vec2{});
   in_->gear_initialised = false;
 }
 
@@ -316,6 +320,7 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
   if (state != PersonState::kWalking) {
     bodies_.velocity_m_per_s[person] = {};
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
+    if (!in_->perceived_velocity.empty()) in_->perceived_velocity[person] = {};
   }
   if (state == PersonState::kRemoved) {
     // No forces on an empty slot (the stages skip it), and their contacts go
@@ -396,6 +401,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
   if (slot < in.gear_xy.size()) in.gear_xy[slot] = {};
   if (slot < in.gear_theta.size()) in.gear_theta[slot] = {};
   if (!in.averaged_along.empty()) in.averaged_along[slot] = 0.0;
+  if (!in.perceived_velocity.empty()) in.perceived_velocity[slot] = bodies_.velocity_m_per_s[slot];
   if (!in.give_way_along.empty()) {
     in.give_way_along[slot] = 0.0;
     in.give_way_blocked_s[slot] = 0.0;

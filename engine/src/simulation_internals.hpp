@@ -278,6 +278,11 @@ struct Simulation::Internals {
   // per step, after the integrator; empty otherwise).
   std::vector<double> averaged_along;
 
+  // DriveReaction::kLagged: per body, the velocity w_i that eq. (3) relaxes
+  // from, a first-order lag of the velocity (updated once per step, after the
+  // integrator; in the checkpoint; empty otherwise).
+  std::vector<Vec2> perceived_velocity;
+
   // Yielding::kWhenBlocked: per body, its desired direction and the sum of
   // the backward parts of its contact forces from people (<= 0), summed in
   // Drive from the contact list in its order (one pass, no threads: the

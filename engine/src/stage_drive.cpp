@@ -135,6 +135,7 @@ void Simulation::Drive() {
   const bool shoulder_turn = mp.shoulder_turn == ShoulderTurn::kWhenBlocked;
   const bool blocked_known = yielding || shoulder_turn;
   const bool giving_way = mp.give_way == GiveWay::kWhereRoom;
+  const bool lagged = mp.drive_reaction == DriveReaction::kLagged;
   if (blocked_known) HeldBackByPeopleAhead(bodies_, contacts_, def_, field_cache, in_->yield_direction, in_->held_back_n);
   // The shoulder's turn as a rotation of e_i (cos, sin of the turn angle).
   const double turn_rad = mp.shoulder_turn_angle_deg * (std::numbers::pi / 180.0);
@@ -212,7 +213,9 @@ void Simulation::Drive() {
         // A held slope (issue 43, off by default): the legs hold its pull,
         // and the pace follows the grade along e (Tobler's hiking function).
         if (slope_held && on_slope) pace *= SlopeWalkingFactor(-def_.slope.gradient * Dot(e, def_.slope.downhill));
-        force += (e * pace - v) * (m * inverse_tau);  // eq. (3)
+        // A reaction time (issue 39, off by default): eq. (3) from the perceived velocity w_i.
+        const Vec2 from = lagged ? in.perceived_velocity[i] : v;
+        force += (e * pace - from) * (m * inverse_tau);  // eq. (3)
         // Gait jitter (issue 39, off by default): eq. (3)'s desired velocity plus u_i(t).
         if (jitter) force += JitterVelocity(jitter_seed, bodies_.id[i], drive_time_s, mp) * (m * inverse_tau);
         // Back force, eq. (15): only when pushed backwards (Theta(x) = 1 for x > 0
@@ -251,6 +254,19 @@ void Simulation::AverageBackForceTrigger() {
     const Vec2 e = def_.targets[bodies_.target[i]].Direction(bodies_.position_m[i], in_->field_cache[i]);
     u[i] += a * (Dot(e, bodies_.velocity_m_per_s[i]) - u[i]);
   }
+}
+
+// w_i <- w_i + (1 - exp(-h/T)) (v_i - w_i): the exact update of the
+// perceived velocity's dw/dt = (v - w)/T for v constant over the step, once
+// per step after the integrator (as the back force's averaged trigger).
+// People who are not walking perceive that they stand (SetPersonState).
+void Simulation::UpdatePerceivedVelocity() {
+  const ModelParameters& mp = def_.parameters;
+  if (mp.drive_reaction != DriveReaction::kLagged) return;
+  std::vector<Vec2>& w = in_->perceived_velocity;
+  const double a = -std::expm1(-dt_s_ / mp.drive_reaction_time_s);
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.state[i] == PersonState::kWalking) w[i] += (bodies_.velocity_m_per_s[i] - w[i]) * a;
 }
 
 // Giving way (ModelParameters::give_way), once per step after the

@@ -368,16 +368,23 @@ TEST(ShoulderTurn, TwoPeopleMeetingInACorridorTooNarrowForBothTurnAndPass) {
   EXPECT_GT(turn, 1.0) << "both pass with a shoulder first";
 }
 
-// Off, the angle changes nothing: the paper's model bit for bit.
-TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
-  ExpectOnlyTheExtensionActs(std::vector<ParameterChange>{[](ModelParameters& p) { p.shoulder_turn_angle_deg = 30.0; }},
-                             [](ModelParameters& p) { p.shoulder_turn = ShoulderTurn::kWhenBlocked; });
+// An extension's settings (`off`) change nothing while it is off: the
+// paper's model bit for bit; switched on (`on`), it acts, and the same on
+// two threads and after a resume.
+void ExpectOffIsThePapersModelAndOnIsDeterministic(const ParameterChange& off, const ParameterChange& on_change) {
+  ExpectOnlyTheExtensionActs(std::vector<ParameterChange>{off}, on_change);
   WorldDef on = RandomGas(6, 0.42, 5, true);
   on.parameters.ground_reaction = true;
-  on.parameters.shoulder_turn = ShoulderTurn::kWhenBlocked;
+  on_change(on.parameters);
   Simulation one(on);
   one.AdvanceTo(0.5);
   ExpectSameOnTwoThreadsAndAfterAResume(on, one);
+}
+
+// Off, the angle changes nothing: the paper's model bit for bit.
+TEST(ShoulderTurn, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
+  ExpectOffIsThePapersModelAndOnIsDeterministic([](ModelParameters& p) { p.shoulder_turn_angle_deg = 30.0; },
+                                                [](ModelParameters& p) { p.shoulder_turn = ShoulderTurn::kWhenBlocked; });
 }
 
 // Two people meet head-on in a corridor too narrow to pass at all (0.45 m:
@@ -439,6 +446,67 @@ TEST(GiveWay, OffIsThePapersModelBitForBit) {
   std::string error;
   EXPECT_FALSE(invalid.IsValid(&error));
   EXPECT_NE(error.find("give_way_max_contacts = 2.5, expected a whole number"), std::string::npos) << error;
+}
+
+// A reaction time (DriveReaction::kLagged): a person starting from rest,
+// alone, with m dv/dt = m/tau (v0 - w) and dw/dt = (v - w)/T, so that
+// u = w - v0 obeys T u'' + u' + u/tau = 0 with u(0) = -v0, u'(0) = 0 and
+// v = w + T w'. For T > tau/4 the roots are alpha +- i beta, alpha = -1/(2T),
+// beta = sqrt(4T/tau - 1)/(2T): u = -v0 e^(alpha t) (cos bt - alpha/b sin bt),
+// and the speed overshoots v0 before it settles, as a driver's with a delay.
+TEST(DriveReaction, APersonStartingFromRestFollowsTheLaggedEquation3) {
+  WorldDef def;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  def.shapes.push_back(ThoraxLikeShape());
+  PersonDef p;
+  SetMassFromShape(def.shapes[0], 1000.0, p);
+  p.desired_speed_m_per_s = 1.2;
+  def.people.push_back(p);
+  def.parameters.drive_reaction = DriveReaction::kLagged;
+  const double T = def.parameters.drive_reaction_time_s, tau = def.parameters.relaxation_time_s;
+  const double v0 = p.desired_speed_m_per_s, alpha = -0.5 / T, beta = std::sqrt(4.0 * T / tau - 1.0) / (2.0 * T);
+  const auto analytic = [&](double t) {
+    const double c = std::cos(beta * t), s = std::sin(beta * t), decay = std::exp(alpha * t);
+    const double u = -v0 * decay * (c - alpha / beta * s);
+    const double du = -v0 * decay * (alpha * c - alpha * alpha / beta * s - beta * s - alpha * c);
+    return v0 + u + T * du;  // v = w + T w'
+  };
+  // The largest error of the speed over 5 s at the engine's step h, and at
+  // h/2 (the update of w assumes v constant over a step: first order in h).
+  const auto run = [&](double step_s, double* peak) {
+    WorldDef at = def;
+    at.parameters.time_step_s = step_s;
+    Simulation sim(at);
+    double largest_error = 0.0;
+    *peak = 0.0;
+    for (int k = 1; k <= 100; ++k) {
+      sim.AdvanceTo(0.05 * k);
+      const double v = sim.bodies().velocity_m_per_s[0].x;
+      largest_error = std::max(largest_error, std::abs(v - analytic(sim.time_s())));
+      *peak = std::max(*peak, v);
+      EXPECT_NEAR(sim.bodies().velocity_m_per_s[0].y, 0.0, 1e-12);
+    }
+    std::printf("step %.3g s: largest error %.3g m/s\n", step_s, largest_error);
+    return largest_error;
+  };
+  const double h = EstimateTimeStep(def).chosen_s;
+  double peak = 0.0, half_peak = 0.0;
+  const double error = run(h, &peak), half_error = run(0.5 * h, &half_peak);
+  EXPECT_LT(error, 1e-3 * v0);
+  EXPECT_NEAR(error / half_error, 2.0, 0.2) << "first order in the step";
+  double analytic_peak = 0.0;
+  for (int k = 1; k <= 5000; ++k) analytic_peak = std::max(analytic_peak, analytic(0.001 * k));
+  std::printf("T = %.2f s: peak speed %.4f m/s (analytic %.4f) for v0 = %.2f m/s\n", T, peak, analytic_peak, v0);
+  EXPECT_GT(analytic_peak, 1.05 * v0) << "an overshoot the paper's model (T = 0) does not have";
+  EXPECT_NEAR(peak, analytic_peak, 1e-3 * v0);
+}
+
+// Off, its time changes nothing: the paper's model bit for bit; on, it acts,
+// the same on two threads and after a resume (the perceived velocities are
+// in the checkpoint).
+TEST(DriveReaction, OffIsThePapersModelBitForBitAndOnIsDeterministic) {
+  ExpectOffIsThePapersModelAndOnIsDeterministic([](ModelParameters& p) { p.drive_reaction_time_s = 3.0; },
+                                                [](ModelParameters& p) { p.drive_reaction = DriveReaction::kLagged; });
 }
 
 }  // namespace

@@ -82,6 +82,18 @@ enum class GiveWay {
                // heading against e_i: walk their way for give_way_duration_s
 };
 
+// Whether the drive reacts to the person's motion at once or after a
+// reaction time (issue 39; docs/decisions.md, "Issue 39: a reaction time"):
+// eq. (3) relaxes toward v0 e_i from the velocity of this very step, so a
+// person whose way clears pushes off at once and one who is stopped stops
+// pushing at once. People react to the person ahead with a delay (measured in
+// the Juelich corridors: scripts/reaction-time-from-data.py), which
+// follow-the-leader models turn into stop-and-go waves.
+enum class DriveReaction {
+  kInstant,  // the paper's eq. (3): m/tau (v0 e_i - v_i) (default)
+  kLagged,   // m/tau (v0 e_i - w_i), w_i the velocity perceived with a first-order lag of drive_reaction_time_s
+};
+
 // How a sloping floor acts on walking people (issue 43; docs/itaewon.md).
 enum class SlopeResponse {
   kBodyForce,  // issue 19: m g sin(theta) downhill on every walking person (default; eq. 3 alone holds it)
@@ -174,6 +186,12 @@ struct ModelParameters {
   double give_way_speed_m_per_s = 0.1;   // issue 19's give-up
   double give_way_duration_s = 5.0;      // issue 19's give-up
   double give_way_max_contacts = 3.0;    // whole number
+  // A reaction time: w_i follows dw/dt = (v_i - w_i) / T, T =
+  // drive_reaction_time_s (the exact update for v_i constant over a step,
+  // once per step after the integrator; in the checkpoint). The mean delay of
+  // this filter is T.
+  DriveReaction drive_reaction = DriveReaction::kInstant;
+  double drive_reaction_time_s = 0.5;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)

@@ -221,6 +221,7 @@ class Simulation {
   void Gather();
   void Drive();
   void AverageBackForceTrigger();  // after each step (stage_drive.cpp)
+  void UpdatePerceivedVelocity();  // after each step (stage_drive.cpp)
   void UpdateGiveWay();            // after each step (stage_drive.cpp)
   void ComputeForces();
   void VerletKickDrift();

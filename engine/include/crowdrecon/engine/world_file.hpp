@@ -7,7 +7,7 @@
 //
 // The format, in the machine's byte order (little-endian on every machine the
 // project runs on; world_file.cpp refuses to build elsewhere):
-//   "CRWORLD7"
+//   "CRWORLD8"
 //   the model parameters, in the order of the parameter table (parameter_table.hpp)
 //     (doubles; enums as uint8; bools as uint8 0 or 1)
 //   shapes  (count; per shape: vertices, radius_m, core_radius_m)
@@ -20,7 +20,7 @@
 // Counts are uint64; a list of numbers or points is its count followed by
 // the values. Each field is written on its own (no structs with padding), so
 // the bytes depend only on the world: SaveWorld(LoadWorld(SaveWorld(d))) ==
-// SaveWorld(d). A change of WorldDef needs a new magic ("CRWORLD7").
+// SaveWorld(d). A change of WorldDef needs a new magic ("CRWORLD8").
 #pragma once
 
 #include <filesystem>
