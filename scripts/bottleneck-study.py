@@ -38,6 +38,8 @@ import subprocess
 import sys
 import time
 
+import petrack  # (this folder: the scripts are run as files, so it is on the path)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 SCENARIO = os.path.join(ROOT, 'venues', 'juelich', 'scenarios', 'wuppertal-bottleneck.json')
@@ -126,16 +128,9 @@ def statistics(tracks, frame_s, first_frame=0):
 
 
 def read_petrack(path):
-    tracks = collections.defaultdict(list)
-    with open(path) as f:
-        for line in f:
-            if line.startswith('#') or not line.strip():
-                continue
-            pid, frame, x, y = line.split()[:4]
-            tracks[int(pid)].append((int(frame), float(x), float(y)))
-    for t in tracks.values():
-        t.sort()
-    return tracks, 1.0 / 25.0
+    """The experiment's tracks (id -> sorted [(frame, x, y)] in metres) and its frame interval (s)."""
+    tracks, fps, _, _ = petrack.read_petrack(path)
+    return tracks, 1.0 / fps
 
 
 def read_run(path):

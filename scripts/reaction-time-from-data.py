@@ -119,6 +119,8 @@ import re
 import sqlite3
 import sys
 
+from petrack import read_petrack  # (this folder: the scripts are run as files, so it is on the path)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, '..', '..', 'shared', 'data')
 DEFAULT_FILES = [os.path.join(DATA, 'juelich-uni', 'traj_UNI_CORR_500_01.txt'),
@@ -138,38 +140,6 @@ FEW_FOLLOWERS = 20        # fewer followers than this: no estimate
 
 
 # ---------------------------------------------------------------- reading
-
-def read_petrack(path, unit=None):
-    """id -> [(frame, x, y)] in metres, the frame rate (1/s) and notes on how the header was read."""
-    header = []
-    tracks = collections.defaultdict(list)
-    with open(path) as f:
-        for line in f:
-            if line.startswith('#') or not line.strip():
-                if not tracks:
-                    header.append(line)
-                continue
-            pid, frame, x, y = line.split()[:4]
-            tracks[int(pid)].append((int(frame), float(x), float(y)))
-    notes = []
-    text = ''.join(header)
-    m = re.search(r'framerate:\s*([0-9.]+)', text)
-    fps = float(m.group(1)) if m else 25.0
-    if not m:
-        notes.append('no frame rate in the header: 25 fps assumed')
-    if unit is None:
-        m = re.search(r'\bx/(mm|cm|m)\b', text)
-        if m:
-            unit = m.group(1)
-        else:
-            unit = 'm'
-            notes.append('the header states no unit: metres assumed (../shared/data/README.md)')
-    scale = {'m': 1.0, 'cm': 0.01, 'mm': 0.001}[unit]
-    for pid, t in tracks.items():
-        t.sort()
-        tracks[pid] = [(fr, x * scale, y * scale) for fr, x, y in t]
-    return tracks, fps, unit, notes
-
 
 def read_corridor(path):
     """(x0, x1, y0, y1) between the two wall obstacles of a corridor's walkable_area.wkt, or None."""

@@ -32,7 +32,7 @@ namespace {
 // Version 4: issue 39's parameters (gait jitter, yielding, creep of the tangential spring) at the table's end.
 // Version 5: and the shoulder's turn and giving way after them.
 // Version 6: the time step's mode and the adaptive step's parameters (issue 42), after time_step_safety.
-// Version 7: the drive's reaction time (issue 39) at the table's end.
+// CRWORLD8: the drive's reaction time (issue 39) at the table's end.
 constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', '8'};
 
 // The bytes are the machine's; the development machine and the GPU machines

@@ -35,6 +35,19 @@ inline void SetMassFromShape(const BodyShape& shape, double rho, PersonDef& p) {
   p.inertia_kg_m2 = rho * sp.polar_moment();
 }
 
+// One walker alone at the origin, at rest, thorax-like, heading `direction`
+// (a unit vector) at `desired_speed_m_per_s`, with the paper's parameters.
+inline WorldDef FreeWalker(Vec2 direction, double desired_speed_m_per_s) {
+  WorldDef def;
+  def.targets.push_back(geometry::NavigationField::Constant(direction));
+  def.shapes.push_back(ThoraxLikeShape());
+  PersonDef p;
+  SetMassFromShape(def.shapes[0], 1000.0, p);
+  p.desired_speed_m_per_s = desired_speed_m_per_s;
+  def.people = {p};
+  return def;
+}
+
 inline WorldDef PassiveWorld() {
   WorldDef def;
   def.parameters.ground_reaction = false;

@@ -455,16 +455,10 @@ TEST(GiveWay, OffIsThePapersModelBitForBit) {
 // beta = sqrt(4T/tau - 1)/(2T): u = -v0 e^(alpha t) (cos bt - alpha/b sin bt),
 // and the speed overshoots v0 before it settles, as a driver's with a delay.
 TEST(DriveReaction, APersonStartingFromRestFollowsTheLaggedEquation3) {
-  WorldDef def;
-  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
-  def.shapes.push_back(ThoraxLikeShape());
-  PersonDef p;
-  SetMassFromShape(def.shapes[0], 1000.0, p);
-  p.desired_speed_m_per_s = 1.2;
-  def.people.push_back(p);
+  WorldDef def = testing::FreeWalker({1.0, 0.0}, 1.2);
   def.parameters.drive_reaction = DriveReaction::kLagged;
   const double T = def.parameters.drive_reaction_time_s, tau = def.parameters.relaxation_time_s;
-  const double v0 = p.desired_speed_m_per_s, alpha = -0.5 / T, beta = std::sqrt(4.0 * T / tau - 1.0) / (2.0 * T);
+  const double v0 = def.people[0].desired_speed_m_per_s, alpha = -0.5 / T, beta = std::sqrt(4.0 * T / tau - 1.0) / (2.0 * T);
   const auto analytic = [&](double t) {
     const double c = std::cos(beta * t), s = std::sin(beta * t), decay = std::exp(alpha * t);
     const double u = -v0 * decay * (c - alpha / beta * s);

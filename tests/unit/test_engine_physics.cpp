@@ -131,13 +131,7 @@ TEST(EnginePhysics, ContactForcesAreEqualAndOpposite) {
 }
 
 TEST(EnginePhysics, FreePersonRelaxesToDesiredVelocityWithTimeConstantTau) {
-  WorldDef def;
-  def.targets.push_back(geometry::NavigationField::Constant({0.6, 0.8}));
-  def.shapes.push_back(ThoraxLikeShape());
-  PersonDef p;
-  SetMassFromShape(def.shapes[0], 1000.0, p);
-  p.desired_speed_m_per_s = 1.1;
-  def.people = {p};
+  const WorldDef def = testing::FreeWalker({0.6, 0.8}, 1.1);
   Simulation sim(def);
   const double tau = def.parameters.relaxation_time_s;
   for (double t : {0.5 * tau, tau, 3.0 * tau}) {
