@@ -27,7 +27,7 @@ echo "uninterrupted: $ref"
 "$exe" simulate "$sc" -o "$tmp/k.sqlite" --threads 1 -q >/dev/null 2>&1 &
 pid=$!
 for _ in $(seq 1 600); do
-  [[ $(sqlite3 "$tmp/k.sqlite" "SELECT COALESCE(MAX(frame),0) FROM frame_time" 2>/dev/null || echo 0) -ge 3 ]] && break
+  [[ $(last_frame "$tmp/k.sqlite") -ge 3 ]] && break
   sleep 0.05
 done
 kill -9 $pid 2>/dev/null || true

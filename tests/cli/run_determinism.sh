@@ -51,7 +51,7 @@ for attempt in 1 2 3 4 5; do
   pid=$!
   for _ in $(seq 1 3000); do
     if [[ -e "$tmp/k.sqlite.checkpoint" ]] && \
-       [[ $(sqlite3 "$tmp/k.sqlite" "SELECT COALESCE(MAX(frame),0) FROM frame_time" 2>/dev/null || echo 0) -ge 7 ]]; then break; fi
+       [[ $(last_frame "$tmp/k.sqlite") -ge 7 ]]; then break; fi
     kill -0 $pid 2>/dev/null || break
     sleep 0.01
   done

@@ -21,3 +21,12 @@ dump_all() {
     sqlite3 -separator ' ' "$1" ".mode quote" "SELECT * FROM person_load ORDER BY frame, id"
     sqlite3 -separator ' ' "$1" ".mode quote" "$census"; } | sha256sum | cut -d' ' -f1
 }
+# last_frame FILE: the last frame a run being written has committed, 0 while
+# there is none. It reads only: a plain `sqlite3 FILE` creates FILE when it is
+# not there yet, and a poll that lands while simulate is creating its file
+# broke simulate's switch to write-ahead logging ("disk I/O error", CI of
+# stop 51); so no file means 0, and an existing one is opened read-only.
+last_frame() {
+  [[ -s $1 ]] || { echo 0; return; }
+  sqlite3 -readonly "$1" "SELECT COALESCE(MAX(frame),0) FROM frame_time" 2>/dev/null || echo 0
+}

@@ -5,6 +5,7 @@
 #   simulate_sigterm.sh CROWDRECON SCENARIO
 set -uo pipefail
 exe=$1; scenario=$2
+source "$(dirname "$0")/run_tables.sh"  # last_frame RUN.sqlite
 d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
 python3 "$(dirname "$0")/../../scripts/scenario-with.py" "$scenario" "$d/long.json" run.duration_s=600
 for signal in TERM INT; do
@@ -12,7 +13,7 @@ for signal in TERM INT; do
   "$exe" simulate "$d/long.json" -o "$d/run.sqlite" -q --threads 1 > /dev/null 2> "$d/err.txt" &
   pid=$!
   for _ in $(seq 300); do
-    [[ $(sqlite3 "$d/run.sqlite" "SELECT COUNT(*) FROM frame_time" 2>/dev/null || echo 0) -ge 3 ]] && break
+    [[ $(last_frame "$d/run.sqlite") -ge 3 ]] && break
     sleep 0.05
   done
   kill -s $signal "$pid"; wait "$pid"; rc=$?
