@@ -43,6 +43,7 @@ struct TimelineArgs {
   double density_cell_m = 0.5, density_sigma_m = 0.5;
   std::vector<std::string> scores;
   double tolerance_s = 120.0;
+  bool area_avalanches = false;
   bool force = false;
 };
 
@@ -89,6 +90,7 @@ void RunEnsemble(const TimelineArgs& args) {
   reports::EnsembleOptions options;
   options.tolerance_s = args.tolerance_s;
   options.smooth_s = args.smooth_s;
+  options.area_avalanches = args.area_avalanches;
   if (std::string error; !options.IsValid(&error)) throw InputError("--tolerance / --smooth: " + error);
   std::vector<PlannedOutput> outputs;
   for (const std::string& f : args.figures) {
@@ -147,7 +149,8 @@ void RunTimeline(const TimelineArgs& args) {
   if (std::string why; !args.density_maps.empty() && !density.IsValid(&why))
     throw InputError("--density-times / --density-cell / --density-sigma: " + why);
   if (!runfile::IsRunFile(args.run)) throw InputError(args.run + ": " + DescribeExisting(args.run) + ", not a crowdrecon run file");
-  const analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
+  analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
+  if (args.area_avalanches) s.avalanches = analysis::AvalanchesWithAreas(s);
   // What may still refuse the run (the maps' times, the sweep's folder) is
   // read or drawn before the run's own figures.
   const std::vector<analysis::DensityMap> maps =
@@ -222,6 +225,10 @@ void RegisterTimelineCommand(CLI::App& app) {
                   "A run's avalanche matches a recorded one within this many seconds of run time (default 120; scale it "
                   "with a compressed scenario's marks)")
       ->check(NumberIn(0.001, 1e7, "s"));
+  cmd->add_flag("--area-avalanches", args->area_avalanches,
+                "The local reading of avalanches: a stop and release inside one of the venue's measurement areas, "
+                "while it held at least 3.6 persons/m2, counts too (one release seen in several places once; "
+                "docs/analysis.md, \"Local avalanches\")");
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] {
     args->run = args->runs.front();

@@ -86,7 +86,11 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   for (const runfile::FrameTime& ft : times) s.time_s.push_back(ft.time_s);
   s.density_per_m2.assign(times.size(), 0.0);  // a frame nobody is in has no rows
   s.area_density_per_m2.assign(s.area_names.size(), std::vector<double>(times.size(), 0.0));
+  s.area_speed_m_per_s.assign(s.area_names.size(), std::vector<double>(times.size(), std::numeric_limits<double>::quiet_NaN()));
   s.counter_fraction.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
+  // Speeds and flows: the analysis of the run (its groups' desired directions
+  // are the areas' too).
+  const RunAnalysis a = AnalyzeRun(run_file);
   std::size_t k = 0;
   while (stream.Next(&frame)) {
     while (k < times.size() && times[k].frame < frame.frame) ++k;
@@ -96,10 +100,20 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
       if (p < group.size() && group[p] == 1) ++counter;
     const std::size_t present = frame.person.size();
     s.density_per_m2[k] = static_cast<double>(present) / s.area_m2;
-    for (std::size_t a = 0; a < s.area_names.size(); ++a) {
-      std::size_t inside = 0;
-      for (Vec2 x : frame.position_m) inside += geometry::PointInRing(stored.measurement_areas[a].polygon, x) ? 1 : 0;
-      if (s.area_m2_each[a] > 0.0) s.area_density_per_m2[a][k] = static_cast<double>(inside) / s.area_m2_each[a];
+    for (std::size_t m = 0; m < s.area_names.size(); ++m) {
+      std::size_t inside = 0, walking = 0;
+      double along = 0.0;
+      for (std::size_t r = 0; r < present; ++r) {
+        if (!geometry::PointInRing(stored.measurement_areas[m].polygon, frame.position_m[r])) continue;
+        ++inside;
+        const std::uint32_t p = frame.person[r];
+        if (frame.state[r] != runfile::PersonStatus::kWalking || p >= group.size() || group[p] >= a.group_direction.size())
+          continue;
+        along += Dot(frame.velocity_m_per_s[r], a.group_direction[group[p]]);
+        ++walking;
+      }
+      if (s.area_m2_each[m] > 0.0) s.area_density_per_m2[m][k] = static_cast<double>(inside) / s.area_m2_each[m];
+      if (walking > 0) s.area_speed_m_per_s[m][k] = along / static_cast<double>(walking);
     }
     if (present > 0) s.counter_fraction[k] = static_cast<double>(counter) / static_cast<double>(present);
   }
@@ -108,8 +122,6 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
     if (row.frame >= 0 && static_cast<std::size_t>(row.frame) < s.queued.size())
       s.queued[static_cast<std::size_t>(row.frame)] = static_cast<double>(row.census.queued);
 
-  // Speeds and flows: the analysis of the run.
-  const RunAnalysis a = AnalyzeRun(run_file);
   s.group_names = a.group_name;
   const std::size_t n = std::min(s.time_s.size(), a.series.time_s.size());
   const auto fit = [n](std::vector<double> v) {
@@ -119,6 +131,7 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   s.time_s.resize(n);
   s.density_per_m2.resize(n);
   for (std::vector<double>& area : s.area_density_per_m2) area.resize(n);
+  for (std::vector<double>& area : s.area_speed_m_per_s) area.resize(n);
   s.counter_fraction.resize(n);
   s.queued.resize(n);
   for (const std::vector<double>& g : a.series.group_mean_speed_m_per_s) s.group_speed_m_per_s.push_back(fit(g));
@@ -169,6 +182,59 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
     }
   }
   return s;
+}
+
+std::vector<TimelineMark> AreaAvalanches(const TimelineSeries& s, const RegimeOptions& options, double min_density_per_m2) {
+  std::vector<TimelineMark> marks;
+  char text[160];
+  for (std::size_t m = 0; m < s.area_speed_m_per_s.size(); ++m) {
+    const std::vector<double>& v = s.area_speed_m_per_s[m];
+    const std::vector<double>& rho = s.area_density_per_m2[m];
+    // Stretches in which someone walks there: an empty area has no flow to
+    // stop, and a gap ends a stop (FindAvalanches takes no NaN).
+    std::size_t from = 0;
+    while (from < v.size()) {
+      while (from < v.size() && std::isnan(v[from])) ++from;
+      std::size_t to = from;
+      while (to < v.size() && !std::isnan(v[to])) ++to;
+      if (to > from) {
+        const std::vector<double> t(s.time_s.begin() + static_cast<std::ptrdiff_t>(from),
+                                    s.time_s.begin() + static_cast<std::ptrdiff_t>(to));
+        const std::vector<double> speed(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
+        for (const Avalanche& a : FindAvalanches(t, speed, options)) {
+          // The stop it released: from stopped_before_s before its start to its start.
+          double sum = 0.0;
+          std::size_t count = 0;
+          for (std::size_t k = from; k < from + a.start_index; ++k)
+            if (s.time_s[k] >= a.start_time_s - a.stopped_before_s - 1e-9) sum += rho[k], ++count;
+          const double stop_density = count > 0 ? sum / static_cast<double>(count) : 0.0;
+          if (stop_density < min_density_per_m2) continue;
+          std::snprintf(text, sizeof text, "area %s: released after a stop of %.1f s at %.1f /m2, rise time %.2f s, peak %.2f m/s",
+                        s.area_names[m].c_str(), a.stopped_before_s, stop_density, a.rise_time_s, a.peak_speed_m_per_s);
+          TimelineMark mark{a.start_time_s, text, "avalanche"};
+          mark.rise_time_s = a.rise_time_s;
+          marks.push_back(mark);
+        }
+      }
+      from = to;
+    }
+  }
+  std::stable_sort(marks.begin(), marks.end(), [](const TimelineMark& a, const TimelineMark& b) { return a.time_s < b.time_s; });
+  return marks;
+}
+
+std::vector<TimelineMark> MergeAvalanches(std::vector<TimelineMark> marks, double within_s) {
+  std::stable_sort(marks.begin(), marks.end(), [](const TimelineMark& a, const TimelineMark& b) { return a.time_s < b.time_s; });
+  std::vector<TimelineMark> kept;
+  for (TimelineMark& m : marks)
+    if (kept.empty() || m.time_s > kept.back().time_s + within_s) kept.push_back(std::move(m));
+  return kept;
+}
+
+std::vector<TimelineMark> AvalanchesWithAreas(const TimelineSeries& s) {
+  std::vector<TimelineMark> all = s.avalanches;
+  for (TimelineMark& m : AreaAvalanches(s)) all.push_back(std::move(m));
+  return MergeAvalanches(std::move(all), RegimeOptions{}.min_stop_duration_s);
 }
 
 }  // namespace crowdrecon::analysis

@@ -93,7 +93,7 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   const analysis::TimelineSeries s = analysis::ComputeTimeline(run_file, options.smooth_s);
   r.clock_start = s.clock_start;
   r.end_s = s.time_s.empty() ? 0.0 : s.time_s.back();
-  for (const analysis::TimelineMark& a : s.avalanches) {
+  for (const analysis::TimelineMark& a : options.area_avalanches ? analysis::AvalanchesWithAreas(s) : s.avalanches) {
     r.avalanche_s.push_back(a.time_s);
     r.rise_time_s.push_back(a.rise_time_s);
   }

@@ -1,7 +1,8 @@
 #!/bin/bash
 # An ensemble of two seeds of a timeline scenario (issue 39): the figure and
 # both score files are written, one row per run; the same run given twice is
-# refused and nothing is written.
+# refused and nothing is written; the local reading of avalanches
+# (--area-avalanches) scores and draws too.
 # Usage: ensemble_two_seeds.sh CROWDRECON SCENARIO
 set -euo pipefail
 crowdrecon=$1
@@ -28,6 +29,14 @@ grep -q '| over the 2 runs | median (range) |' "$d/e.md"
 grep -q '^| seed 11 |' "$d/e.md"
 grep -q '^| seed 12 |' "$d/e.md"
 test "$(wc -l < "$d/e.csv")" -eq 3
+# The local reading (docs/analysis.md, "Local avalanches"): the same runs
+# scored with the hallway's areas; one run's figure with it too.
+"$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" -o "$d/l.png" --scores "$d/l.csv" --tolerance 1 --area-avalanches > /dev/null
+test -s "$d/l.png"
+test "$(wc -l < "$d/l.csv")" -eq 3
+"$crowdrecon" timeline "$d/a.sqlite" -o "$d/one.png" --area-avalanches > "$d/one.txt"
+grep -q 'avalanches and .* falls in the run' "$d/one.txt"
+test -s "$d/one.png"
 if "$crowdrecon" timeline "$d/a.sqlite" "$d/a.sqlite" -o "$d/f.png" > "$d/twice.txt" 2>&1; then
   echo "the same run given twice was accepted"; exit 1
 fi

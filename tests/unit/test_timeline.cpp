@@ -16,6 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include "crowdrecon/analysis/run_analysis.hpp"
+#include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -495,6 +497,104 @@ TEST(Scenario, TheGaitJittersSeedFollowsThePopulationsUnlessGiven) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("gait_jitter_seed = 1.5, expected a whole number"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace timeline_tests
+}  // namespace crowdrecon::scenario
+
+// --- the local reading of avalanches (analysis::AreaAvalanches) -------------
+namespace crowdrecon::scenario {
+namespace timeline_tests {
+
+// One area whose flow walks, stops for 5 s and walks again, at the given
+// density while stopped (10 frames/s, 40 s).
+analysis::TimelineSeries OneAreaStopAndGo(double stop_density_per_m2, bool gap_in_the_stop = false) {
+  analysis::TimelineSeries s;
+  s.area_names = {"end"};
+  s.area_m2_each = {9.0};
+  s.area_speed_m_per_s.assign(1, {});
+  s.area_density_per_m2.assign(1, {});
+  for (int k = 0; k <= 400; ++k) {
+    const double t = k / 10.0;
+    const bool stopped = t >= 20.0 - 1e-9 && t < 25.0 - 1e-9;
+    s.time_s.push_back(t);
+    s.area_speed_m_per_s[0].push_back(stopped ? 0.02 : 0.9);
+    s.area_density_per_m2[0].push_back(stopped ? stop_density_per_m2 : 1.5);
+    if (gap_in_the_stop && t >= 22.0 - 1e-9 && t < 22.5 - 1e-9) s.area_speed_m_per_s[0].back() = NAN;
+  }
+  return s;
+}
+
+TEST(AreaAvalanches, AStopOfACrowdInContactThatReleasesIsOneAvalancheNamedByItsArea) {
+  const std::vector<analysis::TimelineMark> m = analysis::AreaAvalanches(OneAreaStopAndGo(5.0));
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NEAR(m[0].time_s, 25.0, 1e-9);  // the sample where the flow rose (FindAvalanches)
+  EXPECT_EQ(m[0].kind, "avalanche");
+  EXPECT_NE(m[0].label.find("area end: released after a stop of 5.0 s at 5.0 /m2"), std::string::npos) << m[0].label;
+  EXPECT_FALSE(std::isnan(m[0].rise_time_s));
+  // The same stop in a crowd below contact density is not a clog.
+  EXPECT_TRUE(analysis::AreaAvalanches(OneAreaStopAndGo(3.0)).empty());
+  EXPECT_EQ(analysis::AreaAvalanches(OneAreaStopAndGo(3.0), {}, 2.5).size(), 1u);
+  // A moment with nobody walking in the area ends the stop, and what
+  // follows the gap begins at rest, as a crowd placed standing does: not a
+  // stop of a flow (FindAvalanches), so no avalanche.
+  EXPECT_TRUE(analysis::AreaAvalanches(OneAreaStopAndGo(5.0, true)).empty());
+}
+
+TEST(AreaAvalanches, OneReleaseSeenInSeveralPlacesIsMergedOnce) {
+  const std::vector<analysis::TimelineMark> marks = {
+      {13.5, "c", "avalanche"}, {10.0, "a", "avalanche"}, {11.0, "b", "avalanche"}, {16.0, "d", "avalanche"}};
+  const std::vector<analysis::TimelineMark> kept = analysis::MergeAvalanches(marks, 2.0);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept[0].label, "a");
+  EXPECT_EQ(kept[1].label, "c");
+  EXPECT_EQ(kept[2].label, "d");  // 2.5 s after c
+}
+
+// The areas' speeds from a run: the mean over the walking people whose
+// centre is inside of their velocity along their group's direction (the
+// open hallway: +x to the exit, -x to the court), recomputed from the run
+// file's frames directly (with the groups' directions of the run's analysis,
+// which the navigation field makes a little off the axis).
+TEST(AreaAvalanches, TheAreasSpeedIsTheMeanAlongEachGroupsDirectionOfTheWalkersInside) {
+  const TimelineRun run = Simulate(
+      Hallway(R"({"count": 60, "counter_flow_fraction": 0.3, "target": "to_exit", "counter_target": "to_court",
+                  "body": {"mode": "paper", "reference": ")" + (kSource / "venues/bodies/thorax-18.json").string() +
+                  R"("}, "seed": 5})",
+              R"({"duration_s": 2, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})", R"({})"),
+      "area_speeds");
+  const analysis::TimelineSeries s = analysis::ComputeTimeline(run.file);
+  ASSERT_EQ(s.area_names, (std::vector<std::string>{"centre", "court_end", "exit_end"}));
+  const std::vector<Vec2> e = analysis::AnalyzeRun(run.file).group_direction;
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_NEAR(e[0].x, 1.0, 1e-3);
+  EXPECT_NEAR(e[1].x, -1.0, 1e-3);
+  const runfile::RunFileReader reader(run.file);
+  const std::vector<std::uint32_t> group = reader.PersonGroups();
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  auto stream = reader.PersonFrames(times.back().frame);
+  runfile::PersonFrame f;
+  const double x0[3] = {5.0, 1.5, 7.5}, x1[3] = {7.0, 4.5, 10.5};
+  std::size_t k = 0, checked = 0;
+  while (stream.Next(&f)) {
+    while (times[k].frame < f.frame) ++k;
+    for (int a = 0; a < 3; ++a) {
+      double sum = 0.0;
+      int n = 0;
+      for (std::size_t r = 0; r < f.person.size(); ++r) {
+        if (f.position_m[r].x < x0[a] || f.position_m[r].x > x1[a]) continue;
+        sum += Dot(f.velocity_m_per_s[r], e[group[f.person[r]]]);
+        ++n;
+      }
+      if (n == 0) {
+        EXPECT_TRUE(std::isnan(s.area_speed_m_per_s[a][k]));
+      } else {
+        EXPECT_NEAR(s.area_speed_m_per_s[a][k], sum / n, 1e-12) << "area " << a << " frame " << k;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 40u);
 }
 
 }  // namespace timeline_tests

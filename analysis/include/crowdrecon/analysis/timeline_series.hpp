@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/analysis/regime.hpp"
+
 namespace crowdrecon::analysis {
 
 struct TimelineMark {
@@ -43,6 +45,10 @@ struct TimelineSeries {
   std::vector<std::string> area_names;
   std::vector<double> area_m2_each;
   std::vector<std::vector<double>> area_density_per_m2;  // [area][frame]
+  // The same areas' flow: the mean speed of the walking people inside along
+  // their group's desired direction, by frame (NaN where nobody walks there);
+  // the series the local reading of avalanches reads (AreaAvalanches).
+  std::vector<std::vector<double>> area_speed_m_per_s;  // [area][frame]
   std::vector<double> counter_fraction;  // NaN where nobody is present
   std::vector<double> queued;            // waiting at the entries (0 without a census)
   std::vector<std::string> group_names;
@@ -61,6 +67,30 @@ struct TimelineSeries {
 
 // Reads a run file; throws InputError if it is not a run or has no frames.
 TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smooth_s = 10.0);
+
+// The local reading of avalanches (issue 39; docs/analysis.md, "Local
+// avalanches"): the footage's avalanches were seen where a camera looked
+// ("the fifth avalanche, at end of the corridor", paper, Figure 3), not as a
+// stop of a whole hallway, so a stop and release of the flow inside one
+// measurement area counts too. The analysis's detector (FindAvalanches,
+// `options`) runs on each area's speed series, over each stretch of frames
+// in which someone walks there; a release counts when the area was a crowd
+// in contact while it was stopped: its mean density over the stop at least
+// `min_density_per_m2` (Fruin's involuntary contact, kContactDensity). Each
+// mark's label names the area; rise_time_s is the detector's.
+inline constexpr double kContactDensity_per_m2 = 3.6;
+std::vector<TimelineMark> AreaAvalanches(const TimelineSeries& s, const RegimeOptions& options = {},
+                                         double min_density_per_m2 = kContactDensity_per_m2);
+
+// One release seen in several places (the crowd, a direction, areas) is one
+// avalanche: marks sorted by time, and a mark starting within `within_s` of
+// the last one kept is dropped (the first seen stands for it).
+std::vector<TimelineMark> MergeAvalanches(std::vector<TimelineMark> marks, double within_s);
+
+// A run's avalanches under the local reading: its own avalanche events (the
+// crowd's and each direction's) and its areas' (AreaAvalanches, default
+// options), merged within the detector's shortest stop.
+std::vector<TimelineMark> AvalanchesWithAreas(const TimelineSeries& s);
 
 // Centred moving mean over `window_s` (NaN values left out; NaN where a window has none).
 std::vector<double> MovingMean(const std::vector<double>& time_s, const std::vector<double>& values, double window_s);

@@ -48,6 +48,11 @@ struct EnsembleOptions {
   double smooth_s = 10.0;
   // The danger zone's lower edge (reports::RiskOptions::danger_n).
   double danger_n = RiskOptions{}.danger_n;
+  // The local reading of avalanches (analysis::AreaAvalanches): releases
+  // inside the venue's measurement areas count besides the run's own
+  // avalanche events, one release seen in several places once
+  // (analysis::MergeAvalanches within the detector's shortest stop).
+  bool area_avalanches = false;
   bool IsValid(std::string* error) const;
 };
 
