@@ -786,6 +786,29 @@ SurrogateLikelihood::SurrogateLikelihood(const Quadratic& mean, const Objective&
     : mean_(mean), local_(local), lead_(objective.lead), rows_(FittedRows(mean, objective)), scale_(scale),
       covariance_(covariance), power_(covariance.known() ? 0.0 : covariance.Power()) {
   if (!rows_.empty()) white_ = objective.Whiten(rows_);
+  // The part of chi2 no simulated means can remove (the scatter between
+  // recordings of one statistic): the least-squares residual of
+  // |W P mu - b|^2 over free means mu, one per simulated value (lead).
+  if (!rows_.empty() && !covariance_.known()) {
+    std::vector<std::size_t> leads;
+    for (std::size_t r : rows_) leads.push_back(lead_[r]);
+    std::vector<std::size_t> unique = leads;
+    std::sort(unique.begin(), unique.end());
+    unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+    const std::size_t n = rows_.size(), k = unique.size();
+    Eigen::MatrixXd a(n, k);
+    std::vector<double> column(n);
+    for (std::size_t j = 0; j < k; ++j) {
+      for (std::size_t r = 0; r < n; ++r) column[r] = leads[r] == unique[j] ? 1.0 : 0.0;
+      std::vector<double> out(n);
+      white_.Apply(column.data(), 1, false, out.data());
+      for (std::size_t r = 0; r < n; ++r) a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(j)) = out[r];
+    }
+    Eigen::VectorXd b(n);
+    for (std::size_t r = 0; r < n; ++r) b(static_cast<Eigen::Index>(r)) = white_.b[r];
+    const Eigen::VectorXd mu = a.colPivHouseholderQr().solve(b);
+    scatter_chi2_ = (a * mu - b).squaredNorm();
+  }
 }
 
 double SurrogateLikelihood::operator()(const std::vector<double>& u) const { return WithOffset(u, {}); }
@@ -802,7 +825,7 @@ double SurrogateLikelihood::WithOffset(const std::vector<double>& u, const std::
   for (double r : residuals) chi2 += r * r;
   if (!std::isfinite(chi2)) return kNone;
   if (covariance_.known()) return -0.5 * chi2 / scale_;
-  return -0.5 * power_ * std::log1p(chi2 / (scale_ * covariance_.freedom));
+  return -0.5 * power_ * std::log1p(std::max(0.0, chi2 - scatter_chi2_) / (scale_ * covariance_.freedom));
 }
 
 bool SeedSurfaces::Fit(const std::vector<std::vector<double>>& points,

@@ -254,7 +254,13 @@ struct EstimatedCovariance {
 // simulated means read from `mean`, chi2 the objective's generalised one;
 // `scale` >= 1 widens it where the best fit's chi2 per degree of freedom
 // says the statistics scatter more than their covariance allows. With an
-// estimated covariance: -(m / 2) log(1 + chi2 / (scale freedom)).
+// estimated covariance: -(m / 2) log(1 + (chi2 - chi2_scatter) / (scale
+// freedom)), chi2_scatter the part of chi2 that no simulated means remove
+// (the scatter between recordings of one simulated value: the least-squares
+// residual over free means, one per lead), computed once here; Percival et
+// al.'s m is calibrated for a chi2 over the simulated values alone (issue
+// 41, point 3: with the scatter counted the intervals at K = 6 covered more
+// than their level).
 class SurrogateLikelihood {
  public:
   SurrogateLikelihood(const Quadratic& mean, const Objective& objective, double scale = 1.0,
@@ -273,6 +279,7 @@ class SurrogateLikelihood {
   double scale_;
   EstimatedCovariance covariance_;
   double power_;
+  double scatter_chi2_ = 0.0;  // chi2's part that no simulated means remove (with an estimated covariance)
 };
 
 // The error of a mean of K seeds as a function of the parameters (common

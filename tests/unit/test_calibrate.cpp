@@ -435,6 +435,54 @@ TEST(Posterior, TheLikelihoodIsTheScaledChi2) {
   }
 }
 
+// With an estimated covariance the likelihood's argument leaves out the
+// scatter between recordings, the part of chi2 no simulated means can
+// remove (issue 41, point 3: at K = 6 it widened the intervals beyond their
+// level). Two recordings of one simulated value, 0.4 and 0.6, and three of
+// another, 1.0, 1.2, 1.1: at the means that match the recordings' means the
+// likelihood is at its top, log 1 = 0, and elsewhere the argument is chi2
+// less its value there.
+TEST(Posterior, TheEstimatedCovariancesLikelihoodLeavesOutTheScatterBetweenRecordings) {
+  Objective o;
+  const std::vector<std::pair<std::string, double>> recorded = {{"a", 0.4}, {"a", 0.6}, {"b", 1.0}, {"b", 1.2}, {"b", 1.1}};
+  for (std::size_t j = 0; j < recorded.size(); ++j) {
+    Statistic st;
+    st.name = recorded[j].first + std::to_string(j);
+    st.simulated_from = recorded[j].first;
+    st.observation = j;  // each its own recording
+    st.observed = recorded[j].second;
+    st.observed_sigma = 0.05;
+    o.statistics.push_back(st);
+  }
+  const std::size_t n = recorded.size();
+  std::vector<double> s(n * n, 0.0);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i)
+      if (recorded[j].first == recorded[i].first) s[j * n + i] = 0.01;
+  o.WeighCovariance(s, 6.0);
+  ASSERT_EQ(o.lead, (std::vector<std::size_t>{0, 0, 2, 2, 2}));
+  // The simulated means: a = u, b = u + 0.6 (one parameter).
+  std::vector<std::vector<double>> pts, vals;
+  for (double u : {0.0, 0.5, 1.0}) {
+    pts.push_back({u});
+    vals.push_back({u, u, u + 0.6, u + 0.6, u + 0.6});
+  }
+  Quadratic mean;
+  ASSERT_TRUE(mean.Fit(pts, vals, {0.5}, 0.5));
+  const EstimatedCovariance estimated{30.0, 2.0, 1.0};
+  const SurrogateLikelihood l(mean, o, 1.0, nullptr, estimated);
+  const auto chi2 = [&](double u) { return o.Chi2({u, u, u + 0.6, u + 0.6, u + 0.6}); };
+  // The best u: a's recordings say 0.5, b's 0.5 as well.
+  const double scatter = chi2(0.5);
+  EXPECT_GT(scatter, 1.0);  // (0.1^2 + 0.1^2 + 0.1^2 + 0.1^2) / (0.05^2 + 0.01) = 3.2 without correlations
+  EXPECT_NEAR(l({0.5}), 0.0, 1e-12);
+  for (double u : {0.3, 0.45, 0.7})
+    EXPECT_NEAR(l({u}), -0.5 * estimated.Power() * std::log1p((chi2(u) - scatter) / estimated.freedom), 1e-9) << u;
+  // Known sigmas (no estimated covariance): the Gaussian of the whole chi2.
+  const SurrogateLikelihood gaussian(mean, o);
+  EXPECT_NEAR(gaussian({0.7}), -0.5 * chi2(0.7), 1e-9);
+}
+
 // A seeds' covariance estimated from few runs: the Gaussian likelihood
 // that takes it as known gives "95 %" intervals that cover far less; the
 // likelihood for an estimated covariance (Percival et al. 2022) covers as
