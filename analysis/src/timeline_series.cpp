@@ -186,7 +186,6 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
 
 std::vector<TimelineMark> AreaAvalanches(const TimelineSeries& s, const RegimeOptions& options, double min_density_per_m2) {
   std::vector<TimelineMark> marks;
-  char text[160];
   for (std::size_t m = 0; m < s.area_speed_m_per_s.size(); ++m) {
     const std::vector<double>& v = s.area_speed_m_per_s[m];
     const std::vector<double>& rho = s.area_density_per_m2[m];
@@ -209,9 +208,11 @@ std::vector<TimelineMark> AreaAvalanches(const TimelineSeries& s, const RegimeOp
             if (s.time_s[k] >= a.start_time_s - a.stopped_before_s - 1e-9) sum += rho[k], ++count;
           const double stop_density = count > 0 ? sum / static_cast<double>(count) : 0.0;
           if (stop_density < min_density_per_m2) continue;
-          std::snprintf(text, sizeof text, "area %s: released after a stop of %.1f s at %.1f /m2, rise time %.2f s, peak %.2f m/s",
-                        s.area_names[m].c_str(), a.stopped_before_s, stop_density, a.rise_time_s, a.peak_speed_m_per_s);
-          TimelineMark mark{a.start_time_s, text, "avalanche"};
+          TimelineMark mark{a.start_time_s,
+                            "area " + s.area_names[m] + ": released after a stop of " + FormatFixed(a.stopped_before_s, 1) +
+                                " s at " + FormatFixed(stop_density, 1) + " /m2, rise time " + FormatFixed(a.rise_time_s, 2) +
+                                " s, peak " + FormatFixed(a.peak_speed_m_per_s, 2) + " m/s",
+                            "avalanche"};
           mark.rise_time_s = a.rise_time_s;
           marks.push_back(mark);
         }
