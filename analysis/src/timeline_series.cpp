@@ -15,6 +15,25 @@
 
 namespace crowdrecon::analysis {
 
+double ClogForGood(const TimelineSeries& s, double smooth_s, double stop_speed_m_per_s, double min_s) {
+  std::vector<std::vector<double>> speeds;
+  for (const std::vector<double>& g : s.group_speed_m_per_s) speeds.push_back(MovingMean(s.time_s, g, smooth_s));
+  const auto clogged = [&](std::size_t i) {
+    bool anyone = false;
+    for (const std::vector<double>& g : speeds) {
+      if (std::isnan(g[i])) continue;  // nobody of this direction present
+      anyone = true;
+      if (g[i] >= stop_speed_m_per_s) return false;
+    }
+    return anyone;
+  };
+  if (s.time_s.empty() || !clogged(s.time_s.size() - 1)) return std::numeric_limits<double>::quiet_NaN();
+  std::size_t first = s.time_s.size() - 1;
+  while (first > 0 && clogged(first - 1)) --first;
+  if (s.time_s.back() - s.time_s[first] < min_s) return std::numeric_limits<double>::quiet_NaN();
+  return s.time_s[first];
+}
+
 std::vector<double> MovingMean(const std::vector<double>& t, const std::vector<double>& v, double window_s) {
   std::vector<double> out(v.size(), std::numeric_limits<double>::quiet_NaN());
   std::size_t lo = 0, hi = 0, count = 0;

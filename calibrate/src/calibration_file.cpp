@@ -201,6 +201,38 @@ void ReadRecordedAvalanches(const JsonReader& recorded, const scenario::Scenario
   m->events.push_back(e);
 }
 
+// {"recorded": {"kind": "fatal", "uncertainty_s", "from_s", "to_s"}}: the
+// scenario's recorded fatal clog (its one mark of kind "fatal") as a time,
+// against the time from which the run is clogged for good (the window's end
+// if it never is: a censored value, the run's last word).
+void ReadRecordedFatal(const JsonReader& recorded, const scenario::Scenario& sc, ObservationMatch* m) {
+  EventMatch e;
+  e.kind = "clog";
+  e.where = "run";
+  e.direction = "crowd";
+  e.first_time = true;
+  std::size_t marks = 0;
+  for (const scenario::RecordedMark& mark : sc.timeline.recorded)
+    if (mark.kind == "fatal") {
+      e.recorded_time_s = mark.time_s;
+      ++marks;
+    }
+  if (marks == 0)
+    recorded.Fail("the scenario records no \"fatal\" mark in timeline.recorded; expected the time of the incident's "
+                  "fatal clog there (docs/scenarios.md)");
+  if (marks > 1)
+    recorded.Fail("the scenario records " + std::to_string(marks) + " \"fatal\" marks; expected one (the clog that "
+                  "lasted is one time)");
+  e.recorded_sigma_s = recorded.Number("uncertainty_s", 60.0, 1e-3, 1e6);
+  e.from_s = recorded.Number("from_s", 0.0, -1e9, 1e9);
+  e.to_s = recorded.Number("to_s", sc.run.duration_s, -1e9, 1e9);
+  if (!(e.to_s > e.from_s)) recorded.Fail("the window is empty; expected from_s < to_s");
+  if (e.recorded_time_s < e.from_s || e.recorded_time_s > e.to_s)
+    recorded.Fail("the window [" + FormatNumber(e.from_s) + ", " + FormatNumber(e.to_s) + "] s leaves out the fatal clog at " +
+                  FormatNumber(e.recorded_time_s) + " s; expected a window around it");
+  m->events.push_back(e);
+}
+
 // The regions of a spec, listed for a message.
 std::string RegionNames(const observe::ObservationSpec& spec) {
   std::string list;
@@ -320,12 +352,14 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
     if (!item.IsObject()) item.Fail("expected {\"file\": ..., \"series\": [...]}, found " + item.ValueText());
     ObservationMatch m;
     if (auto recorded = item.Find("recorded")) {
-      m.recorded_kind = recorded->Choice("kind", {"avalanche", "max_speed"});
+      m.recorded_kind = recorded->Choice("kind", {"avalanche", "max_speed", "fatal"});
       m.observation.method = "recorded";
       m.observation.source_file = c.base.scenario_file.string();
       if (m.recorded_kind == "max_speed") {
         ReadRecordedMaxSpeed(*recorded, sc, dir, &m);
         CheckFramesForVelocities(*recorded, m.observation.spec, sc.run.output_fps);
+      } else if (m.recorded_kind == "fatal") {
+        ReadRecordedFatal(*recorded, sc, &m);
       } else {
         ReadRecordedAvalanches(*recorded, sc, &m);
       }

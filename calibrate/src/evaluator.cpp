@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/output_path.hpp"
@@ -28,6 +29,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const std::string kRunEvents = "run events";
+const std::string kRunClog = "run clog";
 
 // The run's own events of the kinds a calibration can match (avalanches,
 // detected during the run: docs/scenarios.md), as an observation's events:
@@ -43,6 +45,24 @@ observe::Observation RunEvents(const fs::path& run_file) {
     const std::string who = e.detail.substr(0, e.detail.find(':'));
     ev.direction = who.rfind("direction ", 0) == 0 ? who.substr(10) : who;
     ev.time_s = e.time_s;
+    o.events.push_back(ev);
+  }
+  return o;
+}
+
+// The time from which the run is clogged for good (analysis::ClogForGood,
+// the ensemble score's defaults), as one event of kind "clog" (none if it
+// never is).
+observe::Observation RunClog(const fs::path& run_file) {
+  observe::Observation o;
+  o.bin_s = 1.0;
+  const double t = analysis::ClogForGood(analysis::ComputeTimeline(run_file));
+  if (std::isfinite(t)) {
+    observe::Event ev;
+    ev.kind = "clog";
+    ev.where = "run";
+    ev.direction = "crowd";
+    ev.time_s = t;
     o.events.push_back(ev);
   }
   return o;
@@ -107,13 +127,16 @@ Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& 
   for (const ObservationMatch& m : spec_.observations) {
     // The scenario's recorded events compare with the run's event table: one
     // file per run of that table's events, whatever the spec.
-    const std::string j = m.UsesRunEvents() ? kRunEvents : observe::SpecToJson(m.observation.spec);
+    const std::string j = m.UsesRunEvents() ? kRunEvents
+                          : m.UsesRunClog() ? kRunClog
+                                            : observe::SpecToJson(m.observation.spec);
     std::size_t k = 0;
     while (k < spec_json_.size() && spec_json_[k] != j) ++k;
     if (k == spec_json_.size()) {
       spec_json_.push_back(j);
-      specs_.push_back(j == kRunEvents ? observe::ObservationSpec{} : m.observation.spec);
-      spec_tag_.push_back(j == kRunEvents ? std::string("events") : Sha256Hex(j).substr(0, 12));
+      const bool from_run = j == kRunEvents || j == kRunClog;
+      specs_.push_back(from_run ? observe::ObservationSpec{} : m.observation.spec);
+      spec_tag_.push_back(j == kRunEvents ? std::string("events") : j == kRunClog ? std::string("clog") : Sha256Hex(j).substr(0, 12));
     }
     spec_of_observation_.push_back(k);
   }
@@ -243,6 +266,8 @@ bool Evaluator::RunBatch(const std::vector<std::vector<double>>& sets, const std
       observe::Observation o;
       if (spec_json_[k] == kRunEvents) {
         o = RunEvents(run_file);
+      } else if (spec_json_[k] == kRunClog) {
+        o = RunClog(run_file);
       } else {
         if (!t) t = observe::ReadTrajectories(run_file);
         o = observe::ObserveTrajectories(*t, specs_[k]);

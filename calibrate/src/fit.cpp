@@ -46,14 +46,14 @@ Matrix LowerCholesky(Matrix c) {
 void Objective::Group() {
   const std::size_t n = statistics.size();
   lead.resize(n);
-  using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool>;
+  using Key = std::tuple<std::string, std::string, std::string, std::string, double, double, bool, bool, bool>;
   std::map<Key, std::size_t> first;
   for (std::size_t j = 0; j < n; ++j) {
     const Statistic& st = statistics[j];
     lead[j] = j;
     if (st.simulated_from.empty()) continue;
     lead[j] = first.try_emplace({st.simulated_from, st.quantity, st.where, st.direction, st.sim_from_s, st.sim_to_s,
-                                 st.is_count, st.is_max},
+                                 st.is_count, st.is_max, st.is_time},
                                 j)
                   .first->second;
   }

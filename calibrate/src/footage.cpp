@@ -49,7 +49,7 @@ Layout LayoutOf(const Objective& o, const std::vector<double>& jac, std::size_t 
   double t0 = kInf;
   for (std::size_t j = 0; j < n; ++j) {
     const Statistic& st = o.statistics[j];
-    if (st.observation != 0 || st.is_count) continue;
+    if (st.observation != 0 || st.is_count || st.is_time) continue;
     if (l.window_s == 0.0) l.window_s = st.sim_to_s - st.sim_from_s;
     t0 = std::min(t0, st.sim_from_s);
   }
@@ -58,6 +58,10 @@ Layout LayoutOf(const Objective& o, const std::vector<double>& jac, std::size_t 
     const Statistic& st = o.statistics[j];
     if (st.observation != 0) {
       ++others;
+      continue;
+    }
+    if (st.is_time) {  // one time of one event: more footage of this kind does not repeat it
+      l.left_out.push_back(st.name + ": the time of a single event, which longer or more footage does not add to");
       continue;
     }
     const std::string why = usable(j);

@@ -104,7 +104,9 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
   for (std::size_t i = 0; i < spec.observations.size(); ++i) {
     const ObservationMatch& m = spec.observations[i];
     const std::string tag = "obs" + std::to_string(i) + " ";
-    const std::string simulated_from = m.UsesRunEvents() ? "run events" : observe::SpecToJson(m.observation.spec);
+    const std::string simulated_from = m.UsesRunEvents() ? "run events"
+                                       : m.UsesRunClog() ? "run clog"
+                                                         : observe::SpecToJson(m.observation.spec);
     for (const SeriesMatch& s : m.series) {
       const observe::Series* series = m.observation.Find(s.quantity, s.where, s.direction);
       const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;
@@ -139,6 +141,26 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
       }
     }
     for (const EventMatch& e : m.events) {
+      if (e.first_time) {
+        Statistic st;
+        st.is_time = true;
+        st.simulated_from = simulated_from;
+        st.name = tag + e.kind + " " + e.where + " " + e.direction + ": first in " + Window(e.from_s, e.to_s);
+        st.unit = "s";
+        st.observation = i;
+        st.quantity = e.kind;
+        st.where = e.where;
+        st.direction = e.direction;
+        st.from_s = e.from_s;
+        st.to_s = e.to_s;
+        st.sim_from_s = e.from_s + m.time_offset_s;
+        st.sim_to_s = e.to_s + m.time_offset_s;
+        st.observed = e.recorded_time_s;
+        st.observed_sigma = e.recorded_sigma_s;
+        CheckWithinTheRuns(spec, m, st);
+        out.push_back(st);
+        continue;
+      }
       const std::vector<double> all = Onsets(m.observation, e.kind, e.where, e.direction);
       std::vector<double> checkpoints;
       for (double t : all)
@@ -175,7 +197,15 @@ void SimulatedStatistics(std::size_t index, const observe::Observation& simulate
   for (std::size_t j = 0; j < statistics.size(); ++j) {
     const Statistic& st = statistics[j];
     if (st.observation != index) continue;
-    if (st.is_count) {
+    if (st.is_time) {
+      double first = st.sim_to_s;  // never in the window: censored at its end
+      for (double t : Onsets(simulated, st.quantity, st.where, st.direction))
+        if (t >= st.sim_from_s && t <= st.sim_to_s) {
+          first = t;
+          break;
+        }
+      (*values)[j] = first;
+    } else if (st.is_count) {
       double n = 0;
       for (double t : Onsets(simulated, st.quantity, st.where, st.direction))
         if (t >= st.sim_from_s && t <= st.sim_to_s) ++n;

@@ -35,28 +35,6 @@ bool EnsembleOptions::IsValid(std::string* error) const {
 
 namespace {
 
-// The start of the stretch, reaching the last frame, in which every
-// direction present moves slower than the clog speed (NaN if the last
-// frame is not clogged or the stretch is shorter than clog_min_s).
-double ClogForGood(const analysis::TimelineSeries& s, const EnsembleOptions& o) {
-  std::vector<std::vector<double>> speeds;
-  for (const std::vector<double>& g : s.group_speed_m_per_s) speeds.push_back(analysis::MovingMean(s.time_s, g, o.smooth_s));
-  const auto clogged = [&](std::size_t i) {
-    bool anyone = false;
-    for (const std::vector<double>& g : speeds) {
-      if (std::isnan(g[i])) continue;  // nobody of this direction present
-      anyone = true;
-      if (g[i] >= o.clog_speed_m_per_s) return false;
-    }
-    return anyone;
-  };
-  if (s.time_s.empty() || !clogged(s.time_s.size() - 1)) return std::numeric_limits<double>::quiet_NaN();
-  std::size_t first = s.time_s.size() - 1;
-  while (first > 0 && clogged(first - 1)) --first;
-  if (s.time_s.back() - s.time_s[first] < o.clog_min_s) return std::numeric_limits<double>::quiet_NaN();
-  return s.time_s[first];
-}
-
 std::string LabelOf(const std::filesystem::path& file, const runfile::RunFileReader& reader) {
   const std::string seed = reader.RunValue("seed");
   return seed.empty() ? file.filename().string() : "seed " + seed;
@@ -104,7 +82,7 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   for (const std::vector<double>& a : s.area_density_per_m2)
     r.area_density_per_m2.push_back(analysis::MovingMean(s.time_s, a, options.smooth_s));
   r.recorded = s.recorded;
-  r.clog_for_good_s = ClogForGood(s, options);
+  r.clog_for_good_s = analysis::ClogForGood(s, options.smooth_s, options.clog_speed_m_per_s, options.clog_min_s);
   RiskOptions risk;
   risk.danger_n = options.danger_n;
   const RunRisk rr = AnalyseRunRisk(run_file, risk);

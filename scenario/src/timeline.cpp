@@ -48,7 +48,10 @@ void CheckPoints(const std::vector<std::pair<double, double>>& points, const std
                        FormatNumber(points[k].first) + " s follows " + FormatNumber(points[k - 1].first) + " s");
 }
 
-RateSchedule ReadRate(const JsonReader& inflow, const std::filesystem::path& base_dir) {
+// `every_scale`: the timeline's "rate_scale", which multiplies every inflow's
+// schedule together with the inflow's own (nullptr where absent).
+RateSchedule ReadRate(const JsonReader& inflow, const std::string& id, const std::filesystem::path& base_dir,
+                      const JsonReader* every_scale) {
   RateSchedule rate;
   const bool inline_rate = inflow.Has("rate_per_s"), csv = inflow.Has("rate_csv");
   if (inline_rate == csv) inflow.Fail("give exactly one of \"rate_per_s\" (a number or [[time_s, rate], ...]) and \"rate_csv\"");
@@ -76,13 +79,17 @@ RateSchedule ReadRate(const JsonReader& inflow, const std::filesystem::path& bas
     }
   }
   rate.linear = inflow.Choice("interpolation", "step", {"step", "linear"}) == "linear";
-  if (auto scale = inflow.Find("rate_scale")) {
-    const double k = scale->AsNumber(0.0, 10.0);
+  const auto own_scale = inflow.Find("rate_scale");
+  if (own_scale || every_scale) {
+    const double k = (own_scale ? own_scale->AsNumber(0.0, 10.0) : 1.0) * (every_scale ? every_scale->AsNumber(0.0, 10.0) : 1.0);
+    const JsonReader& blamed = own_scale ? *own_scale : *every_scale;
     for (auto& point : rate.points) {
+      const double unscaled = point.second;
       point.second *= k;
       if (point.second > kMaxRate_per_s)
-        scale->Fail("scales the rate " + FormatNumber(point.second / k) + " persons/s at " + FormatNumber(point.first) +
-                    " s beyond " + FormatNumber(kMaxRate_per_s) + " persons/s");
+        blamed.Fail("scales inflow \"" + id + "\"'s rate " + FormatNumber(unscaled) + " persons/s at " +
+                    FormatNumber(point.first) + " s beyond " + FormatNumber(kMaxRate_per_s) + " persons/s" +
+                    (own_scale && every_scale ? " (with the timeline's rate_scale)" : ""));
     }
   }
   if (auto cap = inflow.Find("max_rate_per_s")) rate.Cap(cap->AsNumber(0.0, kMaxRate_per_s));
@@ -218,6 +225,8 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     return id;
   };
 
+  const auto every_scale = reader.Find("rate_scale");
+  if (every_scale) every_scale->AsNumber(0.0, 10.0);  // checked even without inflows
   if (auto inflows = reader.Find("inflows")) {
     if (!inflows->IsArray()) inflows->Fail("expected a list of inflows [{\"id\": ..., \"entry\": ..., ...}]");
     std::set<std::string> ids;
@@ -250,7 +259,7 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
         item.Fail("group \"" + f.group + "\" needs a \"target\" (only \"main\" and \"counter\" default to the population's)");
       if (!venue.FindTarget(f.target))
         (item.Has("target") ? item.At("target") : item).Fail("the venue has no target or exit \"" + f.target + "\"");
-      f.rate = ReadRate(item, base_dir);
+      f.rate = ReadRate(item, f.id, base_dir, every_scale ? &*every_scale : nullptr);
       f.on_at_start = item.Bool("active", true);
       if (auto speed = item.Find("desired_speed_m_per_s")) {
         if (!speed->IsArray() || speed->Size() != 2) speed->Fail("expected [min, max] in m/s");

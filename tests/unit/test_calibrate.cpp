@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/calibrate/calibration_file.hpp"
 #include "crowdrecon/calibrate/statistics.hpp"
 #include "crowdrecon/common/error.hpp"
@@ -987,6 +988,71 @@ TEST(CalibrationFile, ASpeedRecordedOfTheIncident) {
   expect(calibration(night, fast, R"("where": "exit end", "from_s": 0, "to_s": 100)"), "leaves out the mark");
   expect(calibration("/tests/data/scenarios/sweep-tiny.json", fast, R"("where": "exit end")"),
          "the scenario records no speed in timeline.recorded");
+}
+
+// The recorded fatal clog (the Madrid night's 03:33) as a time: observed the
+// mark's time with the stated uncertainty, simulated the first "clog" event
+// (the time from which the run is clogged for good) in the window, or the
+// window's end where the run never clogs for good; refused with the path
+// where the scenario records none or the window leaves it out.
+TEST(CalibrationFile, TheRecordedFatalClogAsATime) {
+  const std::string src = CROWDRECON_SOURCE_DIR;
+  const auto calibration = [&](const std::string& scenario, const std::string& recorded) {
+    return R"({"format": "crowdrecon-calibration", "version": 1, "scenario": ")" + src + scenario + R"(",
+      "parameters": [{"path": "model.back_force_gamma"}],
+      "observations": [{"recorded": {"kind": "fatal")" + recorded + R"(}}],
+      "seeds": {"first": 1, "count": 2}})";
+  };
+  const std::string night = "/venues/madrid-arena/scenarios/madrid-night-demo.json";
+  const std::vector<Statistic> st = ObservedStatistics(ParseCalibration(calibration(night, ""), "cal.json", ""));
+  ASSERT_EQ(st.size(), 1u);
+  EXPECT_TRUE(st[0].is_time);
+  EXPECT_FALSE(st[0].is_count);
+  EXPECT_EQ(st[0].quantity, "clog");
+  EXPECT_EQ(st[0].simulated_from, "run clog");
+  EXPECT_DOUBLE_EQ(st[0].observed, 279.0);  // the demo's 03:33 (5,580 s / 20)
+  EXPECT_DOUBLE_EQ(st[0].observed_sigma, 60.0);
+  EXPECT_DOUBLE_EQ(st[0].sim_from_s, 0.0);
+  EXPECT_DOUBLE_EQ(st[0].sim_to_s, 285.0);  // the runs' end
+  EXPECT_DOUBLE_EQ(ObservedStatistics(ParseCalibration(calibration(night, R"(, "uncertainty_s": 5)"), "cal.json", ""))[0].observed_sigma, 5.0);
+
+  observe::Observation run;
+  std::vector<double> values;
+  SimulatedStatistics(0, run, st, &values);
+  EXPECT_DOUBLE_EQ(values[0], 285.0);  // never clogged for good: censored at the window's end
+  observe::Event clog;
+  clog.kind = "clog";
+  clog.where = "run";
+  clog.direction = "crowd";
+  clog.time_s = 212.5;
+  run.events.push_back(clog);
+  SimulatedStatistics(0, run, st, &values);
+  EXPECT_DOUBLE_EQ(values[0], 212.5);
+
+  const auto expect = [&](const std::string& text, const std::string& part) {
+    const std::string e = ErrorOf([&] { ParseCalibration(text, "cal.json", ""); });
+    EXPECT_NE(e.find(part), std::string::npos) << "error: " << e << "\nexpected: " << part;
+  };
+  expect(calibration("/tests/data/scenarios/sweep-tiny.json", ""), "/observations/0/recorded: the scenario records no \"fatal\" mark");
+  expect(calibration(night, R"(, "from_s": 0, "to_s": 200)"), "leaves out the fatal clog at 279 s");
+  expect(calibration(night, R"(, "uncertainty_s": 0)"), "/observations/0/recorded/uncertainty_s");
+}
+
+// The time from which a run is clogged for good (the function the ensemble's
+// score and the recorded fatal clog share), on made directions' speeds: the
+// start of the last stretch in which every direction present is still.
+TEST(CalibrationFile, AClogForGoodIsTheStartOfTheLastStillStretch) {
+  analysis::TimelineSeries s;
+  for (int k = 0; k <= 100; ++k) s.time_s.push_back(k);
+  s.group_speed_m_per_s = {std::vector<double>(101, 1.0), std::vector<double>(101, std::numeric_limits<double>::quiet_NaN())};
+  for (int k = 60; k <= 100; ++k) s.group_speed_m_per_s[0][k] = 0.0;
+  EXPECT_DOUBLE_EQ(analysis::ClogForGood(s, 0.0), 60.0);
+  EXPECT_TRUE(std::isnan(analysis::ClogForGood(s, 0.0, 0.1, 50.0)));  // 40 s still: shorter than 50
+  s.group_speed_m_per_s[1].assign(101, 0.5);                           // the other direction still walks
+  EXPECT_TRUE(std::isnan(analysis::ClogForGood(s, 0.0)));
+  s.group_speed_m_per_s[1].assign(101, 0.0);
+  s.group_speed_m_per_s[1][80] = 0.3;                                   // ... until 80 s
+  EXPECT_DOUBLE_EQ(analysis::ClogForGood(s, 0.0), 81.0);
 }
 
 // Every calibration the repository ships is read and its observed statistics

@@ -384,6 +384,26 @@ TEST(Timeline, AnInflowsScaleAndCapShapeItsSchedule) {
   EXPECT_EQ(schedule(R"(, "max_rate_per_s": 0.5)"), (Points{{0.0, 0.5}, {10.0, 0.5}}));
 }
 
+// The timeline's "rate_scale" multiplies every inflow's schedule, together
+// with an inflow's own scale and before its cap: one nuisance parameter for
+// the whole inflow of a night (issue 41).
+TEST(Timeline, TheTimelinesScaleMultipliesEveryInflow) {
+  const auto schedules = [](const std::string& scale, const std::string& second_extra) {
+    const Scenario s = ParseScenario(
+        Hallway(R"({"count": 10, "target": "to_exit"})", R"({"duration_s": 10})",
+                R"({)" + scale + R"("inflows": [{"entry": "from_court", "rate_per_s": [[0, 1], [10, 3]], "interpolation": "linear"},
+                                   {"entry": "from_outside", "group": "counter", "target": "to_court", "rate_per_s": 2)" + second_extra + "}]}"),
+        "scaled.json", kSource);
+    return std::pair{s.timeline.inflows.at(0).rate.points, s.timeline.inflows.at(1).rate.points};
+  };
+  using Points = std::vector<std::pair<double, double>>;
+  EXPECT_EQ(schedules("", ""), (std::pair{Points{{0.0, 1.0}, {10.0, 3.0}}, Points{{0.0, 2.0}}}));
+  EXPECT_EQ(schedules(R"("rate_scale": 1.5, )", ""), (std::pair{Points{{0.0, 1.5}, {10.0, 4.5}}, Points{{0.0, 3.0}}}));
+  EXPECT_EQ(schedules(R"("rate_scale": 0.5, )", R"(, "rate_scale": 3)"), (std::pair{Points{{0.0, 0.5}, {10.0, 1.5}}, Points{{0.0, 3.0}}}));
+  EXPECT_EQ(schedules(R"("rate_scale": 2, )", R"(, "max_rate_per_s": 3)"), (std::pair{Points{{0.0, 2.0}, {10.0, 6.0}}, Points{{0.0, 3.0}}}));
+  EXPECT_EQ(schedules(R"("rate_scale": 1, )", ""), schedules("", ""));
+}
+
 TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   const auto refuse = [](const std::string& timeline, const std::string& expected) {
     try {
@@ -400,8 +420,13 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"inflows": [{"entry": "from_court", "group": "staff", "rate_per_s": 1}]})", "group \"staff\" needs a \"target\"");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 1, "rate_scale": -0.5}]})", "/timeline/inflows/0/rate_scale: value -0.5 is out of range");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 200, "rate_scale": 8}]})",
-         "/timeline/inflows/0/rate_scale: scales the rate 200 persons/s at 0 s beyond 1000 persons/s");
+         "/timeline/inflows/0/rate_scale: scales inflow \"inflow1\"'s rate 200 persons/s at 0 s beyond 1000 persons/s");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 1, "max_rate_per_s": "slow"}]})", "/timeline/inflows/0/max_rate_per_s");
+  refuse(R"({"rate_scale": 11, "inflows": []})", "/timeline/rate_scale: value 11 is out of range");
+  refuse(R"({"rate_scale": 6, "inflows": [{"entry": "from_court", "rate_per_s": 200}]})",
+         "/timeline/rate_scale: scales inflow \"inflow1\"'s rate 200 persons/s at 0 s beyond 1000 persons/s");
+  refuse(R"({"rate_scale": 2, "inflows": [{"entry": "from_court", "rate_per_s": 200, "rate_scale": 3}]})",
+         "/timeline/inflows/0/rate_scale: scales inflow \"inflow1\"'s rate 200 persons/s at 0 s beyond 1000 persons/s (with the timeline's rate_scale)");
   refuse(R"({"events": [{"time_s": 1, "close_exit": "door"}]})", "/timeline/events/0/close_exit: the venue has no exit \"door\"");
   refuse(R"({"events": [{"time_s": 1, "set": {"restitution": 0.5}, "group": "main"}]})", "is the same for everyone");
   refuse(R"({"events": [{"time_s": 1, "set": {"integrator": 1}}]})", "cannot change during a run");

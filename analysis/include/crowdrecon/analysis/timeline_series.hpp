@@ -95,6 +95,17 @@ std::vector<TimelineMark> AvalanchesWithAreas(const TimelineSeries& s);
 // Centred moving mean over `window_s` (NaN values left out; NaN where a window has none).
 std::vector<double> MovingMean(const std::vector<double>& time_s, const std::vector<double>& values, double window_s);
 
+// When the run is clogged for good: the start of the stretch, reaching its
+// last frame, in which every direction present moves slower than
+// `stop_speed_m_per_s` in its desired direction (each direction's speed as a
+// moving mean over `smooth_s`); NaN if the last frame is not clogged or the
+// stretch is shorter than `min_s`. Defaults: the regime classifier's stop
+// speed and frozen window. The ensemble's score and a calibration's recorded
+// fatal clog both read it (docs/reports.md, docs/calibration.md).
+double ClogForGood(const TimelineSeries& s, double smooth_s = 10.0,
+                   double stop_speed_m_per_s = RegimeOptions{}.stop_speed_m_per_s,
+                   double min_s = RegimeOptions{}.frozen_window_s);
+
 // An exit's specific flow: people per metre of its width and second between
 // the times when 10 % and 90 % of those it let out had left (NaN if fewer
 // than 10 left).

@@ -93,6 +93,12 @@ struct EventMatch {
   std::string kind;  // stop, surge
   std::string where, direction;
   double from_s = 0.0, to_s = 0.0;
+  // Instead of counts, the time of the first onset in the window (the
+  // window's end where there is none): a recorded event that happens once,
+  // the Madrid night's fatal clog against the run's clog for good. The
+  // observed time and its uncertainty.
+  bool first_time = false;
+  double recorded_time_s = 0.0, recorded_sigma_s = 0.0;
 };
 
 struct ObservationMatch {
@@ -102,9 +108,12 @@ struct ObservationMatch {
   // five avalanches of the Madrid Arena, against the run's own events of
   // that kind, its event table) or "max_speed" (a speed read from the
   // footage at a mark, against the max_speed series of the run observed
-  // with `observation.spec`, the largest in a window around the mark).
+  // with `observation.spec`, the largest in a window around the mark) or
+  // "fatal" (the recorded fatal clog's time, against the time from which the
+  // run is clogged for good: analysis::ClogForGood).
   std::string recorded_kind;
   bool UsesRunEvents() const { return recorded_kind == "avalanche"; }
+  bool UsesRunClog() const { return recorded_kind == "fatal"; }
   observe::Observation observation;
   // Simulated time = observed time + offset (an experiment's clock against
   // the run's, which starts at 0).

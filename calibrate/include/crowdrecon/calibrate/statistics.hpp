@@ -20,6 +20,7 @@ struct Statistic {
   std::size_t observation = 0;  // index into CalibrationSpec::observations
   bool is_count = false;        // an event count (else a series' window mean, or largest bin)
   bool is_max = false;          // a series' largest bin in the window (SeriesMatch::take_max)
+  bool is_time = false;         // the first onset's time in the window, its end if none (EventMatch::first_time)
   std::string quantity;         // the series' quantity, or the events' kind
   std::string where, direction;
   double from_s = 0.0, to_s = 0.0;  // window (series) or [from, checkpoint] (counts), observed clock
