@@ -141,20 +141,25 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
       }
     }
     for (const EventMatch& e : m.events) {
-      if (e.first_time) {
+      // A statistic of the events over [from_s, to]: where, when, what it is read from.
+      const auto of_events = [&](double to) {
         Statistic st;
-        st.is_time = true;
         st.simulated_from = simulated_from;
-        st.name = tag + e.kind + " " + e.where + " " + e.direction + ": first in " + Window(e.from_s, e.to_s);
-        st.unit = "s";
         st.observation = i;
         st.quantity = e.kind;
         st.where = e.where;
         st.direction = e.direction;
         st.from_s = e.from_s;
-        st.to_s = e.to_s;
+        st.to_s = to;
         st.sim_from_s = e.from_s + m.time_offset_s;
-        st.sim_to_s = e.to_s + m.time_offset_s;
+        st.sim_to_s = to + m.time_offset_s;
+        return st;
+      };
+      if (e.first_time) {
+        Statistic st = of_events(e.to_s);
+        st.is_time = true;
+        st.name = tag + e.kind + " " + e.where + " " + e.direction + ": first in " + Window(e.from_s, e.to_s);
+        st.unit = "s";
         st.observed = e.recorded_time_s;
         st.observed_sigma = e.recorded_sigma_s;
         CheckWithinTheRuns(spec, m, st);
@@ -167,19 +172,10 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
         if (t >= e.from_s && t < e.to_s) checkpoints.push_back(t);
       checkpoints.push_back(e.to_s);
       for (std::size_t k = 0; k < checkpoints.size(); ++k) {
-        Statistic st;
+        Statistic st = of_events(checkpoints[k]);
         st.is_count = true;
-        st.simulated_from = simulated_from;
         st.name = tag + e.kind + "s " + e.where + " " + e.direction + " by " + FormatNumber(checkpoints[k]) + " s";
         st.unit = "events";
-        st.observation = i;
-        st.quantity = e.kind;
-        st.where = e.where;
-        st.direction = e.direction;
-        st.from_s = e.from_s;
-        st.to_s = checkpoints[k];
-        st.sim_from_s = e.from_s + m.time_offset_s;
-        st.sim_to_s = checkpoints[k] + m.time_offset_s;
         // Onsets at the checkpoint count (a count just after the event).
         st.observed = static_cast<double>(std::min(k + 1, checkpoints.size() - 1));
         st.observed_sigma = 0.5;
