@@ -28,6 +28,13 @@ std::string Fixed(double v, int digits) {
 
 namespace {
 
+// Where a statistic stands on the time axis of the fit figure: a count at
+// its checkpoint, a recorded event's time at that time, a window at its
+// middle.
+double WhereOnTheClock(const Statistic& st) {
+  return st.is_count ? st.to_s : st.is_time ? st.observed : 0.5 * (st.from_s + st.to_s);
+}
+
 // Every how many posterior samples one goes into posterior.csv.
 constexpr std::size_t kPosteriorFileEvery = 5;
 
@@ -439,7 +446,7 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
     for (std::size_t k : members) {
       const Statistic& st = r.objective.statistics[k];
       if (st.observation != first) continue;
-      x.push_back(st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s));
+      x.push_back(WhereOnTheClock(st));
       const double m = r.best_set.mean[k], sd = std::isfinite(r.best_set.sd[k]) ? r.best_set.sd[k] : 0.0;
       sim.push_back(m);
       lo.push_back(m - sd);
@@ -459,7 +466,7 @@ void DrawFit(const fs::path& file, const CalibrationResult& r) {
       for (std::size_t k : members) {
         const Statistic& st = r.objective.statistics[k];
         if (st.observation != o) continue;
-        ox.push_back((st.is_count ? st.to_s : 0.5 * (st.from_s + st.to_s)) + shift);
+        ox.push_back(WhereOnTheClock(st) + shift);
         oy.push_back(st.observed);
         oe.push_back(st.observed_sigma);
       }
