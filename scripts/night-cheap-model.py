@@ -216,6 +216,9 @@ def main():
     ap.add_argument("--paths", required=True, help="night-path.py's CSV of the whole nights")
     ap.add_argument("--sweep", action="append", required=True, help="a night-path-points sweep's output folder (keep_runs)")
     ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--confirm", help="night-path.py's CSV of whole nights run at another inflow scale (the confirmation)")
+    ap.add_argument("--confirm-scale", type=float, default=0.85, help="the inflow scale of those nights (and of the prediction)")
+    ap.add_argument("--confirm-end-s", type=float, default=5700.0, help="how far those nights were run (a night not jammed by then is censored)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -309,40 +312,83 @@ def main():
               f"- Their places in the predicted distribution (1 − S(t), uniform if the cheap model is right): {', '.join(f'{u:.2f}' for u in pits)}; "
               f"Kolmogorov–Smirnov distance {ks:.2f} (5 % critical value for 8 values: 0.457)."]
 
+    # A prediction at another inflow scale, and the whole nights run there to confirm it.
+    scaled = survival_curve(b_paper, use_rates, scale=args.confirm_scale)
+    lines += ["", f"## Prediction at the inflow scale {args.confirm_scale:g} (paper's Γ, λ), and whole nights run there", "",
+              "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
+              f"| cheap model at s = {args.confirm_scale:g} | " + " | ".join(fmt(quantile_time(scaled, q)) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |"]
+    if args.confirm:
+        confirm_paths = read_paths(args.confirm)
+        got = {}
+        for run, rows in confirm_paths.items():
+            got[run] = first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S)
+        def cdf_scaled(t):
+            s_at = 1.0
+            for tt, sv, _ in scaled:
+                if tt > t:
+                    break
+                s_at = sv
+            return 1.0 - s_at
+        lines += ["", f"- Whole nights at s = {args.confirm_scale:g}: " + ", ".join(
+            f"{run.split('-')[-1]} first jam {fmt(t)} (place in the prediction {cdf_scaled(t):.2f})" if t is not None else
+            f"{run.split('-')[-1]} no jam by {clock(max(r[0] for r in confirm_paths[run]))} (censored; the prediction gives {1 - cdf_scaled(max(r[0] for r in confirm_paths[run])):.2f} for that)"
+            for run, t in got.items()) + "."]
+
     # The recorded night on the cheap model, under two readings of its first jam.
     if varied:
         lines += ["", "## The recorded night on the cheap model", "",
                   "One recorded time per reading, its likelihood h(t) S(t) under the cheap model; parameters Γ and λ over the range the "
                   "surrogate was measured on (0.6–2.4, 13.5–54; log-spaced grid of 5 × 5) and the inflow schedule's scale s "
-                  "(a nuisance, 0.5–1.5, profiled out; or fixed at the scenario's 1).", "",
-                  "| reading of the recorded night's first jam | best Γ, λ, s | Γ within Δ(−2 ln L) < 3.84 | λ within 3.84 | with s = 1: best Γ, λ; Γ within; λ within | median first jam at the best |",
+                  "(a nuisance, 0.5–1.5 in steps of 0.1, profiled out; or fixed at the scenario's 1). The likelihood with the surrogate's best coefficients, "
+                  "and averaged over 60 draws of them from their covariance (the surrogate's own uncertainty: 59 runs).", "",
+                  "| reading of the recorded night's first jam | likelihood | best Γ, λ, s | Γ within Δ(−2 ln L) < 3.84 | λ within 3.84 | median first jam at the best |",
                   "| --- | --- | --- | --- | --- | --- |"]
         gammas = [0.6 * 4 ** (k / 4) for k in range(5)]
         lambdas = [13.5 * 4 ** (k / 4) for k in range(5)]
+        scales = [0.5 + 0.1 * k for k in range(11)]
+        # The surrogate's own uncertainty: the likelihood averaged over draws of its coefficients.
+        chol_all = cholesky(cov_all)
+        draws_rng = random.Random(7)
+        draws = []
+        for _ in range(60):
+            z = [draws_rng.gauss(0, 1) for _ in b_all]
+            draws.append([b_all[i] + sum(chol_all[i][j] * z[j] for j in range(i + 1)) for i in range(len(b_all))])
         for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0),
                               ("the fatal clog, 03:33 (the avalanches before it as stops the cheap model does not resolve)", FATAL_CLOG_S)):
-            def nll(gamma, lam, scale):
-                c = survival_curve(b_all, use_all, gamma, lam, scale, dt=10.0)
+            def likelihood(beta, gamma, lam, scale):
+                c = survival_curve(beta, use_all, gamma, lam, scale, dt=20.0)
                 i = min(range(len(c)), key=lambda k: abs(c[k][0] - target))
-                return -2.0 * (math.log(max(c[i][2], 1e-300)) + math.log(max(c[i][1], 1e-300))), quantile_time(c, 0.5)
-            free, fixed = [], []
-            for gamma in gammas:
-                for lam in lambdas:
-                    best = min((nll(gamma, lam, 0.5 + 0.05 * k) + (0.5 + 0.05 * k,) for k in range(21)), key=lambda v: v[0])
-                    free.append((gamma, lam, best[2], best[0], best[1]))
-                    one = nll(gamma, lam, 1.0)
-                    fixed.append((gamma, lam, 1.0, one[0], one[1]))
+                return c[i][2] * c[i][1]
 
-            def summary(rows):
+            def nll(gamma, lam, scale, marginal):
+                if not marginal:
+                    return -2.0 * math.log(max(likelihood(b_all, gamma, lam, scale), 1e-300))
+                return -2.0 * math.log(max(sum(likelihood(b, gamma, lam, scale) for b in draws) / len(draws), 1e-300))
+
+            def summary(marginal, scale_fixed):
+                rows = []
+                for gamma in gammas:
+                    for lam in lambdas:
+                        options = [1.0] if scale_fixed else scales
+                        v, sc = min((nll(gamma, lam, x, marginal), x) for x in options)
+                        rows.append((gamma, lam, sc, v))
                 top = min(r[3] for r in rows)
                 b = min(rows, key=lambda r: r[3])
                 ok = [r for r in rows if r[3] - top < 3.84]
                 g = sorted({r[0] for r in ok})
                 l = sorted({r[1] for r in ok})
-                return b, f"{g[0]:.2g}–{g[-1]:.2g} ({len(g)} of 5)", f"{l[0]:.3g}–{l[-1]:.3g} ({len(l)} of 5)"
-            bf, gf, lf = summary(free)
-            b1, g1, l1 = summary(fixed)
-            lines.append(f"| {label} | {bf[0]:.2g}, {bf[1]:.3g}, {bf[2]:.2f} | {gf} | {lf} | {b1[0]:.2g}, {b1[1]:.3g}; {g1}; {l1} | {fmt(bf[4])} |")
+                if marginal:  # the predictive median: the draws' survival averaged
+                    curves = [survival_curve(d, use_all, b[0], b[1], b[2], dt=20.0) for d in draws]
+                    mean_curve = [(curves[0][k][0], sum(c[k][1] for c in curves) / len(curves), 0.0) for k in range(len(curves[0]))]
+                    med = quantile_time(mean_curve, 0.5)
+                else:
+                    med = quantile_time(survival_curve(b_all, use_all, b[0], b[1], b[2], dt=20.0), 0.5)
+                return f"{b[0]:.2g}, {b[1]:.3g}, {b[2]:.1f} | {g[0]:.2g}–{g[-1]:.2g} ({len(g)} of 5) | {l[0]:.3g}–{l[-1]:.3g} ({len(l)} of 5) | {fmt(med)}"
+            for marginal in (False, True):
+                for fixed_scale in (False, True):
+                    how = ("surrogate averaged over its uncertainty" if marginal else "surrogate's best coefficients") + \
+                          ("; s = 1" if fixed_scale else "; s profiled")
+                    lines.append(f"| {label} | {how} | {summary(marginal, fixed_scale)} |")
 
     with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
