@@ -340,7 +340,7 @@ def main():
                   "One recorded time per reading, its likelihood h(t) S(t) under the cheap model; parameters Γ and λ over the range the "
                   "surrogate was measured on (0.6–2.4, 13.5–54; log-spaced grid of 5 × 5) and the inflow schedule's scale s "
                   "(a nuisance, 0.5–1.5 in steps of 0.1, profiled out; or fixed at the scenario's 1). The likelihood with the surrogate's best coefficients, "
-                  "and averaged over 60 draws of them from their covariance (the surrogate's own uncertainty: 59 runs).", "",
+                  "and averaged over 60 draws of them from their covariance (the surrogate's own uncertainty).", "",
                   "| reading of the recorded night's first jam | likelihood | best Γ, λ, s | Γ within Δ(−2 ln L) < 3.84 | λ within 3.84 | median first jam at the best |",
                   "| --- | --- | --- | --- | --- | --- |"]
         gammas = [0.6 * 4 ** (k / 4) for k in range(5)]
