@@ -27,6 +27,9 @@ s["venue"] = src + "/venues/madrid-arena/hallway-periodic.json"
 s["population"]["body"]["reference"] = src + "/venues/bodies/thorax-18.json"
 s["population"]["density_per_m2"] = 2.0
 s["run"]["duration_s"] = 2.0
+# A recorded fatal clog (issue 41): compared as a time with each run's clog
+# for good (none in 2 s: the window's end).
+s["timeline"] = {"recorded": [{"time_s": 1.5, "label": "fatal clog", "kind": "fatal"}]}
 json.dump(s, open(d + "/scenario.json", "w"))
 s["model"] = {"back_force_gamma": 2.5}
 s["population"]["seed"] = 9
@@ -35,7 +38,8 @@ c = {"format": "crowdrecon-calibration", "version": 1, "name": "smoke", "scenari
      "parameters": [{"path": "model.back_force_gamma", "min": 0.5, "max": 4.5}],
      "observations": [{"file": "truth.observation.json", "series": [
          {"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0.4, "to_s": 2, "window_s": 0.8},
-         {"quantity": "share_still", "where": "hallway", "direction": "all", "from_s": 0.4, "to_s": 2}]}],
+         {"quantity": "share_still", "where": "hallway", "direction": "all", "from_s": 0.4, "to_s": 2}]},
+                      {"recorded": {"kind": "fatal", "uncertainty_s": 0.5}}],
      "seeds": {"first": 1, "count": 2}, "starts": [{"model.back_force_gamma": 4}],
      "options": {"refinements": 1, "bootstrap": 20, "profile_points": 3}}
 json.dump(c, open(d + "/calibration.json", "w"))
@@ -58,6 +62,12 @@ assert len(c["parameters"]) == 1 and c["parameters"][0]["determination"] in ("de
 assert len(c["starts"]) == 2 and len(c["profiles"]["model.back_force_gamma"]) == 3
 assert len(rows) == len(c["evaluations"]) == c["sets_evaluated"], (len(rows), len(c["evaluations"]))
 assert all(s["sigma"] is None or s["sigma"] > 0 for s in c["statistics"])
+# The recorded fatal clog: one statistic, the runs' value the window's end
+# (no run clogs for good in 2 s), read from a cached clog file per run.
+import glob, os
+clog = [s for s in c["statistics"] if "clog run crowd" in s["name"]]
+assert len(clog) == 1 and clog[0]["observed"] == 1.5 and clog[0]["simulated_at_best"] == 2.0, clog
+assert len(glob.glob(os.path.dirname(sys.argv[1]) + "/cache/*/seed1-clog.json")) == len(rows), "no clog file per set"
 # The posterior (issue 41): its intervals nest inside the bounds, its samples
 # (every fifth in posterior.csv) lie inside them too.
 post, par = c["posterior"], c["parameters"][0]
