@@ -163,6 +163,16 @@ def survival_curve(beta, use, gamma=GAMMA0, lam=LAMBDA0, scale=1.0, dt=5.0):
     return out
 
 
+def jammed_by(curve, t):
+    """The predicted share of nights jammed by t: 1 - S(t), S stepwise from the curve."""
+    s_at = 1.0
+    for tt, s, _ in curve:
+        if tt > t:
+            break
+        s_at = s
+    return 1.0 - s_at
+
+
 def quantile_time(curve, q):
     """The time by which a share q of nights have jammed (None: later than the night)."""
     for t, s, _ in curve:
@@ -285,14 +295,7 @@ def main():
     observed = sorted(t for t in nights.values() if t is not None)
     obs_median = (observed[(len(observed) - 1) // 2] + observed[len(observed) // 2]) / 2 if observed else float("nan")
     # Probability integral transform of each night under the predicted distribution.
-    def cdf(t):
-        s_at = 1.0
-        for tt, s, _ in curve:
-            if tt > t:
-                break
-            s_at = s
-        return 1.0 - s_at
-    pits = sorted(cdf(t) for t in observed)
+    pits = sorted(jammed_by(curve, t) for t in observed)
     ks = max(max(abs((i + 1) / len(pits) - u), abs(i / len(pits) - u)) for i, u in enumerate(pits)) if pits else float("nan")
     pred = {q: quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9)}
 
@@ -323,12 +326,7 @@ def main():
         for run, rows in confirm_paths.items():
             got[run] = first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S)
         def cdf_scaled(t):
-            s_at = 1.0
-            for tt, sv, _ in scaled:
-                if tt > t:
-                    break
-                s_at = sv
-            return 1.0 - s_at
+            return jammed_by(scaled, t)
         lines += ["", f"- Whole nights at s = {args.confirm_scale:g}: " + ", ".join(
             f"{run.split('-')[-1]} first jam {fmt(t)} (place in the prediction {cdf_scaled(t):.2f})" if t is not None else
             f"{run.split('-')[-1]} no jam by {clock(max(r[0] for r in confirm_paths[run]))} (censored; the prediction gives {1 - cdf_scaled(max(r[0] for r in confirm_paths[run])):.2f} for that)"
