@@ -26,11 +26,12 @@ import csv
 import json
 import math
 import os
-import shutil
 import sqlite3
 import statistics
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from svg_png import svg_to_png  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FOOT_Y = 1.0           # the alley's foot line (venue: alley_foot_line)
@@ -162,12 +163,7 @@ def main():
     name = sqlite3.connect(f"file:{os.path.join(args.sweep, 'results.sqlite')}?mode=ro", uri=True).execute(
         "select value from sweep where key = 'name'").fetchone()[0]
     draw(table, designs, os.path.join(args.out, "envelope.svg"), name)
-    browser = shutil.which("chromium") or shutil.which("chromium-browser")
-    if browser:  # the PNG: the SVG as a headless browser draws it
-        subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-                        f"--screenshot={os.path.abspath(os.path.join(args.out, 'envelope.png'))}", "--window-size=980,560",
-                        "file://" + os.path.abspath(os.path.join(args.out, "envelope.svg"))],
-                       check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    svg_to_png(os.path.join(args.out, "envelope.svg"), os.path.join(args.out, "envelope.png"), 980, 560)
 
 
 def same(a, b):

@@ -37,11 +37,12 @@ import importlib.util
 import math
 import os
 import random
-import shutil
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from svg_png import svg_to_png  # noqa: E402
+
 spec = importlib.util.spec_from_file_location("night_path", os.path.join(HERE, "night-path.py"))
 night_path = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(night_path)
@@ -403,13 +404,7 @@ def main():
     with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, (lo, hi), paths)
-    browser = shutil.which("chromium") or shutil.which("chromium-browser")
-    if browser:
-        svg = os.path.abspath(os.path.join(args.out, "cheap-model.svg"))
-        subprocess.run([browser, "--headless", "--disable-gpu", "--no-sandbox", "--hide-scrollbars",
-                        f"--screenshot={os.path.abspath(os.path.join(args.out, 'cheap-model.png'))}",
-                        "--window-size=1200,900", "file://" + svg], check=False,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    svg_to_png(os.path.join(args.out, "cheap-model.svg"), os.path.join(args.out, "cheap-model.png"), 1200, 900)
     print("\n".join(lines))
 
 

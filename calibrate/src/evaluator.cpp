@@ -28,8 +28,8 @@ using nlohmann::json;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const std::string kRunEvents = "run events";
-const std::string kRunClog = "run clog";
+const std::string kRunEvents = ObservationMatch::kFromRunEvents;
+const std::string kRunClog = ObservationMatch::kFromRunClog;
 
 // The run's own events of the kinds a calibration can match (avalanches,
 // detected during the run: docs/scenarios.md), as an observation's events:
@@ -125,18 +125,17 @@ Evaluator::Evaluator(const CalibrationSpec& spec, const std::vector<Statistic>& 
                      bool show_progress)
     : spec_(spec), statistics_(statistics), dir_(std::move(dir)), jobs_(jobs), show_progress_(show_progress) {
   for (const ObservationMatch& m : spec_.observations) {
-    // The scenario's recorded events compare with the run's event table: one
-    // file per run of that table's events, whatever the spec.
-    const std::string j = m.UsesRunEvents() ? kRunEvents
-                          : m.UsesRunClog() ? kRunClog
-                                            : observe::SpecToJson(m.observation.spec);
+    // The scenario's recorded events compare with the run's event table, its
+    // recorded fatal clog with the run's clog for good: one file per run of
+    // each, whatever the spec.
+    const std::string j = m.SimulatedFrom();
     std::size_t k = 0;
     while (k < spec_json_.size() && spec_json_[k] != j) ++k;
     if (k == spec_json_.size()) {
       spec_json_.push_back(j);
-      const bool from_run = j == kRunEvents || j == kRunClog;
-      specs_.push_back(from_run ? observe::ObservationSpec{} : m.observation.spec);
-      spec_tag_.push_back(j == kRunEvents ? std::string("events") : j == kRunClog ? std::string("clog") : Sha256Hex(j).substr(0, 12));
+      const std::string from_run = j == kRunEvents ? "events" : j == kRunClog ? "clog" : "";
+      specs_.push_back(from_run.empty() ? m.observation.spec : observe::ObservationSpec{});
+      spec_tag_.push_back(from_run.empty() ? Sha256Hex(j).substr(0, 12) : from_run);
     }
     spec_of_observation_.push_back(k);
   }

@@ -104,9 +104,7 @@ std::vector<Statistic> ObservedStatistics(const CalibrationSpec& spec) {
   for (std::size_t i = 0; i < spec.observations.size(); ++i) {
     const ObservationMatch& m = spec.observations[i];
     const std::string tag = "obs" + std::to_string(i) + " ";
-    const std::string simulated_from = m.UsesRunEvents() ? "run events"
-                                       : m.UsesRunClog() ? "run clog"
-                                                         : observe::SpecToJson(m.observation.spec);
+    const std::string simulated_from = m.SimulatedFrom();
     for (const SeriesMatch& s : m.series) {
       const observe::Series* series = m.observation.Find(s.quantity, s.where, s.direction);
       const double width = s.window_s > 0 ? s.window_s : s.to_s - s.from_s;

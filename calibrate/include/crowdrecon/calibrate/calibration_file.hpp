@@ -114,6 +114,14 @@ struct ObservationMatch {
   std::string recorded_kind;
   bool UsesRunEvents() const { return recorded_kind == "avalanche"; }
   bool UsesRunClog() const { return recorded_kind == "fatal"; }
+  // What the runs' values of this match are computed from, one text for the
+  // statistics (Statistic::simulated_from) and the evaluator's cache:
+  // kFromRunEvents, kFromRunClog or the observation spec as JSON.
+  std::string SimulatedFrom() const {
+    return UsesRunEvents() ? kFromRunEvents : UsesRunClog() ? kFromRunClog : observe::SpecToJson(observation.spec);
+  }
+  static constexpr const char* kFromRunEvents = "run events";
+  static constexpr const char* kFromRunClog = "run clog";
   observe::Observation observation;
   // Simulated time = observed time + offset (an experiment's clock against
   // the run's, which starts at 0).
