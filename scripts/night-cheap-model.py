@@ -52,6 +52,8 @@ STAY_S = 30.0
 STILL_M_PER_S = 0.1
 NIGHT_AFTER_S = 300.0
 CHEAP_AFTER_S = 60.0
+CHEAP_RUN_S = 600.0
+AGE_WINDOWS_S = [60.0, 600.0, 1200.0, 1800.0, float("inf")]
 NIGHT_END_S = 5700.0
 GAMMA0, LAMBDA0 = 1.2, 27.0
 M0, C0 = 2.25, 1.6
@@ -81,8 +83,9 @@ def night_rates(t, scale=1.0):
     return scale * (3.0 - 2.0 * t / 5700.0), scale * (0.2 + 3.8 * t / 5700.0)
 
 
-def covariates(m, c, gamma, lam):
-    return [1.0, m - M0, c - C0, math.log(gamma / GAMMA0), math.log(lam / LAMBDA0)]
+def covariates(m, c, gamma, lam, adaptive=False):
+    """The surrogate's covariates; the last says the run took the adaptive step (the whole nights did)."""
+    return [1.0, m - M0, c - C0, math.log(gamma / GAMMA0), math.log(lam / LAMBDA0), 1.0 if adaptive else 0.0]
 
 
 # --- small linear algebra (no numpy on the machines this runs on) ---
@@ -147,19 +150,19 @@ def fit_hazard(runs, use):
     return beta, cov, ll
 
 
-def hazard(beta, use, m, c, gamma=GAMMA0, lam=LAMBDA0):
-    x = covariates(m, c, gamma, lam)
+def hazard(beta, use, m, c, gamma=GAMMA0, lam=LAMBDA0, adaptive=False):
+    x = covariates(m, c, gamma, lam, adaptive)
     return math.exp(sum(b * x[k] for b, k in zip(beta, use)))
 
 
-def survival_curve(beta, use, gamma=GAMMA0, lam=LAMBDA0, scale=1.0, dt=5.0):
+def survival_curve(beta, use, gamma=GAMMA0, lam=LAMBDA0, scale=1.0, dt=5.0, adaptive=False):
     """[(t, S(t), h(t))] from NIGHT_AFTER_S to the night's end."""
-    out = [(NIGHT_AFTER_S, 1.0, hazard(beta, use, *night_rates(NIGHT_AFTER_S, scale), gamma, lam))]
+    out = [(NIGHT_AFTER_S, 1.0, hazard(beta, use, *night_rates(NIGHT_AFTER_S, scale), gamma, lam, adaptive))]
     cum = 0.0
     t = NIGHT_AFTER_S
     while t < NIGHT_END_S - 1e-9:
         h0 = out[-1][2]
-        h1 = hazard(beta, use, *night_rates(t + dt, scale), gamma, lam)
+        h1 = hazard(beta, use, *night_rates(t + dt, scale), gamma, lam, adaptive)
         cum += 0.5 * (h0 + h1) * dt
         t += dt
         out.append((t, math.exp(-cum), h1))
@@ -196,6 +199,7 @@ def read_sweep(folder):
         c = scenario["timeline"]["inflows"][1]["rate_per_s"]
         gamma = scenario["model"].get("back_force_gamma", GAMMA0)
         lam = scenario["model"].get("torsion_stiffness_lambda", LAMBDA0)
+        step = scenario["model"].get("time_step_mode", "fixed")
         rows = night_path.read_run(run_file, SAMPLE_S)
         onset = first_jam([(r["time_s"], r["mean_speed_m_per_s"]) for r in rows], CHEAP_AFTER_S)
         end = rows[-1]["time_s"]
@@ -203,12 +207,164 @@ def read_sweep(folder):
         pre = [r for r in rows if r["time_s"] >= CHEAP_AFTER_S and (onset is None or r["time_s"] < onset)]
         runs.append({
             "run": row["run_id"], "variant": row["variant"], "seed": int(row["seed"]),
-            "leaving_per_s": m, "entering_per_s": c, "gamma": gamma, "lambda": lam,
-            "jammed": 0 if onset is None else 1, "onset_s": onset, "exposure_s": exposure,
+            "leaving_per_s": m, "entering_per_s": c, "gamma": gamma, "lambda": lam, "step": step,
+            "jammed": 0 if onset is None else 1, "onset_s": onset, "exposure_s": exposure, "end_s": end,
             "pre_jam_density_per_m2": sum(r["density_per_m2"] for r in pre) / len(pre) if pre else float("nan"),
-            "x": covariates(m, c, gamma, lam),
+            "x": covariates(m, c, gamma, lam, step == "adaptive"),
         })
     return runs
+
+
+def age_pieces(run):
+    """A run's exposure cut at AGE_WINDOWS_S (piecewise exponential): [(window index, jammed, exposure s)]."""
+    stop = run["onset_s"] if run["onset_s"] is not None else run["end_s"] - STAY_S
+    out = []
+    for k in range(len(AGE_WINDOWS_S) - 1):
+        a, b = AGE_WINDOWS_S[k], AGE_WINDOWS_S[k + 1]
+        if stop <= a:
+            break
+        jammed = 1 if run["onset_s"] is not None and a <= run["onset_s"] < b else 0
+        out.append((k, jammed, min(stop, b) - a))
+    return out
+
+
+def age_section(long_runs):
+    """Does the first jam's hazard grow with the time the hallway has been fed? Long runs, cut into windows."""
+    def window(k):
+        b = AGE_WINDOWS_S[k + 1]
+        return f"{AGE_WINDOWS_S[k]:.0f}–{'end' if b == float('inf') else f'{b:.0f}'} s"
+    points = sorted({(r["leaving_per_s"], r["entering_per_s"]) for r in long_runs})
+    n_windows = len(AGE_WINDOWS_S) - 1
+    out = ["", f"## The hazard against the run's age ({len(long_runs)} runs of {max(r['end_s'] for r in long_runs):.0f} s, "
+           f"{long_runs[0]['step']} step; jams / exposure per window)", "",
+           "| leaving / entering persons/s | runs | first jams at (s) | " + " | ".join(window(k) for k in range(n_windows)) + " |",
+           "| --- | --- | --- | " + " | ".join("---" for _ in range(n_windows)) + " |"]
+    total = [[0, 0.0] for _ in range(n_windows)]
+    pieces = []
+    for m, c in points:
+        rs = [r for r in long_runs if (r["leaving_per_s"], r["entering_per_s"]) == (m, c)]
+        cell = [[0, 0.0] for _ in range(n_windows)]
+        for r in rs:
+            for k, d, e in age_pieces(r):
+                cell[k][0] += d
+                cell[k][1] += e
+                total[k][0] += d
+                total[k][1] += e
+                pieces.append({"jammed": d, "exposure_s": e, "x": r["x"] + [1.0 if k > 0 else 0.0]})
+        onsets = ", ".join(f"{r['onset_s']:.0f}" for r in rs if r["onset_s"] is not None) or "none"
+        out.append(f"| {m:g} / {c:g} | {len(rs)} | {onsets} | " + " | ".join(f"{d} / {e:.0f} s" for d, e in cell) + " |")
+    out.append("| all | " + f"{len(long_runs)} | | " + " | ".join(f"{d} / {e:.0f} s ({600 * d / e:.2f} per 10 min)" if e > 0 else "–" for d, e in total) + " |")
+    use = [0, 1, 2, 6]
+    if sum(p["jammed"] for p in pieces) >= 3 and any(p["x"][6] for p in pieces if p["jammed"]) and any(not p["x"][6] for p in pieces if p["jammed"]):
+        beta, cov, ll = fit_hazard(pieces, use)
+        _, _, ll0 = fit_hazard(pieces, [0, 1, 2])
+        lr = 2.0 * (ll - ll0)
+        se = math.sqrt(cov[3][3])
+        out += ["", f"- The hazard after the first {AGE_WINDOWS_S[1]:.0f} s against before it (the rates as covariates): × {math.exp(beta[3]):.2f} "
+                f"(95 %: {math.exp(beta[3] - 1.96 * se):.2f}–{math.exp(beta[3] + 1.96 * se):.2f}); likelihood ratio {lr:.2f}, "
+                f"p = {math.erfc(math.sqrt(max(lr, 0.0) / 2.0)):.3g} (χ², one degree of freedom)."]
+    else:
+        out += ["", "- Too few first jams on either side of 600 s for a hazard ratio."]
+    return out
+
+
+def cumulative_hazard(beta, use, scale, t_end, dt=5.0):
+    """∫ h from NIGHT_AFTER_S to t_end along the schedule at `scale` (trapezoid)."""
+    total, t = 0.0, NIGHT_AFTER_S
+    while t < t_end - 1e-9:
+        step = min(dt, t_end - t)
+        total += 0.5 * (hazard(beta, use, *night_rates(t, scale)) + hazard(beta, use, *night_rates(t + step, scale))) * step
+        t += step
+    return total
+
+
+def night_offset(beta, use, whole):
+    """The factor e^δ on the cheap hazard that the whole nights say: δ's maximum likelihood and its standard error.
+    whole: [(scale, first jam or None, end of the night's run)]."""
+    jams = sum(1 for _, t, _ in whole if t is not None)
+    exposure = sum(cumulative_hazard(beta, use, s, t if t is not None else end) for s, t, end in whole)
+    return math.log(jams / exposure), 1.0 / math.sqrt(jams)
+
+
+def shifted(beta, delta):
+    return [beta[0] + delta] + beta[1:]
+
+
+def corrected_section(beta, use, whole, other_scale):
+    """A one-factor correction of the cheap model fitted to whole nights, checked across the inflow scales, and the
+    recorded night's inflow scale on the corrected model."""
+    def places(b, nights_at):
+        out = []
+        for s, t, end in nights_at:
+            curve = survival_curve(b, use, scale=s)
+            out.append((jammed_by(curve, t), True) if t is not None else (jammed_by(curve, end), False))
+        return out
+
+    def median_error(b, nights_at):
+        s = nights_at[0][0]
+        jammed = sorted(t for _, t, _ in nights_at if t is not None)
+        if len(jammed) != len(nights_at):
+            return "not all jammed"
+        obs = (jammed[(len(jammed) - 1) // 2] + jammed[len(jammed) // 2]) / 2
+        pred = quantile_time(survival_curve(b, use, scale=s), 0.5)
+        if pred is None:
+            return "the prediction's median after 03:35"
+        n = len(jammed)
+        u = sorted(p for p, _ in places(b, nights_at))
+        ks = max(max((i + 1) / n - x, x - i / n) for i, x in enumerate(u))
+        return f"median {clock(pred)} against {clock(obs)} ({pred - obs:+.0f} s), places {', '.join(f'{x:.2f}' for x in u)}, KS {ks:.2f} (5 %: {KS_CRITICAL_5.get(n, float('nan')):.3f})"
+
+    at_one = [w for w in whole if w[0] == 1.0]
+    at_other = [w for w in whole if w[0] != 1.0]
+    out = ["", "## The cheap model corrected by whole nights (one factor on its hazard)", "",
+           "The whole nights' first jams against the cheap hazard h along the schedule: h_night = e^δ h, δ by maximum "
+           "likelihood (e^δ = jams / Σ ∫h, each night from 300 s to its first jam or its end), its standard error 1/√jams. "
+           "Checked across the inflow scales: δ from the nights at one scale predicts the nights at the other.", "",
+           "| δ fitted on | nights | e^δ (95 %) | predicts the nights at | prediction against them |", "| --- | --- | --- | --- | --- |"]
+    for fit_on, test_on, label_fit, label_test in ((at_one, at_other, "s = 1", f"s = {other_scale:g}"),
+                                                   (at_other, at_one, f"s = {other_scale:g}", "s = 1")):
+        if not fit_on or not test_on:
+            continue
+        d, se = night_offset(beta, use, fit_on)
+        out.append(f"| {label_fit} | {len(fit_on)} | {math.exp(d):.2f} ({math.exp(d - 1.96 * se):.2f}–{math.exp(d + 1.96 * se):.2f}) | "
+                   f"{label_test} | {median_error(shifted(beta, d), test_on)} |")
+    d, se = night_offset(beta, use, whole)
+    out.append(f"| all | {len(whole)} | {math.exp(d):.2f} ({math.exp(d - 1.96 * se):.2f}–{math.exp(d + 1.96 * se):.2f}) | (in-sample) s = 1 | "
+               f"{median_error(shifted(beta, d), at_one)} |")
+
+    # The recorded night on the corrected model: the inflow's scale from one recorded time, δ's uncertainty integrated out.
+    out += ["", "### The recorded night's inflow scale on the corrected model (paper's Γ, λ)", "",
+            "One recorded time per reading; likelihood h(t) S(t) averaged over δ ~ N(δ̂, se²) (41 points); s on a grid of 0.01.", "",
+            "| reading of the recorded night's first jam | best s | s within Δ(−2 ln L) < 3.84 | median first jam at the best s |",
+            "| --- | --- | --- | --- |"]
+    deltas = [d + se * z for z in [-3.0 + 0.15 * k for k in range(41)]]
+    weights = [math.exp(-0.5 * ((x - d) / se) ** 2) for x in deltas]
+    fitted = []
+    for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0),
+                          ("the fatal clog, 03:33", FATAL_CLOG_S)):
+        rows = []
+        for k in range(50, 151):
+            scale = k / 100.0
+            base = survival_curve(beta, use, scale=scale, dt=10.0)
+            i = min(range(len(base)), key=lambda j: abs(base[j][0] - target))
+            t_i, s_i, h_i = base[i]
+            cum = -math.log(max(s_i, 1e-300))
+            like = sum(w * math.exp(x) * h_i * math.exp(-math.exp(x) * cum) for x, w in zip(deltas, weights)) / sum(weights)
+            rows.append((scale, -2.0 * math.log(max(like, 1e-300))))
+        top = min(v for _, v in rows)
+        best = min(rows, key=lambda r: r[1])[0]
+        inside = [sc for sc, v in rows if v - top < 3.84]
+        med = quantile_time(survival_curve(shifted(beta, d), use, scale=best), 0.5)
+        out.append(f"| {label} | {best:.2f} | {inside[0]:.2f}–{inside[-1]:.2f} | {clock(med) if med is not None else 'after 03:35'} |")
+        fitted.append(best)
+    out += ["", "### The first jam predicted at those scales (paper's Γ, λ)", "",
+            "| model | inflow scale | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    for scale in fitted:
+        for label, b in (("cheap model", beta), ("corrected by the 12 whole nights", shifted(beta, d))):
+            curve = survival_curve(b, use, scale=scale)
+            out.append(f"| {label} | {scale:.2f} | " + " | ".join(
+                clock(t) if t is not None else "after 03:35" for t in (quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9))) + " |")
+    return out
 
 
 def read_paths(paths_csv):
@@ -247,103 +403,143 @@ def main():
         for r in runs:
             w.writerow({k: r[k] for k in keys})
 
-    paper = [r for r in runs if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+    # The surrogate is built on the 600-s runs; longer ones answer whether the hazard grows with the run's age.
+    long_runs = [r for r in runs if r["end_s"] > CHEAP_RUN_S + 1.0]
+    runs = [r for r in runs if r["end_s"] <= CHEAP_RUN_S + 1.0]
+    fixed = [r for r in runs if r["step"] == "fixed"]
+    adaptive = [r for r in runs if r["step"] == "adaptive"]
+    paper = [r for r in fixed if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
     use_rates = [0, 1, 2]
     b_paper, cov_paper, _ = fit_hazard(paper, use_rates)
-    varied = len({(r["gamma"], r["lambda"]) for r in runs}) > 1
+    varied = len({(r["gamma"], r["lambda"]) for r in fixed}) > 1
     use_all = [0, 1, 2, 3, 4] if varied else use_rates
-    b_all, cov_all, _ = fit_hazard(runs, use_all)
+    b_all, cov_all, _ = fit_hazard(fixed, use_all)
 
     lines = ["# The Madrid night's cheap forward model: tables", "",
              "Written by `scripts/night-cheap-model.py` (its docstring defines the model and the first jam).", ""]
 
-    # The grid: jams and exposure per point, per parameter set.
+    # The grid: jams and exposure per point, per parameter set and step.
     lines += ["## The cheap runs: first jams per grid point", "",
-              "| Γ, λ | leaving / entering persons/s | runs | jammed | first jams at (s) | exposure (s) | jams per 10 min (raw) | hallway before its jam (persons/m²) |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "| step | Γ, λ | leaving / entering persons/s | runs | jammed | first jams at (s) | exposure (s) | jams per 10 min (raw) | hallway before its jam (persons/m²) |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     cells = collections.defaultdict(list)
     for r in runs:
-        cells[(r["gamma"], r["lambda"], r["leaving_per_s"], r["entering_per_s"])].append(r)
-    for key in sorted(cells):
+        cells[(r["gamma"], r["lambda"], r["leaving_per_s"], r["entering_per_s"], r["step"])].append(r)
+    for key in sorted(cells, key=lambda k: (k[4] != "fixed", k[:4])):
         rs = cells[key]
         d = sum(r["jammed"] for r in rs)
         t = sum(r["exposure_s"] for r in rs)
         onsets = ", ".join(f"{r['onset_s']:.0f}" for r in rs if r["onset_s"] is not None) or "none"
         dens = sum(r["pre_jam_density_per_m2"] for r in rs) / len(rs)
-        lines.append(f"| {key[0]:g}, {key[1]:g} | {key[2]:g} / {key[3]:g} | {len(rs)} | {d} | {onsets} | {t:.0f} | {600 * d / t:.2f} | {dens:.2f} |")
+        lines.append(f"| {key[4]} | {key[0]:g}, {key[1]:g} | {key[2]:g} / {key[3]:g} | {len(rs)} | {d} | {onsets} | {t:.0f} | {600 * d / t:.2f} | {dens:.2f} |")
 
     def coef_table(beta, cov, use, title):
-        names = ["ln h at (2.25, 1.6)", "per person/s leaving", "per person/s entering", "per ln(Γ/1.2)", "per ln(λ/27)"]
+        names = ["ln h at (2.25, 1.6)", "per person/s leaving", "per person/s entering", "per ln(Γ/1.2)", "per ln(λ/27)",
+                 "adaptive step (against fixed)"]
         out = ["", f"## {title}", "", "| coefficient | value | standard error |", "| --- | --- | --- |"]
         for i, k in enumerate(use):
             out.append(f"| {names[k]} | {beta[i]:.3f} | {math.sqrt(cov[i][i]):.3f} |")
         return out
 
-    lines += coef_table(b_paper, cov_paper, use_rates, f"The hazard at the paper's Γ and λ ({len(paper)} runs, {sum(r['jammed'] for r in paper)} first jams)")
+    lines += coef_table(b_paper, cov_paper, use_rates, f"The hazard at the paper's Γ and λ, fixed step ({len(paper)} runs, {sum(r['jammed'] for r in paper)} first jams)")
     if varied:
-        lines += coef_table(b_all, cov_all, use_all, f"The surrogate over Γ and λ ({len(runs)} runs, {sum(r['jammed'] for r in runs)} first jams)")
-
-    # Prediction of the whole nights at the paper's parameters.
-    curve = survival_curve(b_paper, use_rates)
-    rng = random.Random(41)
-    chol = cholesky(cov_paper)
-    medians = []
-    for _ in range(400):
-        z = [rng.gauss(0, 1) for _ in b_paper]
-        b = [b_paper[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(b_paper))]
-        q = quantile_time(survival_curve(b, use_rates, dt=20.0), 0.5)
-        medians.append(q if q is not None else float("inf"))
-    medians.sort()
-    lo, hi = medians[int(0.025 * len(medians))], medians[int(0.975 * len(medians)) - 1]
-    observed = sorted(t for t in nights.values() if t is not None)
-    obs_median = (observed[(len(observed) - 1) // 2] + observed[len(observed) // 2]) / 2 if observed else float("nan")
-    # Probability integral transform of each night under the predicted distribution.
-    pits = sorted(jammed_by(curve, t) for t in observed)
-    ks = max(max(abs((i + 1) / len(pits) - u), abs(i / len(pits) - u)) for i, u in enumerate(pits)) if pits else float("nan")
-    pred = {q: quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9)}
+        lines += coef_table(b_all, cov_all, use_all, f"The surrogate over Γ and λ, fixed step ({len(fixed)} runs, {sum(r['jammed'] for r in fixed)} first jams)")
 
     def fmt(t):
         return "after 03:35" if t is None or t == float("inf") else clock(t)
 
-    lines += ["", "## The whole night predicted by the cheap model, against eight whole nights (paper's model)", "",
-              "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
-              "| cheap model (rates' hazard along the night's schedule) | " + " | ".join(fmt(pred[q]) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |"]
-    if observed:
-        def emp(q):
-            return observed[min(len(observed) - 1, max(0, math.ceil(q * len(observed)) - 1))]
-        lines.append(f"| {len(observed)} whole nights (empirical) | " + " | ".join(clock(emp(q)) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |")
-    lines += ["", f"- The cheap model's median first jam: {fmt(pred[0.5])} (95 % from the hazard's uncertainty: {fmt(lo)}–{fmt(hi)}); the whole nights': {clock(obs_median)}; "
-              f"error of the median {pred[0.5] - obs_median:+.0f} s." if pred[0.5] is not None else "- The cheap model predicts no first jam before 03:35.",
-              "- Each whole night's first jam: " + ", ".join(f"{run.split('-')[-1]} {fmt(t)}" for run, t in nights.items()) + ".",
-              f"- Their places in the predicted distribution (1 − S(t), uniform if the cheap model is right): {', '.join(f'{u:.2f}' for u in pits)}; "
-              f"Kolmogorov–Smirnov distance {ks:.2f} (5 % critical value for {len(pits)} values: {KS_CRITICAL_5.get(len(pits), float('nan')):.3f})."]
+    confirm_paths = read_paths(args.confirm) if args.confirm else {}
 
-    # A prediction at another inflow scale, and the whole nights run there to confirm it.
-    scaled = survival_curve(b_paper, use_rates, scale=args.confirm_scale)
-    lines += ["", f"## Prediction at the inflow scale {args.confirm_scale:g} (paper's Γ, λ), and whole nights run there", "",
-              "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
-              f"| cheap model at s = {args.confirm_scale:g} | " + " | ".join(fmt(quantile_time(scaled, q)) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |"]
-    if args.confirm:
-        confirm_paths = read_paths(args.confirm)
-        got = {}
-        for run, rows in confirm_paths.items():
-            got[run] = first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S)
-        def cdf_scaled(t):
-            return jammed_by(scaled, t)
-        lines += ["", f"- Whole nights at s = {args.confirm_scale:g}: " + ", ".join(
-            f"{run.split('-')[-1]} first jam {fmt(t)} (place in the prediction {cdf_scaled(t):.2f})" if t is not None else
-            f"{run.split('-')[-1]} no jam by {clock(max(r[0] for r in confirm_paths[run]))} (censored; the prediction gives {1 - cdf_scaled(max(r[0] for r in confirm_paths[run])):.2f} for that)"
-            for run, t in got.items()) + "."]
-        jammed = sorted(t for t in got.values() if t is not None)
-        if len(jammed) == len(got) and jammed:
-            places = sorted(jammed_by(scaled, t) for t in jammed)
-            n = len(places)
-            ks_n = max(max((i + 1) / n - u, u - i / n) for i, u in enumerate(places))
-            median_obs = (jammed[(n - 1) // 2] + jammed[n // 2]) / 2
-            median_pred = quantile_time(scaled, 0.5)
-            lines.append(f"- Their median first jam {clock(median_obs)} against the predicted {fmt(median_pred)}"
-                         + (f" (error {median_pred - median_obs:+.0f} s)" if median_pred is not None else "")
-                         + f"; Kolmogorov–Smirnov distance {ks_n:.2f} (5 % critical value for {n} values: {KS_CRITICAL_5.get(n, float('nan')):.3f}).")
+    def against_nights(beta, cov, use, step_adaptive, what):
+        """The whole nights (at s = 1 and at the confirmation's scale) against the hazard `beta` along the schedule."""
+        curve = survival_curve(beta, use, adaptive=step_adaptive)
+        rng = random.Random(41)
+        chol = cholesky(cov)
+        medians = []
+        for _ in range(400):
+            z = [rng.gauss(0, 1) for _ in beta]
+            b = [beta[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(beta))]
+            q = quantile_time(survival_curve(b, use, dt=20.0, adaptive=step_adaptive), 0.5)
+            medians.append(q if q is not None else float("inf"))
+        medians.sort()
+        lo, hi = medians[int(0.025 * len(medians))], medians[int(0.975 * len(medians)) - 1]
+        observed = sorted(t for t in nights.values() if t is not None)
+        obs_median = (observed[(len(observed) - 1) // 2] + observed[len(observed) // 2]) / 2 if observed else float("nan")
+        # Probability integral transform of each night under the predicted distribution.
+        pits = sorted(jammed_by(curve, t) for t in observed)
+        ks = max(max(abs((i + 1) / len(pits) - u), abs(i / len(pits) - u)) for i, u in enumerate(pits)) if pits else float("nan")
+        pred = {q: quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9)}
+        out = ["", f"## The whole night predicted by {what}, against eight whole nights (paper's model)", "",
+               "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
+               "| cheap model (rates' hazard along the night's schedule) | " + " | ".join(fmt(pred[q]) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |"]
+        if observed:
+            def emp(q):
+                return observed[min(len(observed) - 1, max(0, math.ceil(q * len(observed)) - 1))]
+            out.append(f"| {len(observed)} whole nights (empirical) | " + " | ".join(clock(emp(q)) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |")
+        out += ["", f"- The cheap model's median first jam: {fmt(pred[0.5])} (95 % from the hazard's uncertainty: {fmt(lo)}–{fmt(hi)}); the whole nights': {clock(obs_median)}; "
+                f"error of the median {pred[0.5] - obs_median:+.0f} s." if pred[0.5] is not None else "- The cheap model predicts no first jam before 03:35.",
+                "- Each whole night's first jam: " + ", ".join(f"{run.split('-')[-1]} {fmt(t)}" for run, t in nights.items()) + ".",
+                f"- Their places in the predicted distribution (1 − S(t), uniform if the cheap model is right): {', '.join(f'{u:.2f}' for u in pits)}; "
+                f"Kolmogorov–Smirnov distance {ks:.2f} (5 % critical value for {len(pits)} values: {KS_CRITICAL_5.get(len(pits), float('nan')):.3f})."]
+
+        # A prediction at another inflow scale, and the whole nights run there to confirm it.
+        scaled = survival_curve(beta, use, scale=args.confirm_scale, adaptive=step_adaptive)
+        out += ["", f"### Prediction at the inflow scale {args.confirm_scale:g} (paper's Γ, λ), and whole nights run there", "",
+                "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
+                f"| cheap model at s = {args.confirm_scale:g} | " + " | ".join(fmt(quantile_time(scaled, q)) for q in (0.1, 0.25, 0.5, 0.75, 0.9)) + " |"]
+        if confirm_paths:
+            got = {run: first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S) for run, rows in confirm_paths.items()}
+            out += ["", f"- Whole nights at s = {args.confirm_scale:g}: " + ", ".join(
+                f"{run.split('-')[-1]} first jam {fmt(t)} (place in the prediction {jammed_by(scaled, t):.2f})" if t is not None else
+                f"{run.split('-')[-1]} no jam by {clock(max(r[0] for r in confirm_paths[run]))} (censored; the prediction gives {1 - jammed_by(scaled, max(r[0] for r in confirm_paths[run])):.2f} for that)"
+                for run, t in got.items()) + "."]
+            jammed = sorted(t for t in got.values() if t is not None)
+            if len(jammed) == len(got) and jammed:
+                places = sorted(jammed_by(scaled, t) for t in jammed)
+                n = len(places)
+                ks_n = max(max((i + 1) / n - u, u - i / n) for i, u in enumerate(places))
+                median_obs = (jammed[(n - 1) // 2] + jammed[n // 2]) / 2
+                median_pred = quantile_time(scaled, 0.5)
+                out.append(f"- Their median first jam {clock(median_obs)} against the predicted {fmt(median_pred)}"
+                           + (f" (error {median_pred - median_obs:+.0f} s)" if median_pred is not None else "")
+                           + f"; Kolmogorov–Smirnov distance {ks_n:.2f} (5 % critical value for {n} values: {KS_CRITICAL_5.get(n, float('nan')):.3f}).")
+        return out, curve, (lo, hi)
+
+    more, curve, band = against_nights(b_paper, cov_paper, use_rates, False, "the cheap model (fixed step)")
+    lines += more
+    if adaptive:
+        # The step the runs take: the same points and seeds with the whole nights' (adaptive) step.
+        paired = [r for r in runs if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+        points = sorted({(r["leaving_per_s"], r["entering_per_s"]) for r in paired if r["step"] == "adaptive"})
+        lines += ["", "## The step: the same points and seeds with the fixed and the adaptive step", "",
+                  "| leaving / entering persons/s | fixed: jammed / runs | first jams (s) | adaptive: jammed / runs | first jams (s) |",
+                  "| --- | --- | --- | --- | --- |"]
+        for m, c in points:
+            row = [f"{m:g} / {c:g}"]
+            for step in ("fixed", "adaptive"):
+                rs = [r for r in paired if r["step"] == step and (r["leaving_per_s"], r["entering_per_s"]) == (m, c)]
+                row += [f"{sum(r['jammed'] for r in rs)} / {len(rs)}",
+                        ", ".join(f"{r['onset_s']:.0f}" for r in rs if r["onset_s"] is not None) or "none"]
+            lines.append("| " + " | ".join(row) + " |")
+        use_step = [0, 1, 2, 5]
+        b_step, cov_step, ll_step = fit_hazard(paired, use_step)
+        _, _, ll_none = fit_hazard(paired, use_rates)
+        lr = 2.0 * (ll_step - ll_none)
+        p_lr = math.erfc(math.sqrt(max(lr, 0.0) / 2.0))  # chi-square with one degree of freedom
+        lines += coef_table(b_step, cov_step, use_step, f"The hazard with the step as a covariate ({len(paired)} runs at the paper's Γ, λ, {sum(r['jammed'] for r in paired)} first jams)")
+        lines += ["", f"- The adaptive step multiplies the first jam's hazard by {math.exp(b_step[3]):.2f} "
+                  f"(95 %: {math.exp(b_step[3] - 1.96 * math.sqrt(cov_step[3][3])):.2f}–{math.exp(b_step[3] + 1.96 * math.sqrt(cov_step[3][3])):.2f}); "
+                  f"likelihood ratio {lr:.2f}, p = {p_lr:.3g} (χ², one degree of freedom)."]
+        more, curve_a, band_a = against_nights(b_step, cov_step, use_step, True, "the cheap model with the nights' step (adaptive; rates' slopes shared with the fixed-step runs)")
+        lines += more
+        adaptive_paper = [r for r in adaptive if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+        if sum(r["jammed"] for r in adaptive_paper) >= 4:
+            b_ad, cov_ad, _ = fit_hazard(adaptive_paper, use_rates)
+            lines += coef_table(b_ad, cov_ad, use_rates, f"The hazard from the adaptive-step runs alone ({len(adaptive_paper)} runs, {sum(r['jammed'] for r in adaptive_paper)} first jams)")
+            more, _, _ = against_nights(b_ad, cov_ad, use_rates, False, "the adaptive-step runs alone")
+            lines += more
+    if long_runs:
+        lines += age_section(long_runs)
 
     # The recorded night on the cheap model, under two readings of its first jam.
     if varied:
@@ -401,14 +597,21 @@ def main():
                           ("; s = 1" if fixed_scale else "; s profiled")
                     lines.append(f"| {label} | {how} | {summary(marginal, fixed_scale)} |")
 
+    # The cheap model corrected by the whole nights (one factor on its hazard), and the recorded night on it.
+    whole = [(1.0, t, NIGHT_END_S) for t in nights.values()]
+    whole += [(args.confirm_scale, first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S), min(args.confirm_end_s, max(r[0] for r in rows)))
+              for rows in confirm_paths.values()]
+    lines += corrected_section(b_paper, use_rates, whole, args.confirm_scale)
+
     with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, (lo, hi), paths)
+    draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, band, paths,
+         curve_a if adaptive else None)
     svg_to_png(os.path.join(args.out, "cheap-model.svg"), os.path.join(args.out, "cheap-model.png"), 1200, 900)
     print("\n".join(lines))
 
 
-def draw(file, cells, beta, use, curve, nights, median_band, paths):
+def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adaptive=None):
     w, h = 1200, 900
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="DejaVu Sans, sans-serif" font-size="13">',
            f'<rect width="{w}" height="{h}" fill="white"/>']
@@ -439,8 +642,8 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths):
     out.append(f'<text x="{x0}" y="{y0 - 34}" font-weight="bold">The cheap model: a first jam within 10 min at constant rates</text>')
     out.append(f'<text x="{x0}" y="{y0 - 16}" fill="#444" font-size="12">shade: the fitted chance (white 0, red 0.8); numbers: jammed / runs (paper\'s Γ, λ)</text>')
     out.append(f'<clipPath id="plane"><rect x="{x0}" y="{y0}" width="{pw}" height="{ph}"/></clipPath>')
-    for (g, l, m, c), rs in cells.items():
-        if g != GAMMA0 or l != LAMBDA0:
+    for (g, l, m, c, step), rs in cells.items():
+        if g != GAMMA0 or l != LAMBDA0 or step != "fixed":
             continue
         d = sum(r["jammed"] for r in rs)
         out.append(f'<circle cx="{px(m):.1f}" cy="{py(c):.1f}" r="3" fill="black"/>')
@@ -468,7 +671,8 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths):
         return y0 + ph - s * ph
     out.append(f'<rect x="{x1}" y="{y0}" width="{pw2}" height="{ph}" fill="none" stroke="black"/>')
     out.append(f'<text x="{x1}" y="{y0 - 34}" font-weight="bold">Share of nights not yet jammed</text>')
-    out.append(f'<text x="{x1}" y="{y0 - 16}" fill="#444" font-size="12">red: cheap model (band: its median\'s 95 %); black: the 8 whole nights</text>')
+    also = "; orange dashes: adaptive step" if curve_adaptive else ""
+    out.append(f'<text x="{x1}" y="{y0 - 16}" fill="#444" font-size="12">red: cheap model, fixed step (band: its median\'s 95 %){also}; black: 8 whole nights</text>')
     for t, label in RECORDED:
         out.append(f'<line x1="{tx(t):.1f}" y1="{y0}" x2="{tx(t):.1f}" y2="{y0 + ph}" stroke="#999" stroke-dasharray="4,3"/>')
     out.append(f'<text x="{tx(FATAL_CLOG_S) - 4:.1f}" y="{y0 + 14}" text-anchor="end" fill="#777">fatal clog</text>')
@@ -480,6 +684,8 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths):
     if hi != float("inf"):
         out.append(f'<rect x="{tx(lo):.1f}" y="{sy(0.52):.1f}" width="{max(tx(hi) - tx(lo), 1):.1f}" height="{sy(0.48) - sy(0.52):.1f}" fill="#f2b8b8"/>')
     out.append('<polyline fill="none" stroke="#b00" stroke-width="2.5" points="' + " ".join(f"{tx(t):.1f},{sy(s):.1f}" for t, s, _ in curve) + '"/>')
+    if curve_adaptive:
+        out.append('<polyline fill="none" stroke="#e07b00" stroke-width="2.5" stroke-dasharray="7,4" points="' + " ".join(f"{tx(t):.1f},{sy(s):.1f}" for t, s, _ in curve_adaptive) + '"/>')
     observed = sorted(t for t in nights.values() if t is not None)
     pts, s = [(tx(t_lo), sy(1.0))], 1.0
     for t in observed:
