@@ -11,13 +11,20 @@ open hallway fed at constant rates (venues/madrid-arena/scenarios/
 night-path-point.json, sweeps night-path-points*.json: 600-s runs on a grid
 of rates), read as a hazard of the first jam,
 
-    h(m, c; Γ, λ) = exp(b0 + b1 (m - 2.25) + b2 (c - 1.6) + b3 ln(Γ/1.2) + b4 ln(λ/27))
+    h(m, c; Γ, λ, ε) = exp(b0 + b1 (m - 2.25) + b2 (c - 1.6) + b3 ln(Γ/1.2) + b4 ln(λ/27) + b6 ln(ε/0.4))
 
 fitted by maximum likelihood to the runs' first jams (an exponential
 survival model: each run contributes its exposure from 60 s, after the
 start, to its first jam or its end). Along the night the first jam's time
 then has the survival S(t) = exp(-∫ h(s m(u), s c(u)) du) from 300 s (after
 the night's start transient), s the inflow schedule's scale.
+
+Besides: the same grid with the adaptive step (the whole nights' step; b5,
+its effect, with a likelihood-ratio test), longer runs (the hazard against a
+run's age, piecewise in windows of the run), and the cheap model corrected by
+the whole nights (h_night = e^δ h, δ by maximum likelihood from their first
+jams, checked across the inflow scales), on which the recorded night's inflow
+scale is fitted.
 
 The first jam (one definition for whole nights and cheap runs, fixed
 before any cheap run was read): the first sample, at least `after` s into
@@ -55,7 +62,7 @@ CHEAP_AFTER_S = 60.0
 CHEAP_RUN_S = 600.0
 AGE_WINDOWS_S = [60.0, 600.0, 1200.0, 1800.0, float("inf")]
 NIGHT_END_S = 5700.0
-GAMMA0, LAMBDA0 = 1.2, 27.0
+GAMMA0, LAMBDA0, EPS0 = 1.2, 27.0, 0.4
 M0, C0 = 2.25, 1.6
 RECORDED = [(1080, "02:18"), (1140, "02:19"), (2460, "02:41"), (3540, "02:59"), (5340, "03:29"), (5580, "fatal clog 03:33")]
 FATAL_CLOG_S = 5580.0
@@ -83,9 +90,10 @@ def night_rates(t, scale=1.0):
     return scale * (3.0 - 2.0 * t / 5700.0), scale * (0.2 + 3.8 * t / 5700.0)
 
 
-def covariates(m, c, gamma, lam, adaptive=False):
-    """The surrogate's covariates; the last says the run took the adaptive step (the whole nights did)."""
-    return [1.0, m - M0, c - C0, math.log(gamma / GAMMA0), math.log(lam / LAMBDA0), 1.0 if adaptive else 0.0]
+def covariates(m, c, gamma, lam, adaptive=False, eps=EPS0):
+    """The surrogate's covariates (index 5 says the run took the adaptive step, as the whole nights did)."""
+    return [1.0, m - M0, c - C0, math.log(gamma / GAMMA0), math.log(lam / LAMBDA0), 1.0 if adaptive else 0.0,
+            math.log(eps / EPS0)]
 
 
 # --- small linear algebra (no numpy on the machines this runs on) ---
@@ -150,19 +158,19 @@ def fit_hazard(runs, use):
     return beta, cov, ll
 
 
-def hazard(beta, use, m, c, gamma=GAMMA0, lam=LAMBDA0, adaptive=False):
-    x = covariates(m, c, gamma, lam, adaptive)
+def hazard(beta, use, m, c, gamma=GAMMA0, lam=LAMBDA0, adaptive=False, eps=EPS0):
+    x = covariates(m, c, gamma, lam, adaptive, eps)
     return math.exp(sum(b * x[k] for b, k in zip(beta, use)))
 
 
-def survival_curve(beta, use, gamma=GAMMA0, lam=LAMBDA0, scale=1.0, dt=5.0, adaptive=False):
+def survival_curve(beta, use, gamma=GAMMA0, lam=LAMBDA0, scale=1.0, dt=5.0, adaptive=False, eps=EPS0):
     """[(t, S(t), h(t))] from NIGHT_AFTER_S to the night's end."""
-    out = [(NIGHT_AFTER_S, 1.0, hazard(beta, use, *night_rates(NIGHT_AFTER_S, scale), gamma, lam, adaptive))]
+    out = [(NIGHT_AFTER_S, 1.0, hazard(beta, use, *night_rates(NIGHT_AFTER_S, scale), gamma, lam, adaptive, eps))]
     cum = 0.0
     t = NIGHT_AFTER_S
     while t < NIGHT_END_S - 1e-9:
         h0 = out[-1][2]
-        h1 = hazard(beta, use, *night_rates(t + dt, scale), gamma, lam, adaptive)
+        h1 = hazard(beta, use, *night_rates(t + dt, scale), gamma, lam, adaptive, eps)
         cum += 0.5 * (h0 + h1) * dt
         t += dt
         out.append((t, math.exp(-cum), h1))
@@ -200,6 +208,7 @@ def read_sweep(folder):
         gamma = scenario["model"].get("back_force_gamma", GAMMA0)
         lam = scenario["model"].get("torsion_stiffness_lambda", LAMBDA0)
         step = scenario["model"].get("time_step_mode", "fixed")
+        eps = scenario["model"].get("restitution", EPS0)
         rows = night_path.read_run(run_file, SAMPLE_S)
         onset = first_jam([(r["time_s"], r["mean_speed_m_per_s"]) for r in rows], CHEAP_AFTER_S)
         end = rows[-1]["time_s"]
@@ -207,10 +216,10 @@ def read_sweep(folder):
         pre = [r for r in rows if r["time_s"] >= CHEAP_AFTER_S and (onset is None or r["time_s"] < onset)]
         runs.append({
             "run": row["run_id"], "variant": row["variant"], "seed": int(row["seed"]),
-            "leaving_per_s": m, "entering_per_s": c, "gamma": gamma, "lambda": lam, "step": step,
+            "leaving_per_s": m, "entering_per_s": c, "gamma": gamma, "lambda": lam, "restitution": eps, "step": step,
             "jammed": 0 if onset is None else 1, "onset_s": onset, "exposure_s": exposure, "end_s": end,
             "pre_jam_density_per_m2": sum(r["density_per_m2"] for r in pre) / len(pre) if pre else float("nan"),
-            "x": covariates(m, c, gamma, lam, step == "adaptive"),
+            "x": covariates(m, c, gamma, lam, step == "adaptive", eps),
         })
     return runs
 
@@ -250,12 +259,12 @@ def age_section(long_runs):
                 cell[k][1] += e
                 total[k][0] += d
                 total[k][1] += e
-                pieces.append({"jammed": d, "exposure_s": e, "x": r["x"] + [1.0 if k > 0 else 0.0]})
+                pieces.append({"jammed": d, "exposure_s": e, "x": r["x"] + [1.0 if k > 0 else 0.0]})  # index 7: after the first window
         onsets = ", ".join(f"{r['onset_s']:.0f}" for r in rs if r["onset_s"] is not None) or "none"
         out.append(f"| {m:g} / {c:g} | {len(rs)} | {onsets} | " + " | ".join(f"{d} / {e:.0f} s" for d, e in cell) + " |")
     out.append("| all | " + f"{len(long_runs)} | | " + " | ".join(f"{d} / {e:.0f} s ({600 * d / e:.2f} per 10 min)" if e > 0 else "–" for d, e in total) + " |")
-    use = [0, 1, 2, 6]
-    if sum(p["jammed"] for p in pieces) >= 3 and any(p["x"][6] for p in pieces if p["jammed"]) and any(not p["x"][6] for p in pieces if p["jammed"]):
+    use = [0, 1, 2, 7]
+    if sum(p["jammed"] for p in pieces) >= 3 and any(p["x"][7] for p in pieces if p["jammed"]) and any(not p["x"][7] for p in pieces if p["jammed"]):
         beta, cov, ll = fit_hazard(pieces, use)
         _, _, ll0 = fit_hazard(pieces, [0, 1, 2])
         lr = 2.0 * (ll - ll0)
@@ -408,11 +417,14 @@ def main():
     runs = [r for r in runs if r["end_s"] <= CHEAP_RUN_S + 1.0]
     fixed = [r for r in runs if r["step"] == "fixed"]
     adaptive = [r for r in runs if r["step"] == "adaptive"]
-    paper = [r for r in fixed if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+    def at_paper(r):
+        return r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0 and r["restitution"] == EPS0
+    paper = [r for r in fixed if at_paper(r)]
     use_rates = [0, 1, 2]
     b_paper, cov_paper, _ = fit_hazard(paper, use_rates)
     varied = len({(r["gamma"], r["lambda"]) for r in fixed}) > 1
-    use_all = [0, 1, 2, 3, 4] if varied else use_rates
+    eps_varied = len({r["restitution"] for r in fixed}) > 1
+    use_all = ([0, 1, 2, 3, 4] if varied else use_rates) + ([6] if eps_varied else [])
     b_all, cov_all, _ = fit_hazard(fixed, use_all)
 
     lines = ["# The Madrid night's cheap forward model: tables", "",
@@ -435,7 +447,7 @@ def main():
 
     def coef_table(beta, cov, use, title):
         names = ["ln h at (2.25, 1.6)", "per person/s leaving", "per person/s entering", "per ln(Γ/1.2)", "per ln(λ/27)",
-                 "adaptive step (against fixed)"]
+                 "adaptive step (against fixed)", "per ln(ε/0.4)"]
         out = ["", f"## {title}", "", "| coefficient | value | standard error |", "| --- | --- | --- |"]
         for i, k in enumerate(use):
             out.append(f"| {names[k]} | {beta[i]:.3f} | {math.sqrt(cov[i][i]):.3f} |")
@@ -443,7 +455,7 @@ def main():
 
     lines += coef_table(b_paper, cov_paper, use_rates, f"The hazard at the paper's Γ and λ, fixed step ({len(paper)} runs, {sum(r['jammed'] for r in paper)} first jams)")
     if varied:
-        lines += coef_table(b_all, cov_all, use_all, f"The surrogate over Γ and λ, fixed step ({len(fixed)} runs, {sum(r['jammed'] for r in fixed)} first jams)")
+        lines += coef_table(b_all, cov_all, use_all, f"The surrogate over {'Γ, λ and ε' if eps_varied else 'Γ and λ'}, fixed step ({len(fixed)} runs, {sum(r['jammed'] for r in fixed)} first jams)")
 
     def fmt(t):
         return "after 03:35" if t is None or t == float("inf") else clock(t)
@@ -509,7 +521,7 @@ def main():
     lines += more
     if adaptive:
         # The step the runs take: the same points and seeds with the whole nights' (adaptive) step.
-        paired = [r for r in runs if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+        paired = [r for r in runs if at_paper(r)]
         points = sorted({(r["leaving_per_s"], r["entering_per_s"]) for r in paired if r["step"] == "adaptive"})
         lines += ["", "## The step: the same points and seeds with the fixed and the adaptive step", "",
                   "| leaving / entering persons/s | fixed: jammed / runs | first jams (s) | adaptive: jammed / runs | first jams (s) |",
@@ -532,7 +544,7 @@ def main():
                   f"likelihood ratio {lr:.2f}, p = {p_lr:.3g} (χ², one degree of freedom)."]
         more, curve_a, band_a = against_nights(b_step, cov_step, use_step, True, "the cheap model with the nights' step (adaptive; rates' slopes shared with the fixed-step runs)")
         lines += more
-        adaptive_paper = [r for r in adaptive if r["gamma"] == GAMMA0 and r["lambda"] == LAMBDA0]
+        adaptive_paper = [r for r in adaptive if at_paper(r)]
         if sum(r["jammed"] for r in adaptive_paper) >= 4:
             b_ad, cov_ad, _ = fit_hazard(adaptive_paper, use_rates)
             lines += coef_table(b_ad, cov_ad, use_rates, f"The hazard from the adaptive-step runs alone ({len(adaptive_paper)} runs, {sum(r['jammed'] for r in adaptive_paper)} first jams)")
@@ -544,14 +556,15 @@ def main():
     # The recorded night on the cheap model, under two readings of its first jam.
     if varied:
         lines += ["", "## The recorded night on the cheap model", "",
-                  "One recorded time per reading, its likelihood h(t) S(t) under the cheap model; parameters Γ and λ over the range the "
-                  "surrogate was measured on (0.6–2.4, 13.5–54; log-spaced grid of 5 × 5) and the inflow schedule's scale s "
+                  "One recorded time per reading, its likelihood h(t) S(t) under the cheap model; parameters Γ, λ (and ε where its runs are given) over the range the "
+                  "surrogate was measured on (0.6–2.4, 13.5–54, 0.2–0.8; log-spaced grid of 5 × 5 (× 3)) and the inflow schedule's scale s "
                   "(a nuisance, 0.5–1.5 in steps of 0.1, profiled out; or fixed at the scenario's 1). The likelihood with the surrogate's best coefficients, "
                   "and averaged over 60 draws of them from their covariance (the surrogate's own uncertainty).", "",
-                  "| reading of the recorded night's first jam | likelihood | best Γ, λ, s | Γ within Δ(−2 ln L) < 3.84 | λ within 3.84 | median first jam at the best |",
-                  "| --- | --- | --- | --- | --- | --- |"]
+                  "| reading of the recorded night's first jam | likelihood | best Γ, λ, ε, s | Γ within Δ(−2 ln L) < 3.84 | λ within 3.84 | ε within 3.84 | median first jam at the best |",
+                  "| --- | --- | --- | --- | --- | --- | --- |"]
         gammas = [0.6 * 4 ** (k / 4) for k in range(5)]
         lambdas = [13.5 * 4 ** (k / 4) for k in range(5)]
+        epses = [0.2, 0.4, 0.8] if eps_varied else [EPS0]
         scales = [0.5 + 0.1 * k for k in range(11)]
         # The surrogate's own uncertainty: the likelihood averaged over draws of its coefficients.
         chol_all = cholesky(cov_all)
@@ -562,35 +575,44 @@ def main():
             draws.append([b_all[i] + sum(chol_all[i][j] * z[j] for j in range(i + 1)) for i in range(len(b_all))])
         for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0),
                               ("the fatal clog, 03:33 (the avalanches before it as stops the cheap model does not resolve)", FATAL_CLOG_S)):
-            def likelihood(beta, gamma, lam, scale):
-                c = survival_curve(beta, use_all, gamma, lam, scale, dt=20.0)
-                i = min(range(len(c)), key=lambda k: abs(c[k][0] - target))
-                return c[i][2] * c[i][1]
+            def likelihood(beta, prm, scale):
+                """h(target) S(target), integrated up to the target only."""
+                gamma, lam, eps = prm
+                cum, t, dt = 0.0, NIGHT_AFTER_S, 20.0
+                h0 = hazard(beta, use_all, *night_rates(t, scale), gamma, lam, False, eps)
+                while t < target - 1e-9:
+                    step = min(dt, target - t)
+                    h1 = hazard(beta, use_all, *night_rates(t + step, scale), gamma, lam, False, eps)
+                    cum += 0.5 * (h0 + h1) * step
+                    h0, t = h1, t + step
+                return h0 * math.exp(-cum)
 
-            def nll(gamma, lam, scale, marginal):
+            def nll(prm, scale, marginal):
                 if not marginal:
-                    return -2.0 * math.log(max(likelihood(b_all, gamma, lam, scale), 1e-300))
-                return -2.0 * math.log(max(sum(likelihood(b, gamma, lam, scale) for b in draws) / len(draws), 1e-300))
+                    return -2.0 * math.log(max(likelihood(b_all, prm, scale), 1e-300))
+                return -2.0 * math.log(max(sum(likelihood(b, prm, scale) for b in draws) / len(draws), 1e-300))
 
             def summary(marginal, scale_fixed):
                 rows = []
-                for gamma in gammas:
-                    for lam in lambdas:
-                        options = [1.0] if scale_fixed else scales
-                        v, sc = min((nll(gamma, lam, x, marginal), x) for x in options)
-                        rows.append((gamma, lam, sc, v))
-                top = min(r[3] for r in rows)
-                b = min(rows, key=lambda r: r[3])
-                ok = [r for r in rows if r[3] - top < 3.84]
-                g = sorted({r[0] for r in ok})
-                l = sorted({r[1] for r in ok})
+                for prm in ((g, l, e) for g in gammas for l in lambdas for e in epses):
+                    options = [1.0] if scale_fixed else scales
+                    v, sc = min((nll(prm, x, marginal), x) for x in options)
+                    rows.append((prm, sc, v))
+                top = min(r[2] for r in rows)
+                b = min(rows, key=lambda r: r[2])
+                ok = [r for r in rows if r[2] - top < 3.84]
+                within = []
+                for k, values in enumerate((gammas, lambdas, epses)):
+                    got = sorted({r[0][k] for r in ok})
+                    within.append(f"{got[0]:.3g}–{got[-1]:.3g} ({len(got)} of {len(values)})")
+                (g, l, e), sc = b[0], b[1]
                 if marginal:  # the predictive median: the draws' survival averaged
-                    curves = [survival_curve(d, use_all, b[0], b[1], b[2], dt=20.0) for d in draws]
+                    curves = [survival_curve(d, use_all, g, l, sc, dt=20.0, eps=e) for d in draws]
                     mean_curve = [(curves[0][k][0], sum(c[k][1] for c in curves) / len(curves), 0.0) for k in range(len(curves[0]))]
                     med = quantile_time(mean_curve, 0.5)
                 else:
-                    med = quantile_time(survival_curve(b_all, use_all, b[0], b[1], b[2], dt=20.0), 0.5)
-                return f"{b[0]:.2g}, {b[1]:.3g}, {b[2]:.1f} | {g[0]:.2g}–{g[-1]:.2g} ({len(g)} of 5) | {l[0]:.3g}–{l[-1]:.3g} ({len(l)} of 5) | {fmt(med)}"
+                    med = quantile_time(survival_curve(b_all, use_all, g, l, sc, dt=20.0, eps=e), 0.5)
+                return f"{g:.2g}, {l:.3g}, {e:g}, {sc:.1f} | " + " | ".join(within) + f" | {fmt(med)}"
             for marginal in (False, True):
                 for fixed_scale in (False, True):
                     how = ("surrogate averaged over its uncertainty" if marginal else "surrogate's best coefficients") + \
