@@ -299,7 +299,7 @@ def shifted(beta, delta):
     return [beta[0] + delta] + beta[1:]
 
 
-def corrected_section(beta, use, whole, other_scale):
+def corrected_section(beta, use, whole, other_scale, fitted_nights, what="the cheap model"):
     """A one-factor correction of the cheap model fitted to whole nights, checked across the inflow scales, and the
     recorded night's inflow scale on the corrected model."""
     def places(b, nights_at):
@@ -325,7 +325,7 @@ def corrected_section(beta, use, whole, other_scale):
 
     at_one = [w for w in whole if w[0] == 1.0]
     at_other = [w for w in whole if w[0] != 1.0]
-    out = ["", "## The cheap model corrected by whole nights (one factor on its hazard)", "",
+    out = ["", f"## {what[0].upper() + what[1:]} corrected by whole nights (one factor on its hazard)", "",
            "The whole nights' first jams against the cheap hazard h along the schedule: h_night = e^δ h, δ by maximum "
            "likelihood (e^δ = jams / Σ ∫h, each night from 300 s to its first jam or its end), its standard error 1/√jams. "
            "Checked across the inflow scales: δ from the nights at one scale predicts the nights at the other.", "",
@@ -369,10 +369,101 @@ def corrected_section(beta, use, whole, other_scale):
     out += ["", "### The first jam predicted at those scales (paper's Γ, λ)", "",
             "| model | inflow scale | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- | --- |"]
     for scale in fitted:
-        for label, b in (("cheap model", beta), ("corrected by the 12 whole nights", shifted(beta, d))):
+        for label, b in (("uncorrected", beta), (f"corrected by the {len(whole)} whole nights", shifted(beta, d))):
             curve = survival_curve(b, use, scale=scale)
             out.append(f"| {label} | {scale:.2f} | " + " | ".join(
                 clock(t) if t is not None else "after 03:35" for t in (quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9))) + " |")
+    if fitted_nights:
+        out += fitted_check(beta, use, d, fitted_nights)
+    return out
+
+
+def fitted_check(beta, use, delta, nights_at):
+    """Whole nights run at the fitted scale against the corrected and the uncorrected model's predictions."""
+    scale = nights_at[0][0]
+    corrected = survival_curve(shifted(beta, delta), use, scale=scale)
+    plain = survival_curve(beta, use, scale=scale)
+    out = ["", f"### The check: {len(nights_at)} whole nights at s = {scale:g}", "",
+           "A night's place is 1 − S(t) at its first jam (uniform if the model is right); a night not jammed by the end of its "
+           "run is censored there, with the predicted chance of lasting that long.", "",
+           "| night | first jam | place in the corrected prediction | place in the uncorrected one |", "| --- | --- | --- | --- |"]
+    for _, t, end, name in sorted(nights_at, key=lambda n: (n[1] is None, n[1] or 0.0)):
+        if t is not None:
+            out.append(f"| {name} | {clock(t)} | {jammed_by(corrected, t):.2f} | {jammed_by(plain, t):.2f} |")
+        else:
+            out.append(f"| {name} | none by {clock(end)} (censored) | lasts that long: {1 - jammed_by(corrected, end):.2f} | {1 - jammed_by(plain, end):.2f} |")
+    jammed = sorted(n[1] for n in nights_at if n[1] is not None)
+    n = len(nights_at)
+    if len(jammed) > n / 2:
+        # The empirical median (censored nights lie above every jammed one).
+        ordered = jammed + [float("inf")] * (n - len(jammed))
+        obs = (ordered[(n - 1) // 2] + ordered[n // 2]) / 2
+        for label, curve in (("corrected", corrected), ("uncorrected", plain)):
+            pred = quantile_time(curve, 0.5)
+            if len(jammed) == n:
+                u = sorted(jammed_by(curve, t) for t in jammed)
+                ks = max(max((i + 1) / n - x, x - i / n) for i, x in enumerate(u))
+                tail = f"; KS {ks:.2f} (5 %: {KS_CRITICAL_5.get(n, float('nan')):.3f})"
+            else:
+                tail = " (KS not computed: censored nights)"
+            out.append(f"- {label}: median first jam {clock(pred) if pred is not None else 'after 03:35'} against the nights' "
+                       f"{clock(obs) if obs != float('inf') else 'later'}"
+                       + (f" (error {pred - obs:+.0f} s)" if pred is not None and obs != float("inf") else "") + tail + ".")
+    return out
+
+
+def own_hazard_section(nights_at, cheap_fits):
+    """The whole nights' own first-jam hazard, the cheap model's form fitted to them directly (10-s pieces of each night
+    from 300 s to its first jam or its end, the rates of each piece's middle), beside the cheap fits."""
+    pieces = []
+    for scale, t, end in nights_at:
+        stop = t if t is not None else end
+        u = NIGHT_AFTER_S
+        while u < stop - 1e-9:
+            dt = min(SAMPLE_S, stop - u)
+            m, c = night_rates(u + dt / 2, scale)
+            pieces.append({"jammed": 1 if t is not None and u + dt >= stop - 1e-9 else 0, "exposure_s": dt,
+                           "x": covariates(m, c, GAMMA0, LAMBDA0)})
+            u += dt
+    use = [0, 1, 2]
+    beta, cov, _ = fit_hazard(pieces, use)
+    scales = sorted({n[0] for n in nights_at})
+    out = ["", f"## The whole nights' own hazard ({len(nights_at)} nights at the inflow scales {', '.join(f'{x:g}' for x in scales)}, "
+           f"{sum(1 for n in nights_at if n[1] is not None)} first jams)", "",
+           "The cheap model's form fitted to the whole nights themselves (paper's Γ, λ, ε; adaptive step), beside the cheap fits: "
+           "where the cheap model's coefficients leave the nights', it mispredicts them.", "",
+           "| fitted to | ln h at (2.25, 1.6) | per person/s leaving | per person/s entering |", "| --- | --- | --- | --- |"]
+    for label, b, cv in [(f"the {len(nights_at)} whole nights", beta, cov)] + cheap_fits:
+        out.append(f"| {label} | " + " | ".join(f"{b[i]:.2f} ± {math.sqrt(cv[i][i]):.2f}" for i in range(3)) + " |")
+
+    # The recorded night's inflow scale on the whole nights' own hazard, its uncertainty integrated out.
+    rng = random.Random(11)
+    chol = cholesky(cov)
+    draws = []
+    for _ in range(100):
+        z = [rng.gauss(0, 1) for _ in beta]
+        draws.append([beta[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(beta))])
+    out += ["", f"### The recorded night's inflow scale on the whole nights' own hazard (paper's Γ, λ, ε)", "",
+            "One recorded time per reading; likelihood h(t) S(t) averaged over 100 draws of the coefficients from their covariance; "
+            "s on a grid of 0.01 over 0.5–1.5.", "",
+            "| reading of the recorded night's first jam | best s | s within Δ(−2 ln L) < 3.84 | first jam at the best s: 10 % / median / 90 % |",
+            "| --- | --- | --- | --- |"]
+    for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0), ("the fatal clog, 03:33", FATAL_CLOG_S)):
+        rows = []
+        for k in range(50, 151):
+            scale = k / 100.0
+            like = 0.0
+            for b in draws:
+                cum = cumulative_hazard(b, use, scale, target, dt=20.0)
+                like += hazard(b, use, *night_rates(target, scale)) * math.exp(-cum)
+            rows.append((scale, -2.0 * math.log(max(like / len(draws), 1e-300))))
+        top = min(v for _, v in rows)
+        best = min(rows, key=lambda r: r[1])[0]
+        inside = [sc for sc, v in rows if v - top < 3.84]
+        curve = survival_curve(beta, use, scale=best)
+        qs = [quantile_time(curve, q) for q in (0.1, 0.5, 0.9)]
+        out.append(f"| {label} | {best:.2f} | {inside[0]:.2f}–{inside[-1]:.2f} | "
+                   + " / ".join(clock(t) if t is not None else "after 03:35" for t in qs) + " |")
     return out
 
 
@@ -397,6 +488,9 @@ def main():
     ap.add_argument("--confirm", help="night-path.py's CSV of whole nights run at another inflow scale (the confirmation)")
     ap.add_argument("--confirm-scale", type=float, default=0.85, help="the inflow scale of those nights (and of the prediction)")
     ap.add_argument("--confirm-end-s", type=float, default=5700.0, help="how far those nights were run (a night not jammed by then is censored)")
+    ap.add_argument("--fitted", action="append", default=[], help="night-path.py's CSV of whole nights run at the fitted scale "
+                    "(the check of the corrected model's prediction; repeatable; each night censored at its last sample)")
+    ap.add_argument("--fitted-scale", type=float, default=1.12, help="the inflow scale of those nights")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -432,18 +526,18 @@ def main():
 
     # The grid: jams and exposure per point, per parameter set and step.
     lines += ["## The cheap runs: first jams per grid point", "",
-              "| step | Γ, λ | leaving / entering persons/s | runs | jammed | first jams at (s) | exposure (s) | jams per 10 min (raw) | hallway before its jam (persons/m²) |",
+              "| step | Γ, λ, ε | leaving / entering persons/s | runs | jammed | first jams at (s) | exposure (s) | jams per 10 min (raw) | hallway before its jam (persons/m²) |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     cells = collections.defaultdict(list)
     for r in runs:
-        cells[(r["gamma"], r["lambda"], r["leaving_per_s"], r["entering_per_s"], r["step"])].append(r)
-    for key in sorted(cells, key=lambda k: (k[4] != "fixed", k[:4])):
+        cells[(r["gamma"], r["lambda"], r["restitution"], r["leaving_per_s"], r["entering_per_s"], r["step"])].append(r)
+    for key in sorted(cells, key=lambda k: (k[5] != "fixed", k[:5])):
         rs = cells[key]
         d = sum(r["jammed"] for r in rs)
         t = sum(r["exposure_s"] for r in rs)
         onsets = ", ".join(f"{r['onset_s']:.0f}" for r in rs if r["onset_s"] is not None) or "none"
         dens = sum(r["pre_jam_density_per_m2"] for r in rs) / len(rs)
-        lines.append(f"| {key[4]} | {key[0]:g}, {key[1]:g} | {key[2]:g} / {key[3]:g} | {len(rs)} | {d} | {onsets} | {t:.0f} | {600 * d / t:.2f} | {dens:.2f} |")
+        lines.append(f"| {key[5]} | {key[0]:g}, {key[1]:g}, {key[2]:g} | {key[3]:g} / {key[4]:g} | {len(rs)} | {d} | {onsets} | {t:.0f} | {600 * d / t:.2f} | {dens:.2f} |")
 
     def coef_table(beta, cov, use, title):
         names = ["ln h at (2.25, 1.6)", "per person/s leaving", "per person/s entering", "per ln(Γ/1.2)", "per ln(λ/27)",
@@ -623,17 +717,35 @@ def main():
     whole = [(1.0, t, NIGHT_END_S) for t in nights.values()]
     whole += [(args.confirm_scale, first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S), min(args.confirm_end_s, max(r[0] for r in rows)))
               for rows in confirm_paths.values()]
-    lines += corrected_section(b_paper, use_rates, whole, args.confirm_scale)
+    fitted_nights = []
+    for path in args.fitted:
+        for run, rows in read_paths(path).items():
+            fitted_nights.append((args.fitted_scale, first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S), max(r[0] for r in rows),
+                                  run.split("-")[-1]))
+    lines += corrected_section(b_paper, use_rates, whole, args.confirm_scale, fitted_nights)
+    lines += own_hazard_section(whole + [n[:3] for n in fitted_nights], [
+        ("the cheap model, fixed step", b_paper, cov_paper),
+        *([("the cheap model, adaptive step (as the nights)", *fit_hazard([r for r in adaptive if at_paper(r)], use_rates)[:2])]
+          if sum(r["jammed"] for r in adaptive if at_paper(r)) >= 4 else [])])
+    if sum(r["jammed"] for r in adaptive if at_paper(r)) >= 4:
+        # The cheap model in the whole nights' own step (found after the fitted nights' check, not committed before it).
+        b_ad, _, _ = fit_hazard([r for r in adaptive if at_paper(r)], use_rates)
+        lines += corrected_section(b_ad, use_rates, whole, args.confirm_scale, fitted_nights,
+                                   "the cheap model in the nights' step (adaptive runs only)")
 
     with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
+    delta, _ = night_offset(b_paper, use_rates, whole)
+    adaptive_paper = [r for r in adaptive if at_paper(r)]
+    adaptive_ok = sum(r["jammed"] for r in adaptive_paper) >= 4
     draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, band, paths,
-         curve_a if adaptive else None)
+         survival_curve(fit_hazard(adaptive_paper, use_rates)[0], use_rates) if adaptive_ok else None,
+         survival_curve(shifted(b_paper, delta), use_rates))
     svg_to_png(os.path.join(args.out, "cheap-model.svg"), os.path.join(args.out, "cheap-model.png"), 1200, 900)
     print("\n".join(lines))
 
 
-def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adaptive=None):
+def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adaptive=None, curve_corrected=None):
     w, h = 1200, 900
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="DejaVu Sans, sans-serif" font-size="13">',
            f'<rect width="{w}" height="{h}" fill="white"/>']
@@ -662,10 +774,10 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adapti
     out.append(f'<text x="{x0 + pw / 2}" y="{y0 + ph + 38}" text-anchor="middle">leaving, persons/s (from the court)</text>')
     out.append(f'<text x="{x0 - 50}" y="{y0 + ph / 2}" text-anchor="middle" transform="rotate(-90 {x0 - 50} {y0 + ph / 2})">entering, persons/s (from the street)</text>')
     out.append(f'<text x="{x0}" y="{y0 - 34}" font-weight="bold">The cheap model: a first jam within 10 min at constant rates</text>')
-    out.append(f'<text x="{x0}" y="{y0 - 16}" fill="#444" font-size="12">shade: the fitted chance (white 0, red 0.8); numbers: jammed / runs (paper\'s Γ, λ)</text>')
+    out.append(f'<text x="{x0}" y="{y0 - 16}" fill="#444" font-size="12">shade: the fitted chance (white 0, red 0.8); numbers: jammed / runs (paper\'s Γ, λ, fixed step)</text>')
     out.append(f'<clipPath id="plane"><rect x="{x0}" y="{y0}" width="{pw}" height="{ph}"/></clipPath>')
-    for (g, l, m, c, step), rs in cells.items():
-        if g != GAMMA0 or l != LAMBDA0 or step != "fixed":
+    for (g, l, e, m, c, step), rs in cells.items():
+        if g != GAMMA0 or l != LAMBDA0 or e != EPS0 or step != "fixed":
             continue
         d = sum(r["jammed"] for r in rs)
         out.append(f'<circle cx="{px(m):.1f}" cy="{py(c):.1f}" r="3" fill="black"/>')
@@ -692,9 +804,10 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adapti
     def sy(s):
         return y0 + ph - s * ph
     out.append(f'<rect x="{x1}" y="{y0}" width="{pw2}" height="{ph}" fill="none" stroke="black"/>')
-    out.append(f'<text x="{x1}" y="{y0 - 34}" font-weight="bold">Share of nights not yet jammed</text>')
-    also = "; orange dashes: adaptive step" if curve_adaptive else ""
-    out.append(f'<text x="{x1}" y="{y0 - 16}" fill="#444" font-size="12">red: cheap model, fixed step (band: its median\'s 95 %){also}; black: 8 whole nights</text>')
+    out.append(f'<text x="{x1}" y="{y0 - 46}" font-weight="bold">Share of nights not yet jammed (inflow scale 1)</text>')
+    also = ", orange dashes: adaptive step" if curve_adaptive else ""
+    out.append(f'<text x="{x1}" y="{y0 - 28}" fill="#444" font-size="12">red: cheap model, fixed step (band: median\'s 95 %){also};</text>')
+    out.append(f'<text x="{x1}" y="{y0 - 12}" fill="#444" font-size="12">{"green: corrected by the whole nights (× e^δ); " if curve_corrected else ""}black: the 8 whole nights</text>')
     for t, label in RECORDED:
         out.append(f'<line x1="{tx(t):.1f}" y1="{y0}" x2="{tx(t):.1f}" y2="{y0 + ph}" stroke="#999" stroke-dasharray="4,3"/>')
     out.append(f'<text x="{tx(FATAL_CLOG_S) - 4:.1f}" y="{y0 + 14}" text-anchor="end" fill="#777">fatal clog</text>')
@@ -706,6 +819,8 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adapti
     if hi != float("inf"):
         out.append(f'<rect x="{tx(lo):.1f}" y="{sy(0.52):.1f}" width="{max(tx(hi) - tx(lo), 1):.1f}" height="{sy(0.48) - sy(0.52):.1f}" fill="#f2b8b8"/>')
     out.append('<polyline fill="none" stroke="#b00" stroke-width="2.5" points="' + " ".join(f"{tx(t):.1f},{sy(s):.1f}" for t, s, _ in curve) + '"/>')
+    if curve_corrected:
+        out.append('<polyline fill="none" stroke="#1a7f37" stroke-width="2.5" points="' + " ".join(f"{tx(t):.1f},{sy(s):.1f}" for t, s, _ in curve_corrected) + '"/>')
     if curve_adaptive:
         out.append('<polyline fill="none" stroke="#e07b00" stroke-width="2.5" stroke-dasharray="7,4" points="' + " ".join(f"{tx(t):.1f},{sy(s):.1f}" for t, s, _ in curve_adaptive) + '"/>')
     observed = sorted(t for t in nights.values() if t is not None)
