@@ -131,6 +131,32 @@ def cholesky(a):
     return l
 
 
+def coefficient_draws(beta, cov, n, seed):
+    """n draws of the coefficients from N(beta, cov) (the fits' own uncertainty)."""
+    rng = random.Random(seed)
+    chol = cholesky(cov)
+    draws = []
+    for _ in range(n):
+        z = [rng.gauss(0, 1) for _ in beta]
+        draws.append([beta[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(beta))])
+    return draws
+
+
+def ks_distance(places):
+    """One-sample Kolmogorov-Smirnov distance of sorted places in [0, 1] from the uniform."""
+    n = len(places)
+    return max(max((i + 1) / n - u, u - i / n) for i, u in enumerate(places)) if places else float("nan")
+
+
+def profile_scale(likelihood):
+    """The inflow scale over 0.50-1.50 (steps of 0.01) for one recorded time: its best value and the values within
+    Δ(-2 ln L) < 3.84. likelihood: scale -> L."""
+    rows = [(k / 100.0, -2.0 * math.log(max(likelihood(k / 100.0), 1e-300))) for k in range(50, 151)]
+    top = min(v for _, v in rows)
+    inside = [sc for sc, v in rows if v - top < 3.84]
+    return min(rows, key=lambda r: r[1])[0], inside[0], inside[-1]
+
+
 def fit_hazard(runs, use):
     """Exponential survival regression on the covariates `use` (indices)."""
     beta = [0.0] * len(use)
@@ -303,11 +329,7 @@ def corrected_section(beta, use, whole, other_scale, fitted_nights, what="the ch
     """A one-factor correction of the cheap model fitted to whole nights, checked across the inflow scales, and the
     recorded night's inflow scale on the corrected model."""
     def places(b, nights_at):
-        out = []
-        for s, t, end in nights_at:
-            curve = survival_curve(b, use, scale=s)
-            out.append((jammed_by(curve, t), True) if t is not None else (jammed_by(curve, end), False))
-        return out
+        return [jammed_by(survival_curve(b, use, scale=s), t if t is not None else end) for s, t, end in nights_at]
 
     def median_error(b, nights_at):
         s = nights_at[0][0]
@@ -319,8 +341,8 @@ def corrected_section(beta, use, whole, other_scale, fitted_nights, what="the ch
         if pred is None:
             return "the prediction's median after 03:35"
         n = len(jammed)
-        u = sorted(p for p, _ in places(b, nights_at))
-        ks = max(max((i + 1) / n - x, x - i / n) for i, x in enumerate(u))
+        u = sorted(places(b, nights_at))
+        ks = ks_distance(u)
         return f"median {clock(pred)} against {clock(obs)} ({pred - obs:+.0f} s), places {', '.join(f'{x:.2f}' for x in u)}, KS {ks:.2f} (5 %: {KS_CRITICAL_5.get(n, float('nan')):.3f})"
 
     at_one = [w for w in whole if w[0] == 1.0]
@@ -351,20 +373,14 @@ def corrected_section(beta, use, whole, other_scale, fitted_nights, what="the ch
     fitted = []
     for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0),
                           ("the fatal clog, 03:33", FATAL_CLOG_S)):
-        rows = []
-        for k in range(50, 151):
-            scale = k / 100.0
+        def likelihood(scale):
             base = survival_curve(beta, use, scale=scale, dt=10.0)
-            i = min(range(len(base)), key=lambda j: abs(base[j][0] - target))
-            t_i, s_i, h_i = base[i]
+            _, s_i, h_i = min(base, key=lambda row: abs(row[0] - target))
             cum = -math.log(max(s_i, 1e-300))
-            like = sum(w * math.exp(x) * h_i * math.exp(-math.exp(x) * cum) for x, w in zip(deltas, weights)) / sum(weights)
-            rows.append((scale, -2.0 * math.log(max(like, 1e-300))))
-        top = min(v for _, v in rows)
-        best = min(rows, key=lambda r: r[1])[0]
-        inside = [sc for sc, v in rows if v - top < 3.84]
+            return sum(w * math.exp(x) * h_i * math.exp(-math.exp(x) * cum) for x, w in zip(deltas, weights)) / sum(weights)
+        best, lo, hi = profile_scale(likelihood)
         med = quantile_time(survival_curve(shifted(beta, d), use, scale=best), 0.5)
-        out.append(f"| {label} | {best:.2f} | {inside[0]:.2f}–{inside[-1]:.2f} | {clock(med) if med is not None else 'after 03:35'} |")
+        out.append(f"| {label} | {best:.2f} | {lo:.2f}–{hi:.2f} | {clock(med) if med is not None else 'after 03:35'} |")
         fitted.append(best)
     out += ["", "### The first jam predicted at those scales (paper's Γ, λ)", "",
             "| model | inflow scale | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- | --- |"]
@@ -401,8 +417,7 @@ def fitted_check(beta, use, delta, nights_at):
         for label, curve in (("corrected", corrected), ("uncorrected", plain)):
             pred = quantile_time(curve, 0.5)
             if len(jammed) == n:
-                u = sorted(jammed_by(curve, t) for t in jammed)
-                ks = max(max((i + 1) / n - x, x - i / n) for i, x in enumerate(u))
+                ks = ks_distance(sorted(jammed_by(curve, t) for t in jammed))
                 tail = f"; KS {ks:.2f} (5 %: {KS_CRITICAL_5.get(n, float('nan')):.3f})"
             else:
                 tail = " (KS not computed: censored nights)"
@@ -437,32 +452,20 @@ def own_hazard_section(nights_at, cheap_fits):
         out.append(f"| {label} | " + " | ".join(f"{b[i]:.2f} ± {math.sqrt(cv[i][i]):.2f}" for i in range(3)) + " |")
 
     # The recorded night's inflow scale on the whole nights' own hazard, its uncertainty integrated out.
-    rng = random.Random(11)
-    chol = cholesky(cov)
-    draws = []
-    for _ in range(100):
-        z = [rng.gauss(0, 1) for _ in beta]
-        draws.append([beta[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(beta))])
+    draws = coefficient_draws(beta, cov, 100, 11)
     out += ["", f"### The recorded night's inflow scale on the whole nights' own hazard (paper's Γ, λ, ε)", "",
             "One recorded time per reading; likelihood h(t) S(t) averaged over 100 draws of the coefficients from their covariance; "
             "s on a grid of 0.01 over 0.5–1.5.", "",
             "| reading of the recorded night's first jam | best s | s within Δ(−2 ln L) < 3.84 | first jam at the best s: 10 % / median / 90 % |",
             "| --- | --- | --- | --- |"]
     for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0), ("the fatal clog, 03:33", FATAL_CLOG_S)):
-        rows = []
-        for k in range(50, 151):
-            scale = k / 100.0
-            like = 0.0
-            for b in draws:
-                cum = cumulative_hazard(b, use, scale, target, dt=20.0)
-                like += hazard(b, use, *night_rates(target, scale)) * math.exp(-cum)
-            rows.append((scale, -2.0 * math.log(max(like / len(draws), 1e-300))))
-        top = min(v for _, v in rows)
-        best = min(rows, key=lambda r: r[1])[0]
-        inside = [sc for sc, v in rows if v - top < 3.84]
+        def likelihood(scale):
+            return sum(hazard(b, use, *night_rates(target, scale)) * math.exp(-cumulative_hazard(b, use, scale, target, dt=20.0))
+                       for b in draws) / len(draws)
+        best, lo, hi = profile_scale(likelihood)
         curve = survival_curve(beta, use, scale=best)
         qs = [quantile_time(curve, q) for q in (0.1, 0.5, 0.9)]
-        out.append(f"| {label} | {best:.2f} | {inside[0]:.2f}–{inside[-1]:.2f} | "
+        out.append(f"| {label} | {best:.2f} | {lo:.2f}–{hi:.2f} | "
                    + " / ".join(clock(t) if t is not None else "after 03:35" for t in qs) + " |")
     return out
 
@@ -516,6 +519,9 @@ def main():
     paper = [r for r in fixed if at_paper(r)]
     use_rates = [0, 1, 2]
     b_paper, cov_paper, _ = fit_hazard(paper, use_rates)
+    # The cheap model in the whole nights' own (adaptive) step, where enough of its runs jammed to fit it.
+    adaptive_paper = [r for r in adaptive if at_paper(r)]
+    fit_adaptive = fit_hazard(adaptive_paper, use_rates) if sum(r["jammed"] for r in adaptive_paper) >= 4 else None
     varied = len({(r["gamma"], r["lambda"]) for r in fixed}) > 1
     eps_varied = len({r["restitution"] for r in fixed}) > 1
     use_all = ([0, 1, 2, 3, 4] if varied else use_rates) + ([6] if eps_varied else [])
@@ -559,12 +565,8 @@ def main():
     def against_nights(beta, cov, use, step_adaptive, what):
         """The whole nights (at s = 1 and at the confirmation's scale) against the hazard `beta` along the schedule."""
         curve = survival_curve(beta, use, adaptive=step_adaptive)
-        rng = random.Random(41)
-        chol = cholesky(cov)
         medians = []
-        for _ in range(400):
-            z = [rng.gauss(0, 1) for _ in beta]
-            b = [beta[i] + sum(chol[i][j] * z[j] for j in range(i + 1)) for i in range(len(beta))]
+        for b in coefficient_draws(beta, cov, 400, 41):
             q = quantile_time(survival_curve(b, use, dt=20.0, adaptive=step_adaptive), 0.5)
             medians.append(q if q is not None else float("inf"))
         medians.sort()
@@ -573,7 +575,7 @@ def main():
         obs_median = (observed[(len(observed) - 1) // 2] + observed[len(observed) // 2]) / 2 if observed else float("nan")
         # Probability integral transform of each night under the predicted distribution.
         pits = sorted(jammed_by(curve, t) for t in observed)
-        ks = max(max(abs((i + 1) / len(pits) - u), abs(i / len(pits) - u)) for i, u in enumerate(pits)) if pits else float("nan")
+        ks = ks_distance(pits)
         pred = {q: quantile_time(curve, q) for q in (0.1, 0.25, 0.5, 0.75, 0.9)}
         out = ["", f"## The whole night predicted by {what}, against eight whole nights (paper's model)", "",
                "| | first jam: 10 % | 25 % | median | 75 % | 90 % |", "| --- | --- | --- | --- | --- | --- |",
@@ -603,7 +605,7 @@ def main():
             if len(jammed) == len(got) and jammed:
                 places = sorted(jammed_by(scaled, t) for t in jammed)
                 n = len(places)
-                ks_n = max(max((i + 1) / n - u, u - i / n) for i, u in enumerate(places))
+                ks_n = ks_distance(places)
                 median_obs = (jammed[(n - 1) // 2] + jammed[n // 2]) / 2
                 median_pred = quantile_time(scaled, 0.5)
                 out.append(f"- Their median first jam {clock(median_obs)} against the predicted {fmt(median_pred)}"
@@ -638,9 +640,8 @@ def main():
                   f"likelihood ratio {lr:.2f}, p = {p_lr:.3g} (χ², one degree of freedom)."]
         more, curve_a, band_a = against_nights(b_step, cov_step, use_step, True, "the cheap model with the nights' step (adaptive; rates' slopes shared with the fixed-step runs)")
         lines += more
-        adaptive_paper = [r for r in adaptive if at_paper(r)]
-        if sum(r["jammed"] for r in adaptive_paper) >= 4:
-            b_ad, cov_ad, _ = fit_hazard(adaptive_paper, use_rates)
+        if fit_adaptive:
+            b_ad, cov_ad, _ = fit_adaptive
             lines += coef_table(b_ad, cov_ad, use_rates, f"The hazard from the adaptive-step runs alone ({len(adaptive_paper)} runs, {sum(r['jammed'] for r in adaptive_paper)} first jams)")
             more, _, _ = against_nights(b_ad, cov_ad, use_rates, False, "the adaptive-step runs alone")
             lines += more
@@ -661,12 +662,7 @@ def main():
         epses = [0.2, 0.4, 0.8] if eps_varied else [EPS0]
         scales = [0.5 + 0.1 * k for k in range(11)]
         # The surrogate's own uncertainty: the likelihood averaged over draws of its coefficients.
-        chol_all = cholesky(cov_all)
-        draws_rng = random.Random(7)
-        draws = []
-        for _ in range(60):
-            z = [draws_rng.gauss(0, 1) for _ in b_all]
-            draws.append([b_all[i] + sum(chol_all[i][j] * z[j] for j in range(i + 1)) for i in range(len(b_all))])
+        draws = coefficient_draws(b_all, cov_all, 60, 7)
         for label, target in (("the stop released by the first recorded avalanche, 02:18", 1080.0),
                               ("the fatal clog, 03:33 (the avalanches before it as stops the cheap model does not resolve)", FATAL_CLOG_S)):
             def likelihood(beta, prm, scale):
@@ -725,21 +721,17 @@ def main():
     lines += corrected_section(b_paper, use_rates, whole, args.confirm_scale, fitted_nights)
     lines += own_hazard_section(whole + [n[:3] for n in fitted_nights], [
         ("the cheap model, fixed step", b_paper, cov_paper),
-        *([("the cheap model, adaptive step (as the nights)", *fit_hazard([r for r in adaptive if at_paper(r)], use_rates)[:2])]
-          if sum(r["jammed"] for r in adaptive if at_paper(r)) >= 4 else [])])
-    if sum(r["jammed"] for r in adaptive if at_paper(r)) >= 4:
+        *([("the cheap model, adaptive step (as the nights)", *fit_adaptive[:2])] if fit_adaptive else [])])
+    if fit_adaptive:
         # The cheap model in the whole nights' own step (found after the fitted nights' check, not committed before it).
-        b_ad, _, _ = fit_hazard([r for r in adaptive if at_paper(r)], use_rates)
-        lines += corrected_section(b_ad, use_rates, whole, args.confirm_scale, fitted_nights,
+        lines += corrected_section(fit_adaptive[0], use_rates, whole, args.confirm_scale, fitted_nights,
                                    "the cheap model in the nights' step (adaptive runs only)")
 
     with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     delta, _ = night_offset(b_paper, use_rates, whole)
-    adaptive_paper = [r for r in adaptive if at_paper(r)]
-    adaptive_ok = sum(r["jammed"] for r in adaptive_paper) >= 4
     draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, band, paths,
-         survival_curve(fit_hazard(adaptive_paper, use_rates)[0], use_rates) if adaptive_ok else None,
+         survival_curve(fit_adaptive[0], use_rates) if fit_adaptive else None,
          survival_curve(shifted(b_paper, delta), use_rates))
     svg_to_png(os.path.join(args.out, "cheap-model.svg"), os.path.join(args.out, "cheap-model.png"), 1200, 900)
     print("\n".join(lines))
