@@ -294,12 +294,13 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
       TimelineEvent e;
       e.where = item.Where();
       e.time_s = item.Number("time_s", 0.0, kMaxTime_s);
-      const char* kinds[] = {"set", "target", "open_exit", "close_exit", "start_inflow", "stop_inflow"};
+      const char* kinds[] = {"set", "target", "open_exit", "close_exit", "start_inflow", "stop_inflow", "fall"};
       int found = -1, count = 0;
-      for (int c = 0; c < 6; ++c)
+      for (int c = 0; c < 7; ++c)
         if (item.Has(kinds[c])) found = c, ++count;
       if (count != 1)
-        item.Fail("expected exactly one of \"set\", \"target\", \"open_exit\", \"close_exit\", \"start_inflow\", \"stop_inflow\"");
+        item.Fail("expected exactly one of \"set\", \"target\", \"open_exit\", \"close_exit\", \"start_inflow\", "
+                  "\"stop_inflow\", \"fall\"");
       e.kind = static_cast<TimelineEvent::Kind>(found);
       if (item.Has("group")) {
         const JsonReader g = item.At("group");
@@ -336,6 +337,21 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
         case TimelineEvent::Kind::kCloseExit: e.name = exit_named(item.At("close_exit")); break;
         case TimelineEvent::Kind::kStartInflow: e.name = inflow_named(item.At("start_inflow")); break;
         case TimelineEvent::Kind::kStopInflow: e.name = inflow_named(item.At("stop_inflow")); break;
+        case TimelineEvent::Kind::kFall: {
+          const JsonReader fall = item.At("fall");
+          if (!fall.IsObject()) fall.Fail("expected {\"at\": [x, y], \"count\": n, \"within_m\": r}");
+          const JsonReader at = fall.At("at");
+          if (!at.IsArray() || at.Size() != 2) at.Fail("expected [x, y] in m");
+          e.fall_at_x = at.Element(0).AsNumber(-1e6, 1e6);
+          e.fall_at_y = at.Element(1).AsNumber(-1e6, 1e6);
+          if (!geometry::IsWalkable(venue, Vec2{e.fall_at_x, e.fall_at_y}))
+            at.Fail("(" + FormatNumber(e.fall_at_x) + ", " + FormatNumber(e.fall_at_y) +
+                    ") is not in the venue's walkable area; expected a point where people stand");
+          e.fall_count = static_cast<std::size_t>(fall.Integer("count", 1, 10000));
+          e.fall_within_m = fall.Number("within_m", 2.0, 0.01, 1000.0);
+          fall.Finish();
+          break;
+        }
       }
       item.Finish();
       t.events.push_back(std::move(e));

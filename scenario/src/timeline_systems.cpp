@@ -146,6 +146,36 @@ class TimelineEventSystem : public RunSystem {
         s_.Event(t, on ? "inflow_started" : "inflow_stopped", -1, e.name);
         break;
       }
+      case TimelineEvent::Kind::kFall: {
+        // The walking people nearest the point (ties by id), of those within
+        // reach of it: the accounts say where and how many, not who.
+        const engine::BodyState& b = sim.bodies();
+        const Vec2 at{e.fall_at_x, e.fall_at_y};
+        std::vector<std::pair<double, std::uint32_t>> near;  // (distance, slot)
+        for (std::uint32_t i = 0; i < b.size(); ++i) {
+          if (b.state[i] != engine::PersonState::kWalking) continue;
+          const double d = Length(b.position_m[i] - at);
+          if (d <= e.fall_within_m) near.emplace_back(d, i);
+        }
+        std::sort(near.begin(), near.end(), [&](const auto& p, const auto& q) {
+          return p.first != q.first ? p.first < q.first : b.id[p.second] < b.id[q.second];
+        });
+        if (near.size() > e.fall_count) near.resize(e.fall_count);
+        const std::string where = "(" + FormatNumber(at.x) + ", " + FormatNumber(at.y) + ") m";
+        for (const auto& [d, i] : near) {
+          sim.SetPersonState(i, engine::PersonState::kFallen);
+          ++s_.fallen;
+          s_.Event(t, "fall", b.id[i],
+                   "recorded: " + std::to_string(near.size()) + " of the " + std::to_string(e.fall_count) +
+                       " nearest " + where + " within " + FormatNumber(e.fall_within_m) + " m (" + e.where +
+                       "), this one at " + FormatFixed(d, 2) + " m");
+        }
+        s_.Event(t, "recorded_fall", -1,
+                 std::to_string(near.size()) + " of " + std::to_string(e.fall_count) + " fell at once near " + where +
+                     (near.size() < e.fall_count ? ": fewer people walking within " + FormatNumber(e.fall_within_m) + " m"
+                                                 : ""));
+        break;
+      }
     }
   }
 

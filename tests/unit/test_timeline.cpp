@@ -312,6 +312,72 @@ TEST(Timeline, APersonHitHardFallsAndOneJostledDoesNot) {
   EXPECT_GT(loaded, 0.0) << "no fallen person carried any load";
 }
 
+// A fall the accounts record (issue 43): at its time the walking people
+// nearest its point fall at once, the nearest first, and stay down; when
+// fewer are within reach, those who are fall and the event says so.
+TEST(Timeline, ARecordedFallFellsTheNearestWalkersAtItsTime) {
+  const TimelineRun run = Simulate(
+      Hallway(R"({"count": 60, "target": "to_court", "seed": 4, "desired_speed_m_per_s": [0.0, 0.0],
+                  "placement": {"region": "walkable"}})",
+              R"({"duration_s": 2.5, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": true})",
+              R"({"closed_exits": ["court", "exit"],
+                  "events": [{"time_s": 1.0, "fall": {"at": [6, 1.5], "count": 4, "within_m": 2}},
+                             {"time_s": 2.0, "fall": {"at": [2, 1.5], "count": 500, "within_m": 0.8}}],
+                  "falls": {"criterion": "acceleration", "trip_over_fallen": true}})"),
+      "recorded_fall");
+  ExpectConservation(run);
+  const std::vector<runfile::Event> falls = run.Kind("fall"), recorded = run.Kind("recorded_fall");
+  ASSERT_EQ(recorded.size(), 2u);
+  EXPECT_EQ(recorded[0].detail, "4 of 4 fell at once near (6, 1.5) m");
+  EXPECT_NE(recorded[1].detail.find(" fell at once near (2, 1.5) m: fewer people walking within 0.8 m"), std::string::npos)
+      << recorded[1].detail;
+  std::vector<std::int64_t> first, second;
+  for (const runfile::Event& f : falls) {
+    ASSERT_EQ(f.detail.rfind("recorded: ", 0), 0u) << "a fall the run made itself: " << f.detail;
+    (f.time_s < 1.5 ? first : second).push_back(f.person);
+    EXPECT_NEAR(f.time_s, f.time_s < 1.5 ? 1.0 : 2.0, 0.01);
+  }
+  ASSERT_EQ(first.size(), 4u);
+  ASSERT_GE(second.size(), 1u);
+  ASSERT_LT(second.size(), 500u);
+  EXPECT_EQ(recorded[1].detail.rfind(std::to_string(second.size()) + " of 500", 0), 0u) << recorded[1].detail;
+  // The first four are the four walking nearest (6, 1.5) m at 1.0 s, and
+  // none of the fallen moves from then on.
+  const runfile::RunFileReader reader(run.file);
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  runfile::PersonFrame frame;
+  auto stream = reader.PersonFrames(1 << 30);
+  std::map<std::int64_t, Vec2> pose;
+  std::size_t k = 0;
+  while (stream.Next(&frame)) {
+    const double t = times[k++].time_s;
+    if (std::abs(t - 1.0) < 1e-9) {
+      std::vector<std::pair<double, std::int64_t>> near;
+      for (std::size_t i = 0; i < frame.person.size(); ++i)
+        near.emplace_back(Length(frame.position_m[i] - Vec2{6.0, 1.5}), frame.person[i]);
+      std::sort(near.begin(), near.end());
+      std::vector<std::int64_t> nearest;
+      for (std::size_t i = 0; i < 4; ++i) nearest.push_back(near[i].second);
+      std::vector<std::int64_t> felled = first;
+      std::sort(nearest.begin(), nearest.end());
+      std::sort(felled.begin(), felled.end());
+      EXPECT_EQ(felled, nearest);
+      EXPECT_LE(near[3].first, 2.0);
+    }
+    for (std::size_t i = 0; i < frame.person.size(); ++i) {
+      if (t < 1.05 || std::find(first.begin(), first.end(), frame.person[i]) == first.end()) continue;
+      EXPECT_EQ(frame.state[i], runfile::PersonStatus::kFallen);
+      if (auto seen = pose.find(frame.person[i]); seen != pose.end()) {
+        EXPECT_EQ(seen->second.x, frame.position_m[i].x);
+        EXPECT_EQ(seen->second.y, frame.position_m[i].y);
+      }
+      pose[frame.person[i]] = frame.position_m[i];
+    }
+  }
+  EXPECT_EQ(pose.size(), 4u);
+  EXPECT_EQ(run.census.back().census.fallen, static_cast<std::int64_t>(falls.size()));
+}
+
 TEST(Timeline, ASmallRoomEmptiesThroughItsDoorAtABottleneckFlow) {
   // tests/data/venues/room.json: 10 m x 4 m, a pillar, a 1 m door in the east
   // wall. 40 people head for it; the run ends when all have left. The
@@ -436,6 +502,17 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
   refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
   refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
+  // Issue 43: a fall the accounts record.
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [6, 1.5]}}]})", "/timeline/events/0/fall: missing required key \"count\"");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [50, 1.5], "count": 2}}]})",
+         "/timeline/events/0/fall/at: (50, 1.5) is not in the venue's walkable area");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": 3, "count": 2}}]})", "/timeline/events/0/fall/at: expected [x, y] in m");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [6, 1.5], "count": 0}}]})", "/timeline/events/0/fall/count");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [6, 1.5], "count": 2, "within_m": -1}}]})",
+         "/timeline/events/0/fall/within_m");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [6, 1.5], "count": 2, "who": "x"}}]})", "/timeline/events/0/fall");
+  refuse(R"({"events": [{"time_s": 1, "fall": {"at": [6, 1.5], "count": 2}, "group": "main"}]})",
+         "only \"set\" and \"target\" events apply to a group");
   // Issue 40: an event after the run's end (10 s) would never happen.
   refuse(R"({"events": [{"time_s": 1, "close_exit": "court"}, {"time_s": 12.5, "close_exit": "exit"}]})",
          "bad.json: /timeline/events/1/time_s: 12.5 s lies after the run's end (run.duration_s = 10 s)");

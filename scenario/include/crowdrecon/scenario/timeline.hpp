@@ -1,7 +1,8 @@
 // The incident timeline of a scenario (issue 20): an open venue whose people
 // arrive through entry zones on an inflow schedule and leave through exits,
 // timed events (a parameter change, an evacuation order, an exit opened or
-// closed, an inflow started or stopped) and people who fall. Scenario key
+// closed, an inflow started or stopped, falls the accounts record) and
+// people who fall. Scenario key
 // "timeline" (docs/scenarios.md, "Timelines"):
 //
 //   "timeline": {
@@ -15,7 +16,8 @@
 //     "events": [
 //       {"time_s": 300, "set": {"back_force_gamma": 2.0}, "group": "main"},
 //       {"time_s": 600, "target": "street", "group": "counter"},
-//       {"time_s": 900, "close_exit": "court"}, {"time_s": 950, "stop_inflow": "arriving"}
+//       {"time_s": 900, "close_exit": "court"}, {"time_s": 950, "stop_inflow": "arriving"},
+//       {"time_s": 1000, "fall": {"at": [6, 1.5], "count": 5, "within_m": 3}}
 //     ],
 //     "falls": {"criterion": "acceleration", "threshold_m_per_s2": 5, "window_s": 0.5}
 //              (or "criterion": "load"; with "acceleration", "trip_over_fallen": true)
@@ -85,7 +87,7 @@ struct InflowSpec {
 };
 
 struct TimelineEvent {
-  enum class Kind { kSetParameters, kTarget, kOpenExit, kCloseExit, kStartInflow, kStopInflow };
+  enum class Kind { kSetParameters, kTarget, kOpenExit, kCloseExit, kStartInflow, kStopInflow, kFall };
   double time_s = 0.0;
   Kind kind = Kind::kSetParameters;
   std::string group;  // "" = everyone (kSetParameters, kTarget)
@@ -93,6 +95,14 @@ struct TimelineEvent {
   // "desired_speed_m_per_s" (everyone of the group, and later arrivals of it).
   std::vector<std::pair<std::string, double>> parameters;
   std::string name;   // kTarget: target; k*Exit: exit id; k*Inflow: inflow id
+  // kFall, a fall the accounts record (an input, unlike a RecordedMark): the
+  // `fall_count` walking people whose centres are nearest `fall_at` (ties by
+  // id), of those within `fall_within_m` of it, fall at once. The model does
+  // not decide who falls first; the fall criterion and tripping decide who
+  // falls after them.
+  double fall_at_x = 0.0, fall_at_y = 0.0;
+  std::size_t fall_count = 0;
+  double fall_within_m = 0.0;
   std::string where;  // JSON path, for messages
 };
 
