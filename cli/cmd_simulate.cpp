@@ -1,4 +1,4 @@
-// crowdrecon simulate SCENARIO -o RUN.sqlite [--threads N] [--device cpu|cuda] [--resume]
+// crowdrecon simulate SCENARIO -o RUN.sqlite [--threads N] [--device cpu|cuda] [--resume | --branch-from RUN]
 #include <unistd.h>
 
 #include <cstdio>
@@ -24,6 +24,7 @@ struct SimulateArgs {
   int threads = 0;
   std::string device = "cpu";
   bool resume = false;
+  std::string branch_from;
   bool force = false;
   bool quiet = false;
   bool fixed_threads = false;
@@ -36,15 +37,21 @@ int RunSimulate(const SimulateArgs& args) {
                {{"the scenario", sc.file},
                 {"the venue", sc.venue_file},
                 {"the reference body", sc.population.reference_body},
-                {"the anthropometry extract", sc.population.anthropometry}},
+                {"the anthropometry extract", sc.population.anthropometry},
+                {"the run to branch from", args.branch_from}},
                args.force);
+  if (!args.branch_from.empty()) {
+    // CheckOutputs allowed replacing -o: a branch starts it anew.
+    const double t_s = scenario::BranchRun(sc, args.branch_from, args.output);
+    std::fprintf(stderr, "crowdrecon: branched from %s at t = %.3f s\n", args.branch_from.c_str(), t_s);
+  }
   scenario::RunOptions options;
   options.output = args.output;
   options.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   if (!engine::FromString(args.device, &options.device))
     throw InputError("--device: \"" + args.device + "\", expected \"cpu\" or \"cuda\"");
   options.adapt_threads = !args.fixed_threads;
-  options.resume = args.resume;
+  options.resume = args.resume || !args.branch_from.empty();
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.stop_after_s = args.stop_after_s;
   scenario::InstallInterruptHandlers();
@@ -106,7 +113,12 @@ void RegisterSimulateCommand(CLI::App& app) {
   cmd->add_flag("--fixed-threads", args->fixed_threads,
                 "Keep exactly --threads threads, even while fewer are faster (another program busy on a core); "
                 "for benchmarks. By default the count adapts; results do not depend on it");
-  cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  auto* resume = cmd->add_flag("--resume", args->resume, "Continue an interrupted run from its checkpoint");
+  cmd->add_option("--branch-from", args->branch_from,
+                  "Start the run as the given unfinished run stood at its checkpoint and continue it under this "
+                  "scenario, which may differ from that run's only in its name, notes and timeline events from the "
+                  "checkpoint's time on (a what-if from a moment of a long run)")
+      ->excludes(resume);
   AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption")

@@ -475,6 +475,16 @@ bool IsRunFile(const std::filesystem::path& file) {
 }
 
 OutputKind RunFileOutput() { return {"a crowdrecon run file", false, IsRunFile}; }
+
+void CopyRunFile(const std::filesystem::path& from, const std::filesystem::path& to) {
+  std::error_code ec;
+  if (std::filesystem::exists(to, ec)) throw InputError(to.string() + ": exists; a copy of a run file is written only anew");
+  std::string quoted = "'";
+  for (const char c : to.string()) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  quoted += "'";
+  const Database db(from.string(), SQLITE_OPEN_READONLY | kWriterMutexMode);
+  db.Exec("VACUUM INTO " + quoted);
+}
 RunFileReader::~RunFileReader() = default;
 
 std::string RunFileReader::RunValue(const std::string& key) const {

@@ -38,13 +38,14 @@ extern "C" void OnInterrupt(int signal) {
   g_stop_requested.store(true);
 }
 
-// FNV-1a of the scenario text and thread-independent settings: a checkpoint
-// only resumes the run it was written for.
-std::uint64_t ScenarioFingerprint(const Scenario& s) {
+// FNV-1a of the scenario text: a checkpoint only resumes the run it was
+// written for.
+std::uint64_t TextFingerprint(const std::string& json_text) {
   std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s.json_text) h = (h ^ c) * 1099511628211ull;
+  for (unsigned char c : json_text) h = (h ^ c) * 1099511628211ull;
   return h;
 }
+std::uint64_t ScenarioFingerprint(const Scenario& s) { return TextFingerprint(s.json_text); }
 
 // Checkpoint: magic, the scenario's fingerprint, the last frame written, the
 // engine's state (Simulation::SaveState), then each run-loop system's state
@@ -289,6 +290,103 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
 }
 
 }  // namespace
+
+namespace {
+
+// A scenario's JSON without what a branch may change (name, notes, the
+// timeline's events), and those events in the order the parser applies
+// them (stably by time), each with its time.
+struct BranchParts {
+  nlohmann::json rest;
+  std::vector<std::pair<double, nlohmann::json>> events;
+};
+
+BranchParts SplitForBranch(const std::string& json_text, const std::string& what) {
+  BranchParts parts;
+  try {
+    parts.rest = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(what + ": its scenario is not JSON (" + e.what() + ")");
+  }
+  if (!parts.rest.is_object()) throw InputError(what + ": its scenario is not a JSON object");
+  parts.rest.erase("name");
+  parts.rest.erase("notes");
+  if (auto t = parts.rest.find("timeline"); t != parts.rest.end() && t->is_object()) {
+    if (auto e = t->find("events"); e != t->end() && e->is_array()) {
+      for (const nlohmann::json& event : *e) {
+        const auto time = event.find("time_s");
+        parts.events.emplace_back(time != event.end() && time->is_number() ? time->get<double>() : 0.0, event);
+      }
+      t->erase("events");
+    }
+  }
+  std::stable_sort(parts.events.begin(), parts.events.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  return parts;
+}
+
+}  // namespace
+
+double BranchRun(const Scenario& scenario, const std::filesystem::path& from, const std::filesystem::path& output) {
+  const std::string name = from.string();
+  if (!runfile::IsRunFile(from)) throw InputError(name + ": not a crowdrecon run file (the run to branch from)");
+  std::error_code ec;
+  const runfile::RunFileReader reader(from);
+  const std::string old_text = reader.RunValue("scenario");
+  if (!std::filesystem::exists(CheckpointPath(from), ec))
+    throw InputError(name + ": has no checkpoint to branch from (" + CheckpointPath(from).string() +
+                     "); a run keeps its last checkpoint while it is unfinished");
+  const Checkpoint c = ReadCheckpoint(CheckpointPath(from), TextFingerprint(old_text));
+  double t_s = -1.0;
+  for (const runfile::FrameTime& f : reader.FrameTimes())
+    if (f.frame == c.last_frame) t_s = f.time_s;
+  if (t_s < 0.0)
+    throw InputError(name + ": its checkpoint is at frame " + std::to_string(c.last_frame) +
+                     ", which the run file does not have (the file and the checkpoint are not of one run)");
+
+  // The same run up to the checkpoint: everything but the name, the notes
+  // and the events from the checkpoint's time on.
+  const std::string at = " (a branch at t = " + FormatNumber(t_s) + " s may change only the name, the notes and "
+                         "timeline events at or after that time)";
+  const BranchParts was = SplitForBranch(old_text, name);
+  const BranchParts now = SplitForBranch(scenario.json_text, scenario.file.string());
+  if (was.rest != now.rest) {
+    const nlohmann::json patch = nlohmann::json::diff(was.rest, now.rest);
+    const std::string path = patch.empty() ? "/" : patch[0].value("path", "/");
+    throw InputError(scenario.file.string() + ": " + path + ": differs from the scenario of " + name + at);
+  }
+  // An event at the checkpoint's time is applied at the first step after it.
+  const auto before = [&](const BranchParts& p) {
+    std::vector<nlohmann::json> out;
+    for (const auto& [time, event] : p.events)
+      if (time < t_s - 1e-9) out.push_back(event);
+    return out;
+  };
+  const std::vector<nlohmann::json> was_before = before(was), now_before = before(now);
+  if (was_before != now_before) {
+    std::size_t k = 0;
+    while (k < was_before.size() && k < now_before.size() && was_before[k] == now_before[k]) ++k;
+    throw InputError(scenario.file.string() + ": /timeline/events: the events before t = " + FormatNumber(t_s) +
+                     " s differ from those of " + name + " from the " + std::to_string(k + 1) +
+                     (k == 0 ? "st" : k == 1 ? "nd" : k == 2 ? "rd" : "th") + " on" + at);
+  }
+
+  // The run file to its checkpoint's frame, now the scenario's; the
+  // checkpoint with the scenario's fingerprint.
+  std::filesystem::remove(output, ec);
+  std::filesystem::remove(CheckpointPath(output), ec);
+  runfile::CopyRunFile(from, output);
+  {
+    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(output, c.last_frame);
+    writer.SetRunValue("scenario", scenario.json_text);
+    writer.SetRunValue("scenario_file", scenario.file.string());
+    writer.SetRunValue("branched_from", name + " at t = " + FormatNumber(t_s) + " s (frame " +
+                                            std::to_string(c.last_frame) + ")");
+    writer.SetStatus("interrupted");
+  }
+  WriteCheckpoint(CheckpointPath(output), ScenarioFingerprint(scenario), c);
+  return t_s;
+}
 
 EngineAtCheckpoint ReadEngineAtCheckpoint(const Scenario& scenario, const std::filesystem::path& run_file, int threads) {
   BuiltWorld built = BuildWorld(scenario, threads, [](const std::string&) {});

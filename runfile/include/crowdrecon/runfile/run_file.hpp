@@ -393,5 +393,9 @@ class RunFileReader {
 OutputKind RunFileOutput();
 // True if `file` is a crowdrecon run file (false for anything else, no error).
 bool IsRunFile(const std::filesystem::path& file);
+// Copies the run file `from` to `to` (which must not exist): a consistent
+// snapshot, also of a run being written (SQLite's VACUUM INTO). For a run
+// branched at a checkpoint (scenario::BranchRun).
+void CopyRunFile(const std::filesystem::path& from, const std::filesystem::path& to);
 
 }  // namespace crowdrecon::runfile

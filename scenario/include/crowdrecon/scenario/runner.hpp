@@ -65,6 +65,21 @@ int InterruptedExitStatus();
 
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
 
+// A run branched at the checkpoint of another (a what-if from a moment of a
+// long run: "and if at 22:15 people fell there"): writes `output` and its
+// checkpoint as the run `from` stood at its checkpoint, now belonging to
+// `scenario`, so that RunScenario with `resume` continues it under
+// `scenario`. The scenario may differ from the one `from` was written for
+// only in its name, its notes and the timeline's events at or after the
+// checkpoint's time; the world, the population, the model, the run's
+// duration and every event before that time must be the same (else the
+// state would not be the one `scenario` gives; the engine's state also
+// checks the time step and the people). Throws InputError naming the run,
+// the checkpoint or the first JSON path that differs, before anything is
+// written; then replaces `output` and its checkpoint (the caller has checked
+// that it may: CheckOutputs). Returns the checkpoint's time (s).
+double BranchRun(const Scenario& scenario, const std::filesystem::path& from, const std::filesystem::path& output);
+
 // The engine's world and its state at the checkpoint of an interrupted run
 // (CheckpointPath(run_file)), built as RunScenario builds them (the same
 // world, time step and state a resumed run continues from), with `threads`.
