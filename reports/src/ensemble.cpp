@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 
 #include "crowdrecon/analysis/plausibility.hpp"
@@ -101,6 +102,12 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
 EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions& options) {
   if (std::string error; !options.IsValid(&error)) throw InputError("ensemble options: " + error);
   if (runs.empty()) throw InputError("an ensemble needs at least one run");
+  // Runs of one seed under different settings (a sweep's variants) are told
+  // apart by their files' names.
+  std::map<std::string, int> uses;
+  for (const EnsembleRun& r : runs) ++uses[r.label];
+  for (EnsembleRun& r : runs)
+    if (uses[r.label] > 1) r.label = std::filesystem::path(r.run_file).stem().string();
   const auto same_marks = [](const std::vector<analysis::TimelineMark>& a, const std::vector<analysis::TimelineMark>& b) {
     if (a.size() != b.size()) return false;
     for (std::size_t k = 0; k < a.size(); ++k)

@@ -104,6 +104,21 @@ TEST(Ensemble, RunsOfAnotherIncidentAndBadOptionsAreRefused) {
   EXPECT_THROW(ScoreEnsemble({}, EnsembleOptions{}), InputError);
 }
 
+// A sweep's variants share seeds: their rows are told apart by the files'
+// names; distinct seeds keep their "seed N".
+TEST(Ensemble, RunsOfOneSeedAreLabelledByTheirFiles) {
+  EnsembleRun a = MakeRun("seed 1", {}, {}, kNaN, 0, 8.0), b = MakeRun("seed 1", {}, {}, kNaN, 0, 8.0);
+  a.run_file = "runs/0000-foot-count=4-seed1.sqlite";
+  b.run_file = "runs/0002-foot-count=8-seed1.sqlite";
+  const EnsembleScore s = ScoreEnsemble({a, b, MakeRun("seed 2", {}, {}, kNaN, 0, 8.0)}, EnsembleOptions{});
+  EXPECT_EQ(s.runs[0].label, "0000-foot-count=4-seed1");
+  EXPECT_EQ(s.runs[1].label, "0002-foot-count=8-seed1");
+  EXPECT_EQ(s.runs[2].label, "seed 2");
+  const EnsembleScore distinct =
+      ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0), MakeRun("seed 2", {}, {}, kNaN, 0, 8.0)}, EnsembleOptions{});
+  EXPECT_EQ(distinct.runs[0].label, "seed 1");
+}
+
 TEST(Ensemble, ItsScoreFilesAreKnownAsPreviousOutputs) {
   const EnsembleScore s = ScoreEnsemble({MakeRun("seed 1", {130.0}, {}, kNaN, 0, 8.0)}, EnsembleOptions{});
   const OutputKind kind = EnsembleScoresOutput();

@@ -214,6 +214,46 @@ TEST(RenderRun, StrongerForcesDrawThickerLines) {
   EXPECT_GT(thick, 2 * thin);
 }
 
+// A person who fell (event `fall`) is drawn grey with a cross from then on,
+// and counted in the legend and the summary; before it, in their group's colour.
+TEST(RenderRun, TheFallenAreDrawnGreyFromTheirFall) {
+  const ScratchDir dir("fallen");
+  const std::filesystem::path run = WriteRun(dir.path(), 11);
+  {
+    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(run, 10);
+    runfile::Event e;
+    e.time_s = 0.5;
+    e.kind = "fall";
+    for (std::int64_t person : {2, 7}) {
+      e.person = person;
+      writer.WriteEvent(5, e);
+    }
+    writer.SetStatus("complete");
+  }
+  const auto grey_pixels = [&](const std::string& frames, const std::string& sub, RenderSummary* summary) {
+    RenderOptions options;
+    options.output_dir = dir.path() / sub;
+    options.frames = ParseFrameSelection(frames);
+    *summary = RenderRun(run, options);
+    const cv::Mat image = media::ReadImage(summary->first_picture.string(), cv::IMREAD_COLOR);
+    int count = 0;
+    for (int y = static_cast<int>(summary->margin_px); y < image.rows - static_cast<int>(summary->margin_px); ++y)
+      for (int x = 0; x < image.cols; ++x) {
+        const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+        // The fallen's fill: 0x3a3a3a lightened 45 % toward white (about 0x939393).
+        if (std::abs(p[0] - 147) < 8 && std::abs(p[1] - 147) < 8 && std::abs(p[2] - 147) < 8) ++count;
+      }
+    return count;
+  };
+  RenderSummary before, after;
+  const int grey_before = grey_pixels("0", "before", &before), grey_after = grey_pixels("last", "after", &after);
+  EXPECT_EQ(before.most_fallen, 0u);
+  EXPECT_LT(grey_before, 20);  // (a few edge pixels of other colours blend to it)
+  EXPECT_EQ(after.most_fallen, 2u);
+  EXPECT_GT(grey_after, 10 * std::max(grey_before, 5));
+  EXPECT_NE(after.BriefReport().find("fallen: up to 2 in a frame"), std::string::npos) << after.BriefReport();
+}
+
 TEST(RenderRun, WithoutAPeriodicBoxLeavesOutBranchesAcrossTheSeam) {
   const ScratchDir dir("seam");
   const std::filesystem::path run = WriteRun(dir.path(), 11, /*record_periodic_box=*/false);

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <regex>
 #include <system_error>
@@ -83,6 +84,13 @@ struct Scene {
   std::vector<std::uint32_t> person_group;
   std::optional<PeriodicBox> periodic;
   std::string floor_note;  // why the walkable area is not drawn, if it is not
+  // When each person fell (event `fall`; NaN: never): from then on they are
+  // drawn as lying obstacles (grey, a cross).
+  std::vector<double> fell_at_s;
+
+  bool FallenAt(std::size_t person, double t_s) const {
+    return person < fell_at_s.size() && fell_at_s[person] <= t_s + 1e-9;
+  }
 
   const ShapeInfo& ShapeOf(std::size_t person) const {
     const std::uint32_t s = person < person_shape.size() ? person_shape[person] : 0;
@@ -133,6 +141,12 @@ Scene LoadScene(const runfile::RunFileReader& run, const std::string& file) {
   if (scene.shapes.empty()) throw InputError(file + ": run file has no body shapes (table shape is empty)");
   scene.person_shape = run.PersonShapes();
   scene.person_group = run.PersonGroups();
+  for (const runfile::Event& e : run.Events()) {
+    if (e.kind != "fall" || e.person < 0) continue;
+    const auto person = static_cast<std::size_t>(e.person);
+    if (person >= scene.fell_at_s.size()) scene.fell_at_s.resize(person + 1, std::numeric_limits<double>::quiet_NaN());
+    if (!(scene.fell_at_s[person] <= e.time_s)) scene.fell_at_s[person] = e.time_s;
+  }
   // Run files need not record a periodic box: without one, seams are handled
   // by leaving out contact lines that would span the box (see DrawForceNetwork).
   if (const PeriodicBox box = run.periodic_box(); box.any()) scene.periodic = box;
@@ -214,6 +228,7 @@ const Color kWall = Color::Hex(0x303030);
 const Color kForce = Color{0.55, 0.05, 0.05, 0.85};
 const Color kText = Color::Hex(0x202020);
 const Color kSubtleText = Color::Hex(0x505050);
+const Color kFallenBody = Color::Hex(0x3a3a3a);
 
 // Offsets of the periodic images of a body at `p` that reach into the box:
 // {0} plus one per seam the body straddles (and the corner image).
@@ -264,6 +279,15 @@ void DrawBody(Canvas& canvas, const Layout& layout, const ShapeInfo& shape, Vec2
   const Vec2 base = position + ahead * (0.9 * shape.front_m - 0.4 * shape.front_m);
   const double half_width_m = 0.22 * shape.front_m;
   canvas.FillPolygon({tip, base + side * half_width_m, base - side * half_width_m}, outline);
+}
+
+// A fallen person (an obstacle lying on the floor): a cross over the body,
+// as wide as its front.
+void DrawFallenCross(Canvas& canvas, Vec2 position, const ShapeInfo& shape) {
+  const double h = 0.7 * shape.front_m;
+  const Color ink = Color::Hex(0x101010);
+  canvas.Line(position + Vec2{-h, -h}, position + Vec2{h, h}, ink, 1.5);
+  canvas.Line(position + Vec2{-h, h}, position + Vec2{h, -h}, ink, 1.5);
 }
 
 // A force line: a band of `width_px` from a to b with square ends (a stroked
@@ -329,6 +353,7 @@ struct FrameLegend {
   std::int64_t frame = 0;
   double time_s = 0.0;
   std::size_t people = 0;
+  std::size_t fallen = 0;
   std::vector<std::uint32_t> groups_present;
 };
 
@@ -343,15 +368,16 @@ void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend,
 
   // Groups: a swatch and a name each.
   double x = kMargin_px;
-  for (std::uint32_t g : legend.groups_present) {
-    const Color c = GroupColor(g);
+  const auto swatch = [&](Color c, const std::string& name) {
     const Vec2 a = layout.World(x, 32.0), b = layout.World(x + 11.0, 43.0);
     canvas.FillPolygon({a, {b.x, a.y}, b, {a.x, b.y}}, Lighter(c, 0.45));
     canvas.StrokePolygon({a, {b.x, a.y}, b, {a.x, b.y}}, Darker(c, 0.6), 1.0);
-    const std::string name = "group " + std::to_string(g) + (g == 1 ? " (counter-flow)" : "");
     canvas.TextPx(x + 16.0, 42.0, name, 12, kSubtleText);
     x += 16.0 + 7.0 * static_cast<double>(name.size()) + 18.0;
-  }
+  };
+  for (std::uint32_t g : legend.groups_present)
+    swatch(GroupColor(g), "group " + std::to_string(g) + (g == 1 ? " (counter-flow)" : ""));
+  if (legend.fallen > 0) swatch(kFallenBody, "fallen: " + std::to_string(legend.fallen) + " (a cross)");
   canvas.TextPx(x, 42.0, "triangle: chest    lines: contact forces (centroid to contact point)", 12, kSubtleText);
 
   // Scale bar (lower left) and force scale (lower right): sample lines of
@@ -626,6 +652,8 @@ std::string RenderSummary::BriefReport() const {
                   std::to_string(height_px) + " px\n";
   s += "contact force: max " + FormatFixed(max_contact_force_n, 1) + " N, drawn at " +
        FormatNumber(std::round(force_n_per_px * 1000.0) / 1000.0) + " N per px of line width\n";
+  if (most_fallen > 0)
+    s += "fallen: up to " + std::to_string(most_fallen) + " in a frame, drawn grey with a cross\n";
   if (branches_left_out > 0)
     s += "note: " + std::to_string(branches_left_out) +
          " contact line(s) across a periodic seam left out (the run file records no periodic box)\n";
@@ -741,6 +769,10 @@ FrameLegend LegendOf(const runfile::RunFrame& frame, const Scene& scene, std::ve
     const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
     if (person >= slot_of_person->size()) slot_of_person->resize(person + 1, -1);
     (*slot_of_person)[person] = static_cast<std::int64_t>(i);
+    if (scene.FallenAt(person, frame.time_s)) {
+      ++legend.fallen;
+      continue;
+    }
     const std::uint32_t g = scene.GroupOf(person);
     if (std::find(legend.groups_present.begin(), legend.groups_present.end(), g) == legend.groups_present.end())
       legend.groups_present.push_back(g);
@@ -772,9 +804,12 @@ std::pair<double, double> DrawFrame(const std::filesystem::path& path, const run
   for (std::size_t i = 0; i < frame.ids.size(); ++i) {
     const auto person = static_cast<std::size_t>(frame.ids[i] - 1);
     const ShapeInfo& shape = scene.ShapeOf(person);
-    for (Vec2 offset : ImageOffsets(scene, frame.position_m[i], shape.reach_m))
+    const bool fallen = scene.FallenAt(person, frame.time_s);
+    for (Vec2 offset : ImageOffsets(scene, frame.position_m[i], shape.reach_m)) {
       DrawBody(canvas, layout, shape, frame.position_m[i] + offset, frame.orientation[i],
-               GroupColor(scene.GroupOf(person)));
+               fallen ? kFallenBody : GroupColor(scene.GroupOf(person)));
+      if (fallen) DrawFallenCross(canvas, frame.position_m[i] + offset, shape);
+    }
   }
   *stats = FrameStats{};
   DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, stats);
@@ -831,6 +866,7 @@ RenderSummary RenderRun(const std::filesystem::path& run_file, const RenderOptio
     }
     summary.last_frame = frame.frame;
     summary.branches_left_out += stats.branches_left_out;
+    summary.most_fallen = std::max(summary.most_fallen, legend.fallen);
     ++summary.frames_written;
     if (options.progress) options.progress({k + 1, frames.size(), frame.frame, frame.time_s});
   }

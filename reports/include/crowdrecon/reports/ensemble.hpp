@@ -58,7 +58,7 @@ struct EnsembleOptions {
 
 struct EnsembleRun {
   std::string run_file;
-  std::string label;  // "seed 3", or the file's name
+  std::string label;  // "seed 3", or the file's name (also where seeds repeat: ScoreEnsemble)
   std::string clock_start;
   double end_s = 0.0;
   std::vector<double> avalanche_s;  // the run's avalanche events

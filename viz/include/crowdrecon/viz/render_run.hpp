@@ -112,6 +112,7 @@ struct RenderSummary {
   double margin_px = 0.0;
   double max_contact_force_n = 0.0;     // over the selected frames
   double force_n_per_px = 0.0;          // the scale used
+  std::size_t most_fallen = 0;          // most people drawn fallen in one frame (event `fall`)
   std::filesystem::path video_written;  // empty if none
   std::string video_codec;              // "mp4v" or "MJPG"
   double video_fps = 0.0;
