@@ -39,6 +39,7 @@ import sys
 
 LOAD_N = 400.0
 NEAR_M = 3.0  # "at the fall's place": within this of its point
+ALLEY_TOP_Y = 45.0  # the venue: the sidewalk below y = 0, the alley to y = 45, the food street above
 
 
 def open_run(path):
@@ -94,6 +95,18 @@ def run_metrics(path):
             run = run + 1 if c > LOAD_N else 0
             best = max(best, run)
         longest.append(best * dt)
+    # The force pressing on each recorded fallen (their contacts' normal
+    # forces summed): the floor holds a fallen body, so a push from one side
+    # is carried without compressing the chest across (the chest load above).
+    pressed = {}
+    if fallen_ids:
+        ids = ",".join(str(int(p)) for p in fallen_ids)
+        for frame, a, b, fn in db.execute(
+                f"select c.frame, c.a, c.b, c.normal_force_n from contact c join frame_time f on f.frame = c.frame "
+                f"where f.time_s >= ? and (c.a in ({ids}) or (c.wall = 0 and c.b in ({ids})))", (t0,)):
+            for pid in (a, b):
+                if pid in fallen_ids:
+                    pressed[(frame, pid)] = pressed.get((frame, pid), 0.0) + fn
     # The crowd at the fall's place, per frame from the fall on.
     near = {}
     near_loaded = {}
@@ -106,9 +119,13 @@ def run_metrics(path):
             near_loaded[frame] = near_loaded.get(frame, 0) + (chest > LOAD_N)
     first = min(near) if near else None
     later_dist = []
+    places = {"sidewalk": 0, "alley": 0, "food street": 0}
     for f in later:
         x, y = where(f[0], f[2])
         later_dist.append(math.hypot(x - px, y - py))
+        places["sidewalk" if y < 0 else "alley" if y < ALLEY_TOP_Y else "food street"] += 1
+    groups = dict(db.execute("select id, grp from person"))
+    later_counter = sum(1 for f in later if groups.get(f[2]) == 1)  # (ids 1-based in every table)
     above = above_at_once(db, t0)
     return {
         "scenario_t0": t0, "point": (px, py), "asked": asked,
@@ -117,9 +134,12 @@ def run_metrics(path):
         "later_tripped": sum(1 for f in later if f[3].startswith("tripped")),
         "later_first_after_s": (min(f[1] for f in later if f[1] >= t0) - t0) if len(later) > len(early) else None,
         "later_within_3m": sum(1 for d in later_dist if d <= NEAR_M),
+        "later_on_sidewalk": places["sidewalk"], "later_in_alley": places["alley"],
+        "later_on_food_street": places["food street"], "later_counter_flow": later_counter,
         "fallen_max_load_n": max(most, default=0.0),
         "fallen_median_max_load_n": statistics.median(most) if most else 0.0,
         "fallen_longest_above_400n_s": max(longest, default=0.0),
+        "fallen_most_pressed_n": max(pressed.values(), default=0.0),
         "near_at_fall": near.get(first, 0) if first is not None else 0,
         "near_peak_after": max(near.values(), default=0),
         "near_above_400n_peak": max(near_loaded.values(), default=0),
@@ -161,8 +181,9 @@ def main():
               f"({m['later_tripped']} tripped); fallen's largest load {m['fallen_max_load_n']:.0f} N", file=sys.stderr)
     os.makedirs(args.out, exist_ok=True)
     keys = ["run_id", "variant", "asked", "seed", "recorded", "before_fall_falls", "later_falls", "later_tripped",
-            "later_first_after_s", "later_within_3m", "fallen_max_load_n", "fallen_median_max_load_n",
-            "fallen_longest_above_400n_s", "near_at_fall", "near_peak_after", "near_above_400n_peak",
+            "later_first_after_s", "later_within_3m", "later_on_sidewalk", "later_in_alley", "later_on_food_street",
+            "later_counter_flow", "fallen_max_load_n", "fallen_median_max_load_n",
+            "fallen_longest_above_400n_s", "fallen_most_pressed_n", "near_at_fall", "near_peak_after", "near_above_400n_peak",
             "above_400n_most_after", "baseline_above_400n_most_after", "baseline_same_before_fall", "wall_s"]
     with open(os.path.join(args.out, "recorded-falls.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
@@ -182,18 +203,21 @@ def main():
         f"Sweep `{os.path.relpath(args.sweep)}`" + (f", baseline `{os.path.relpath(args.baseline)}`" if args.baseline else "")
         + f"; written by `scripts/itaewon-recorded-falls.py`. At {table[0]['scenario_t0']:g} s (22:15 on the shortened"
         " evening's clock) the walking people nearest the point fall at once (`timeline.events[].fall`); every later"
-        " fall is the model's own (the paper's acceleration rule, tripping over the fallen on). Loads are chest loads"
-        f" (`person_load`), 'near' is within {NEAR_M:g} m of the point.",
+        " fall is the model's own (the paper's acceleration rule, and tripping over the fallen where the run has it:"
+        " `timeline.falls.trip_over_fallen`). Loads are chest loads (`person_load`); 'most pressed' is the sum of a"
+        f" fallen person's contact forces; 'near' is within {NEAR_M:g} m of the point; the sweep's paths are where it"
+        " ran (its run files are not kept in the repository).",
         "",
-        "| run | place | asked | fell | later falls (tripped) | first after | within 3 m | fallen: largest load | fallen: median of largest | fallen: longest above 400 N | near at the fall | near, peak after | near above 400 N, peak | network above 400 N, most after | baseline, same frames | baseline identical before |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| run | place | asked | fell | later falls (tripped) | first after | within 3 m | sidewalk / alley / food street | of them coming down | fallen: largest load | fallen: median of largest | fallen: longest above 400 N | fallen: most pressed (contacts' sum) | near at the fall | near, peak after | near above 400 N, peak | network above 400 N, most after | baseline, same frames | baseline identical before |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for m in table:
         first = "–" if m["later_first_after_s"] is None else f"{m['later_first_after_s']:.1f} s"
         lines.append(
             f"| {m['run_id']} | {m['variant']} ({m['point'][0]:g}, {m['point'][1]:g}) | {m['asked']} | {m['recorded']} | "
             f"{m['later_falls']} ({m['later_tripped']}) | {first} | {m['later_within_3m']} | "
-            f"{m['fallen_max_load_n']:.0f} N | {m['fallen_median_max_load_n']:.0f} N | {m['fallen_longest_above_400n_s']:.1f} s | "
+            f"{m['later_on_sidewalk']} / {m['later_in_alley']} / {m['later_on_food_street']} | {m['later_counter_flow']} | "
+            f"{m['fallen_max_load_n']:.0f} N | {m['fallen_median_max_load_n']:.0f} N | {m['fallen_longest_above_400n_s']:.1f} s | {m['fallen_most_pressed_n']:.0f} N | "
             f"{m['near_at_fall']} | {m['near_peak_after']} | {m['near_above_400n_peak']} | {m['above_400n_most_after']} | "
             f"{fmt(m['baseline_above_400n_most_after'])} | {fmt(m['baseline_same_before_fall'])} |")
     if any(m["before_fall_falls"] for m in table):

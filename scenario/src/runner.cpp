@@ -301,7 +301,28 @@ struct BranchParts {
   std::vector<std::pair<double, nlohmann::json>> events;
 };
 
-BranchParts SplitForBranch(const std::string& json_text, const std::string& what) {
+// The scenario's file paths (venue, body files, rate tables) resolved
+// against its folder, as the parser resolves them: two scenarios in
+// different folders that name the same files are the same.
+void ResolveFilePaths(nlohmann::json& scenario, const std::filesystem::path& base_dir) {
+  const auto resolve = [&](nlohmann::json& value) {
+    if (!value.is_string()) return;
+    const std::filesystem::path p(value.get<std::string>());
+    value = (p.is_absolute() ? p : std::filesystem::absolute(base_dir / p)).lexically_normal().string();
+  };
+  if (scenario.contains("venue")) resolve(scenario["venue"]);
+  if (auto pop = scenario.find("population"); pop != scenario.end() && pop->is_object())
+    if (auto body = pop->find("body"); body != pop->end() && body->is_object())
+      for (const char* key : {"reference", "anthropometry"})
+        if (body->contains(key)) resolve((*body)[key]);
+  if (auto t = scenario.find("timeline"); t != scenario.end() && t->is_object())
+    if (auto inflows = t->find("inflows"); inflows != t->end() && inflows->is_array())
+      for (nlohmann::json& inflow : *inflows)
+        if (inflow.is_object() && inflow.contains("rate_csv")) resolve(inflow["rate_csv"]);
+}
+
+BranchParts SplitForBranch(const std::string& json_text, const std::filesystem::path& scenario_file,
+                           const std::string& what) {
   BranchParts parts;
   try {
     parts.rest = nlohmann::json::parse(json_text);
@@ -309,6 +330,7 @@ BranchParts SplitForBranch(const std::string& json_text, const std::string& what
     throw InputError(what + ": its scenario is not JSON (" + e.what() + ")");
   }
   if (!parts.rest.is_object()) throw InputError(what + ": its scenario is not a JSON object");
+  ResolveFilePaths(parts.rest, scenario_file.parent_path());
   parts.rest.erase("name");
   parts.rest.erase("notes");
   if (auto t = parts.rest.find("timeline"); t != parts.rest.end() && t->is_object()) {
@@ -348,8 +370,8 @@ double BranchRun(const Scenario& scenario, const std::filesystem::path& from, co
   // and the events from the checkpoint's time on.
   const std::string at = " (a branch at t = " + FormatNumber(t_s) + " s may change only the name, the notes and "
                          "timeline events at or after that time)";
-  const BranchParts was = SplitForBranch(old_text, name);
-  const BranchParts now = SplitForBranch(scenario.json_text, scenario.file.string());
+  const BranchParts was = SplitForBranch(old_text, reader.RunValue("scenario_file"), name);
+  const BranchParts now = SplitForBranch(scenario.json_text, scenario.file, scenario.file.string());
   if (was.rest != now.rest) {
     const nlohmann::json patch = nlohmann::json::diff(was.rest, now.rest);
     const std::string path = patch.empty() ? "/" : patch[0].value("path", "/");

@@ -349,6 +349,7 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
                     ") is not in the venue's walkable area; expected a point where people stand");
           e.fall_count = static_cast<std::size_t>(fall.Integer("count", 1, 10000));
           e.fall_within_m = fall.Number("within_m", 2.0, 0.01, 1000.0);
+          e.name = item.path();
           fall.Finish();
           break;
         }

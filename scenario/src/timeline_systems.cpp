@@ -167,7 +167,7 @@ class TimelineEventSystem : public RunSystem {
           ++s_.fallen;
           s_.Event(t, "fall", b.id[i],
                    "recorded: " + std::to_string(near.size()) + " of the " + std::to_string(e.fall_count) +
-                       " nearest " + where + " within " + FormatNumber(e.fall_within_m) + " m (" + e.where +
+                       " nearest " + where + " within " + FormatNumber(e.fall_within_m) + " m (" + e.name +
                        "), this one at " + FormatFixed(d, 2) + " m");
         }
         s_.Event(t, "recorded_fall", -1,

@@ -3,7 +3,8 @@
 #   1. the open-hallway timeline without its recorded fall, interrupted at
 #      1.2 s, branched under the timeline with it (a fall at 2 s) and run
 #      on, gives the same tables as the timeline with it run whole;
-#   2. the run branched from is untouched; a branch resumes like any run;
+#   2. the run branched from is untouched; a branch resumes like any run; the
+#      branch's scenario may live in another folder (paths compared resolved);
 #   3. a scenario that differs before the checkpoint (a seed, an event
 #      before it) is refused naming the JSON path, and nothing is written;
 #      -o the same as --branch-from, and --branch-from with --resume, are refused.
@@ -28,6 +29,12 @@ seed = json.loads(json.dumps(with_fall)); seed["population"]["seed"] += 1
 json.dump(seed, open(f"{tmp}/seed.json", "w"))
 early = json.loads(json.dumps(with_fall)); early["timeline"]["events"].append({"time_s": 0.5, "close_exit": "exit"})
 json.dump(early, open(f"{tmp}/early.json", "w"))
+# The same scenario in another folder, its files named relative to it.
+os.makedirs(f"{tmp}/elsewhere")
+moved = json.loads(json.dumps(with_fall))
+moved["venue"] = os.path.relpath(moved["venue"], f"{tmp}/elsewhere")
+moved["population"]["body"]["reference"] = os.path.relpath(moved["population"]["body"]["reference"], f"{tmp}/elsewhere")
+json.dump(moved, open(f"{tmp}/elsewhere/with.json", "w"))
 PY
 set +e
 "$exe" simulate "$tmp/without.json" -o "$tmp/a.sqlite" -q --stop-after 1.2 >/dev/null 2>&1
@@ -45,6 +52,9 @@ echo "whole: $dw"; echo "branch: $db"
 [[ $(sqlite3 "$tmp/branch.sqlite" "SELECT value FROM run WHERE key = 'branched_from'") == *"a.sqlite at t = 1.2 s (frame 12)" ]] || { echo "FAIL: branched_from"; exit 1; }
 [[ $("$exe" analyze "$tmp/a.sqlite" --digest) == "$before" ]] && cmp -s "$tmp/a.sqlite.checkpoint" "$tmp/a.checkpoint.copy" \
   || { echo "FAIL: the run branched from changed"; exit 1; }
+# The branch's scenario may live in another folder (its file paths are compared as resolved).
+"$exe" simulate "$tmp/elsewhere/with.json" -o "$tmp/moved.sqlite" -q --branch-from "$tmp/a.sqlite" >/dev/null 2>&1
+[[ $("$exe" analyze "$tmp/moved.sqlite" --digest) == "$dw" ]] || { echo "FAIL: the branch from another folder differs"; exit 1; }
 # A branch is a run like any: interrupted, it resumes to the same tables.
 set +e
 "$exe" simulate "$tmp/with.json" -o "$tmp/b2.sqlite" -q --branch-from "$tmp/a.sqlite" --stop-after 2.6 >/dev/null 2>&1

@@ -71,7 +71,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
 // `scenario`, so that RunScenario with `resume` continues it under
 // `scenario`. The scenario may differ from the one `from` was written for
 // only in its name, its notes and the timeline's events at or after the
-// checkpoint's time; the world, the population, the model, the run's
+// checkpoint's time (file paths compared as resolved against each
+// scenario's folder, so it may live elsewhere); the world, the population, the model, the run's
 // duration and every event before that time must be the same (else the
 // state would not be the one `scenario` gives; the engine's state also
 // checks the time step and the people). Throws InputError naming the run,

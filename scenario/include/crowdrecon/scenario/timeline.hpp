@@ -94,7 +94,8 @@ struct TimelineEvent {
   // kSetParameters: model parameters by name (engine parameter table), plus
   // "desired_speed_m_per_s" (everyone of the group, and later arrivals of it).
   std::vector<std::pair<std::string, double>> parameters;
-  std::string name;   // kTarget: target; k*Exit: exit id; k*Inflow: inflow id
+  std::string name;   // kTarget: target; k*Exit: exit id; k*Inflow: inflow id; kFall: its JSON path alone
+                      // (the run's events name it; the file's name would differ between a run and its branch)
   // kFall, a fall the accounts record (an input, unlike a RecordedMark): the
   // `fall_count` walking people whose centres are nearest `fall_at` (ties by
   // id), of those within `fall_within_m` of it, fall at once. The model does
