@@ -395,18 +395,27 @@ double BranchRun(const Scenario& scenario, const std::filesystem::path& from, co
 
   // The run file to its checkpoint's frame, now the scenario's; the
   // checkpoint with the scenario's fingerprint.
-  std::filesystem::remove(output, ec);
-  std::filesystem::remove(CheckpointPath(output), ec);
-  runfile::CopyRunFile(from, output);
-  {
-    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(output, c.last_frame);
-    writer.SetRunValue("scenario", scenario.json_text);
-    writer.SetRunValue("scenario_file", scenario.file.string());
-    writer.SetRunValue("branched_from", name + " at t = " + FormatNumber(t_s) + " s (frame " +
-                                            std::to_string(c.last_frame) + ")");
-    writer.SetStatus("interrupted");
+  // (A copy cut short, by a full disk say, is removed: nothing half-made is left.)
+  const auto remove_output = [&] {
+    std::filesystem::remove(output, ec);
+    std::filesystem::remove(CheckpointPath(output), ec);
+  };
+  remove_output();
+  try {
+    runfile::CopyRunFile(from, output);
+    {
+      runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(output, c.last_frame);
+      writer.SetRunValue("scenario", scenario.json_text);
+      writer.SetRunValue("scenario_file", scenario.file.string());
+      writer.SetRunValue("branched_from", name + " at t = " + FormatNumber(t_s) + " s (frame " +
+                                              std::to_string(c.last_frame) + ")");
+      writer.SetStatus("interrupted");
+    }
+    WriteCheckpoint(CheckpointPath(output), ScenarioFingerprint(scenario), c);
+  } catch (...) {
+    remove_output();
+    throw;
   }
-  WriteCheckpoint(CheckpointPath(output), ScenarioFingerprint(scenario), c);
   return t_s;
 }
 
