@@ -260,9 +260,19 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
       try {
         summary = scenario::RunScenario(sc, options);
       } catch (const InputError&) {
-        // An unusable checkpoint (or a failure after it, which then repeats
-        // identically from the start): start over.
         if (g_stop.load()) return std::nullopt;
+        // A run that went numerically wrong after its checkpoint would go
+        // wrong again, identically, from the start (hours later, for a long
+        // run, and with its message and saved state deleted): it is
+        // recorded as failed, its files kept. Only an unusable checkpoint
+        // starts over.
+        bool run_failed = false;
+        try {
+          run_failed = runfile::RunFileReader(file).RunValue("status").rfind("failed", 0) == 0;
+        } catch (const std::exception&) {
+          // Unreadable: as an unusable checkpoint.
+        }
+        if (run_failed) throw;
         RemoveRunFiles(file);
         options.resume = false;
         summary = scenario::RunScenario(sc, options);
