@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
@@ -228,6 +230,51 @@ TEST(SweepRunner, AThirdGroupsMetricsStayOutOfTheTable) {
   EXPECT_NE(header.find("mean_speed_g1_m_per_s"), std::string::npos);
   EXPECT_EQ(header.find("_g2"), std::string::npos) << header;
   EXPECT_NE(row.find("complete"), std::string::npos) << row;
+}
+
+// A run that goes numerically wrong after it resumed is recorded as failed
+// with its files kept, not started over (it would fail again, identically,
+// hours later for a long run, and its message and saved state were deleted).
+// The run is interrupted before its failure (20 people sprinting into a wall
+// go through it at 0.35 s), marked, and the sweep resumes it: the mark stays.
+TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-fails-after-resume");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "out" / "runs");
+  const std::string source = CROWDRECON_SOURCE_DIR;
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << source
+      << R"(/tests/data/scenarios/bad-sprint-into-wall.json", "seeds": [3], "keep_runs": true})";
+  }
+  const SweepSpec spec = LoadSweep(dir / "sweep.json");
+  const std::vector<RunPlan> runs = ExpandRuns(spec);
+  ASSERT_EQ(runs.size(), 1u);
+  const std::filesystem::path file = dir / "out" / "runs" / (runs[0].id + ".sqlite");
+  scenario::RunOptions stopped;
+  stopped.output = file;
+  stopped.stop_after_s = 0.1;
+  ASSERT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs[0]), stopped).status, "interrupted");
+  ASSERT_TRUE(std::filesystem::exists(scenario::CheckpointPath(file)));
+  {
+    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 1);
+    writer.SetRunValue("test_mark", "the file of the first attempt");
+  }
+  SweepOptions options;
+  options.sweep_file = dir / "sweep.json";
+  options.output_dir = dir / "out";
+  options.jobs = 1;
+  const SweepSummary summary = RunSweep(options);
+  EXPECT_EQ(summary.failed, 1u);
+  EXPECT_TRUE(std::filesystem::exists(file.string() + ".failed-state"));
+  const runfile::RunFileReader reader(file);
+  EXPECT_EQ(reader.RunValue("test_mark"), "the file of the first attempt") << "the run was started over";
+  EXPECT_EQ(reader.RunValue("status").rfind("failed: ", 0), 0u) << reader.RunValue("status");
+  std::ifstream csv(dir / "out" / "results.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_NE(row.find("went through wall"), std::string::npos) << row;
 }
 
 TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
