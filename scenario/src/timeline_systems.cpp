@@ -162,14 +162,11 @@ class TimelineEventSystem : public RunSystem {
         });
         if (near.size() > e.fall_count) near.resize(e.fall_count);
         const std::string where = "(" + FormatNumber(at.x) + ", " + FormatNumber(at.y) + ") m";
-        for (const auto& [d, i] : near) {
-          sim.SetPersonState(i, engine::PersonState::kFallen);
-          ++s_.fallen;
-          s_.Event(t, "fall", b.id[i],
-                   "recorded: " + std::to_string(near.size()) + " of the " + std::to_string(e.fall_count) +
-                       " nearest " + where + " within " + FormatNumber(e.fall_within_m) + " m (" + e.name +
-                       "), this one at " + FormatFixed(d, 2) + " m");
-        }
+        for (const auto& [d, i] : near)
+          s_.Fall(sim, i,
+                  "recorded: " + std::to_string(near.size()) + " of the " + std::to_string(e.fall_count) +
+                      " nearest " + where + " within " + FormatNumber(e.fall_within_m) + " m (" + e.name +
+                      "), this one at " + FormatFixed(d, 2) + " m");
         s_.Event(t, "recorded_fall", -1,
                  std::to_string(near.size()) + " of " + std::to_string(e.fall_count) + " fell at once near " + where +
                      (near.size() < e.fall_count ? ": fewer people walking within " + FormatNumber(e.fall_within_m) + " m"
@@ -380,9 +377,7 @@ class FallSystem : public RunSystem {
                   FormatFixed(load_[i], 0) + " N)";
       }
       if (cause.empty()) continue;
-      sim.SetPersonState(i, engine::PersonState::kFallen);
-      ++s_.fallen;
-      s_.Event(sim.time_s(), "fall", b.id[i], cause);
+      s_.Fall(sim, i, cause);
     }
   }
   std::string SaveState() const override {
@@ -604,6 +599,13 @@ std::uint64_t TimelineState::Entered() const {
   std::uint64_t n = built.initial_people;
   for (std::uint64_t p : placed) n += p;
   return n;
+}
+
+void TimelineState::Fall(engine::Simulation& sim, std::uint32_t slot, const std::string& cause) {
+  const std::int64_t person = sim.bodies().id[slot];
+  sim.SetPersonState(slot, engine::PersonState::kFallen);
+  ++fallen;
+  Event(sim.time_s(), "fall", person, cause);
 }
 
 void TimelineState::Event(double time_s, const std::string& kind, std::int64_t person, const std::string& detail) {

@@ -68,6 +68,9 @@ struct TimelineState {
   // entered != walking + fallen + removed.
   runfile::Census Count(const engine::Simulation& sim) const;
   void Event(double time_s, const std::string& kind, std::int64_t person, const std::string& detail);
+  // The person in `slot` falls now (by the fall criterion or a recorded
+  // fall): lies as an obstacle, counted, with a `fall` event saying why.
+  void Fall(engine::Simulation& sim, std::uint32_t slot, const std::string& cause);
   std::string SaveState() const;
   void LoadState(const std::string& state);
 };

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -196,6 +197,24 @@ TEST(SweepFile, ANumberInAPathNamesAListsElement) {
       << m;
 }
 
+// Runs the sweep DIR/sweep.json into DIR/out, one run at a time.
+SweepSummary RunSweepIn(const std::filesystem::path& dir) {
+  SweepOptions options;
+  options.sweep_file = dir / "sweep.json";
+  options.output_dir = dir / "out";
+  options.jobs = 1;
+  return RunSweep(options);
+}
+
+// The header and first row of DIR/out/results.csv.
+std::pair<std::string, std::string> FirstResultRow(const std::filesystem::path& dir) {
+  std::ifstream csv(dir / "out" / "results.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  return {header, row};
+}
+
 // A scenario with a third group (an inflow's own: the Itaewon envelope's
 // people walking along the food street) runs in a sweep; the table keeps the
 // first two groups' columns (it stopped the sweep with an internal error).
@@ -217,16 +236,9 @@ TEST(SweepRunner, AThirdGroupsMetricsStayOutOfTheTable) {
     std::ofstream f(dir / "sweep.json");
     f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": "scenario.json", "seeds": [1]})";
   }
-  SweepOptions options;
-  options.sweep_file = dir / "sweep.json";
-  options.output_dir = dir / "out";
-  options.jobs = 1;
-  const SweepSummary summary = RunSweep(options);
+  const SweepSummary summary = RunSweepIn(dir);
   EXPECT_EQ(summary.failed, 0u);
-  std::ifstream csv(dir / "out" / "results.csv");
-  std::string header, row;
-  std::getline(csv, header);
-  std::getline(csv, row);
+  const auto [header, row] = FirstResultRow(dir);
   EXPECT_NE(header.find("mean_speed_g1_m_per_s"), std::string::npos);
   EXPECT_EQ(header.find("_g2"), std::string::npos) << header;
   EXPECT_NE(row.find("complete"), std::string::npos) << row;
@@ -260,20 +272,13 @@ TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
     runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 1);
     writer.SetRunValue("test_mark", "the file of the first attempt");
   }
-  SweepOptions options;
-  options.sweep_file = dir / "sweep.json";
-  options.output_dir = dir / "out";
-  options.jobs = 1;
-  const SweepSummary summary = RunSweep(options);
+  const SweepSummary summary = RunSweepIn(dir);
   EXPECT_EQ(summary.failed, 1u);
   EXPECT_TRUE(std::filesystem::exists(file.string() + ".failed-state"));
   const runfile::RunFileReader reader(file);
   EXPECT_EQ(reader.RunValue("test_mark"), "the file of the first attempt") << "the run was started over";
   EXPECT_EQ(reader.RunValue("status").rfind("failed: ", 0), 0u) << reader.RunValue("status");
-  std::ifstream csv(dir / "out" / "results.csv");
-  std::string header, row;
-  std::getline(csv, header);
-  std::getline(csv, row);
+  const std::string row = FirstResultRow(dir).second;
   EXPECT_NE(row.find("went through wall"), std::string::npos) << row;
 }
 
