@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <ostream>
 #include <string>
@@ -176,6 +178,54 @@ TEST(Venue, TheItaewonAlleySlopesInsideItsRegion) {
   EXPECT_NE(ParseError(std::string(kRoom) + R"(, "slope": {"direction": [1, 0], "gradient": 0.1, "region": [[0, 0], [1, 0]]})")
                 .find("/slope/region"),
             std::string::npos);
+}
+
+// The Itaewon alley's building fronts are walls with a thickness drawn outside
+// the walkable area (issue 43: a line of radius 0 let a body's core through at
+// 4.3 kN): every wall's face lies on the walkable edge, so the free widths are
+// the drawn ones. Points along the edge (exits excepted) are one radius from
+// the nearest wall line (near the buildings' corners, no nearer and at most
+// the rounded corner's gap further); no walkable point is nearer than that.
+TEST(Venue, TheItaewonWallFacesLieOnTheWalkableEdge) {
+  const Venue v = LoadVenue(std::filesystem::path(CROWDRECON_SOURCE_DIR) / "venues/itaewon/alley.json");
+  const std::vector<WallSegment> walls = WallSegments(v);
+  ASSERT_FALSE(walls.empty());
+  const auto clearance = [&](Vec2 p) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const WallSegment& w : walls) nearest = std::min(nearest, DistanceToSegment(p, w.a, w.b) - w.radius_m);
+    return nearest;
+  };
+  const auto on_exit = [&](Vec2 p) {
+    for (const Exit& e : v.exits)
+      if (DistanceToSegment(p, e.a, e.b) < 1e-6) return true;
+    return false;
+  };
+  for (const WallSegment& w : walls) EXPECT_DOUBLE_EQ(w.radius_m, 0.15);
+  const Ring& edge = v.walkable_area.at(0);
+  int checked = 0;
+  for (std::size_t i = 0; i < edge.size(); ++i) {
+    const Vec2 a = edge[i], b = edge[(i + 1) % edge.size()];
+    for (int k = 0; k <= 200; ++k) {
+      const Vec2 p = a + (b - a) * (k / 200.0);
+      if (on_exit(p)) continue;
+      // Within two radii of a corner of the buildings, the thick walls'
+      // rounded mitre leaves the corner itself up to r (1 / sin(angle / 2) - 1)
+      // free; the buildings' corners are no sharper than 85 degrees.
+      const double corner = std::min(Length(p - a), Length(p - b));
+      const double slack = corner < 0.3 ? 0.15 * (1.0 / std::sin(85.0 / 2.0 * std::numbers::pi / 180.0) - 1.0) : 0.0;
+      EXPECT_GE(clearance(p), -2e-4) << "edge " << i << " at (" << p.x << ", " << p.y << ")";
+      EXPECT_LE(clearance(p), slack + 2e-4) << "edge " << i << " at (" << p.x << ", " << p.y << ")";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1500);
+  Vec2 lo, hi;
+  WalkableBounds(v, &lo, &hi);
+  for (double x = lo.x; x <= hi.x; x += 0.05)
+    for (double y = lo.y; y <= hi.y; y += 0.05) {
+      if (!IsWalkable(v, {x, y}) || DistanceToRing(edge, {x, y}) < kVenueTolerance_m) continue;
+      ASSERT_GE(clearance({x, y}), -2e-4) << "(" << x << ", " << y << ")";
+    }
 }
 
 TEST(Venue, MissingFileIsAnError) {
