@@ -26,6 +26,7 @@ struct RenderArgs {
   double fps = 0.0;
   int width_px = 1280;
   double force_n_per_px = 0.0;
+  std::string window;
   bool svg = false;
   bool force = false;
 };
@@ -46,6 +47,7 @@ void RunRender(const RenderArgs& args) {
   options.width_px = args.width_px;
   options.force_n_per_px = args.force_n_per_px;
   options.svg = args.svg;
+  if (!args.window.empty()) viz::ParseRenderWindow(args.window, &options);
   // A progress line only for a person watching: logs and pipes stay clean.
   const bool terminal = isatty(fileno(stderr)) != 0;
   if (terminal)
@@ -83,6 +85,9 @@ void RegisterRenderCommand(CLI::App& app) {
   render->add_option("--force-scale", args->force_n_per_px,
                      "newtons per pixel of force-line width (default: the largest force ~0.12 m wide)")
       ->check(NumberIn(1e-6, 1e9, "N/px"));
+  render->add_option("--window", args->window,
+                     "draw only the world window x0,y0,x1,y1 (m, lower-left and upper-right corners), at --width: "
+                     "a part of a large venue at a readable scale (default: the venue and everyone in it)");
   render->add_flag("--svg", args->svg, "also write frame_NNNNNN.svg");
   AddForceFlag(render, &args->force);
   render->callback([args] { RunRender(*args); });

@@ -152,6 +152,10 @@ crowdrecon_cli_test(render.bad_video fail "--video .*run.gif: unknown video form
                     render ${render_data}/run.sqlite -o @TMP@/frames --video @TMP@/run.gif)
 crowdrecon_cli_test(render.bad_width fail "--width: value 100 is out of range. expected a whole number in \\[320, 8000\\]"
                     render ${render_data}/run.sqlite -o @TMP@/frames --width 100)
+crowdrecon_cli_test(render.window ok "window: \\(0, 0\\) to \\(1.2, 1.5\\) m"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --frames last --width 800 --window 0,0,1.2,1.5)
+crowdrecon_cli_test(render.bad_window fail "--window \"0,0,1\": 3 numbers. expected x0,y0,x1,y1 in metres"
+                    render ${render_data}/run.sqlite -o @TMP@/frames --window 0,0,1)
 get_property(render_tests DIRECTORY PROPERTY TESTS)
 list(FILTER render_tests INCLUDE REGEX "^cli\\.render\\.")
 list(REMOVE_ITEM render_tests cli.render.make_data)

@@ -254,6 +254,70 @@ TEST(RenderRun, TheFallenAreDrawnGreyFromTheirFall) {
   EXPECT_NE(after.BriefReport().find("fallen: up to 2 in a frame"), std::string::npos) << after.BriefReport();
 }
 
+// A window (--window) draws a part of the venue at the picture's width: its
+// corners are the picture's world window exactly, a body inside it is drawn in
+// its group's colour where the layout says, and a body that straddles its edge
+// is clipped there, not drawn into the margin beside it.
+TEST(RenderRun, AWindowDrawsAPartOfTheVenueClippedAtItsEdge) {
+  const ScratchDir dir("window");
+  const std::filesystem::path run = WriteRun(dir.path(), 3);
+  RenderOptions options;
+  options.output_dir = dir.path() / "frames";
+  options.frames = ParseFrameSelection("0");
+  options.width_px = 800;
+  ParseRenderWindow("0, 0, 1.2, 1.5", &options);
+  const RenderSummary summary = RenderRun(run, options);
+  EXPECT_TRUE(summary.cropped);
+  EXPECT_EQ(summary.world_min_m, (Vec2{0.0, 0.0}));
+  EXPECT_EQ(summary.world_max_m, (Vec2{1.2, 1.5}));
+  EXPECT_EQ(summary.width_px, 800);
+  EXPECT_NEAR(summary.pixels_per_metre, (800.0 - 2.0 * summary.margin_px) / 1.2, 1e-6);
+  EXPECT_NE(summary.BriefReport().find("window: (0, 0) to (1.2, 1.5) m"), std::string::npos) << summary.BriefReport();
+
+  const cv::Mat image = media::ReadImage(summary.first_picture.string(), cv::IMREAD_COLOR);
+  const auto coloured = [](const cv::Vec3b& p) {  // a group's fill: blue or orange, not grey, white or black
+    return std::abs(int(p[0]) - int(p[2])) > 40;
+  };
+  runfile::RunFileReader reader(run);
+  const runfile::RunFrame frame0 = reader.Frame(0);
+  int inside = 0, straddling = 0;
+  for (std::size_t i = 0; i < frame0.ids.size(); ++i) {
+    const Vec2 x = frame0.position_m[i];
+    if (x.x < 1.0) {  // wholly inside the window
+      const Vec2 px = summary.PixelOf(x - frame0.orientation[i] * 0.06);
+      EXPECT_TRUE(coloured(image.at<cv::Vec3b>(static_cast<int>(px.y), static_cast<int>(px.x)))) << frame0.ids[i];
+      ++inside;
+    } else if (x.x < 1.2) {
+      ++straddling;  // the column at 1.125 m reaches past 1.2 m
+    }
+  }
+  EXPECT_EQ(inside, 3);
+  EXPECT_EQ(straddling, 3);
+  // The straddling bodies and the floor stop at the window's edge: the right
+  // margin is the background, though the bodies reach about 0.045 m (26 px)
+  // and the floor 1.8 m into it.
+  const int edge_px = static_cast<int>(std::ceil(summary.PixelOf({1.2, 0.0}).x)) + 1;
+  int beyond = 0, before = 0;
+  for (int y = static_cast<int>(summary.margin_px); y < image.rows - static_cast<int>(summary.margin_px); ++y) {
+    for (int x = edge_px; x < image.cols; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+      beyond += !(p[0] > 250 && p[1] > 250 && p[2] > 250);
+    }
+    for (int x = edge_px - 20; x < edge_px - 2; ++x) before += coloured(image.at<cv::Vec3b>(y, x));
+  }
+  EXPECT_EQ(beyond, 0);
+  EXPECT_GT(before, 100);  // and they are drawn up to it
+
+  EXPECT_NE(ErrorOf([&] { ParseRenderWindow("0,0,1", &options); }).find("--window \"0,0,1\": 3 numbers; expected x0,y0,x1,y1"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ParseRenderWindow("1,0,0,1", &options); }).find("not lower-left then upper-right"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ParseRenderWindow("0,0,a,1", &options); }).find("\"a\" is not a number"), std::string::npos);
+  RenderOptions flat = options;
+  flat.window_max_m.y = flat.window_min_m.y;
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, flat); }).find("--window: (0, 0) to (1.2, 0) m, expected"), std::string::npos);
+}
+
 TEST(RenderRun, WithoutAPeriodicBoxLeavesOutBranchesAcrossTheSeam) {
   const ScratchDir dir("seam");
   const std::filesystem::path run = WriteRun(dir.path(), 11, /*record_periodic_box=*/false);

@@ -108,6 +108,17 @@ Canvas::~Canvas() {
   }
 }
 
+void Canvas::ClipToWorld() {
+  const Impl& m = *impl_;
+  cairo_reset_clip(m.cr);
+  cairo_new_path(m.cr);
+  cairo_rectangle(m.cr, m.X(m.world_min.x), m.Y(m.world_max.y), (m.world_max.x - m.world_min.x) * m.scale,
+                  (m.world_max.y - m.world_min.y) * m.scale);
+  cairo_clip(m.cr);
+}
+
+void Canvas::ResetClip() { cairo_reset_clip(impl_->cr); }
+
 double Canvas::width_px() const { return impl_->width; }
 double Canvas::height_px() const { return impl_->height; }
 

@@ -192,6 +192,7 @@ struct Layout {
   Vec2 lo, hi;        // world window (m)
   double ppm = 1.0;   // pixels per metre
   int width_px = 0, height_px = 0;
+  bool cropped = false;  // RenderOptions::has_window: drawing is clipped to the window
 
   // World point at a device position (pixels from the top-left corner).
   Vec2 World(double x_px, double y_px) const {
@@ -617,6 +618,14 @@ bool RenderOptions::IsValid(std::string* error) const {
     return fail("--fps: " + FormatNumber(video_fps) + ", expected 0 (the run's rate) or up to 1000");
   if (!(force_n_per_px >= 0.0 && std::isfinite(force_n_per_px)))
     return fail("--force-scale: " + FormatNumber(force_n_per_px) + " N/px, expected a positive number (0: automatic)");
+  if (has_window) {
+    const auto finite = [](Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); };
+    if (!finite(window_min_m) || !finite(window_max_m) || !(window_min_m.x < window_max_m.x) ||
+        !(window_min_m.y < window_max_m.y))
+      return fail("--window: (" + FormatNumber(window_min_m.x) + ", " + FormatNumber(window_min_m.y) + ") to (" +
+                  FormatNumber(window_max_m.x) + ", " + FormatNumber(window_max_m.y) +
+                  ") m, expected finite corners with x0 < x1 and y0 < y1");
+  }
   if (!video.empty()) {
     std::string ext = video.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -624,6 +633,31 @@ bool RenderOptions::IsValid(std::string* error) const {
       return fail("--video " + video.string() + ": unknown video format \"" + ext + "\", expected .mp4 or .avi");
   }
   return true;
+}
+
+void ParseRenderWindow(const std::string& text, RenderOptions* options) {
+  const auto fail = [&](const std::string& why) {
+    throw InputError("--window \"" + text + "\": " + why +
+                     "; expected x0,y0,x1,y1 in metres, the lower-left and upper-right corners (x0 < x1, y0 < y1)");
+  };
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part = Trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    double x = 0.0;
+    const char* end = part.data() + part.size();
+    const auto [ptr, ec] = std::from_chars(part.data(), end, x);
+    if (part.empty() || ec != std::errc() || ptr != end || !std::isfinite(x)) fail("\"" + part + "\" is not a number");
+    v.push_back(x);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (v.size() != 4) fail(std::to_string(v.size()) + " numbers");
+  if (!(v[0] < v[2] && v[1] < v[3])) fail("the corners are not lower-left then upper-right");
+  options->has_window = true;
+  options->window_min_m = {v[0], v[1]};
+  options->window_max_m = {v[2], v[3]};
 }
 
 std::filesystem::path FramePicturePath(const std::filesystem::path& dir, std::int64_t frame,
@@ -650,7 +684,11 @@ std::string RenderSummary::BriefReport() const {
   std::string s = "rendered " + std::to_string(frames_written) + " frame(s), " + std::to_string(first_frame) +
                   " to " + std::to_string(last_frame) + ", " + std::to_string(width_px) + " x " +
                   std::to_string(height_px) + " px\n";
-  s += "contact force: max " + FormatFixed(max_contact_force_n, 1) + " N, drawn at " +
+  if (cropped)
+    s += "window: (" + FormatNumber(world_min_m.x) + ", " + FormatNumber(world_min_m.y) + ") to (" +
+         FormatNumber(world_max_m.x) + ", " + FormatNumber(world_max_m.y) + ") m\n";
+  s += "contact force" + std::string(cropped ? " inside the window" : "") + ": max " +
+       FormatFixed(max_contact_force_n, 1) + " N, drawn at " +
        FormatNumber(std::round(force_n_per_px * 1000.0) / 1000.0) + " N per px of line width\n";
   if (most_fallen > 0)
     s += "fallen: up to " + std::to_string(most_fallen) + " in a frame, drawn grey with a cross\n";
@@ -695,19 +733,28 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
                          "; expected ids from 1 (trajectory_data.id)");
     for (std::size_t i = 0; i < frame.position_m.size(); ++i)
       include(frame.position_m[i], scene.ShapeOf(static_cast<std::size_t>(frame.ids[i] - 1)).reach_m);
-    for (const runfile::Contact& c : frame.contacts)
-      summary->max_contact_force_n = std::max(summary->max_contact_force_n, Length(c.Force()));
+    for (const runfile::Contact& c : frame.contacts) {
+      const bool shown = !options.has_window || (c.point_m.x >= options.window_min_m.x && c.point_m.x <= options.window_max_m.x &&
+                                                 c.point_m.y >= options.window_min_m.y && c.point_m.y <= options.window_max_m.y);
+      if (shown) summary->max_contact_force_n = std::max(summary->max_contact_force_n, Length(c.Force()));
+    }
   }
-  if (!(lo.x < hi.x && lo.y < hi.y)) {  // a lone person and no venue: a square around them
-    lo -= Vec2{1.0, 1.0};
-    hi += Vec2{1.0, 1.0};
+  if (options.has_window) {  // a crop: exactly the window
+    lo = options.window_min_m;
+    hi = options.window_max_m;
+  } else {
+    if (!(lo.x < hi.x && lo.y < hi.y)) {  // a lone person and no venue: a square around them
+      lo -= Vec2{1.0, 1.0};
+      hi += Vec2{1.0, 1.0};
+    }
+    const double pad_m = 0.02 * std::max(hi.x - lo.x, hi.y - lo.y);
+    lo -= Vec2{pad_m, pad_m};
+    hi += Vec2{pad_m, pad_m};
   }
-  const double pad_m = 0.02 * std::max(hi.x - lo.x, hi.y - lo.y);
-  lo -= Vec2{pad_m, pad_m};
-  hi += Vec2{pad_m, pad_m};
   Layout layout;
   layout.lo = lo;
   layout.hi = hi;
+  layout.cropped = options.has_window;
   // A hair below the exact scale, so that Canvas's ceil() lands on width_px.
   layout.ppm = (options.width_px - 2.0 * kMargin_px) / (hi.x - lo.x) * (1.0 - 1e-9);
   layout.width_px = static_cast<int>(std::ceil((hi.x - lo.x) * layout.ppm + 2.0 * kMargin_px));
@@ -716,6 +763,7 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
     throw InputError(file + ": the drawn region is " + FormatFixed(hi.x - lo.x, 1) + " m x " + FormatFixed(hi.y - lo.y, 1) +
                      " m; at --width " + std::to_string(options.width_px) + " the pictures would be " +
                      std::to_string(layout.height_px) + " px tall (at most 20000): give a larger --width");
+  summary->cropped = layout.cropped;
   summary->world_min_m = layout.lo;
   summary->world_max_m = layout.hi;
   summary->pixels_per_metre = layout.ppm;
@@ -789,6 +837,7 @@ std::pair<double, double> DrawFrame(const std::filesystem::path& path, const run
                                     const std::vector<std::int64_t>& slot_of_person, const RenderSummary& summary,
                                     FrameStats* stats) {
   Canvas canvas(path, layout.lo, layout.hi, layout.ppm, kMargin_px);
+  if (layout.cropped) canvas.ClipToWorld();
   if (!scene.floor_rings.empty()) canvas.FillRings(scene.floor_rings, kFloor);
   for (const WallPiece& w : scene.walls) canvas.Line(w.a, w.b, kWall, std::max(3.0, 2.0 * w.radius_m * layout.ppm));
   if (scene.periodic) {  // dashed grey lines across the box where it wraps
@@ -814,6 +863,7 @@ std::pair<double, double> DrawFrame(const std::filesystem::path& path, const run
   *stats = FrameStats{};
   DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, stats);
   for (Vec2 p : frame.position_m) canvas.Dot(p, std::clamp(0.02 * layout.ppm, 1.0, 2.5), kForce);
+  canvas.ResetClip();
   DrawLegend(canvas, layout, legend, *stats, summary.force_n_per_px, summary.max_contact_force_n);
   canvas.Finish();
   return {canvas.width_px(), canvas.height_px()};

@@ -64,6 +64,11 @@ class Canvas {
   void TextPxAligned(double x_px, double y_px, const std::string& text, double size_px, double align_x,
                      double align_y, Color color = Color::Black(), double angle_rad = 0.0, bool bold = false,
                      double max_width_px = 0.0);
+  // Drawing from here on is clipped to the world window (the picture less its
+  // margins), so that what lies outside a cropped window stays out of the
+  // margins' legend; ResetClip() draws everywhere again.
+  void ClipToWorld();
+  void ResetClip();
   // A scale bar of `length_m` at the lower-left corner.
   void ScaleBar(double length_m);
 

@@ -91,12 +91,22 @@ struct RenderOptions {
   // wide. Lines are never thinner than kMinForceLineWidth_px.
   double force_n_per_px = 0.0;
   bool svg = false;  // also write frame_NNNNNN.svg
+  // A crop: the world window [window_min_m, window_max_m] drawn instead of
+  // the whole venue and everyone in it (a part of a large venue at a
+  // readable scale, as the pile at an alley's foot); what lies outside is
+  // clipped. The force scale is then chosen from the contacts inside it.
+  bool has_window = false;
+  Vec2 window_min_m, window_max_m;
   // Called after each frame (may be empty).
   std::function<void(const RenderProgress&)> progress;
 
   // False, with "option: value, expected ..." in *error, if an option is out of range.
   bool IsValid(std::string* error) const;
 };
+
+// Parses --window "x0,y0,x1,y1" (metres) into options->window_*; throws
+// InputError ("--window \"x\": ...; expected ...").
+void ParseRenderWindow(const std::string& text, RenderOptions* options);
 
 // Thinnest force line drawn (px), so that every contact stays visible.
 inline constexpr double kMinForceLineWidth_px = 0.5;
@@ -110,7 +120,8 @@ struct RenderSummary {
   Vec2 world_min_m, world_max_m;
   double pixels_per_metre = 0.0;
   double margin_px = 0.0;
-  double max_contact_force_n = 0.0;     // over the selected frames
+  bool cropped = false;                 // drawn in RenderOptions' window (world_min_m .. world_max_m)
+  double max_contact_force_n = 0.0;     // over the selected frames (inside the window if cropped)
   double force_n_per_px = 0.0;          // the scale used
   std::size_t most_fallen = 0;          // most people drawn fallen in one frame (event `fall`)
   std::filesystem::path video_written;  // empty if none
