@@ -24,6 +24,7 @@ struct ReportArgs {
   bool no_pdf = false;
   std::string chromium;
   std::size_t table_rows = 40;
+  double close_up_m = 12.0;
   std::string envelope_metric = "people_danger";
   double envelope_level = 0.0;
   bool force = false, quiet = false;
@@ -40,6 +41,7 @@ void RunReport(const ReportArgs& args) {
   o.pdf = !args.no_pdf;
   o.chromium = args.chromium;
   o.table_rows = args.table_rows;
+  o.close_up_m = args.close_up_m;
   o.envelope_metric = args.envelope_metric;
   o.envelope_level = args.envelope_level;
   o.force = args.force;
@@ -76,6 +78,10 @@ void RegisterReportCommand(CLI::App& app) {
   cmd->add_option("--smoothing", args->risk.smoothing_s, "Moving mean of the chest load (s)");
   cmd->add_option("--table-rows", args->table_rows, "People listed in the HTML table (all are in people.csv)")
       ->check(IntegerIn(0, 1000000));
+  cmd->add_option("--close-up", args->close_up_m,
+                  "Side (m) of the force network's close-up around the most loaded person at the worst moment, drawn "
+                  "when the whole view is more than three times as large (default 12; 0: none)")
+      ->check(NumberIn(0.0, 1e4, "m"));
   cmd->add_option("--envelope-metric", args->envelope_metric,
                   "For a sweep's folder: the risk column of its results the design envelope bounds (people_danger, "
                   "people_uncomfortable, people_beyond_tolerance, ...)");

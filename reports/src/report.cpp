@@ -10,8 +10,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/child_process.hpp"
@@ -131,8 +133,12 @@ std::string Base64(const std::string& bytes) {
 // 6,800-person evacuation's network is 24 MB, its PNG about 1 MB.
 constexpr std::uint32_t kNetworkSvgPeople = 2000;
 
-// The force network of `frame` of a run, drawn by viz (the paper's Figure 6 a-b).
-std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uint32_t people, const std::string& id_prefix) {
+// The force network of `frame` of a run, drawn by viz (the paper's Figure 6
+// a-b): the whole view, or with `window` (its lower-left and upper-right
+// corners) that part of it; `summary` (may be null) receives the layout.
+std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uint32_t people, const std::string& id_prefix,
+                               const std::optional<std::pair<Vec2, Vec2>>& window = std::nullopt,
+                               viz::RenderSummary* summary = nullptr) {
   std::mt19937_64 rng(std::random_device{}());
   const fs::path dir = fs::temp_directory_path() / ("crowdrecon-report-" + std::to_string(rng()));
   viz::RenderOptions o;
@@ -141,9 +147,15 @@ std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uin
   const bool as_svg = people <= kNetworkSvgPeople;
   o.svg = as_svg;
   o.width_px = as_svg ? 1100 : 2000;
+  if (window) {
+    o.has_window = true;
+    o.window_min_m = window->first;
+    o.window_max_m = window->second;
+  }
   std::string text;
   try {
-    viz::RenderRun(run, o);
+    const viz::RenderSummary drawn = viz::RenderRun(run, o);
+    if (summary) *summary = drawn;
     text = ReadInputFile(viz::FramePicturePath(dir, frame, as_svg ? ".svg" : ".png"), "rendered force network");
   } catch (...) {
     std::error_code ec;
@@ -344,6 +356,10 @@ bool ReportOptions::IsValid(std::string* error) const {
   }
   if (table_rows == 0 || table_rows > 100000) {
     if (error) *error = "table rows = " + std::to_string(table_rows) + ", expected in [1, 100000]";
+    return false;
+  }
+  if (!(close_up_m == 0.0 || (close_up_m >= 0.5 && close_up_m <= 1e4))) {
+    if (error) *error = "--close-up: " + FormatNumber(close_up_m) + " m, expected 0 (none) or 0.5 .. 10000";
     return false;
   }
   return risk.IsValid(error);
@@ -663,12 +679,30 @@ ReportSummary WriteReport(const ReportOptions& options) {
     std::uint32_t people = 0;
     for (const FrameRisk& fr : r.frames)
       if (fr.frame == r.worst_frame) people = fr.present;
-    std::string f = "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix) + "<figcaption>" + Escape(label) +
-                    ": frame " + std::to_string(r.worst_frame) + " (t = " + Short(r.worst_time_s, 4) +
-                    " s) of " + Escape(r.file.filename().string()) +
+    viz::RenderSummary whole;
+    std::string f = "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix, std::nullopt, &whole) +
+                    "<figcaption>" + Escape(label) + ": frame " + std::to_string(r.worst_frame) + " (t = " +
+                    Short(r.worst_time_s, 4) + " s) of " + Escape(r.file.filename().string()) +
                     ", the moment with the most people above F0. A line from each body's centre to each contact point, "
                     "its thickness the contact force (the paper's Figure 6 a–b).</figcaption></figure>\n";
     ++figures;
+    // A close-up where the whole view is too large to read the network: a
+    // square around the most loaded person, moved inside the whole view.
+    const double side = options.close_up_m;
+    const Vec2 extent = whole.world_max_m - whole.world_min_m;
+    if (side > 0.0 && r.worst_person > 0 && std::max(extent.x, extent.y) > 3.0 * side) {
+      Vec2 lo = r.worst_place_m - Vec2{side / 2.0, side / 2.0};
+      lo.x = std::clamp(lo.x, whole.world_min_m.x, std::max(whole.world_min_m.x, whole.world_max_m.x - side));
+      lo.y = std::clamp(lo.y, whole.world_min_m.y, std::max(whole.world_min_m.y, whole.world_max_m.y - side));
+      const Vec2 hi = {std::min(lo.x + side, whole.world_max_m.x), std::min(lo.y + side, whole.world_max_m.y)};
+      say("drawing its close-up around person " + std::to_string(r.worst_person));
+      f += "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix + "c-", std::pair{lo, hi}) +
+           "<figcaption>" + Escape(label) + ", the same moment, close up: x " + Short(lo.x, 4) + " to " +
+           Short(hi.x, 4) + " m, y " + Short(lo.y, 4) + " to " + Short(hi.y, 4) + " m, around person " +
+           std::to_string(r.worst_person) +
+           ", the most loaded then; its force scale is that of the contacts inside it.</figcaption></figure>\n";
+      ++figures;
+    }
     return f;
   };
   h += network(first, options.label, "n1-");

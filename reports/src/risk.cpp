@@ -291,7 +291,15 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
       risk.worst_contact_forces_n.clear();
       for (const LoadContact& c : load_contacts) risk.worst_contact_forces_n.push_back(Length(c.force_on_a_n));
       risk.worst_person_loads_n.clear();
-      for (std::uint32_t i : pf.person) risk.worst_person_loads_n.push_back(smoothed[i]);
+      risk.worst_person = 0;
+      for (std::size_t k = 0; k < pf.person.size(); ++k) {
+        const std::uint32_t i = pf.person[k];
+        risk.worst_person_loads_n.push_back(smoothed[i]);
+        if (risk.worst_person == 0 || smoothed[i] > smoothed[static_cast<std::size_t>(risk.worst_person - 1)]) {
+          risk.worst_person = std::int64_t{i} + 1;
+          risk.worst_place_m = pf.position_m[k];
+        }
+      }
     }
     if (have_contacts) more_contacts = contact_stream.Next(&contact_frame, &contacts);
     if (options.progress) options.progress(++done, times.size());

@@ -3,14 +3,16 @@
 sqlite3, no crowdrecon code) and compares them with the report's people.csv
 (issue 21: the report's numbers checked against an independent recomputation).
 
-  test_report.py RUN.sqlite people.csv [--f0 400] [--danger 1112] [--smoothing 1]
+  test_report.py RUN.sqlite people.csv [--f0 400] [--danger 1112] [--smoothing 1] [--close-up report.html]
 
 The chest load follows docs/reports.md: along an axis u, the contacts on the
 side u points to push with P+ = sum max(0, -F.u), the others with
 P- = sum max(0, F.u); the load is min(P+, P-); the person's load is the larger
 of the chest (u = facing) and shoulder (u = perpendicular) loads, then a moving
-mean over round(smoothing * fps) frames."""
-import argparse, csv, json, math, sqlite3, sys
+mean over round(smoothing * fps) frames. With --close-up, the report's force
+network close-up must be centred on the person with the largest smoothed load
+at the frame of its worst moment (its captions name both), recomputed here."""
+import argparse, csv, json, math, re, sqlite3, sys
 from collections import defaultdict, deque
 
 
@@ -23,7 +25,18 @@ def main():
     ap.add_argument("--smoothing", type=float, default=1.0)
     ap.add_argument("--short", type=float, nargs=2, default=(6227.0, 15.0))
     ap.add_argument("--long", type=float, nargs=2, default=(1112.0, 300.0))
+    ap.add_argument("--close-up", help="report.html whose close-up is checked")
     a = ap.parse_args()
+    close_up = None  # (worst frame, the person the close-up is around)
+    if a.close_up:
+        html = open(a.close_up).read()
+        worst = re.search(r"runs: frame ([0-9]+) \(t = ", html)
+        around = re.search(r"close up: x .*? m, around person ([0-9]+)", html)
+        if not worst or not around:
+            print(f"{a.close_up}: no worst frame or no close-up caption")
+            return 1
+        close_up = (int(worst.group(1)), int(around.group(1)))
+    worst_loads = {}
 
     db = sqlite3.connect(a.run)
     run = dict(db.execute("SELECT key, value FROM run"))
@@ -122,6 +135,8 @@ def main():
             if len(q) > window:
                 q.popleft()
             s = max(0.0, sum(q) / len(q))
+            if close_up and frame == close_up[0]:
+                worst_loads[pid] = s
             st = stat.setdefault(pid, dict(max=0.0, above=0.0, dose=0.0, danger=0.0))
             st["max"] = max(st["max"], s)
             if s > a.f0:
@@ -160,6 +175,12 @@ def main():
             failures += 1
     print(f"{len(rows)} people checked; recomputed zones: " + ", ".join(f"{z} {counts[z]}" for z in ("safe", "uncomfortable", "danger")) +
           f"; largest load {max(s['max'] for s in stat.values()):.1f} N; {failures} differences")
+    if close_up:
+        most = max(worst_loads, key=lambda pid: (worst_loads[pid], -pid))
+        print(f"close-up at frame {close_up[0]} around person {close_up[1]}; recomputed the most loaded then: "
+              f"person {most} ({worst_loads[most]:.1f} N)")
+        if most != close_up[1]:
+            failures += 1
     return 1 if failures or load_failures else 0
 
 

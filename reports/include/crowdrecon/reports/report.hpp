@@ -38,6 +38,11 @@ struct ReportOptions {
   std::string chromium;     // the browser to print with; "" = chromium, chromium-browser, google-chrome on PATH
   std::string command_line; // recorded in the reproducibility section
   std::size_t table_rows = 40;  // people listed in the HTML table (all of them in people.csv)
+  // The force network's close-up: a square window of this side (m) around
+  // the most loaded person at the worst moment, drawn beside the whole view
+  // when the whole view is more than three times as large (a 3-m alley in a
+  // 75-m street network); 0: never.
+  double close_up_m = 12.0;
   // A sweep's folder (DIR/results.sqlite) as the only input gives the
   // venue-design envelope: the region of the sweep's diagram where the median
   // over seeds of `envelope_metric` (a risk column of the results) stays at or

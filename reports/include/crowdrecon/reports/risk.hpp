@@ -121,6 +121,10 @@ struct RunRisk {
   double worst_time_s = 0.0;
   std::vector<double> worst_contact_forces_n;  // every contact's |F| at the worst frame
   std::vector<double> worst_person_loads_n;    // every present person's smoothed load then
+  // The person with the largest smoothed load at the worst moment (id,
+  // 1-based; 0: nobody present) and where they stood: the report's close-up.
+  std::int64_t worst_person = 0;
+  Vec2 worst_place_m;
   std::array<std::uint32_t, kZones> counts{};  // people per zone
   std::uint32_t beyond_tolerance = 0;          // dose >= 1
   std::uint32_t fallen = 0;
