@@ -313,6 +313,12 @@ TEST(RenderRun, AWindowDrawsAPartOfTheVenueClippedAtItsEdge) {
   EXPECT_NE(ErrorOf([&] { ParseRenderWindow("1,0,0,1", &options); }).find("not lower-left then upper-right"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ParseRenderWindow("0,0,a,1", &options); }).find("\"a\" is not a number"), std::string::npos);
+  // A window far taller than wide: the pictures would be too tall, said with the way out.
+  RenderOptions tall = options;
+  tall.width_px = 8000;
+  ParseRenderWindow("0, 0, 0.05, 1.5", &tall);
+  EXPECT_NE(ErrorOf([&] { RenderRun(run, tall); }).find("px tall (at most 20000): give a smaller --width or a wider --window"),
+            std::string::npos);
   RenderOptions flat = options;
   flat.window_max_m.y = flat.window_min_m.y;
   EXPECT_NE(ErrorOf([&] { RenderRun(run, flat); }).find("--window: (0, 0) to (1.2, 0) m, expected"), std::string::npos);

@@ -762,7 +762,8 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
   if (layout.height_px > 20000)
     throw InputError(file + ": the drawn region is " + FormatFixed(hi.x - lo.x, 1) + " m x " + FormatFixed(hi.y - lo.y, 1) +
                      " m; at --width " + std::to_string(options.width_px) + " the pictures would be " +
-                     std::to_string(layout.height_px) + " px tall (at most 20000): give a larger --width");
+                     std::to_string(layout.height_px) + " px tall (at most 20000): give a smaller --width" +
+                     (options.has_window ? " or a wider --window" : ""));
   summary->cropped = layout.cropped;
   summary->world_min_m = layout.lo;
   summary->world_max_m = layout.hi;
