@@ -47,7 +47,21 @@ std::optional<std::int64_t> ParseInteger(const std::string& s) {
   return value;
 }
 
-std::optional<double> ParseSeconds(const std::string& s) {
+// The comma-separated items of an option's value, each trimmed (an empty
+// item stays, for its message).
+std::vector<std::string> CommaItems(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = text.find(',', start);
+    items.push_back(Trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    if (comma == std::string::npos) return items;
+    start = comma + 1;
+  }
+}
+
+// A finite number (seconds, metres).
+std::optional<double> ParseNumber(const std::string& s) {
   double value = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (ec != std::errc() || end != s.data() + s.size() || s.empty() || !std::isfinite(value)) return std::nullopt;
@@ -518,12 +532,12 @@ FrameSelection ParseFrameSelection(const std::string& raw) {
     if (a.empty() && b.empty()) FailSelection(raw, "a time range needs at least one of T1, T2");
     s.kind = FrameSelection::Kind::kTimeRange;
     if (!a.empty()) {
-      const auto t = ParseSeconds(a);
+      const auto t = ParseNumber(a);
       if (!t) FailSelection(raw, "T1 \"" + a + "\" is not a number of seconds");
       s.from_s = *t;
     }
     if (!b.empty()) {
-      const auto t = ParseSeconds(b);
+      const auto t = ParseNumber(b);
       if (!t) FailSelection(raw, "T2 \"" + b + "\" is not a number of seconds");
       s.to_s = *t;
     }
@@ -533,10 +547,7 @@ FrameSelection ParseFrameSelection(const std::string& raw) {
     return s;
   }
   s.kind = FrameSelection::Kind::kList;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const auto comma = text.find(',', start);
-    const std::string item = Trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+  for (const std::string& item : CommaItems(text)) {
     if (item == "first") {
       s.list.push_back(FrameSelection::kFirst);
     } else if (item == "last") {
@@ -548,8 +559,6 @@ FrameSelection ParseFrameSelection(const std::string& raw) {
                                         : "\"" + item + "\" is not a frame number, first or last");
       s.list.push_back(*n);
     }
-    if (comma == std::string::npos) break;
-    start = comma + 1;
   }
   return s;
 }
@@ -641,17 +650,10 @@ void ParseRenderWindow(const std::string& text, RenderOptions* options) {
                      "; expected x0,y0,x1,y1 in metres, the lower-left and upper-right corners (x0 < x1, y0 < y1)");
   };
   std::vector<double> v;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string part = Trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    double x = 0.0;
-    const char* end = part.data() + part.size();
-    const auto [ptr, ec] = std::from_chars(part.data(), end, x);
-    if (part.empty() || ec != std::errc() || ptr != end || !std::isfinite(x)) fail("\"" + part + "\" is not a number");
-    v.push_back(x);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
+  for (const std::string& part : CommaItems(text)) {
+    const auto x = ParseNumber(part);
+    if (!x) fail("\"" + part + "\" is not a number");
+    v.push_back(*x);
   }
   if (v.size() != 4) fail(std::to_string(v.size()) + " numbers");
   if (!(v[0] < v[2] && v[1] < v[3])) fail("the corners are not lower-left then upper-right");
