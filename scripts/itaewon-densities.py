@@ -10,7 +10,8 @@ median bodies, 0.0868 m², the runs' validity statements' measure).
 
     scripts/itaewon-densities.py RUN.sqlite... -o DENSITIES.md [--csv DENSITIES.csv]
 
-A run that ended before a time gives no figure for it (said in the table).
+A run that ended before a time (or, still running, has not reached it) gives no
+figure for it (said in the table).
 """
 import argparse
 import csv
@@ -105,7 +106,7 @@ def main():
         low, high = r["recorded"]
         stem = path.rsplit("/", 1)[-1].removesuffix(".sqlite")
         if r["areas"] is None:
-            ended = "no frames" if r["ended"] is None else f"run ended at {r['ended']:.1f} s"
+            ended = "no frames" if r["ended"] is None else f"not reached (the last frame at {r['ended']:.1f} s)"
             lines.append(f"| {stem} ({seed}) | {r['clock']} | {low}–{high} | " + " | ".join(ended for _ in names) + " |")
             continue
         cells = []
