@@ -324,6 +324,30 @@ TEST(RenderRun, AWindowDrawsAPartOfTheVenueClippedAtItsEdge) {
   EXPECT_NE(ErrorOf([&] { RenderRun(run, flat); }).find("--window: (0, 0) to (1.2, 0) m, expected"), std::string::npos);
 }
 
+TEST(RenderRun, ANarrowPicturesLegendShrinksToItsWidth) {
+  // The legend's two lines (time, people, contacts, the largest force; the
+  // groups and the key) are some 800 px long at their sizes: on a narrower
+  // picture they shrink rather than run off its right edge.
+  const ScratchDir dir("narrow");
+  const std::filesystem::path run = WriteRun(dir.path(), 3);
+  RenderOptions options;
+  options.output_dir = dir.path() / "frames";
+  options.frames = ParseFrameSelection("0");
+  options.width_px = 480;
+  const RenderSummary summary = RenderRun(run, options);
+  const cv::Mat image = media::ReadImage(summary.first_picture.string(), cv::IMREAD_COLOR);
+  const int margin = static_cast<int>(summary.margin_px);
+  int drawn_in_margin = 0, drawn_in_legend = 0;
+  for (int y = 0; y < margin; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+      const bool background = p[0] > 250 && p[1] > 250 && p[2] > 250;
+      (x >= image.cols - margin / 2 ? drawn_in_margin : drawn_in_legend) += !background;
+    }
+  EXPECT_EQ(drawn_in_margin, 0);
+  EXPECT_GT(drawn_in_legend, 500);
+}
+
 TEST(RenderRun, WithoutAPeriodicBoxLeavesOutBranchesAcrossTheSeam) {
   const ScratchDir dir("seam");
   const std::filesystem::path run = WriteRun(dir.path(), 11, /*record_periodic_box=*/false);

@@ -379,7 +379,9 @@ void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend,
                             "    people " + std::to_string(legend.people) + "    contacts " +
                             std::to_string(stats.contacts) + " (" + std::to_string(stats.wall_contacts) +
                             " with walls)    max contact force " + FormatFixed(stats.max_force_n, 0) + " N";
-  canvas.TextPx(kMargin_px, 22.0, line1, 15, kText);
+  // Both lines shrink to the picture's width rather than run off its edge (a
+  // narrow picture, a tall window).
+  canvas.TextPxAligned(kMargin_px, 26.0, line1, 15, 0.0, 1.0, kText, 0.0, false, w - 2.0 * kMargin_px);
 
   // Groups: a swatch and a name each.
   double x = kMargin_px;
@@ -393,7 +395,8 @@ void DrawLegend(Canvas& canvas, const Layout& layout, const FrameLegend& legend,
   for (std::uint32_t g : legend.groups_present)
     swatch(GroupColor(g), "group " + std::to_string(g) + (g == 1 ? " (counter-flow)" : ""));
   if (legend.fallen > 0) swatch(kFallenBody, "fallen: " + std::to_string(legend.fallen) + " (a cross)");
-  canvas.TextPx(x, 42.0, "triangle: chest    lines: contact forces (centroid to contact point)", 12, kSubtleText);
+  canvas.TextPxAligned(x, 45.0, "triangle: chest    lines: contact forces (centroid to contact point)", 12, 0.0, 1.0,
+                       kSubtleText, 0.0, false, std::max(w - kMargin_px - x, 1.0));
 
   // Scale bar (lower left) and force scale (lower right): sample lines of
   // round forces up to the largest force of the selected frames.
