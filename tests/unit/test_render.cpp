@@ -258,13 +258,19 @@ TEST(RenderRun, TheFallenAreDrawnGreyFromTheirFall) {
 // corners are the picture's world window exactly, a body inside it is drawn in
 // its group's colour where the layout says, and a body that straddles its edge
 // is clipped there, not drawn into the margin beside it.
-TEST(RenderRun, AWindowDrawsAPartOfTheVenueClippedAtItsEdge) {
-  const ScratchDir dir("window");
-  const std::filesystem::path run = WriteRun(dir.path(), 3);
+// Options that draw a run's first frame at a width into the scratch folder.
+RenderOptions FirstFrameAt(const ScratchDir& dir, int width_px) {
   RenderOptions options;
   options.output_dir = dir.path() / "frames";
   options.frames = ParseFrameSelection("0");
-  options.width_px = 800;
+  options.width_px = width_px;
+  return options;
+}
+
+TEST(RenderRun, AWindowDrawsAPartOfTheVenueClippedAtItsEdge) {
+  const ScratchDir dir("window");
+  const std::filesystem::path run = WriteRun(dir.path(), 3);
+  RenderOptions options = FirstFrameAt(dir, 800);
   ParseRenderWindow("0, 0, 1.2, 1.5", &options);
   const RenderSummary summary = RenderRun(run, options);
   EXPECT_TRUE(summary.cropped);
@@ -329,12 +335,7 @@ TEST(RenderRun, ANarrowPicturesLegendShrinksToItsWidth) {
   // groups and the key) are some 800 px long at their sizes: on a narrower
   // picture they shrink rather than run off its right edge.
   const ScratchDir dir("narrow");
-  const std::filesystem::path run = WriteRun(dir.path(), 3);
-  RenderOptions options;
-  options.output_dir = dir.path() / "frames";
-  options.frames = ParseFrameSelection("0");
-  options.width_px = 480;
-  const RenderSummary summary = RenderRun(run, options);
+  const RenderSummary summary = RenderRun(WriteRun(dir.path(), 3), FirstFrameAt(dir, 480));
   const cv::Mat image = media::ReadImage(summary.first_picture.string(), cv::IMREAD_COLOR);
   const int margin = static_cast<int>(summary.margin_px);
   int drawn_in_margin = 0, drawn_in_legend = 0;
