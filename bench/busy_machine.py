@@ -73,7 +73,7 @@ def run_once(exe, scenario, threads, extra, env, busy, folder):
             hog.wait()
     if result.returncode != 0:
         bc.fail(f"{scenario.name} --threads {threads} {' '.join(extra)}: exit {result.returncode}\n{result.stderr}")
-    wall = re.search(r"simulated: [0-9.]+ s in ([0-9.]+) s wall", result.stdout)
+    wall = re.search(r"simulated: (?:from [0-9.]+ to )?[0-9.]+ s in ([0-9.]+) s wall", result.stdout)
     threads_line = re.search(r"threads: (.*)", result.stdout)
     return float(wall.group(1)), threads_line.group(1) if threads_line else ""
 

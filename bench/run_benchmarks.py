@@ -86,7 +86,7 @@ def parse_summary(stdout):
     if not m:
         raise ValueError("no 'people: ...' line in the summary")
     out["people"], out["time_step_s"], out["threads"] = int(m[1]), float(m[2]), int(m[3])
-    m = re.search(r"simulated: ([0-9.]+) s in ([0-9.]+) s wall \(real-time factor ([0-9.eE+-]+)\)", stdout)
+    m = re.search(r"simulated: (?:from [0-9.]+ to )?([0-9.]+) s in ([0-9.]+) s wall \(real-time factor ([0-9.eE+-]+)\)", stdout)
     if not m:
         raise ValueError("no 'simulated: ...' line in the summary")
     out["simulated_s"], out["loop_wall_s"], out["real_time_factor"] = float(m[1]), float(m[2]), float(m[3])

@@ -71,7 +71,11 @@ int RunSimulate(const SimulateArgs& args) {
                                                                : ", person-pair forces on CUDA until it failed (see the note)");
   if (!s.threads_report.empty()) std::printf("threads: %s\n", s.threads_report.c_str());
   if (!s.systems_report.empty()) std::printf("run loop: %s\n", s.systems_report.c_str());
-  std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
+  if (s.started_at_s > 0.0)  // resumed (or branched): this part, then the whole
+    std::printf("simulated: from %.3f to %.3f s in %.2f s wall (real-time factor %.3f); the run so far %.2f s wall\n",
+                s.started_at_s, s.simulated_s, s.wall_s, s.real_time_factor, s.total_wall_s);
+  else
+    std::printf("simulated: %.3f s in %.2f s wall (real-time factor %.3f)\n", s.simulated_s, s.wall_s, s.real_time_factor);
   std::printf("run file: %s (%lld frames), status %s\n", args.output.c_str(), static_cast<long long>(s.frames),
               s.status.c_str());
   const engine::Profile& p = s.profile;

@@ -251,6 +251,7 @@ struct OpenedRun {
   runfile::RunFileWriter writer;
   std::int64_t last_frame = -1;  // -1: nothing written yet
   std::vector<std::pair<std::string, std::string>> systems;
+  double earlier_wall_s = 0.0;  // a resumed run's wall time to its checkpoint (run value wall_s)
 };
 
 OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const BuiltWorld& built,
@@ -266,7 +267,10 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
     const Checkpoint c = ReadCheckpoint(checkpoint, fingerprint);
     sim.LoadState(c.state);
     say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(c.last_frame) + ")");
-    return {runfile::RunFileWriter::Resume(options.output, c.last_frame), c.last_frame, c.systems};
+    // The wall time its frames took so far (written with each checkpoint;
+    // absent in a run written before it was kept: counted from here).
+    const double earlier_wall_s = std::max(0.0, std::strtod(runfile::RunFileReader(options.output).RunValue("wall_s").c_str(), nullptr));
+    return {runfile::RunFileWriter::Resume(options.output, c.last_frame), c.last_frame, c.systems, earlier_wall_s};
   }
   std::filesystem::remove(checkpoint, ec);
   runfile::RunHeader header;
@@ -518,9 +522,16 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     writer.WriteEvent(frame, event);
   };
   RunLoop loop(sim, loop_options);
+  // The run's wall time over all its invocations (run value wall_s): what
+  // its frames took to compute, to its last checkpoint while it is
+  // unfinished (a run killed outright computes again what followed it).
+  const auto record_wall_time = [&] {
+    writer.SetRunValue("wall_s", FormatNumber(opened.earlier_wall_s + std::chrono::duration<double>(Clock::now() - start).count()));
+  };
   const auto checkpoint_at = [&](const std::filesystem::path& file, std::int64_t frame) {
     frames.Flush();
     WriteCheckpoint(file, fingerprint, Checkpoint{frame, sim.SaveState(), loop.SaveStates()});
+    record_wall_time();
   };
   if (timeline) {  // the incident timeline's systems, around the steps (timeline_systems.hpp)
     loop.Add(detail::MakeTimelineEventSystem(*timeline));
@@ -602,6 +613,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     writer.SetRunValue("adaptive_steps", (steps.empty() ? "every step 1 h (the fixed step)" : steps) +
                                              (options.resume ? " (since the resume)" : ""));
   }
+  record_wall_time();
   writer.SetStatus(status);
   if (status == "complete") {
     std::error_code ec;
@@ -610,7 +622,9 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   summary.systems_report = loop.summary().BriefReport();
   summary.status = status;
   summary.simulated_s = sim.time_s();
+  summary.started_at_s = start_sim;
   summary.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.total_wall_s = opened.earlier_wall_s + summary.wall_s;
   summary.real_time_factor = summary.wall_s > 0 ? (sim.time_s() - start_sim) / summary.wall_s : 0.0;
   summary.frames = last_frame + 1;
   summary.profile = sim.profile();

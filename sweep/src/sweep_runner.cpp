@@ -253,6 +253,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
 
   ResultRow row;
   bool failed = false;
+  double earlier_wall_s = 0.0;  // a resumed run's earlier invocations
   try {
     scenario::RunSummary summary;
     if (resume) {
@@ -281,6 +282,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
       summary = scenario::RunScenario(sc, options);
     }
     if (summary.status != "complete") return std::nullopt;
+    earlier_wall_s = summary.total_wall_s - summary.wall_s;
     row = RowOf(run, analysis::AnalyzeRun(file, ctx.analysis));
     AddRiskColumns(file, &row);
   } catch (const InputError& e) {
@@ -298,7 +300,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
   if (ctx.after_run && *ctx.after_run) (*ctx.after_run)(run, file, failed ? row.status : std::string("complete"));
   // A failed run keeps its file (and saved state) for inspection.
   if (!ctx.spec.keep_runs && !failed) RemoveRunFiles(file);
-  row.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  row.wall_s = earlier_wall_s + std::chrono::duration<double>(Clock::now() - start).count();
   return row;
 }
 

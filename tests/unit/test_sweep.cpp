@@ -282,6 +282,42 @@ TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
   EXPECT_NE(row.find("went through wall"), std::string::npos) << row;
 }
 
+// A run resumed by the sweep records the wall time of all its parts (the run
+// file's wall_s, here as if its first part had taken 1,000 s), not the last
+// part's alone: the hours of a long incident run interrupted by the end of a
+// working day stay in the results.
+TEST(SweepRunner, AResumedRunsWallTimeCountsItsEarlierParts) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-wall-time");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "out" / "runs");
+  const std::string source = CROWDRECON_SOURCE_DIR;
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << source
+      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": [2], "keep_runs": true})";
+  }
+  const SweepSpec spec = LoadSweep(dir / "sweep.json");
+  const std::vector<RunPlan> runs = ExpandRuns(spec);
+  ASSERT_EQ(runs.size(), 1u);
+  const std::filesystem::path file = dir / "out" / "runs" / (runs[0].id + ".sqlite");
+  scenario::RunOptions stopped;
+  stopped.output = file;
+  stopped.stop_after_s = 0.5;
+  ASSERT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs[0]), stopped).status, "interrupted");
+  {
+    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 5);
+    writer.SetRunValue("wall_s", "1000");
+  }
+  const SweepSummary summary = RunSweepIn(dir);
+  EXPECT_EQ(summary.failed, 0u);
+  const ResultsTable table = ReadResults(dir / "out");
+  ASSERT_EQ(table.rows.size(), 1u);
+  const double wall_s = table.rows[0][table.Column("wall_s")].number;
+  EXPECT_GE(wall_s, 1000.0);
+  EXPECT_LT(wall_s, 1600.0);
+  EXPECT_GE(std::stod(runfile::RunFileReader(file).RunValue("wall_s")), 1000.0);
+}
+
 TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {
   const struct {
     std::string body;

@@ -574,6 +574,36 @@ TEST(Timeline, TheEngineAtACheckpointContinuesAsTheRunDoes) {
   }
 }
 
+// A run's wall time (run value wall_s) counts every invocation of a resumed
+// run, so that a sweep's results and a long run's statement of what it cost
+// are not the last part's alone.
+TEST(Timeline, AResumedRunsWallTimeCountsAllItsParts) {
+  const Scenario s = LoadScenario(kSource / "tests/data/scenarios/hallway-short.json");
+  RunOptions options;
+  options.output = crowdrecon::testing::ScratchFile("wall-time.sqlite");
+  std::filesystem::remove(options.output);
+  std::filesystem::remove(CheckpointPath(options.output));
+  const auto recorded = [&] { return std::stod(runfile::RunFileReader(options.output).RunValue("wall_s")); };
+
+  options.stop_after_s = 1.0;
+  const RunSummary first = RunScenario(s, options);
+  ASSERT_EQ(first.status, "interrupted");
+  EXPECT_EQ(first.total_wall_s, first.wall_s);
+  // Written at the end, just before the summary's own reading of the clock.
+  const double after_first = recorded();
+  EXPECT_GT(after_first, 0.0);
+  EXPECT_LE(after_first, first.wall_s * (1.0 + 1e-9));
+
+  options.stop_after_s = -1.0;
+  options.resume = true;
+  const RunSummary second = RunScenario(s, options);
+  ASSERT_EQ(second.status, "complete");
+  EXPECT_DOUBLE_EQ(second.total_wall_s, after_first + second.wall_s);
+  EXPECT_GT(recorded(), after_first);
+  EXPECT_LE(recorded(), second.total_wall_s * (1.0 + 1e-9));
+  EXPECT_GT(second.total_wall_s, second.wall_s);
+}
+
 }  // namespace timeline_tests
 }  // namespace crowdrecon::scenario
 

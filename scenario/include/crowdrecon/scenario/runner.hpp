@@ -41,7 +41,9 @@ struct RunOptions {
 struct RunSummary {
   std::string status;           // "complete" or "interrupted"
   double simulated_s = 0.0;
-  double wall_s = 0.0;
+  double started_at_s = 0.0;    // the simulated time this invocation began at (a resumed run's checkpoint)
+  double wall_s = 0.0;           // this invocation
+  double total_wall_s = 0.0;     // over all the run's invocations (run value wall_s; to the checkpoint each resumed from)
   double time_step_s = 0.0;
   std::size_t people = 0;       // at the start
   std::size_t slots = 0;        // a timeline's engine slots (people of the start and places for arrivals); 0 without

@@ -50,7 +50,7 @@ struct ResultRow {
   std::string regime;          // analysis::ToString(Regime); "" if failed
   std::string regime_reason;
   std::vector<double> metrics;  // MetricColumns() order; NaN = no value
-  double wall_s = 0.0;          // simulation and analysis of this run (s)
+  double wall_s = 0.0;          // simulation (over all its invocations, if resumed) and analysis of this run (s)
 };
 
 // Exact binary form of a row (for messages between MPI ranks).
