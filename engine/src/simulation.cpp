@@ -47,7 +47,7 @@ void ValidateWorld(WorldDef& def) {
   if (n >= (std::size_t{1} << 31)) throw InputError("too many people");
   for (std::size_t i = 0; i < n; ++i) {
     const PersonDef& p = def.people[i];
-    const std::string who = PersonText(static_cast<std::uint32_t>(i));
+    const std::string who = "person " + std::to_string(i + 1);
     if (p.shape >= def.shapes.size()) throw InputError(who + ": shape index out of range");
     if (p.target >= def.targets.size()) throw InputError(who + ": target index out of range");
     if (!(p.mass_kg > 0) || !(p.inertia_kg_m2 > 0))
@@ -364,7 +364,7 @@ WorldDef Simulation::ProbeWorld(const ModelParameters& parameters) const {
 void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id) {
   if (slot >= bodies_.size()) throw InputError("slot " + std::to_string(slot) + " out of range");
   if (bodies_.state[slot] != PersonState::kRemoved)
-    throw InputError("slot " + std::to_string(slot) + " is taken (" + PersonText(slot) + " is in the venue)");
+    throw InputError("slot " + std::to_string(slot) + " is taken (" + PersonText(bodies_, slot) + " is in the venue)");
   if (p.shape >= def_.shapes.size() || p.target >= def_.targets.size() || !(p.mass_kg > 0) ||
       !(p.inertia_kg_m2 > 0) || !std::isfinite(p.position_m.x) || !std::isfinite(p.position_m.y) ||
       !std::isfinite(p.angle_rad) || p.state != PersonState::kWalking)

@@ -101,8 +101,11 @@ class ScopedTimer {
   Clock::time_point start_;
 };
 
-// People are named by id = index + 1, as in run files.
-inline std::string PersonText(std::uint32_t i) { return "person " + std::to_string(i + 1); }
+// People are named by their id + 1, as in run files (a timeline's slot
+// index is not its person's id: arrivals take whichever slot is free).
+inline std::string PersonText(const BodyState& bodies, std::uint32_t slot) {
+  return "person " + std::to_string(std::uint64_t{bodies.id[slot]} + 1);
+}
 
 
 // The periodic box (WorldDef::periodic): a position wrapped into it, and the

@@ -31,7 +31,7 @@ void Simulation::Check() {
     const Vec2 x = bodies_.position_m[i], v = bodies_.velocity_m_per_s[i];
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(v.x) || !std::isfinite(v.y) ||
         !std::isfinite(bodies_.angle_rad[i]) || !std::isfinite(bodies_.angular_velocity_rad_per_s[i]))
-      throw SimulationError("non-finite state of " + PersonText(i) + " at t = " + FormatNumber(time_s_) +
+      throw SimulationError("non-finite state of " + PersonText(bodies_, i) + " at t = " + FormatNumber(time_s_) +
                             " s (position " + FormatNumber(x.x) + ", " + FormatNumber(x.y) + "; velocity " +
                             FormatNumber(v.x) + ", " + FormatNumber(v.y) + ")",
                             i, -1, time_s_);
@@ -44,7 +44,7 @@ void Simulation::Check() {
     const auto separation = [this](Vec2 x, Vec2 y) { return detail::Separation(def_.periodic, x, y); };
     if (before && WentThroughWall(c, *before, rb, ra + rb, separation)) {
       const Vec2 x = bodies_.position_m[c.a];
-      throw SimulationError(PersonText(c.a) + " went through wall " + std::to_string(c.b) + " at t = " +
+      throw SimulationError(PersonText(bodies_, c.a) + " went through wall " + std::to_string(c.b) + " at t = " +
                             FormatNumber(time_s_) + " s near (" + FormatNumber(c.point_m.x) + ", " +
                             FormatNumber(c.point_m.y) + "), centre at (" + FormatNumber(x.x) + ", " +
                             FormatNumber(x.y) + "): the core crossed the wall line, a load beyond k_n (r_person + r_wall) = " +
@@ -53,8 +53,8 @@ void Simulation::Check() {
                             c.a, -1, time_s_);
     }
     if (!(c.overlap_m <= ra + rb)) {
-      const std::string other = c.wall ? "wall " + std::to_string(c.b) : PersonText(c.b);
-      throw SimulationError("overlap of " + PersonText(c.a) + " and " + other + " is " +
+      const std::string other = c.wall ? "wall " + std::to_string(c.b) : PersonText(bodies_, c.b);
+      throw SimulationError("overlap of " + PersonText(bodies_, c.a) + " and " + other + " is " +
                             FormatNumber(c.overlap_m) + " m at t = " + FormatNumber(time_s_) +
                             " s, beyond the sum of their sphero-radii " + FormatNumber(ra + rb) +
                             " m: the cores interpenetrate (time step too large or forces too strong)",

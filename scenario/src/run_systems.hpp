@@ -48,21 +48,23 @@ inline void WriteTimelineFrame(runfile::FrameWriterThread& frames, const engine:
 // engine's contact check: walls x people segment tests per frame).
 class WallCheckSystem : public RunSystem {
  public:
-  explicit WallCheckSystem(const engine::Simulation& sim) : centres_(sim.bodies().position_m), ids_(sim.bodies().id) {}
+  explicit WallCheckSystem(const engine::Simulation& sim)
+      : centres_(sim.bodies().position_m), ids_(SlotHolders(sim.bodies())) {}
   std::string_view name() const override { return "wall_check"; }
   void AtFrame(FrameContext& c) override {
-    // A slot that changed hands since (a timeline's arrival) has no path to check.
+    // A slot that changed hands since (a timeline's arrival, also into a
+    // slot empty then: SlotHolders) has no path to check.
     const engine::BodyState& b = c.sim.bodies();
     for (std::size_t i = 0; i < b.size(); ++i)
       if (b.id[i] != ids_[i]) centres_[i] = b.position_m[i];
     engine::CheckCentresStayInsideWalls(c.sim, centres_);
     centres_ = b.position_m;
-    ids_ = b.id;
+    ids_ = SlotHolders(b);
   }
 
  private:
   std::vector<Vec2> centres_;  // at the last frame (a checkpoint is taken at a frame: they are the positions then)
-  std::vector<std::uint32_t> ids_;  // who held each slot then
+  std::vector<std::uint32_t> ids_;  // who held each slot then (kNoOne: empty)
 };
 
 // Writes the frame; with a timeline, also its head count and the events

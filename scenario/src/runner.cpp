@@ -583,8 +583,13 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     Event event;
     event.time_s = sim.time_s();
     event.kind = "numerical_failure";
-    event.person = e.person();
-    event.other = e.other();
+    // The engine names slots; the run file names people (a timeline's
+    // arrivals take whichever slot is free).
+    const auto id_of = [&](std::int64_t slot) {
+      return slot >= 0 && static_cast<std::size_t>(slot) < sim.bodies().size() ? std::int64_t{sim.bodies().id[static_cast<std::size_t>(slot)]} : slot;
+    };
+    event.person = id_of(e.person());
+    event.other = id_of(e.other());
     event.detail = e.what();
     writer.WriteEvent(last_frame, event);
     writer.SetStatus(std::string("failed: ") + e.what());

@@ -75,6 +75,17 @@ struct TimelineState {
   void LoadState(const std::string& state);
 };
 
+// Who holds each engine slot, for the systems that follow a person's path
+// from one check to the next: an empty slot (never used, or its person
+// removed) holds no one (kNoOne), so that whoever is spawned into it is a
+// newcomer. (An empty slot's placeholder carries the slot's index as its
+// id, which may be the id of the arrival spawned into it: compared by id
+// alone, that arrival walked from the placeholder's parking place, the
+// walkable area's lower corner, to its entry; the Itaewon evening's wall
+// check stopped both seeds at 22:20 on such a path.)
+constexpr std::uint32_t kNoOne = UINT32_MAX;
+std::vector<std::uint32_t> SlotHolders(const engine::BodyState& bodies);
+
 std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& state);
