@@ -244,29 +244,40 @@ TEST(SweepRunner, AThirdGroupsMetricsStayOutOfTheTable) {
   EXPECT_NE(row.find("complete"), std::string::npos) << row;
 }
 
+// A sweep of one seed of a test scenario in a scratch folder DIR (its
+// output DIR/out), its run simulated up to `stop_after_s` and interrupted,
+// as a sweep stopped by a signal leaves it: the folder and the run file.
+struct InterruptedRun {
+  std::filesystem::path dir, file;
+};
+InterruptedRun InterruptedSweepRun(const std::string& name, const std::string& scenario_file, int seed,
+                                   double stop_after_s) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile(name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "out" / "runs");
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
+      << "/tests/data/scenarios/" << scenario_file << R"(", "seeds": [)" << seed << R"(], "keep_runs": true})";
+  }
+  const SweepSpec spec = LoadSweep(dir / "sweep.json");
+  const std::vector<RunPlan> runs = ExpandRuns(spec);
+  EXPECT_EQ(runs.size(), 1u);
+  const std::filesystem::path file = dir / "out" / "runs" / (runs.at(0).id + ".sqlite");
+  scenario::RunOptions stopped;
+  stopped.output = file;
+  stopped.stop_after_s = stop_after_s;
+  EXPECT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs.at(0)), stopped).status, "interrupted");
+  return {dir, file};
+}
+
 // A run that goes numerically wrong after it resumed is recorded as failed
 // with its files kept, not started over (it would fail again, identically,
 // hours later for a long run, and its message and saved state were deleted).
 // The run is interrupted before its failure (20 people sprinting into a wall
 // go through it at 0.35 s), marked, and the sweep resumes it: the mark stays.
 TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
-  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-fails-after-resume");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir / "out" / "runs");
-  const std::string source = CROWDRECON_SOURCE_DIR;
-  {
-    std::ofstream f(dir / "sweep.json");
-    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << source
-      << R"(/tests/data/scenarios/bad-sprint-into-wall.json", "seeds": [3], "keep_runs": true})";
-  }
-  const SweepSpec spec = LoadSweep(dir / "sweep.json");
-  const std::vector<RunPlan> runs = ExpandRuns(spec);
-  ASSERT_EQ(runs.size(), 1u);
-  const std::filesystem::path file = dir / "out" / "runs" / (runs[0].id + ".sqlite");
-  scenario::RunOptions stopped;
-  stopped.output = file;
-  stopped.stop_after_s = 0.1;
-  ASSERT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs[0]), stopped).status, "interrupted");
+  const auto [dir, file] = InterruptedSweepRun("sweep-fails-after-resume", "bad-sprint-into-wall.json", 3, 0.1);
   ASSERT_TRUE(std::filesystem::exists(scenario::CheckpointPath(file)));
   {
     runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 1);
@@ -287,23 +298,7 @@ TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
 // part's alone: the hours of a long incident run interrupted by the end of a
 // working day stay in the results.
 TEST(SweepRunner, AResumedRunsWallTimeCountsItsEarlierParts) {
-  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-wall-time");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir / "out" / "runs");
-  const std::string source = CROWDRECON_SOURCE_DIR;
-  {
-    std::ofstream f(dir / "sweep.json");
-    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << source
-      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": [2], "keep_runs": true})";
-  }
-  const SweepSpec spec = LoadSweep(dir / "sweep.json");
-  const std::vector<RunPlan> runs = ExpandRuns(spec);
-  ASSERT_EQ(runs.size(), 1u);
-  const std::filesystem::path file = dir / "out" / "runs" / (runs[0].id + ".sqlite");
-  scenario::RunOptions stopped;
-  stopped.output = file;
-  stopped.stop_after_s = 0.5;
-  ASSERT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs[0]), stopped).status, "interrupted");
+  const auto [dir, file] = InterruptedSweepRun("sweep-wall-time", "sweep-tiny.json", 2, 0.5);
   {
     runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 5);
     writer.SetRunValue("wall_s", "1000");
