@@ -8,6 +8,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
+#include "simulation_internals.hpp"
 
 namespace crowdrecon::engine {
 
@@ -33,7 +34,7 @@ void CheckCentresStayInsideWalls(const Simulation& sim, const std::vector<Vec2>&
       const std::size_t segments = wall.closed ? wall.points.size() : wall.points.size() - 1;
       for (std::size_t k = 0; k < segments; ++k)
         if (PathCrossesSegment(from, to, wall.points[k], wall.points[(k + 1) % wall.points.size()]))
-          throw SimulationError("the centre of person " + std::to_string(std::uint64_t{bodies.id[i]} + 1) + " went through wall " +
+          throw SimulationError("the centre of " + detail::PersonText(bodies, static_cast<std::uint32_t>(i)) + " went through wall " +
                                     std::to_string(w) + " before t = " + FormatNumber(sim.time_s()) +
                                     " s: its path since the last check runs from (" + FormatNumber(from.x) + ", " +
                                     FormatNumber(from.y) + ") to (" + FormatNumber(to.x) + ", " + FormatNumber(to.y) +

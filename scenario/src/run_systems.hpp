@@ -48,8 +48,9 @@ inline void WriteTimelineFrame(runfile::FrameWriterThread& frames, const engine:
 // engine's contact check: walls x people segment tests per frame).
 class WallCheckSystem : public RunSystem {
  public:
-  explicit WallCheckSystem(const engine::Simulation& sim)
-      : centres_(sim.bodies().position_m), ids_(SlotHolders(sim.bodies())) {}
+  explicit WallCheckSystem(const engine::Simulation& sim) : centres_(sim.bodies().position_m) {
+    SlotHolders(sim.bodies(), &ids_);
+  }
   std::string_view name() const override { return "wall_check"; }
   void AtFrame(FrameContext& c) override {
     // A slot that changed hands since (a timeline's arrival, also into a
@@ -59,7 +60,7 @@ class WallCheckSystem : public RunSystem {
       if (b.id[i] != ids_[i]) centres_[i] = b.position_m[i];
     engine::CheckCentresStayInsideWalls(c.sim, centres_);
     centres_ = b.position_m;
-    ids_ = SlotHolders(b);
+    SlotHolders(b, &ids_);
   }
 
  private:

@@ -292,7 +292,7 @@ class ExitSystem : public RunSystem {
       }
     }
     before_ = b.position_m;
-    id_ = SlotHolders(b);
+    SlotHolders(b, &id_);
   }
 
   static constexpr std::uint64_t kCheckSteps = 10;
@@ -673,11 +673,10 @@ void TimelineState::LoadState(const std::string& state) {
 }
 
 std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& s) { return std::make_unique<TimelineEventSystem>(s); }
-std::vector<std::uint32_t> SlotHolders(const engine::BodyState& bodies) {
-  std::vector<std::uint32_t> holders(bodies.id);
-  for (std::size_t i = 0; i < holders.size(); ++i)
-    if (bodies.state[i] == engine::PersonState::kRemoved) holders[i] = kNoOne;
-  return holders;
+void SlotHolders(const engine::BodyState& bodies, std::vector<std::uint32_t>* holders) {
+  *holders = bodies.id;
+  for (std::size_t i = 0; i < holders->size(); ++i)
+    if (bodies.state[i] == engine::PersonState::kRemoved) (*holders)[i] = kNoOne;
 }
 
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& s) { return std::make_unique<InflowSystem>(s); }

@@ -84,7 +84,7 @@ struct TimelineState {
 // walkable area's lower corner, to its entry; the Itaewon evening's wall
 // check stopped both seeds at 22:20 on such a path.)
 constexpr std::uint32_t kNoOne = UINT32_MAX;
-std::vector<std::uint32_t> SlotHolders(const engine::BodyState& bodies);
+void SlotHolders(const engine::BodyState& bodies, std::vector<std::uint32_t>* holders);  // reuses its storage
 
 std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& state);
