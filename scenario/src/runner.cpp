@@ -618,6 +618,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     writer.SetRunValue("adaptive_steps", (steps.empty() ? "every step 1 h (the fixed step)" : steps) +
                                              (options.resume ? " (since the resume)" : ""));
   }
+  if (adapt_threads)  // how many engine threads the governor chose (several asked for)
+    writer.SetRunValue("engine_threads", governor.summary().BriefReport() + (options.resume ? " (since the resume)" : ""));
   record_wall_time();
   writer.SetStatus(status);
   if (status == "complete") {

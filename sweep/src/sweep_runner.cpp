@@ -172,6 +172,9 @@ struct Context {
   fs::path runs_dir;
   analysis::AnalysisOptions analysis;
   const std::function<void(const RunPlan&, const fs::path&, const std::string&)>* after_run = nullptr;
+  // The engine threads each run may use, by run index (1 unless set by the
+  // coordinator before it hands the run out; see Coordinator::Run).
+  const std::vector<int>* threads_of_run = nullptr;
 };
 
 // Each metric's position in ResultRow::metrics, by name.
@@ -246,7 +249,10 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
   const scenario::Scenario sc = RunScenarioOf(ctx.spec, run);  // checked before the sweep started
   scenario::RunOptions options;
   options.output = file;
-  options.threads = 1;  // parallel over runs, not within one
+  // Parallel over runs, not within one; a run handed out when no other was
+  // left to start may take the cores that the runs before it free as they
+  // end (engine::ThreadGovernor keeps it on one thread while they run).
+  options.threads = ctx.threads_of_run ? ctx.threads_of_run->at(run.index) : 1;
   options.stop_flag = &g_stop;
   const bool resume = fs::exists(file) && fs::exists(scenario::CheckpointPath(file));
   if (!resume) RemoveRunFiles(file);  // a run killed outright starts over
@@ -483,9 +489,9 @@ void RunWorkerRank(MpiTransport& transport, int rank, int jobs, const Work& work
 class Coordinator {
  public:
   Coordinator(const SweepOptions& options, const SweepSetup& setup, MpiTransport* transport, int ranks, int jobs,
-              Clock::time_point start, SweepSummary* s)
+              Clock::time_point start, std::vector<int>* threads_of_run, SweepSummary* s)
       : options_(options), store_(*setup.store), transport_(transport), ranks_(ranks), jobs_(jobs), start_(start),
-        s_(*s), progress_(options.show_progress) {
+        threads_of_run_(*threads_of_run), s_(*s), progress_(options.show_progress) {
     s_.already_done = store_.done().size();
     s_.results_sqlite = store_.sqlite_file();
     s_.results_csv = store_.csv_file();
@@ -504,8 +510,10 @@ class Coordinator {
         bool acted = false;  // something happened: look again before waiting
         StopIfAsked();
         while (!stopping_ && !pending_.empty() && pool.outstanding() < static_cast<std::size_t>(jobs_)) {
-          pool.Submit(pending_.front());
+          const std::size_t index = pending_.front();
           pending_.pop_front();
+          threads_of_run_.at(index) = TailThreads();
+          pool.Submit(index);
           acted = true;
         }
         if (transport_) acted |= ServeWorkerRanks();
@@ -538,6 +546,19 @@ class Coordinator {
 
  private:
   double Elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+  // The engine threads of the run being handed out: 1 while others are left
+  // to start (the cores go to runs); the sweep's last run gets up to one per
+  // worker (at most the cores), so that it does not run on one core for
+  // hours after the others have ended. A long ensemble's last seed is the
+  // case. Locally only: an MPI rank's other slots are not this process's to
+  // count. The results do not depend on it (the engine's results do not
+  // depend on its thread count).
+  int TailThreads() const {
+    if (transport_ || !pending_.empty()) return 1;
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    return std::max(1, std::min(jobs_, cores));
+  }
 
   // A signal or a stop anywhere stops everyone (the worker ranks once).
   void StopIfAsked() {
@@ -594,6 +615,7 @@ class Coordinator {
   MpiTransport* transport_;  // null without MPI
   int ranks_, jobs_;
   Clock::time_point start_;
+  std::vector<int>& threads_of_run_;
   SweepSummary& s_;
   ProgressLine progress_;
   std::deque<std::size_t> pending_;
@@ -629,7 +651,8 @@ SweepSummary RunSweep(const SweepOptions& options) {
   if (mpi && !AgreeOnSetUp(*transport, rank, setup.error, &s)) return s;
   if (setup.error) std::rethrow_exception(setup.error);
 
-  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}, &options.after_run};
+  std::vector<int> threads_of_run(setup.runs.size(), 1);  // set by rank 0's coordinator before each hand-out
+  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}, &options.after_run, &threads_of_run};
   const Work work = [&ctx](std::size_t index) {
     Outcome o;
     o.index = index;
@@ -656,7 +679,7 @@ SweepSummary RunSweep(const SweepOptions& options) {
     return s;
   }
   try {
-    Coordinator(options, setup, transport.get(), ranks, jobs, start, &s).Run(work);
+    Coordinator(options, setup, transport.get(), ranks, jobs, start, &threads_of_run, &s).Run(work);
   } catch (...) {
     if (mpi) transport->RootStatus(kFailed);
     throw;

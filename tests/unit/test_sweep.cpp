@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -311,6 +312,57 @@ TEST(SweepRunner, AResumedRunsWallTimeCountsItsEarlierParts) {
   EXPECT_GE(wall_s, 1000.0);
   EXPECT_LT(wall_s, 1600.0);
   EXPECT_GE(std::stod(runfile::RunFileReader(file).RunValue("wall_s")), 1000.0);
+}
+
+// The sweep's last run (handed out when no other is left to start) may take
+// the cores the runs before it free: with two at a time, the first two of
+// three runs get one engine thread, the third up to two (the governor's
+// account is in its run file); a sweep of one at a time gives every run one.
+TEST(SweepRunner, TheLastRunMayTakeTheCoresTheOthersFree) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-last-run-threads");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
+      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": {"first": 1, "count": 3}, "keep_runs": true})";
+  }
+  const std::vector<RunPlan> runs = ExpandRuns(LoadSweep(dir / "sweep.json"));
+  ASSERT_EQ(runs.size(), 3u);
+  const auto threads_account = [&](const std::string& out, std::size_t i) {
+    const runfile::RunFileReader reader(dir / out / "runs" / (runs[i].id + ".sqlite"));
+    EXPECT_EQ(reader.RunValue("status"), "complete");
+    return reader.RunValue("engine_threads");  // "" when one thread was asked for
+  };
+  SweepOptions options;
+  options.sweep_file = dir / "sweep.json";
+  options.output_dir = dir / "two";
+  options.jobs = 2;
+  EXPECT_EQ(RunSweep(options).failed, 0u);
+  EXPECT_EQ(threads_account("two", 0), "");
+  EXPECT_EQ(threads_account("two", 1), "");
+  const std::string last = threads_account("two", 2);
+  if (std::thread::hardware_concurrency() >= 2) {
+    EXPECT_TRUE(last.rfind("1 thread now", 0) == 0 || last.rfind("2 threads now", 0) == 0) << last;
+    EXPECT_NE(last.find("steps at "), std::string::npos) << last;
+  } else {
+    EXPECT_EQ(last, "");  // one core: nothing to take
+  }
+  options.output_dir = dir / "one";
+  options.jobs = 1;
+  EXPECT_EQ(RunSweep(options).failed, 0u);
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(threads_account("one", i), "") << i;
+  // The same results either way (every column but the wall time).
+  const ResultsTable two = ReadResults(dir / "two"), one = ReadResults(dir / "one");
+  ASSERT_EQ(two.rows.size(), 3u);
+  ASSERT_EQ(one.rows.size(), 3u);
+  const std::size_t wall = two.Column("wall_s");
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < two.rows[r].size(); ++c)
+      if (c != wall) {
+        EXPECT_EQ(two.rows[r][c].null, one.rows[r][c].null) << "run " << r << ", column " << two.columns[c];
+        EXPECT_EQ(two.rows[r][c].text, one.rows[r][c].text) << "run " << r << ", column " << two.columns[c];
+      }
 }
 
 TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {

@@ -1,5 +1,6 @@
 // Running a sweep: every run of a sweep file (sweep_file.hpp) simulated
-// (scenario::RunScenario, one engine thread per run), analysed
+// (scenario::RunScenario, one engine thread per run but the last; see
+// docs/sweeps.md), analysed
 // (analysis::AnalyzeRun) and written as one row of DIR/results.* (results.hpp).
 //
 // Local: `jobs` runs at a time on worker threads of this process; a progress
