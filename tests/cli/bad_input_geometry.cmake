@@ -1,7 +1,8 @@
 # Geometry inputs (body outlines, body files, pictures, WKT, DXF, raster plans)
 # never crash, hang or run out of memory: each case checks the exit status
 # (2 for a user error), the message (file, place, value, what was expected),
-# the time, and that nothing was written. Large inputs are made by the test
+# the processor time it took (not the wall time: geometry_case.sh says why),
+# and that nothing was written. Large inputs are made by the test
 # (cli/make_geometry_input.py) at a size that took more than 10 s before the
 # fix, or just over a limit of crowdrecon/geometry/input_limits.hpp.
 set(GEOMETRY_CASE ${CMAKE_CURRENT_SOURCE_DIR}/cli/geometry_case.sh)
