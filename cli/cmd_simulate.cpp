@@ -27,6 +27,7 @@ struct SimulateArgs {
   std::string branch_from;
   bool force = false;
   bool quiet = false;
+  double log_every_s = kLogEveryDefaultS;  // --log-every
   bool fixed_threads = false;
   double stop_after_s = -1.0;
 };
@@ -53,6 +54,7 @@ int RunSimulate(const SimulateArgs& args) {
   options.adapt_threads = !args.fixed_threads;
   options.resume = args.resume || !args.branch_from.empty();
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
+  options.log_progress_every_s = LogProgressEvery(args.log_every_s, args.quiet);
   options.stop_after_s = args.stop_after_s;
   scenario::InstallInterruptHandlers();
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
@@ -125,6 +127,7 @@ void RegisterSimulateCommand(CLI::App& app) {
       ->excludes(resume);
   AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
+  AddLogEveryOption(cmd, &args->log_every_s);
   cmd->add_option("--stop-after", args->stop_after_s, "Stop as if interrupted at this simulated time (s), for testing resumption")
       ->check(NumberIn(0.0, 1e9, "s"));
   cmd->callback([args] {

@@ -23,6 +23,7 @@ struct SweepArgs {
   std::string output;
   int jobs = 0;
   bool quiet = false;
+  double log_every_s = kLogEveryDefaultS;  // --log-every
   bool force = false;
   long long stop_after_runs = -1;
 };
@@ -34,6 +35,7 @@ int RunSweepCommand(const SweepArgs& args) {
   options.output_dir = args.output;
   options.jobs = args.jobs;
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
+  options.log_progress_every_s = LogProgressEvery(args.log_every_s, args.quiet);
   options.stop_after_runs = args.stop_after_runs;
   const sweep::SweepSummary s = sweep::RunSweep(options);
   // MPI ranks other than 0 say nothing, but exit as rank 0 does.
@@ -58,6 +60,7 @@ void RegisterSweepCommand(CLI::App& app) {
 
   AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
+  AddLogEveryOption(cmd, &args->log_every_s);
   cmd->add_option("--stop-after-runs", args->stop_after_runs,
                   "Stop as if interrupted once this many runs have been written (for testing resumption)")
       ->check(IntegerIn(0, 1LL << 40));

@@ -1,5 +1,7 @@
 #include "option_checks.hpp"
 
+#include <unistd.h>
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -56,5 +58,14 @@ void SayIfUnfinished(const std::string& run_file) {
   const std::string note = runfile::RunFileReader(run_file).UnfinishedNote();
   if (!note.empty()) std::printf("note: %s\n", note.c_str());
 }
+
+void AddLogEveryOption(CLI::App* cmd, double* seconds) {
+  cmd->add_option("--log-every", *seconds,
+                  "Where stderr is not a terminal (a log): a progress line this often, in wall seconds (0: never)")
+      ->check(NumberIn(0.0, 1e7, "s"))
+      ->capture_default_str();
+}
+
+double LogProgressEvery(double seconds, bool quiet) { return quiet || isatty(STDERR_FILENO) ? 0.0 : seconds; }
 
 }  // namespace crowdrecon::cli

@@ -30,4 +30,12 @@ void CheckPictureName(const std::string& option, const std::string& file);
 // interrupted run says so); nothing for a finished run or a file that is no run.
 void SayIfUnfinished(const std::string& run_file);
 
+// --log-every SECONDS of a long command (simulate, sweep): where stderr is
+// not a terminal (a log, under nohup or a batch system), a progress line of
+// its own this often; 0 never. Returns the interval the command uses: 0 with
+// -q or on a terminal (which gets the line rewritten in place instead).
+constexpr double kLogEveryDefaultS = 600.0;
+void AddLogEveryOption(CLI::App* cmd, double* seconds);
+double LogProgressEvery(double seconds, bool quiet);
+
 }  // namespace crowdrecon::cli

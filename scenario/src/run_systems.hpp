@@ -7,7 +7,8 @@
 //   settle          ends a run whose regime has settled (run.stop_when_settled, settle.hpp)
 //   checkpoint      the periodic checkpoint (run.checkpoint_interval_s)
 //   stop_request    Ctrl-C, SIGTERM, a caller's flag, --stop-after: stop here (a checkpoint follows)
-//   progress        the progress line on a terminal
+//   progress        the progress line on a terminal, or a line in a log now and
+//                   then; the simulated time reached, for a caller (a sweep)
 //
 // The incident timeline's systems (inflow, exits, timed events, falls) come
 // before them, acting around the engine steps.
@@ -23,6 +24,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/vec2.hpp"
+#include "crowdrecon/common/wall_clock.hpp"
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/settle.hpp"
@@ -183,23 +185,44 @@ class StopRequestSystem : public RunSystem {
 // stop and at the end), on stderr.
 class ProgressSystem : public RunSystem {
  public:
-  ProgressSystem(double duration_s, double start_sim_s) : duration_s_(duration_s), start_sim_s_(start_sim_s) {}
+  struct Options {
+    double duration_s = 0.0;     // the run's end
+    double start_sim_s = 0.0;    // where this invocation began (a resumed run's checkpoint)
+    bool terminal = false;       // a line rewritten in place every half second
+    double log_every_s = 0.0;    // > 0 (and no terminal line): a line of its own this often (wall s)
+    std::atomic<double>* simulated_s = nullptr;  // if set: the simulated time, at every frame
+  };
+  explicit ProgressSystem(const Options& options) : options_(options) {}
   std::string_view name() const override { return "progress"; }
   void AtFrame(FrameContext& c) override {
+    if (options_.simulated_s) options_.simulated_s->store(c.sim.time_s(), std::memory_order_relaxed);
     const auto now = Clock::now();
-    if (!(now - last_print_ > std::chrono::milliseconds(500) || c.stop || c.frame == c.last_frame)) return;
+    const bool last = c.stop || c.frame == c.last_frame;
+    if (options_.terminal) {
+      if (!(now - last_print_ > std::chrono::milliseconds(500) || last)) return;
+    } else if (options_.log_every_s > 0) {
+      // A log gets no line at the end: the run's summary follows.
+      if (!(std::chrono::duration<double>(now - last_print_).count() >= options_.log_every_s) || last) return;
+    } else {
+      return;
+    }
     last_print_ = now;
     const double wall = std::chrono::duration<double>(now - start_).count();
-    const double rtf = wall > 0 ? (c.sim.time_s() - start_sim_s_) / wall : 0.0;
-    const double left = rtf > 0 ? (duration_s_ - c.sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
-    std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", c.sim.time_s(),
-                 duration_s_, rtf, FormatDuration(left).c_str());
+    const double rtf = wall > 0 ? (c.sim.time_s() - options_.start_sim_s) / wall : 0.0;
+    const double left = rtf > 0 ? (options_.duration_s - c.sim.time_s()) / rtf : std::numeric_limits<double>::infinity();
+    if (options_.terminal) {
+      std::fprintf(stderr, "\r  t = %.1f / %.1f s   real-time factor %.3f   time left %s      ", c.sim.time_s(),
+                   options_.duration_s, rtf, FormatDuration(left).c_str());
+    } else {
+      std::fprintf(stderr, "  %s  t = %.1f / %.1f s, real-time factor %.3f, time left %s\n", WallClockNow().c_str(),
+                   c.sim.time_s(), options_.duration_s, rtf, FormatDuration(left).c_str());
+    }
     std::fflush(stderr);
   }
 
  private:
   using Clock = std::chrono::steady_clock;
-  double duration_s_, start_sim_s_;
+  Options options_;
   Clock::time_point start_ = Clock::now(), last_print_ = Clock::now();
 };
 

@@ -558,8 +558,15 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   loop.Add(std::make_unique<detail::CheckpointSystem>(
       checkpoint_every, [&](std::int64_t frame) { checkpoint_at(checkpoint, frame); }));
   loop.Add(std::make_unique<detail::StopRequestSystem>(g_stop_requested, options.stop_flag, options.stop_after_s));
-  if (options.show_progress)
-    loop.Add(std::make_unique<detail::ProgressSystem>(scenario.run.duration_s, start_sim));
+  if (options.show_progress || options.log_progress_every_s > 0 || options.simulated_s) {
+    detail::ProgressSystem::Options progress;
+    progress.duration_s = scenario.run.duration_s;
+    progress.start_sim_s = start_sim;
+    progress.terminal = options.show_progress;
+    progress.log_every_s = options.log_progress_every_s;
+    progress.simulated_s = options.simulated_s;
+    loop.Add(std::make_unique<detail::ProgressSystem>(progress));
+  }
   loop.LoadStates(opened.systems);
 
   // 6. Run; a run that goes numerically wrong stops with its state saved.

@@ -15,12 +15,15 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/wall_clock.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/reports/risk.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -175,6 +178,8 @@ struct Context {
   // The engine threads each run may use, by run index (1 unless set by the
   // coordinator before it hands the run out; see Coordinator::Run).
   const std::vector<int>* threads_of_run = nullptr;
+  // Each run's simulated time so far, by run index (< 0: not started here).
+  std::atomic<double>* simulated_s = nullptr;
 };
 
 // Each metric's position in ResultRow::metrics, by name.
@@ -254,6 +259,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
   // end (engine::ThreadGovernor keeps it on one thread while they run).
   options.threads = ctx.threads_of_run ? ctx.threads_of_run->at(run.index) : 1;
   options.stop_flag = &g_stop;
+  if (ctx.simulated_s) options.simulated_s = &ctx.simulated_s[run.index];
   const bool resume = fs::exists(file) && fs::exists(scenario::CheckpointPath(file));
   if (!resume) RemoveRunFiles(file);  // a run killed outright starts over
 
@@ -489,9 +495,11 @@ void RunWorkerRank(MpiTransport& transport, int rank, int jobs, const Work& work
 class Coordinator {
  public:
   Coordinator(const SweepOptions& options, const SweepSetup& setup, MpiTransport* transport, int ranks, int jobs,
-              Clock::time_point start, std::vector<int>* threads_of_run, SweepSummary* s)
-      : options_(options), store_(*setup.store), transport_(transport), ranks_(ranks), jobs_(jobs), start_(start),
-        threads_of_run_(*threads_of_run), s_(*s), progress_(options.show_progress) {
+              Clock::time_point start, std::vector<int>* threads_of_run, std::atomic<double>* simulated_s,
+              SweepSummary* s)
+      : options_(options), spec_(setup.spec), runs_(setup.runs), store_(*setup.store), transport_(transport),
+        ranks_(ranks), jobs_(jobs), start_(start), threads_of_run_(*threads_of_run), simulated_s_(simulated_s), s_(*s),
+        progress_(options.show_progress) {
     s_.already_done = store_.done().size();
     s_.results_sqlite = store_.sqlite_file();
     s_.results_csv = store_.csv_file();
@@ -513,6 +521,7 @@ class Coordinator {
           const std::size_t index = pending_.front();
           pending_.pop_front();
           threads_of_run_.at(index) = TailThreads();
+          in_flight_.insert(index);
           pool.Submit(index);
           acted = true;
         }
@@ -520,6 +529,7 @@ class Coordinator {
         Outcome o;
         while (pool.TryPop(&o)) {
           acted = true;
+          in_flight_.erase(o.index);
           if (o.fatal) {
             if (!fatal_) fatal_ = o.fatal;
             stopping_ = true;
@@ -530,6 +540,7 @@ class Coordinator {
         }
         progress_.Show(store_.done().size(), s_.total, s_.completed, s_.failed, pool.outstanding() + remote_in_flight_,
                        Elapsed(), false);
+        LogProgress(pool.outstanding() + remote_in_flight_);
         if (pool.outstanding() == 0 && (pending_.empty() || stopping_) && remote_stopped_ == remote_slots) break;
         if (!acted) pool.WaitFor(std::chrono::milliseconds(transport_ ? 2 : 200));
       }
@@ -558,6 +569,26 @@ class Coordinator {
     if (transport_ || !pending_.empty()) return 1;
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     return std::max(1, std::min(jobs_, cores));
+  }
+
+  // Now and then, for a log (SweepOptions::log_progress_every_s): the runs
+  // done, and how far each of this process's running runs has got.
+  void LogProgress(std::size_t running) {
+    if (options_.show_progress || !(options_.log_progress_every_s > 0)) return;
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_log_).count() < options_.log_progress_every_s) return;
+    last_log_ = now;
+    std::string line = "  " + WallClockNow() + "  sweep: " + std::to_string(store_.done().size()) + " / " +
+                       std::to_string(s_.total) + " runs (" + std::to_string(s_.failed) + " failed), " +
+                       std::to_string(running) + " running, " + FormatDuration(Elapsed()) + " elapsed";
+    for (const std::size_t index : in_flight_) {
+      const double t = simulated_s_[index].load(std::memory_order_relaxed);
+      if (t < 0) continue;  // not started yet
+      if (!duration_s_.contains(index)) duration_s_[index] = RunScenarioOf(spec_, runs_[index]).run.duration_s;
+      line += "; " + runs_[index].id + " at " + FormatFixed(t, 1) + " / " + FormatNumber(duration_s_[index]) + " s";
+    }
+    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
   }
 
   // A signal or a stop anywhere stops everyone (the worker ranks once).
@@ -611,11 +642,14 @@ class Coordinator {
   }
 
   const SweepOptions& options_;
+  const SweepSpec& spec_;
+  const std::vector<RunPlan>& runs_;
   ResultsStore& store_;
   MpiTransport* transport_;  // null without MPI
   int ranks_, jobs_;
   Clock::time_point start_;
   std::vector<int>& threads_of_run_;
+  std::atomic<double>* simulated_s_;
   SweepSummary& s_;
   ProgressLine progress_;
   std::deque<std::size_t> pending_;
@@ -625,6 +659,9 @@ class Coordinator {
   bool interrupt_sent_ = false;
   std::exception_ptr fatal_;
   Clock::time_point last_csv_ = Clock::now();
+  std::set<std::size_t> in_flight_;            // this process's runs handed out, not yet back
+  std::map<std::size_t, double> duration_s_;   // their scenarios' durations, once asked
+  Clock::time_point last_log_ = Clock::now();
 };
 
 }  // namespace
@@ -652,7 +689,10 @@ SweepSummary RunSweep(const SweepOptions& options) {
   if (setup.error) std::rethrow_exception(setup.error);
 
   std::vector<int> threads_of_run(setup.runs.size(), 1);  // set by rank 0's coordinator before each hand-out
-  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}, &options.after_run, &threads_of_run};
+  const std::unique_ptr<std::atomic<double>[]> simulated_s(new std::atomic<double>[setup.runs.size()]);
+  for (std::size_t i = 0; i < setup.runs.size(); ++i) simulated_s[i].store(-1.0);
+  const Context ctx{setup.spec, setup.runs, options.output_dir, setup.runs_dir, {}, &options.after_run,
+                    &threads_of_run, simulated_s.get()};
   const Work work = [&ctx](std::size_t index) {
     Outcome o;
     o.index = index;
@@ -679,7 +719,7 @@ SweepSummary RunSweep(const SweepOptions& options) {
     return s;
   }
   try {
-    Coordinator(options, setup, transport.get(), ranks, jobs, start, &threads_of_run, &s).Run(work);
+    Coordinator(options, setup, transport.get(), ranks, jobs, start, &threads_of_run, simulated_s.get(), &s).Run(work);
   } catch (...) {
     if (mpi) transport->RootStatus(kFailed);
     throw;

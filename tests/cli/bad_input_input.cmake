@@ -87,7 +87,9 @@ foreach(case
     "venue_import_threshold~--dark-threshold: value 300 is out of range. expected a whole number in \\[1, 255\\]~venue;import;tests/data/venues/room-50ppm.png;-o;@OUT@/v.json;--pixels-per-metre;50;--dark-threshold;300"
     "venue_check_grid~--grid-spacing: value inf is not finite~venue;check;tests/data/venues/room.json;--grid-spacing;inf"
     "sweep_jobs~--jobs: value -1 is out of range. expected a whole number in \\[0, 4096\\]~sweep;tests/data/sweeps/tiny.json;-o;@OUT@/s;--jobs;-1"
-    "sweep_stop_after_runs~--stop-after-runs: \"1.5\" is not a whole number~sweep;tests/data/sweeps/tiny.json;-o;@OUT@/s;--stop-after-runs;1.5")
+    "sweep_stop_after_runs~--stop-after-runs: \"1.5\" is not a whole number~sweep;tests/data/sweeps/tiny.json;-o;@OUT@/s;--stop-after-runs;1.5"
+    "sweep_log_every~--log-every: value -1 is out of range. expected a number in \\[0, 10000000\\] s~sweep;tests/data/sweeps/tiny.json;-o;@OUT@/s;--log-every;-1"
+    "simulate_log_every_nan~--log-every: value nan is not finite~simulate;${S}/hallway-short.json;-o;@OUT@/x.sqlite;--log-every;nan")
   string(REPLACE "~" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 regex)

@@ -3,9 +3,11 @@
 // order; the overrides as the scenario parser sees them; result rows.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
@@ -363,6 +365,78 @@ TEST(SweepRunner, TheLastRunMayTakeTheCoresTheOthersFree) {
         EXPECT_EQ(two.rows[r][c].null, one.rows[r][c].null) << "run " << r << ", column " << two.columns[c];
         EXPECT_EQ(two.rows[r][c].text, one.rows[r][c].text) << "run " << r << ", column " << two.columns[c];
       }
+}
+
+// The lines of `text` that contain `what`.
+std::vector<std::string> LinesWith(const std::string& text, const std::string& what) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (line.find(what) != std::string::npos) lines.push_back(line);
+  return lines;
+}
+
+// A long run whose stderr is a log (RunOptions::log_progress_every_s) gets
+// progress lines of their own (no carriage returns), none at the end, and a
+// caller's counter follows the simulated time (a sweep reports from it).
+TEST(Progress, ARunsLogGetsLinesOfTheirOwnAndTheCallerTheSimulatedTime) {
+  const SweepSpec spec = Parse("{" + kHead + R"(, "seeds": [1]})");
+  scenario::RunOptions options;
+  options.output = crowdrecon::testing::ScratchFile("progress-log.sqlite");
+  std::filesystem::remove(options.output);
+  options.log_progress_every_s = 1e-9;  // every frame but the last
+  std::atomic<double> simulated_s{-1.0};
+  options.simulated_s = &simulated_s;
+  ::testing::internal::CaptureStderr();
+  const scenario::RunSummary summary = scenario::RunScenario(RunScenarioOf(spec, ExpandRuns(spec).at(0)), options);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(summary.status, "complete");
+  EXPECT_EQ(log.find('\r'), std::string::npos) << log;
+  const std::vector<std::string> lines = LinesWith(log, "real-time factor");
+  ASSERT_GE(lines.size(), 5u) << log;   // 1 s at 10 frames a second
+  EXPECT_LE(lines.size(), 10u) << log;  // not at the last frame
+  EXPECT_NE(lines.front().find("t = 0.1 / 1.0 s, real-time factor "), std::string::npos) << lines.front();
+  EXPECT_NE(lines.front().find(", time left "), std::string::npos) << lines.front();
+  EXPECT_EQ(simulated_s.load(), summary.simulated_s);
+  EXPECT_NEAR(simulated_s.load(), 1.0, 1e-9);
+
+  // Without the option (and without a progress line) nothing is said.
+  options.log_progress_every_s = 0;
+  std::filesystem::remove(options.output);
+  ::testing::internal::CaptureStderr();
+  scenario::RunScenario(RunScenarioOf(spec, ExpandRuns(spec).at(0)), options);
+  EXPECT_EQ(LinesWith(::testing::internal::GetCapturedStderr(), "real-time factor").size(), 0u);
+}
+
+// A sweep whose stderr is a log says now and then how many runs are done and
+// how far each running run has got.
+TEST(Progress, ASweepsLogSaysHowFarEachRunningRunHasGot) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-progress-log");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "sweep.json");
+    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
+      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": {"first": 1, "count": 2}, "set": {"run.duration_s": 4}})";
+  }
+  SweepOptions options;
+  options.sweep_file = dir / "sweep.json";
+  options.output_dir = dir / "out";
+  options.jobs = 1;
+  options.log_progress_every_s = 1e-9;  // at every look of the coordinator (every 200 ms at most)
+  ::testing::internal::CaptureStderr();
+  const SweepSummary summary = RunSweep(options);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(summary.failed, 0u);
+  EXPECT_EQ(log.find('\r'), std::string::npos) << log;
+  const std::vector<std::string> first = LinesWith(log, "sweep: 0 / 2 runs (0 failed), 1 running, ");
+  const std::vector<std::string> second = LinesWith(log, "sweep: 1 / 2 runs (0 failed), 1 running, ");
+  ASSERT_FALSE(first.empty()) << log;
+  ASSERT_FALSE(second.empty()) << log;
+  const std::vector<RunPlan> runs = ExpandRuns(LoadSweep(dir / "sweep.json"));
+  EXPECT_FALSE(LinesWith(log, "; " + runs[0].id + " at ").empty()) << log;
+  EXPECT_FALSE(LinesWith(log, "; " + runs[1].id + " at ").empty()) << log;
+  EXPECT_NE(first.back().find(" / 4 s"), std::string::npos) << first.back();
 }
 
 TEST(SweepFile, ErrorsNameFilePathValueAndExpectation) {

@@ -28,6 +28,13 @@ struct RunOptions {
   engine::ComputeDevice device = engine::ComputeDevice::kCpu;
   bool resume = false;           // continue from output + ".checkpoint"
   bool show_progress = false;    // a progress line on stderr
+  // > 0 (and no progress line): a line of its own on stderr this often, in
+  // wall seconds (the wall clock, the simulated time, the time left): the
+  // progress of a long run whose stderr is a log, not a terminal.
+  double log_progress_every_s = 0.0;
+  // If set: the simulated time reached, updated at every frame (a sweep
+  // reports its runs' progress from it).
+  std::atomic<double>* simulated_s = nullptr;
   // Stop (as if interrupted) once the simulated time reaches this; < 0 never.
   // For tests of interruption and resume.
   double stop_after_s = -1.0;

@@ -48,6 +48,10 @@ struct SweepOptions {
   // (per MPI rank: mpirun starts one rank per core).
   int jobs = 0;
   bool show_progress = false;  // a progress line on stderr (rank 0)
+  // > 0 (and no progress line): a line of its own on stderr this often, in
+  // wall seconds, with the runs done and how far each running run has got
+  // (rank 0's own runs): the progress of a long sweep whose stderr is a log.
+  double log_progress_every_s = 0.0;
   // For tests of resumption: stop as if interrupted once this many rows have
   // been written by this invocation (< 0: never).
   long long stop_after_runs = -1;
