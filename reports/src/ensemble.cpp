@@ -237,8 +237,8 @@ namespace {
 
 constexpr double kWidth = 1400, kLeft = 150, kRight = 1130, kTop = 96, kDensity = 170, kRow = 34;
 const viz::Color kInk = viz::Color::Hex(0x222222), kGrid = viz::Color::Hex(0xe3e3e3);
-const viz::Color kRecorded = viz::RecordedMarkColor(false), kFatal = viz::RecordedMarkColor(true),
-                 kDetected = viz::Color::Hex(0x6a3d9a), kClog = viz::Color::Hex(0x525252);
+const viz::Color kFatal = viz::RecordedMarkStyleOf("fatal").color, kDetected = viz::Color::Hex(0x6a3d9a),
+                 kClog = viz::Color::Hex(0x525252);
 
 }  // namespace
 
@@ -289,9 +289,9 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
   }
   for (const analysis::TimelineMark& m : score.runs.front().recorded) {
     if (m.time_s < t0 || m.time_s > t1) continue;
-    const bool fatal = m.kind == "fatal";
+    const viz::RecordedMarkStyle style = viz::RecordedMarkStyleOf(m.kind);
     for (auto [y0, y1] : {std::pair{top, bottom}, std::pair{rows_top, rows_bottom}})
-      canvas.StrokePolyline({P(X(m.time_s), y0), P(X(m.time_s), y1)}, fatal ? kFatal : kRecorded, fatal ? 2.5 : 1.6, !fatal);
+      canvas.StrokePolyline({P(X(m.time_s), y0), P(X(m.time_s), y1)}, style.color, style.width_px, style.dashed);
   }
   for (std::size_t k = 0; k < n; ++k) {
     const EnsembleRun& r = score.runs[k];
@@ -369,10 +369,11 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
     canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::AreaColor(a), 2.0, true);
     text("density in " + score.runs.front().area_names[a]);
   }
-  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kRecorded, 2.0, true);
-  text("recorded avalanche");
-  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, kFatal, 2.5);
-  text("recorded fatal clog");
+  for (const std::string& kind : viz::RecordedMarkKinds(score.runs.front().recorded, t0, t1)) {
+    const viz::RecordedMarkStyle style = viz::RecordedMarkStyleOf(kind);
+    canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, style.color, std::max(2.0, style.width_px), style.dashed);
+    text(style.legend);
+  }
   canvas.FillPolygon({P(lx + 12, ly + 13), P(lx + 5, ly + 1), P(lx + 19, ly + 1)}, kDetected);
   text("avalanche in a run");
   canvas.Line(P(lx + 7, ly + 1), P(lx + 17, ly + 11), kFatal, 2.0);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -19,6 +20,7 @@
 #include "crowdrecon/viz/canvas.hpp"
 #include "crowdrecon/viz/chart.hpp"
 #include "crowdrecon/viz/render_run.hpp"
+#include "crowdrecon/viz/timeline_figure.hpp"
 #include "render_scene.hpp"
 
 namespace crowdrecon::viz {
@@ -404,6 +406,48 @@ TEST(RenderRun, ReportsUserErrorsClearly) {
 // name only when complete (issue 40: a kill during a figure truncated the
 // previous picture to 0 bytes): a canvas given up before Finish leaves the
 // previous picture as it was and nothing else behind, in every format.
+// A recorded mark that is not an avalanche (a police call, a rescue team:
+// kind "other") is drawn and named as what it is, not as a recorded
+// avalanche (the Itaewon evening's 22:11 and 22:19 were drawn as
+// avalanches); the legend names only the kinds the marks have.
+TEST(TimelineFigure, EachKindOfRecordedMarkIsDrawnAndNamedAsItself) {
+  EXPECT_EQ(viz::RecordedMarkKinds({{60, "call", "other"}, {120, "crush", "fatal"}, {900, "later", "avalanche"}}, 0, 200),
+            (std::vector<std::string>{"fatal", "other"}));
+  const viz::RecordedMarkStyle avalanche = viz::RecordedMarkStyleOf("avalanche"),
+                               fatal = viz::RecordedMarkStyleOf("fatal"), other = viz::RecordedMarkStyleOf("other");
+  EXPECT_NE(other.color.r, avalanche.color.r);
+  EXPECT_NE(fatal.color.r, avalanche.color.r);
+  EXPECT_FALSE(fatal.dashed);
+
+  const ScratchDir dir("timeline-marks");
+  analysis::TimelineSeries ts;
+  for (int i = 0; i <= 200; ++i) {
+    ts.time_s.push_back(i);
+    ts.density_per_m2.push_back(1.0 + 0.01 * i);
+  }
+  ts.clock_start = "21:45";
+  ts.recorded = {{60, "22:46 police call", "other"}, {120, "22:47 the crush", "fatal"}};
+  const std::filesystem::path svg = dir.path() / "t.svg";
+  viz::DrawTimelineFigure(ts, "marks", svg);
+  std::ifstream in(svg);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Cairo writes text as glyphs: the strokes' colours tell the kinds apart.
+  const auto percent = [](double v) {  // as Cairo writes it: %f without trailing zeros
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%f", 100 * v);
+    std::string digits = buffer;
+    digits.erase(digits.find_last_not_of('0') + 1);
+    if (digits.back() == '.') digits.pop_back();
+    return digits + "%";
+  };
+  const auto stroke = [&](const viz::Color& c) {
+    return "stroke:rgb(" + percent(c.r) + "," + percent(c.g) + "," + percent(c.b) + ")";
+  };
+  EXPECT_NE(text.find(stroke(other.color)), std::string::npos) << stroke(other.color);
+  EXPECT_NE(text.find(stroke(fatal.color)), std::string::npos) << stroke(fatal.color);
+  EXPECT_EQ(text.find(stroke(avalanche.color)), std::string::npos) << "no mark is an avalanche";
+}
+
 TEST(Canvas, APictureReplacesThePreviousOneOnlyWhenComplete) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crowdrecon-canvas-atomic";
   std::filesystem::remove_all(dir);

@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 150, kGap = 26;
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
-const Color kRecorded = RecordedMarkColor(false), kFatal = RecordedMarkColor(true), kDetected = Color::Hex(0x6a3d9a);
+const Color kFatal = RecordedMarkStyleOf("fatal").color, kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
 
 // Pixels from the top-left corner on a canvas of one world unit per pixel.
@@ -134,9 +134,10 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   // Marks across every panel: what was recorded of the incident.
   for (const analysis::TimelineMark& m : ts.recorded) {
     if (m.time_s < t0 || m.time_s > t1) continue;
-    const Color c = m.kind == "fatal" ? kFatal : kRecorded;
-    for (const Panel& q : p) s.canvas.StrokePolyline({s.P(q.X(m.time_s), q.top), s.P(q.X(m.time_s), q.bottom)}, c,
-                                                     m.kind == "fatal" ? 2.5 : 1.6, m.kind != "fatal");
+    const RecordedMarkStyle style = RecordedMarkStyleOf(m.kind);
+    for (const Panel& q : p)
+      s.canvas.StrokePolyline({s.P(q.X(m.time_s), q.top), s.P(q.X(m.time_s), q.bottom)}, style.color, style.width_px,
+                              style.dashed);
   }
   std::vector<double> shares(share.size());
   for (std::size_t i = 0; i < share.size(); ++i) shares[i] = 100.0 * share[i];
@@ -201,9 +202,9 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
           false);
   }
   ly += 8;
-  if (!ts.recorded.empty()) {
-    entry(kRecorded, "recorded avalanche", true);
-    entry(kFatal, "recorded fatal clog", false);
+  for (const std::string& kind : RecordedMarkKinds(ts.recorded, t0, t1)) {
+    const RecordedMarkStyle style = RecordedMarkStyleOf(kind);
+    entry(style.color, style.legend, style.dashed);
   }
   s.canvas.FillPolygon({s.P(lx + 13, ly + 13), s.P(lx + 7, ly + 2), s.P(lx + 19, ly + 2)}, kDetected);
   s.canvas.TextPxAligned(lx + 32, ly + 6, "avalanche in the run (" + std::to_string(ts.avalanches.size()) + ")", 12, 0.0,
@@ -230,7 +231,23 @@ void DrawRecordedMarkLabels(Canvas& canvas, const std::vector<analysis::Timeline
   const std::vector<int> rows = LabelRows(at, text, 10, 3);
   for (std::size_t k = 0; k < shown.size(); ++k)
     canvas.TextPxAligned(at[k], top_px - 4 - 11.0 * rows[k], text[k], 10, 0.0, 1.0,
-                         RecordedMarkColor(shown[k]->kind == "fatal"));
+                         RecordedMarkStyleOf(shown[k]->kind).color);
+}
+
+RecordedMarkStyle RecordedMarkStyleOf(const std::string& kind) {
+  if (kind == "fatal") return {Color::Hex(0xb2182b), 2.5, false, "recorded fatal event"};
+  if (kind == "avalanche") return {Color::Hex(0xe6550d), 1.6, true, "recorded avalanche"};
+  return {Color::Hex(0x999999), 1.2, true, "recorded, other"};
+}
+
+std::vector<std::string> RecordedMarkKinds(const std::vector<analysis::TimelineMark>& marks, double t0, double t1) {
+  std::vector<std::string> kinds;
+  for (const char* kind : {"avalanche", "fatal", "other"})
+    if (std::any_of(marks.begin(), marks.end(), [&](const analysis::TimelineMark& m) {
+          return m.kind == kind && m.time_s >= t0 && m.time_s <= t1;
+        }))
+      kinds.push_back(kind);
+  return kinds;
 }
 
 }  // namespace crowdrecon::viz

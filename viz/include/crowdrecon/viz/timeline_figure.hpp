@@ -19,9 +19,20 @@ namespace crowdrecon::viz {
 void DrawTimelineFigure(const analysis::TimelineSeries& series, const std::string& title,
                         const std::filesystem::path& file);
 
-// The colour of a recorded mark in every timeline figure (the fatal clog's,
-// or an avalanche's and the others').
-inline Color RecordedMarkColor(bool fatal) { return Color::Hex(fatal ? 0xb2182b : 0xe6550d); }
+// How a recorded mark of a kind ("avalanche", "fatal", "other": the
+// scenario's timeline.recorded[].kind) is drawn in every timeline figure,
+// and what the legend calls it. Each kind its own, so that a mark that is
+// not an avalanche (a police call, a rescue team) is not read as one.
+struct RecordedMarkStyle {
+  Color color;
+  double width_px = 1.6;
+  bool dashed = true;
+  std::string legend;  // "recorded avalanche", ...
+};
+RecordedMarkStyle RecordedMarkStyleOf(const std::string& kind);
+// The kinds of the marks within [t0, t1] (those a figure of that time
+// shows), each once, in the legend's order (avalanche, fatal, other).
+std::vector<std::string> RecordedMarkKinds(const std::vector<analysis::TimelineMark>& marks, double t0, double t1);
 
 // The labels of the recorded marks within [t0, t1] above a panel whose top
 // is at top_px, each at x_px(its time), in rows where they would overlap
