@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <exception>
 #include <functional>
@@ -246,6 +247,15 @@ void AddRiskColumns(const fs::path& file, ResultRow* row) {
   row->metrics[column_of.at("longest_above_f0_s")] = longest;
 }
 
+// A run file's status ("complete", "running", ...; "" if unreadable).
+std::string StatusOf(const fs::path& file) {
+  try {
+    return runfile::RunFileReader(file).RunValue("status");
+  } catch (const std::exception&) {
+    return "";
+  }
+}
+
 // Simulates and analyses one run. No row (nullopt) if it was interrupted: its
 // run file and checkpoint stay for the next attempt.
 std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
@@ -261,14 +271,21 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
   options.stop_flag = &g_stop;
   if (ctx.simulated_s) options.simulated_s = &ctx.simulated_s[run.index];
   const bool resume = fs::exists(file) && fs::exists(scenario::CheckpointPath(file));
-  if (!resume) RemoveRunFiles(file);  // a run killed outright starts over
+  // A run that completed but whose row was never written (the sweep was
+  // stopped or killed while analysing it: hours of a long run's analysis)
+  // is analysed, not simulated again.
+  const bool completed = !resume && fs::exists(file) && StatusOf(file) == "complete";
+  if (!resume && !completed) RemoveRunFiles(file);  // a run killed outright starts over
 
   ResultRow row;
   bool failed = false;
   double earlier_wall_s = 0.0;  // a resumed run's earlier invocations
   try {
     scenario::RunSummary summary;
-    if (resume) {
+    if (completed) {
+      summary.status = "complete";
+      summary.total_wall_s = std::max(0.0, std::strtod(runfile::RunFileReader(file).RunValue("wall_s").c_str(), nullptr));
+    } else if (resume) {
       options.resume = true;
       try {
         summary = scenario::RunScenario(sc, options);
@@ -279,13 +296,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
         // run, and with its message and saved state deleted): it is
         // recorded as failed, its files kept. Only an unusable checkpoint
         // starts over.
-        bool run_failed = false;
-        try {
-          run_failed = runfile::RunFileReader(file).RunValue("status").rfind("failed", 0) == 0;
-        } catch (const std::exception&) {
-          // Unreadable: as an unusable checkpoint.
-        }
-        if (run_failed) throw;
+        if (StatusOf(file).rfind("failed", 0) == 0) throw;  // (unreadable: as an unusable checkpoint)
         RemoveRunFiles(file);
         options.resume = false;
         summary = scenario::RunScenario(sc, options);
@@ -294,7 +305,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
       summary = scenario::RunScenario(sc, options);
     }
     if (summary.status != "complete") return std::nullopt;
-    earlier_wall_s = summary.total_wall_s - summary.wall_s;
+    earlier_wall_s = summary.total_wall_s - summary.wall_s;  // (all of it for a run simulated before)
     row = RowOf(run, analysis::AnalyzeRun(file, ctx.analysis));
     AddRiskColumns(file, &row);
   } catch (const InputError& e) {

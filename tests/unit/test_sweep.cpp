@@ -249,7 +249,9 @@ TEST(SweepRunner, AThirdGroupsMetricsStayOutOfTheTable) {
 
 // A sweep of one seed of a test scenario in a scratch folder DIR (its
 // output DIR/out), its run simulated up to `stop_after_s` and interrupted,
-// as a sweep stopped by a signal leaves it: the folder and the run file.
+// as a sweep stopped by a signal leaves it: the folder and the run file
+// (with `stop_after_s` < 0: run to its end, as a sweep stopped while it
+// analysed the run leaves it).
 struct InterruptedRun {
   std::filesystem::path dir, file;
 };
@@ -270,7 +272,8 @@ InterruptedRun InterruptedSweepRun(const std::string& name, const std::string& s
   scenario::RunOptions stopped;
   stopped.output = file;
   stopped.stop_after_s = stop_after_s;
-  EXPECT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs.at(0)), stopped).status, "interrupted");
+  EXPECT_EQ(scenario::RunScenario(RunScenarioOf(spec, runs.at(0)), stopped).status,
+            stop_after_s < 0 ? "complete" : "interrupted");
   return {dir, file};
 }
 
@@ -294,6 +297,32 @@ TEST(SweepRunner, ARunThatFailsAfterResumingIsRecordedFailedNotStartedOver) {
   EXPECT_EQ(reader.RunValue("status").rfind("failed: ", 0), 0u) << reader.RunValue("status");
   const std::string row = FirstResultRow(dir).second;
   EXPECT_NE(row.find("went through wall"), std::string::npos) << row;
+}
+
+// A run that completed but has no row (the sweep was stopped or killed while
+// analysing it: for a long run, its hours were spent) is analysed, not
+// simulated again: the run file is the one that was there, and the row
+// takes its wall time.
+TEST(SweepRunner, ACompletedRunWithoutARowIsAnalysedNotSimulatedAgain) {
+  const auto [dir, file] = InterruptedSweepRun("sweep-completed-no-row", "sweep-tiny.json", 2, -1.0);
+  ASSERT_FALSE(std::filesystem::exists(scenario::CheckpointPath(file)));
+  {
+    runfile::RunFileWriter writer = runfile::RunFileWriter::Resume(file, 10);  // (marks it running)
+    writer.SetRunValue("test_mark", "the file of the first attempt");
+    writer.SetRunValue("wall_s", "5000");
+    writer.SetStatus("complete");
+  }
+  const SweepSummary summary = RunSweepIn(dir);
+  EXPECT_EQ(summary.completed, 1u);
+  EXPECT_EQ(summary.failed, 0u);
+  const runfile::RunFileReader reader(file);
+  EXPECT_EQ(reader.RunValue("test_mark"), "the file of the first attempt") << "the run was simulated again";
+  EXPECT_EQ(reader.RunValue("status"), "complete");
+  const ResultsTable table = ReadResults(dir / "out");
+  ASSERT_EQ(table.rows.size(), 1u);
+  EXPECT_EQ(table.rows[0][table.Column("status")].text, "complete");
+  EXPECT_GE(table.rows[0][table.Column("wall_s")].number, 5000.0);
+  EXPECT_FALSE(table.rows[0][table.Column("mean_speed_m_per_s")].null);
 }
 
 // A run resumed by the sweep records the wall time of all its parts (the run
