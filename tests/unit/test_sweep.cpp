@@ -345,19 +345,25 @@ TEST(SweepRunner, AResumedRunsWallTimeCountsItsEarlierParts) {
   EXPECT_GE(std::stod(runfile::RunFileReader(file).RunValue("wall_s")), 1000.0);
 }
 
+// A scratch folder DIR holding DIR/sweep.json: the test scenario
+// sweep-tiny.json with `rest` (the sweep's other keys).
+std::filesystem::path TinySweepIn(const std::string& name, const std::string& rest) {
+  const std::filesystem::path dir = crowdrecon::testing::ScratchFile(name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream f(dir / "sweep.json");
+  f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
+    << "/tests/data/scenarios/sweep-tiny.json\", " << rest << "}";
+  return dir;
+}
+
 // The sweep's last run (handed out when no other is left to start) may take
 // the cores the runs before it free: with two at a time, the first two of
 // three runs get one engine thread, the third up to two (the governor's
 // account is in its run file); a sweep of one at a time gives every run one.
 TEST(SweepRunner, TheLastRunMayTakeTheCoresTheOthersFree) {
-  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-last-run-threads");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream f(dir / "sweep.json");
-    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
-      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": {"first": 1, "count": 3}, "keep_runs": true})";
-  }
+  const std::filesystem::path dir =
+      TinySweepIn("sweep-last-run-threads", R"("seeds": {"first": 1, "count": 3}, "keep_runs": true)");
   const std::vector<RunPlan> runs = ExpandRuns(LoadSweep(dir / "sweep.json"));
   ASSERT_EQ(runs.size(), 3u);
   const auto threads_account = [&](const std::string& out, std::size_t i) {
@@ -440,14 +446,8 @@ TEST(Progress, ARunsLogGetsLinesOfTheirOwnAndTheCallerTheSimulatedTime) {
 // A sweep whose stderr is a log says now and then how many runs are done and
 // how far each running run has got.
 TEST(Progress, ASweepsLogSaysHowFarEachRunningRunHasGot) {
-  const std::filesystem::path dir = crowdrecon::testing::ScratchFile("sweep-progress-log");
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream f(dir / "sweep.json");
-    f << R"({"format": "crowdrecon-sweep", "version": 1, "scenario": ")" << CROWDRECON_SOURCE_DIR
-      << R"(/tests/data/scenarios/sweep-tiny.json", "seeds": {"first": 1, "count": 2}, "set": {"run.duration_s": 10}})";
-  }
+  const std::filesystem::path dir =
+      TinySweepIn("sweep-progress-log", R"("seeds": {"first": 1, "count": 2}, "set": {"run.duration_s": 10})");
   SweepOptions options;
   options.sweep_file = dir / "sweep.json";
   options.output_dir = dir / "out";
