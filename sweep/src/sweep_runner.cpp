@@ -758,12 +758,7 @@ std::vector<fs::path> RemovePartialRuns(const fs::path& sweep_dir) {
   for (const fs::path& p : files) {
     std::error_code gone;
     if (p.extension() == ".sqlite") {
-      std::string status;
-      try {
-        status = runfile::RunFileReader(p).RunValue("status");
-      } catch (const std::exception&) {
-        status = "unreadable";  // killed before its first tables were written
-      }
+      const std::string status = StatusOf(p);  // "" if killed before its first tables were written
       if (status.rfind("failed", 0) == 0 || status == "complete") continue;
       RemoveRunFiles(p);
       removed.push_back(p);
