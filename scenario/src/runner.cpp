@@ -51,6 +51,8 @@ std::uint64_t ScenarioFingerprint(const Scenario& s) { return TextFingerprint(s.
 // engine's state (Simulation::SaveState), then each run-loop system's state
 // (count; per system its name and state, each as a length and bytes).
 // Version 1 (no system states) is still read.
+// The run value that keeps a run's wall time over all its invocations.
+constexpr char kWallSecondsKey[] = "wall_s";
 constexpr char kCheckpointMagic[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '2'};
 constexpr char kCheckpointMagicV1[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '1'};
 
@@ -183,6 +185,11 @@ std::filesystem::path CheckpointPath(const std::filesystem::path& run_file) {
   return run_file.string() + ".checkpoint";
 }
 
+double RecordedWallSeconds(const std::filesystem::path& run_file) {
+  const double s = std::strtod(runfile::RunFileReader(run_file).RunValue(kWallSecondsKey).c_str(), nullptr);
+  return std::isfinite(s) ? std::max(0.0, s) : 0.0;
+}
+
 int InterruptedExitStatus() {
   const int signal = g_interrupt_signal.load();
   return signal == SIGTERM ? 128 + SIGTERM : 128 + SIGINT;
@@ -269,7 +276,7 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
     say("resuming at t = " + FormatNumber(sim.time_s()) + " s (frame " + std::to_string(c.last_frame) + ")");
     // The wall time its frames took so far (written with each checkpoint;
     // absent in a run written before it was kept: counted from here).
-    const double earlier_wall_s = std::max(0.0, std::strtod(runfile::RunFileReader(options.output).RunValue("wall_s").c_str(), nullptr));
+    const double earlier_wall_s = RecordedWallSeconds(options.output);
     return {runfile::RunFileWriter::Resume(options.output, c.last_frame), c.last_frame, c.systems, earlier_wall_s};
   }
   std::filesystem::remove(checkpoint, ec);
@@ -526,7 +533,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   // its frames took to compute, to its last checkpoint while it is
   // unfinished (a run killed outright computes again what followed it).
   const auto record_wall_time = [&] {
-    writer.SetRunValue("wall_s", FormatNumber(opened.earlier_wall_s + std::chrono::duration<double>(Clock::now() - start).count()));
+    writer.SetRunValue(kWallSecondsKey, FormatNumber(opened.earlier_wall_s + std::chrono::duration<double>(Clock::now() - start).count()));
   };
   const auto checkpoint_at = [&](const std::filesystem::path& file, std::int64_t frame) {
     frames.Flush();

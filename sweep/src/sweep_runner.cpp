@@ -284,7 +284,7 @@ std::optional<ResultRow> ExecuteRun(const Context& ctx, const RunPlan& run) {
     scenario::RunSummary summary;
     if (completed) {
       summary.status = "complete";
-      summary.total_wall_s = std::max(0.0, std::strtod(runfile::RunFileReader(file).RunValue("wall_s").c_str(), nullptr));
+      summary.total_wall_s = scenario::RecordedWallSeconds(file);
     } else if (resume) {
       options.resume = true;
       try {

@@ -621,7 +621,7 @@ TEST(Timeline, AResumedRunsWallTimeCountsAllItsParts) {
   options.output = crowdrecon::testing::ScratchFile("wall-time.sqlite");
   std::filesystem::remove(options.output);
   std::filesystem::remove(CheckpointPath(options.output));
-  const auto recorded = [&] { return std::stod(runfile::RunFileReader(options.output).RunValue("wall_s")); };
+  const auto recorded = [&] { return scenario::RecordedWallSeconds(options.output); };
 
   options.stop_after_s = 1.0;
   const RunSummary first = RunScenario(s, options);

@@ -65,6 +65,11 @@ struct RunSummary {
 // Path of the checkpoint that belongs to a run file.
 std::filesystem::path CheckpointPath(const std::filesystem::path& run_file);
 
+// The wall time a run's frames took over all its invocations, as RunScenario
+// records it with every checkpoint and at the end (run value wall_s); 0 for a
+// run written before it was kept.
+double RecordedWallSeconds(const std::filesystem::path& run_file);
+
 // Installs SIGINT/SIGTERM handlers that ask running scenarios to stop at the
 // next step (after writing a checkpoint).
 void InstallInterruptHandlers();
