@@ -170,10 +170,7 @@ void RunTimeline(const TimelineArgs& args) {
               analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
               s.recorded.size());
   SayIfUnfinished(args.run);
-  {
-    const analysis::Plausibility validity = analysis::ComputePlausibility(args.run);
-    std::printf("validity: %s\n", validity.Statement(analysis::PlausibilityOptions{}).c_str());
-  }
+  std::printf("validity: %s\n", s.validity.Statement(analysis::PlausibilityOptions{}).c_str());
   if (!args.density_maps.empty()) {
     const geometry::Venue venue =
         geometry::ParseVenue(runfile::RunFileReader(args.run).venue_json(), args.run + ": run value venue");

@@ -113,74 +113,105 @@ Neighbourhoods CountWithin(const std::vector<Vec2>& p, const std::vector<double>
 
 }  // namespace
 
+PlausibilityPass::PlausibilityPass(const runfile::RunFileReader& reader, const PlausibilityOptions& options)
+    : options_(options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("plausibility: " + why);
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  if (times.empty()) throw InputError(reader.file() + ": the run has no frames");
+  for (const runfile::FrameTime& f : times) time_of_[f.frame] = f.time_s;
+  frame_s_ = times.size() > 1 ? (times.back().time_s - times.front().time_s) / double(times.size() - 1) : 0.0;
+  for (const runfile::Shape& s : reader.Shapes())
+    shape_area_.push_back(geometry::Spheropolygon::Create(s.vertices, s.radius_m).area());
+  person_shape_ = reader.PersonShapes();
+  box_ = reader.periodic_box();
+  radius_ = std::sqrt(options.disc_area_m2 / std::numbers::pi);
+}
+
+void PlausibilityPass::AddPeople(const runfile::PersonFrame& frame) {
+  const PlausibilityOptions& o = options_;
+  ++result_.frames;
+  position_.clear();
+  area_.clear();
+  who_.clear();
+  for (std::size_t k = 0; k < frame.person.size(); ++k) {
+    if (frame.state[k] == runfile::PersonStatus::kRemoved) continue;
+    const std::uint32_t person = frame.person[k];
+    position_.push_back(frame.position_m[k]);
+    area_.push_back(person < person_shape_.size() && person_shape_[person] < shape_area_.size()
+                        ? shape_area_[person_shape_[person]]
+                        : o.reference_body_area_m2);
+    who_.push_back(person);
+  }
+  const Neighbourhoods near = CountWithin(position_, area_, radius_, box_);
+  double frame_peak_equivalent = 0.0;
+  for (std::size_t i = 0; i < position_.size(); ++i) {
+    const double density = near.count[i] / o.disc_area_m2;
+    const double equivalent = near.area_sum[i] / o.reference_body_area_m2 / o.disc_area_m2;
+    frame_peak_equivalent = std::max(frame_peak_equivalent, equivalent);
+    if (density > result_.peak_density_per_m2 ||
+        (density == result_.peak_density_per_m2 && equivalent > result_.peak_equivalent_density_per_m2)) {
+      result_.peak_density_per_m2 = density;
+      result_.peak_equivalent_density_per_m2 = equivalent;
+      result_.peak_mean_body_area_m2 = near.area_sum[i] / near.count[i];
+      result_.peak_time_s = time_of_[frame.frame];
+      result_.peak_place_m = position_[i];
+      result_.peak_person = static_cast<std::int64_t>(who_[i]) + 1;
+    }
+  }
+  if (frame_peak_equivalent > o.static_critical_per_m2) result_.time_beyond_static_s += frame_s_;
+  if (frame_peak_equivalent > o.crush_highest_per_m2) result_.time_beyond_measured_s += frame_s_;
+}
+
+// The first largest overlap in the order of frames and rows, as the
+// reader's LargestContactOverlap picks it.
+void PlausibilityPass::AddContacts(std::int64_t frame, const std::vector<runfile::Contact>& contacts) {
+  for (const runfile::Contact& c : contacts)
+    if (!contacts_given_ || c.overlap_m > largest_overlap_m_) {
+      contacts_given_ = true;
+      largest_overlap_m_ = c.overlap_m;
+      largest_overlap_frame_ = frame;
+      largest_overlap_wall_ = c.wall;
+    }
+}
+
+Plausibility PlausibilityPass::Finish(const runfile::RunFileReader& reader) {
+  Plausibility result = result_;
+  if (!contacts_given_)
+    if (const auto largest = reader.LargestContactOverlap()) {
+      contacts_given_ = true;
+      largest_overlap_m_ = largest->overlap_m;
+      largest_overlap_frame_ = largest->frame;
+      largest_overlap_wall_ = largest->wall;
+    }
+  if (contacts_given_) {
+    result.contacts_available = true;
+    if (largest_overlap_m_ > 0.0) {
+      result.max_overlap_m = largest_overlap_m_;
+      result.max_overlap_time_s = time_of_[largest_overlap_frame_];
+      result.max_overlap_with_wall = largest_overlap_wall_;
+    }
+  }
+  const PlausibilityOptions& o = options_;
+  const bool overlap_beyond = result.max_overlap_m > o.critical_compression * o.reference_chest_depth_m;
+  result.verdict = result.peak_equivalent_density_per_m2 > o.crush_highest_per_m2 || overlap_beyond
+                       ? PlausibilityVerdict::kBeyondMeasured
+                   : result.peak_equivalent_density_per_m2 > o.static_critical_per_m2 ? PlausibilityVerdict::kBeyondStatic
+                                                                                       : PlausibilityVerdict::kWithin;
+  return result;
+}
+
 Plausibility ComputePlausibility(const std::filesystem::path& run_file, const PlausibilityOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("plausibility: " + why);
   if (!runfile::IsRunFile(run_file)) throw InputError(run_file.string() + ": not a crowdrecon run file");
   const runfile::RunFileReader reader(run_file);
+  PlausibilityPass pass(reader, options);
   const std::vector<runfile::FrameTime> times = reader.FrameTimes();
-  if (times.empty()) throw InputError(run_file.string() + ": the run has no frames");
-  std::unordered_map<std::int64_t, double> time_of;
-  for (const runfile::FrameTime& f : times) time_of[f.frame] = f.time_s;
-  const double frame_s = times.size() > 1 ? (times.back().time_s - times.front().time_s) / double(times.size() - 1) : 0.0;
-  std::vector<double> shape_area;
-  for (const runfile::Shape& s : reader.Shapes()) shape_area.push_back(geometry::Spheropolygon::Create(s.vertices, s.radius_m).area());
-  const std::vector<std::uint32_t> person_shape = reader.PersonShapes();
-  const PeriodicBox box = reader.periodic_box();
-  const double radius = std::sqrt(options.disc_area_m2 / std::numbers::pi);
-
-  Plausibility result;
   runfile::PersonFrameStream stream = reader.PersonFrames(times.back().frame);
   runfile::PersonFrame frame;
-  std::vector<Vec2> position;
-  std::vector<double> area;
-  std::vector<std::uint32_t> who;
-  while (stream.Next(&frame)) {
-    ++result.frames;
-    position.clear();
-    area.clear();
-    who.clear();
-    for (std::size_t k = 0; k < frame.person.size(); ++k) {
-      if (frame.state[k] == runfile::PersonStatus::kRemoved) continue;
-      const std::uint32_t person = frame.person[k];
-      position.push_back(frame.position_m[k]);
-      area.push_back(person < person_shape.size() && person_shape[person] < shape_area.size() ? shape_area[person_shape[person]]
-                                                                                           : options.reference_body_area_m2);
-      who.push_back(person);
-    }
-    const Neighbourhoods near = CountWithin(position, area, radius, box);
-    double frame_peak_equivalent = 0.0;
-    for (std::size_t i = 0; i < position.size(); ++i) {
-      const double density = near.count[i] / options.disc_area_m2;
-      const double equivalent = near.area_sum[i] / options.reference_body_area_m2 / options.disc_area_m2;
-      frame_peak_equivalent = std::max(frame_peak_equivalent, equivalent);
-      if (density > result.peak_density_per_m2 ||
-          (density == result.peak_density_per_m2 && equivalent > result.peak_equivalent_density_per_m2)) {
-        result.peak_density_per_m2 = density;
-        result.peak_equivalent_density_per_m2 = equivalent;
-        result.peak_mean_body_area_m2 = near.area_sum[i] / near.count[i];
-        result.peak_time_s = time_of[frame.frame];
-        result.peak_place_m = position[i];
-        result.peak_person = static_cast<std::int64_t>(who[i]) + 1;
-      }
-    }
-    if (frame_peak_equivalent > options.static_critical_per_m2) result.time_beyond_static_s += frame_s;
-    if (frame_peak_equivalent > options.crush_highest_per_m2) result.time_beyond_measured_s += frame_s;
-  }
-  if (const auto largest = reader.LargestContactOverlap()) {
-    result.contacts_available = true;
-    if (largest->overlap_m > 0.0) {
-      result.max_overlap_m = largest->overlap_m;
-      result.max_overlap_time_s = time_of[largest->frame];
-      result.max_overlap_with_wall = largest->wall;
-    }
-  }
-  const bool overlap_beyond = result.max_overlap_m > options.critical_compression * options.reference_chest_depth_m;
-  result.verdict = result.peak_equivalent_density_per_m2 > options.crush_highest_per_m2 || overlap_beyond
-                       ? PlausibilityVerdict::kBeyondMeasured
-                   : result.peak_equivalent_density_per_m2 > options.static_critical_per_m2 ? PlausibilityVerdict::kBeyondStatic
-                                                                                             : PlausibilityVerdict::kWithin;
-  return result;
+  while (stream.Next(&frame)) pass.AddPeople(frame);
+  return pass.Finish(reader);
 }
 
 std::string Plausibility::Statement(const PlausibilityOptions& o) const {

@@ -344,7 +344,9 @@ class FramePass {
     out_.max_load_n = -1.0;
   }
 
-  void Run(const runfile::RunFileReader& run) {
+  // `validity` is given every frame of people read (the run's validity in
+  // the same pass).
+  void Run(const runfile::RunFileReader& run, PlausibilityPass* validity) {
     runfile::PersonFrameStream stream = run.PersonFrames(c_.frame.back());
     runfile::PersonFrame rows;
     bool have_rows = stream.Next(&rows);
@@ -364,6 +366,7 @@ class FramePass {
       // one transaction), but are skipped rather than trusted.
       while (have_rows && rows.frame < c_.frame[k]) have_rows = stream.Next(&rows);
       if (have_rows && rows.frame == c_.frame[k]) {
+        validity->AddPeople(rows);
         for (std::size_t r = 0; r < rows.person.size(); ++r) {
           const std::size_t i = rows.person[r];
           if (i >= n_people_) continue;
@@ -591,8 +594,9 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
   // group with people (group 0, the main flow, in every scenario).
   ChooseMeasurementLine(options, venue, run, out.group_direction[contents.first_group], &out);
   const std::size_t first_stationary = FirstStationaryFrame(contents.time_s, options, &out);
+  PlausibilityPass validity(run);  // issue 39: states a human crowd can reach
   FramePass pass(contents, options, first_stationary, &out);
-  pass.Run(run);
+  pass.Run(run, &validity);
   Flows(pass, options, first_stationary, &out);
   // 6. Regime. The mean speed of a frame with nobody in it is taken as 0 (an
   //    empty corridor has no flow).
@@ -613,7 +617,7 @@ RunAnalysis AnalyzeRun(const fs::path& run_file, const AnalysisOptions& options)
     out.passages.push_back(AnalyzePassages(std::move(pass.passage_times[g]), contents.time_s[first_stationary],
                                            contents.time_s.back(), options.passages));
   Summarize(speed_for_regime, first_stationary, std::move(pass.stationary_loads), options, &out);
-  out.plausibility = ComputePlausibility(run_file);  // issue 39: states a human crowd can reach
+  out.plausibility = validity.Finish(run);
   return out;
 }
 

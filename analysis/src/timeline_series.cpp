@@ -142,6 +142,7 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
       s.queued[static_cast<std::size_t>(row.frame)] = static_cast<double>(row.census.queued);
 
   s.group_names = a.group_name;
+  s.validity = a.plausibility;
   const std::size_t n = std::min(s.time_s.size(), a.series.time_s.size());
   const auto fit = [n](std::vector<double> v) {
     v.resize(n, std::numeric_limits<double>::quiet_NaN());

@@ -93,9 +93,8 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
       r.danger_peak = f.above_danger;
       r.danger_peak_time_s = f.time_s;
     }
-  const analysis::Plausibility p = analysis::ComputePlausibility(run_file);
-  r.peak_density_per_m2 = p.peak_density_per_m2;
-  r.peak_equivalent_density_per_m2 = p.peak_equivalent_density_per_m2;
+  r.peak_density_per_m2 = s.validity.peak_density_per_m2;
+  r.peak_equivalent_density_per_m2 = s.validity.peak_equivalent_density_per_m2;
   return r;
 }
 

@@ -534,11 +534,15 @@ ReportSummary WriteReport(const ReportOptions& options) {
   const auto say = [&](const std::string& text) {
     if (options.progress) options.progress(text);
   };
+  // Each run's loads and its validity (section 1's last part) in one pass.
+  const analysis::PlausibilityOptions validity_options;
+  RiskOptions with_validity = options.risk;
+  with_validity.validity = validity_options;
   const auto analyse = [&](const std::vector<fs::path>& files) {
     std::vector<RunRisk> runs;
     for (std::size_t k = 0; k < files.size(); ++k) {
       say("reading " + files[k].string() + " (" + std::to_string(k + 1) + " of " + std::to_string(files.size()) + ")");
-      runs.push_back(AnalyseRunRisk(files[k], options.risk));
+      runs.push_back(AnalyseRunRisk(files[k], with_validity));
     }
     return runs;
   };
@@ -628,16 +632,15 @@ ReportSummary WriteReport(const ReportOptions& options) {
 
   // Validity: whether the states are ones a human crowd can reach (issue 39).
   {
-    const analysis::PlausibilityOptions po;
+    const analysis::PlausibilityOptions& po = validity_options;
     h += "<h3>Are these states a human crowd can reach?</h3>\n";
-    const auto validity = [&](const std::string& label, const std::vector<fs::path>& files) {
-      if (files.empty()) return;
+    const auto validity = [&](const std::string& label, const std::vector<RunRisk>& runs) {
+      if (runs.empty()) return;
       std::vector<double> peak, equivalent, overlap;
       analysis::Plausibility worst;
       bool first_run = true;
-      for (const fs::path& f : files) {
-        say("checking the densities of " + f.string());
-        const analysis::Plausibility p = analysis::ComputePlausibility(f, po);
+      for (const RunRisk& r : runs) {
+        const analysis::Plausibility& p = *r.validity;
         peak.push_back(p.peak_density_per_m2);
         equivalent.push_back(p.peak_equivalent_density_per_m2);
         if (p.contacts_available) overlap.push_back(p.max_overlap_m);
@@ -646,7 +649,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
       }
       const Spread sp = SpreadOf(peak), se = SpreadOf(equivalent);
       std::string line = label + ": peak local density " + Short(sp.median) + " persons/m2 (" + Short(sp.low) + "-" +
-                         Short(sp.high) + " over " + std::to_string(files.size()) + (files.size() == 1 ? " run" : " runs") + "), as real-size people " +
+                         Short(sp.high) + " over " + std::to_string(runs.size()) + (runs.size() == 1 ? " run" : " runs") + "), as real-size people " +
                          Short(se.median) + " (" + Short(se.low) + "-" + Short(se.high) + ")";
       if (!overlap.empty()) line += "; largest overlap " + Short(SpreadOf(overlap).high * 100.0) + " cm";
       line += std::string("; ") + (worst.verdict == analysis::PlausibilityVerdict::kWithin ? "within the range of human crowds"
@@ -659,8 +662,8 @@ ReportSummary WriteReport(const ReportOptions& options) {
       h += "<p><b>" + Escape(label) + ".</b> " + Escape(body) + ". The run that comes closest "
            "to the edge: " + Escape(worst.Statement(po)) + "</p>\n";
     };
-    validity(options.label, main_files);
-    validity(options.compare_label, other_files);
+    validity(options.label, main_runs);
+    validity(options.compare_label, other_runs);
     h += "<p class=\"note\">Local density: people whose centres lie within 1 m² of a person, the peak over every person "
          "and frame; as real-size people: the same floor covered by ANSUR II median bodies (0.0868 m², thorax with "
          "arms). Range: Fruin's 7.1 /m² (critical static crowd), about 9–10 /m² measured in crushes, 38 % chest "
@@ -819,6 +822,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
     });
     RiskOptions o2 = o;
     o2.progress = nullptr;
+    o2.validity.reset();
     for (std::size_t k = 0; k < order.size() && k < 6; ++k) o2.series_of.push_back(order[k]->id);
     say("the chest loads over time of the " + std::to_string(o2.series_of.size()) + " most exposed of " + r.file.string());
     const RunRisk again = AnalyseRunRisk(r.file, o2);

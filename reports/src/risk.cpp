@@ -42,6 +42,7 @@ bool RiskOptions::IsValid(std::string* error) const {
     return fail("the tolerance point " + FormatNumber(lethal_long_n) + " N must lie above F0 = " + FormatNumber(f0_n) + " N");
   if (!(smoothing_s >= 0.0 && smoothing_s <= 60.0))
     return fail("smoothing = " + FormatNumber(smoothing_s) + " s, expected in [0, 60]");
+  if (std::string why; validity && !validity->IsValid(&why)) return fail("validity: " + why);
   return true;
 }
 
@@ -143,6 +144,8 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   const std::vector<runfile::FrameTime> times = reader.FrameTimes();
   if (times.empty()) throw InputError(run_file.string() + ": the run has no frames; expected a run with at least one frame");
   risk.duration_s = times.back().time_s - times.front().time_s;
+  std::optional<analysis::PlausibilityPass> validity;
+  if (options.validity) validity.emplace(reader, *options.validity);
 
   const std::size_t n = setup.size();
   risk.people.resize(n);
@@ -194,6 +197,7 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     const double dt = std::max(0.0, t - previous_time);
     previous_time = t;
     for (Pose& p : poses) p.present = false;
+    if (validity) validity->AddPeople(pf);
     for (std::size_t k = 0; k < pf.person.size(); ++k) {
       const std::uint32_t i = pf.person[k];
       if (i >= n) throw InputError(run_file.string() + ": frame " + std::to_string(pf.frame) + " has person id " +
@@ -209,6 +213,7 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     fr.frame = pf.frame;
     fr.time_s = t;
     if (have_contacts) {
+      if (validity) validity->AddContacts(pf.frame, contacts);
       for (const runfile::Contact& c : contacts) {
         const Vec2 f = c.Force();
         load_contacts.push_back({c.a, c.b, c.wall, c.point_m, f});
@@ -305,6 +310,11 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     if (options.progress) options.progress(++done, times.size());
   }
   if (risk.frames.empty()) throw InputError(run_file.string() + ": the run has no people in any frame");
+  if (validity) {
+    for (; more_contacts; more_contacts = contact_stream.Next(&contact_frame, &contacts))
+      validity->AddContacts(contact_frame, contacts);  // rows after the last frame of people, if any
+    risk.validity = validity->Finish(reader);
+  }
   const FrameRisk& worst = risk.frames[static_cast<std::size_t>(risk.worst_frame)];
   risk.worst_time_s = worst.time_s;
   risk.worst_frame = worst.frame;

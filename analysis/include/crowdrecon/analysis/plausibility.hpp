@@ -28,8 +28,17 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
+#include "crowdrecon/common/periodic_box.hpp"
 #include "crowdrecon/common/vec2.hpp"
+
+namespace crowdrecon::runfile {
+class RunFileReader;
+struct PersonFrame;
+struct Contact;
+}  // namespace crowdrecon::runfile
 
 namespace crowdrecon::analysis {
 
@@ -72,5 +81,38 @@ struct Plausibility {
 // Reads every frame of the run (positions, and contacts if it has them).
 // Throws InputError for a file that is not a run or a run without frames.
 Plausibility ComputePlausibility(const std::filesystem::path& run_file, const PlausibilityOptions& options = {});
+
+// ComputePlausibility's pass, for a reader of the run's frames that reads
+// them anyway (AnalyzeRun, the risk report): a run of many gigabytes is then
+// read once, not once more for its validity. Give it every frame of people of
+// the run in order (runfile::PersonFrameStream) and, optionally, the contacts
+// of every frame that has any; Finish returns what ComputePlausibility
+// returns, reading the run's largest contact overlap from its table only if
+// no contacts were given.
+class PlausibilityPass {
+ public:
+  // Throws InputError for a run without frames or invalid options.
+  explicit PlausibilityPass(const runfile::RunFileReader& reader, const PlausibilityOptions& options = {});
+  void AddPeople(const runfile::PersonFrame& frame);
+  void AddContacts(std::int64_t frame, const std::vector<runfile::Contact>& contacts);
+  Plausibility Finish(const runfile::RunFileReader& reader);
+
+ private:
+  PlausibilityOptions options_;
+  std::unordered_map<std::int64_t, double> time_of_;
+  double frame_s_ = 0.0;
+  std::vector<double> shape_area_;
+  std::vector<std::uint32_t> person_shape_;
+  PeriodicBox box_;
+  double radius_ = 0.0;
+  Plausibility result_;
+  bool contacts_given_ = false;
+  double largest_overlap_m_ = 0.0;
+  std::int64_t largest_overlap_frame_ = 0;
+  bool largest_overlap_wall_ = false;
+  std::vector<Vec2> position_;
+  std::vector<double> area_;
+  std::vector<std::uint32_t> who_;
+};
 
 }  // namespace crowdrecon::analysis

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/analysis/regime.hpp"
 
 namespace crowdrecon::analysis {
@@ -62,6 +63,7 @@ struct TimelineSeries {
   std::vector<TimelineMark> avalanches;  // detected during the run (events `avalanche`)
   std::vector<TimelineMark> falls;       // events `fall`
   std::vector<TimelineMark> recorded;    // the scenario's marks (run value timeline_recorded)
+  Plausibility validity;                 // states a human crowd can reach (the run's analysis, default options)
   double smooth_s = 10.0;
 };
 

@@ -16,10 +16,12 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/vec2.hpp"
 
 namespace crowdrecon::reports {
@@ -50,6 +52,9 @@ struct RiskOptions {
   // People (ids, 1-based) whose smoothed chest-load series RunRisk::series
   // keeps (the report's exposure timelines of the most exposed).
   std::vector<std::uint32_t> series_of;
+  // Also the run's validity (analysis/plausibility.hpp) with these options,
+  // in the same pass (RunRisk::validity): a long run is read once.
+  std::optional<analysis::PlausibilityOptions> validity;
 
   bool IsValid(std::string* error) const;
   // The exponent k of the tolerance power law.
@@ -133,6 +138,7 @@ struct RunRisk {
   std::vector<std::vector<std::pair<double, double>>> series;
   bool loads_recorded = false;  // chest loads from table person_load (else computed from the contacts)
   bool has_contacts = false;    // the run has a contact table with rows: force network and force distributions
+  std::optional<analysis::Plausibility> validity;  // if RiskOptions::validity asked for it
 };
 
 RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions& options);
