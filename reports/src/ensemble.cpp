@@ -86,6 +86,7 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   r.clog_for_good_s = analysis::ClogForGood(s, options.smooth_s, options.clog_speed_m_per_s, options.clog_min_s);
   RiskOptions risk;
   risk.danger_n = options.danger_n;
+  risk.read_contacts = false;  // the loads suffice
   const RunRisk rr = AnalyseRunRisk(run_file, risk);
   r.loads_available = rr.loads_recorded || rr.has_contacts;
   for (const FrameRisk& f : rr.frames)

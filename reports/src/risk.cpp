@@ -167,12 +167,17 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     if (options.series_of[k] >= 1 && options.series_of[k] <= n) series_slot[options.series_of[k] - 1] = static_cast<int>(k);
 
   runfile::PersonFrameStream people = reader.PersonFrames(times.back().frame);
-  runfile::ContactFrameStream contact_stream = reader.ContactFrames(times.back().frame);
-  std::int64_t contact_frame = -1;
-  bool more_contacts = contact_stream.Next(&contact_frame, &contacts);
   // The chest loads the run loop recorded (table person_load), or, in runs
-  // written before it did, computed here from the contacts.
+  // written before it did, computed here from the contacts; the contacts are
+  // read where the loads need them or the caller asks for them.
   risk.loads_recorded = reader.HasPersonLoads();
+  std::optional<runfile::ContactFrameStream> contact_stream;
+  std::int64_t contact_frame = -1;
+  bool more_contacts = false;
+  if (options.read_contacts || !risk.loads_recorded) {
+    contact_stream.emplace(reader.ContactFrames(times.back().frame));
+    more_contacts = contact_stream->Next(&contact_frame, &contacts);
+  }
   if (!risk.loads_recorded && !more_contacts)
     throw InputError(run_file.string() + ": the run records neither chest loads (table person_load) nor contacts; "
                      "expected a run written by this crowdrecon, or one simulated with \"run\": {\"contacts\": true}");
@@ -306,12 +311,12 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
         }
       }
     }
-    if (have_contacts) more_contacts = contact_stream.Next(&contact_frame, &contacts);
+    if (have_contacts) more_contacts = contact_stream->Next(&contact_frame, &contacts);
     if (options.progress) options.progress(++done, times.size());
   }
   if (risk.frames.empty()) throw InputError(run_file.string() + ": the run has no people in any frame");
   if (validity) {
-    for (; more_contacts; more_contacts = contact_stream.Next(&contact_frame, &contacts))
+    for (; more_contacts; more_contacts = contact_stream->Next(&contact_frame, &contacts))
       validity->AddContacts(contact_frame, contacts);  // rows after the last frame of people, if any
     risk.validity = validity->Finish(reader);
   }

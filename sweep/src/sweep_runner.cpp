@@ -230,8 +230,10 @@ ResultRow RowOf(const RunPlan& run, const analysis::RunAnalysis& a) {
 void AddRiskColumns(const fs::path& file, ResultRow* row) {
   const std::map<std::string, std::size_t>& column_of = MetricColumnOf();
   reports::RunRisk risk;
+  reports::RiskOptions options;
+  options.read_contacts = false;  // the loads suffice
   try {
-    risk = reports::AnalyseRunRisk(file, reports::RiskOptions{});
+    risk = reports::AnalyseRunRisk(file, options);
   } catch (const InputError&) {
     return;
   }

@@ -73,5 +73,40 @@ TEST(ValidityPass, TheAnalysisAndTheRiskPassGiveWhatTheValidityAloneGives) {
   EXPECT_NE(why.find("validity: disc_area_m2 = -1"), std::string::npos) << why;
 }
 
+// A caller that needs the loads alone (a sweep's risk columns, an
+// ensemble's scores) skips the contact table, most of a long run's file:
+// where the run records its chest loads, everyone's exposure is the same
+// and the validity's largest overlap comes from the table instead.
+TEST(ValidityPass, TheLoadsAloneNeedNoContactsWhereTheRunRecordsThem) {
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "loads-alone.sqlite";
+  std::filesystem::remove(file);
+  const engine::testing::CorridorScene scene;
+  engine::Simulation sim(engine::testing::CounterFlowCorridor(engine::testing::ThoraxLikeShape(), scene));
+  engine::testing::WriteCorridorRun(file, sim, scene, 21, 10.0, /*record_periodic_box=*/true);
+
+  RiskOptions options;
+  options.validity = analysis::PlausibilityOptions{};
+  const RunRisk all = AnalyseRunRisk(file, options);
+  options.read_contacts = false;
+  const RunRisk loads = AnalyseRunRisk(file, options);
+  ASSERT_TRUE(all.loads_recorded);
+  ASSERT_TRUE(all.has_contacts);
+  EXPECT_GT(all.contact_rows, 0u);
+  EXPECT_FALSE(loads.has_contacts);
+  EXPECT_EQ(loads.contact_rows, 0u);
+  ASSERT_EQ(loads.people.size(), all.people.size());
+  for (std::size_t i = 0; i < all.people.size(); ++i) {
+    EXPECT_EQ(loads.people[i].id, all.people[i].id);
+    EXPECT_EQ(loads.people[i].max_load_n, all.people[i].max_load_n);
+    EXPECT_EQ(loads.people[i].dose, all.people[i].dose);
+    EXPECT_EQ(loads.people[i].longest_above_f0_s, all.people[i].longest_above_f0_s);
+  }
+  EXPECT_EQ(loads.counts, all.counts);
+  EXPECT_EQ(loads.worst_frame, all.worst_frame);
+  ASSERT_EQ(loads.frames.size(), all.frames.size());
+  for (std::size_t k = 0; k < all.frames.size(); ++k) EXPECT_EQ(loads.frames[k].above_danger, all.frames[k].above_danger);
+  ExpectSame(*loads.validity, *all.validity);
+}
+
 }  // namespace
 }  // namespace crowdrecon::reports

@@ -55,6 +55,12 @@ struct RiskOptions {
   // Also the run's validity (analysis/plausibility.hpp) with these options,
   // in the same pass (RunRisk::validity): a long run is read once.
   std::optional<analysis::PlausibilityOptions> validity;
+  // false: the run's contacts are read only where it records no chest loads
+  // (table person_load) -- the loads alone, for callers that draw no force
+  // figures (a sweep's risk columns, an ensemble's scores): in a long run the
+  // contact table is most of the file. RunRisk::has_contacts is then false
+  // and the contact force statistics are empty.
+  bool read_contacts = true;
 
   bool IsValid(std::string* error) const;
   // The exponent k of the tolerance power law.
@@ -137,7 +143,7 @@ struct RunRisk {
   // The smoothed load over time of each of RiskOptions::series_of: (time, load) while present.
   std::vector<std::vector<std::pair<double, double>>> series;
   bool loads_recorded = false;  // chest loads from table person_load (else computed from the contacts)
-  bool has_contacts = false;    // the run has a contact table with rows: force network and force distributions
+  bool has_contacts = false;    // the run has a contact table with rows, read: force network and force distributions
   std::optional<analysis::Plausibility> validity;  // if RiskOptions::validity asked for it
 };
 
