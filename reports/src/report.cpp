@@ -823,6 +823,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
     RiskOptions o2 = o;
     o2.progress = nullptr;
     o2.validity.reset();
+    o2.read_contacts = false;  // their loads alone
     for (std::size_t k = 0; k < order.size() && k < 6; ++k) o2.series_of.push_back(order[k]->id);
     say("the chest loads over time of the " + std::to_string(o2.series_of.size()) + " most exposed of " + r.file.string());
     const RunRisk again = AnalyseRunRisk(r.file, o2);
