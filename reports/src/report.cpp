@@ -53,6 +53,8 @@ namespace {
 constexpr const char* kGenerator = "<meta name=\"generator\" content=\"crowdrecon report\">";
 constexpr std::array<const char*, kZones> kZoneColor = {"#2e8b57", "#e0a800", "#c0392b"};
 constexpr const char* kOtherColor = "#7b3f98";
+// Runs of at least this many frames get progress lines during their pass.
+constexpr std::size_t kFramesForProgress = 1000;
 
 // Counts whole (a median of an even number of runs may end in .5); other
 // values with `digits` significant digits.
@@ -538,6 +540,12 @@ ReportSummary WriteReport(const ReportOptions& options) {
   const analysis::PlausibilityOptions validity_options;
   RiskOptions with_validity = options.risk;
   with_validity.validity = validity_options;
+  // A long run's pass takes minutes: a line at each tenth of its frames.
+  const auto tenths = [&](std::size_t done, std::size_t total) {
+    if (total >= kFramesForProgress && done * 10 / total != (done - 1) * 10 / total)
+      say("  " + std::to_string(done * 100 / total) + " % of its " + std::to_string(total) + " frames");
+  };
+  if (options.progress) with_validity.progress = tenths;
   const auto analyse = [&](const std::vector<fs::path>& files) {
     std::vector<RunRisk> runs;
     for (std::size_t k = 0; k < files.size(); ++k) {
@@ -821,7 +829,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
       return a->dose != b->dose ? a->dose > b->dose : a->max_load_n > b->max_load_n;
     });
     RiskOptions o2 = o;
-    o2.progress = nullptr;
+    o2.progress = options.progress ? std::function<void(std::size_t, std::size_t)>(tenths) : nullptr;
     o2.validity.reset();
     o2.read_contacts = false;  // their loads alone
     for (std::size_t k = 0; k < order.size() && k < 6; ++k) o2.series_of.push_back(order[k]->id);
