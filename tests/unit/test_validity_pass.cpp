@@ -5,6 +5,7 @@
 // range and the same largest overlap, whether that comes from the contacts
 // the risk pass streams or from the contact table.
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -34,15 +35,22 @@ void ExpectSame(const analysis::Plausibility& a, const analysis::Plausibility& b
   EXPECT_EQ(a.verdict, b.verdict);
 }
 
-TEST(ValidityPass, TheAnalysisAndTheRiskPassGiveWhatTheValidityAloneGives) {
-  // 12 people in head-on counter-flow, 21 frames with contacts: the bodies
-  // press into each other after the first frames, so the largest overlap and
-  // the densest moment lie inside the run, not at its first frame.
-  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "validity-pass.sqlite";
+// 12 people in head-on counter-flow, 21 frames at 10 fps with contacts and
+// chest loads.
+std::filesystem::path CounterFlowRun(const std::string& name) {
+  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / name;
   std::filesystem::remove(file);
   const engine::testing::CorridorScene scene;
   engine::Simulation sim(engine::testing::CounterFlowCorridor(engine::testing::ThoraxLikeShape(), scene));
   engine::testing::WriteCorridorRun(file, sim, scene, 21, 10.0, /*record_periodic_box=*/true);
+  return file;
+}
+
+TEST(ValidityPass, TheAnalysisAndTheRiskPassGiveWhatTheValidityAloneGives) {
+  // 12 people in head-on counter-flow, 21 frames with contacts: the bodies
+  // press into each other after the first frames, so the largest overlap and
+  // the densest moment lie inside the run, not at its first frame.
+  const std::filesystem::path file = CounterFlowRun("validity-pass.sqlite");
 
   const analysis::Plausibility alone = analysis::ComputePlausibility(file);
   ASSERT_EQ(alone.frames, 21u);
@@ -78,11 +86,7 @@ TEST(ValidityPass, TheAnalysisAndTheRiskPassGiveWhatTheValidityAloneGives) {
 // where the run records its chest loads, everyone's exposure is the same
 // and the validity's largest overlap comes from the table instead.
 TEST(ValidityPass, TheLoadsAloneNeedNoContactsWhereTheRunRecordsThem) {
-  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "loads-alone.sqlite";
-  std::filesystem::remove(file);
-  const engine::testing::CorridorScene scene;
-  engine::Simulation sim(engine::testing::CounterFlowCorridor(engine::testing::ThoraxLikeShape(), scene));
-  engine::testing::WriteCorridorRun(file, sim, scene, 21, 10.0, /*record_periodic_box=*/true);
+  const std::filesystem::path file = CounterFlowRun("loads-alone.sqlite");
 
   RiskOptions options;
   options.validity = analysis::PlausibilityOptions{};
