@@ -51,10 +51,11 @@ std::uint64_t ScenarioFingerprint(const Scenario& s) { return TextFingerprint(s.
 // engine's state (Simulation::SaveState), then each run-loop system's state
 // (count; per system its name and state, each as a length and bytes).
 // Version 1 (no system states) is still read.
-// The run value that keeps a run's wall time over all its invocations.
-constexpr char kWallSecondsKey[] = "wall_s";
 constexpr char kCheckpointMagic[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '2'};
 constexpr char kCheckpointMagicV1[8] = {'C', 'R', 'C', 'H', 'E', 'C', 'K', '1'};
+
+// The run value that keeps a run's wall time over all its invocations.
+constexpr char kWallSecondsKey[] = "wall_s";
 
 struct Checkpoint {
   std::int64_t last_frame = -1;
