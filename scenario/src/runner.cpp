@@ -291,13 +291,18 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
   header.seed = scenario.population.seed;
   if (!scenario.timeline.enabled) return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
   // A timeline's people: those of the start, then every arrival the schedule
-  // may bring (ids in that order, BuiltTimeline), whether or not they come.
+  // may bring, each at its id (BuiltTimeline), whether or not they come.
   runfile::RunSetup setup = RunSetupOf(sim, built.target_names);
-  setup.people.resize(built.timeline.initial_people);
-  for (const auto& list : built.timeline.arrivals)
-    for (const engine::PersonDef& p : list)
-      setup.people.push_back({p.shape, p.mass_kg, p.inertia_kg_m2, p.desired_speed_m_per_s, p.group,
-                              built.target_names[p.target]});
+  const BuiltTimeline& t = built.timeline;
+  std::size_t people = t.initial_people;
+  for (const auto& list : t.arrivals) people += list.size();
+  setup.people.resize(people);  // every row past the start is an arrival's (ids are a permutation)
+  for (std::size_t f = 0; f < t.arrivals.size(); ++f)
+    for (std::size_t k = 0; k < t.arrivals[f].size(); ++k) {
+      const engine::PersonDef& p = t.arrivals[f][k];
+      setup.people[t.arrival_id[f][k]] = {p.shape, p.mass_kg, p.inertia_kg_m2, p.desired_speed_m_per_s, p.group,
+                                          built.target_names[p.target]};
+    }
   return {CreateRunFileOf(options.output, header, sim, setup), -1, {}};
 }
 
@@ -575,7 +580,11 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     progress.simulated_s = options.simulated_s;
     loop.Add(std::make_unique<detail::ProgressSystem>(progress));
   }
-  loop.LoadStates(opened.systems);
+  try {
+    loop.LoadStates(opened.systems);
+  } catch (const InputError& e) {  // (the file that holds the states)
+    throw InputError(checkpoint.string() + ": " + e.what());
+  }
 
   // 6. Run; a run that goes numerically wrong stops with its state saved.
   std::string status = "complete";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -156,8 +157,43 @@ double RateSchedule::Integral(double a, double b) const {
   return Cumulative(b) - Cumulative(a);
 }
 
+double RateSchedule::TimeOfCumulative(double count) const {
+  if (points.empty()) return std::numeric_limits<double>::infinity();
+  if (prefix.size() != points.size()) {  // not prepared: as Cumulative
+    RateSchedule copy = *this;
+    copy.Prepare();
+    return copy.TimeOfCumulative(count);
+  }
+  if (!(count > 0.0)) return points.front().first;
+  // The first point by which the integral has reached `count`, if any.
+  const std::size_t k = static_cast<std::size_t>(std::lower_bound(prefix.begin(), prefix.end(), count) - prefix.begin());
+  if (k == points.size()) {  // after the last point the rate stays at its last value
+    const auto& [t_last, r_last] = points.back();
+    if (!(r_last > 0.0)) return std::numeric_limits<double>::infinity();
+    return t_last + (count - prefix.back()) / r_last;
+  }
+  // Within the piece [k - 1, k] (k >= 1: prefix[0] = 0 < count).
+  const auto& [t0, r0] = points[k - 1];
+  const auto& [t1, r1] = points[k];
+  const double need = count - prefix[k - 1];
+  double s = 0.0;
+  if (!linear || r1 == r0) {
+    s = need / r0;  // r0 > 0: the piece adds to the integral
+  } else {
+    // r0 s + a s^2 = need, a = (r1 - r0) / (2 (t1 - t0)); the root in a
+    // form without cancellation.
+    const double a = 0.5 * (r1 - r0) / (t1 - t0);
+    s = 2.0 * need / (r0 + std::sqrt(std::max(0.0, r0 * r0 + 4.0 * a * need)));
+  }
+  return std::min(t0 + s, t1);
+}
+
 std::size_t ArrivalsDue(const RateSchedule& rate, double t_s) {
   return static_cast<std::size_t>(std::floor(rate.Integral(0.0, t_s) + 1e-9));  // (nothing is due before t = 0)
+}
+
+double ArrivalDueTime(const RateSchedule& rate, std::size_t k) {
+  return std::max(0.0, rate.TimeOfCumulative(rate.Cumulative(0.0) + static_cast<double>(k)));
 }
 
 RateSchedule ReadRateCsv(const std::filesystem::path& file) {

@@ -24,7 +24,12 @@ constexpr double kEventTolerance_s = 1e-9;
 constexpr double kRetryInterval_s = 0.1;
 // Places drawn per attempt for the queue's head.
 constexpr int kPlacesPerAttempt = 20;
-constexpr char kStateMagic[8] = {'T', 'L', 'I', 'N', 'E', '0', '0', '1'};
+// The timeline's checkpoint state; 002 since arrivals are numbered by the
+// time they are due (BuiltTimeline::arrival_id). A 001 state belongs to a
+// run whose person table numbers them inflow by inflow: this build would
+// give its later arrivals other people's rows, so it does not resume it.
+constexpr char kStateMagic[8] = {'T', 'L', 'I', 'N', 'E', '0', '0', '2'};
+constexpr char kStateMagicInflowByInflow[8] = {'T', 'L', 'I', 'N', 'E', '0', '0', '1'};
 
 std::size_t GroupIndex(const TimelineSpec& spec, const std::string& name) {
   return static_cast<std::size_t>(std::find(spec.groups.begin(), spec.groups.end(), name) - spec.groups.begin());
@@ -224,7 +229,7 @@ class InflowSystem : public RunSystem {
       p.position_m = at;
       p.angle_rad = theta;
       p.velocity_m_per_s = e * p.desired_speed_m_per_s;  // walking in at their own pace
-      const std::uint32_t id = s_.built.first_id[f] + static_cast<std::uint32_t>(k);
+      const std::uint32_t id = s_.built.arrival_id[f][k];
       sim.Spawn(slot, p, id);
       ++s_.placed[f];
       s_.Event(t, "enter", id, s_.spec.inflows[f].id + " at " + s_.spec.inflows[f].entry);
@@ -645,6 +650,10 @@ std::string TimelineState::SaveState() const {
 void TimelineState::LoadState(const std::string& state) {
   StateReader r(state, "the run's timeline");
   r.Need(sizeof kStateMagic);
+  if (state.compare(0, sizeof kStateMagic, std::string(kStateMagicInflowByInflow, sizeof kStateMagic)) == 0)
+    throw InputError("the timeline's state was written by an earlier build of crowdrecon, which numbered the arrivals "
+                     "inflow by inflow (this one numbers them by the time they are due): the run cannot be resumed "
+                     "by this build; run it again without --resume, or resume it with the build that began it");
   if (state.compare(0, sizeof kStateMagic, std::string(kStateMagic, sizeof kStateMagic)) != 0) r.Fail();
   for (std::size_t i = 0; i < sizeof kStateMagic; ++i) r.Get<char>();
   const std::size_t inflows = spec.inflows.size(), exits = scenario.venue.exits.size(), groups = spec.groups.size();

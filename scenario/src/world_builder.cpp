@@ -6,6 +6,7 @@
 #include <numbers>
 #include <optional>
 #include <random>
+#include <tuple>
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/narrow_phase.hpp"
@@ -353,6 +354,27 @@ std::uint32_t TargetIndex(const geometry::Venue& venue, BuiltWorld& built, const
   return static_cast<std::uint32_t>(built.target_names.size() - 1);
 }
 
+// The arrivals' run ids (BuiltTimeline::arrival_id): after the initial
+// people, by the time each is due, then by inflow, then in the inflow's order.
+void NumberArrivals(const TimelineSpec& timeline, BuiltTimeline& out) {
+  struct Due {
+    double time_s;
+    std::size_t inflow, k;
+  };
+  std::vector<Due> due;
+  out.arrival_id.assign(out.arrivals.size(), {});
+  for (std::size_t f = 0; f < out.arrivals.size(); ++f) {
+    out.arrival_id[f].resize(out.arrivals[f].size());
+    for (std::size_t k = 0; k < out.arrivals[f].size(); ++k)
+      due.push_back({ArrivalDueTime(timeline.inflows[f].rate, k + 1), f, k});
+  }
+  std::sort(due.begin(), due.end(), [](const Due& a, const Due& b) {
+    return std::tie(a.time_s, a.inflow, a.k) < std::tie(b.time_s, b.inflow, b.k);
+  });
+  for (std::size_t n = 0; n < due.size(); ++n)
+    out.arrival_id[due[n].inflow][due[n].k] = static_cast<std::uint32_t>(out.initial_people + n);
+}
+
 // The timeline's people to come (issue 20): per inflow, every arrival the
 // schedule can bring within the run (its rate integrated over the whole run,
 // as if always on), drawn from the population's rules with a seed of the
@@ -369,13 +391,11 @@ void AddArrivals(const Scenario& scenario, const geometry::Body& reference,
   engine::WorldDef& def = built.world;
   BuiltTimeline& out = built.timeline;
   out.initial_people = def.people.size();
-  std::uint32_t next_id = static_cast<std::uint32_t>(def.people.size());
   std::size_t total = 0;
   double smallest = 1e300;  // the smallest arriving body's area (m^2)
   for (std::size_t j = 0; j < timeline.inflows.size(); ++j) {
     const InflowSpec& inflow = timeline.inflows[j];
     const std::size_t count = ArrivalsDue(inflow.rate, scenario.run.duration_s);
-    out.first_id.push_back(next_id);
     out.arrivals.emplace_back();
     if (count == 0) continue;
     // A seed per inflow (splitmix64 of the population's seed and the index).
@@ -410,9 +430,9 @@ void AddArrivals(const Scenario& scenario, const geometry::Body& reference,
       p.target = target;
       out.arrivals.back().push_back(p);
     }
-    next_id += static_cast<std::uint32_t>(count);
     total += count;
   }
+  NumberArrivals(timeline, out);
   // Every target an event may give.
   for (const TimelineEvent& e : timeline.events)
     if (e.kind == TimelineEvent::Kind::kTarget) TargetIndex(venue, built, e.name);

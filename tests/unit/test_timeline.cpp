@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -98,6 +100,42 @@ TEST(RateSchedule, StepAndLinearIntegralsAreExact) {
   late.Prepare();
   EXPECT_DOUBLE_EQ(late.Integral(0.0, 5.0), 0.0);
   EXPECT_EQ(ArrivalsDue(late, 7.25), 4u);
+}
+
+// The time the k-th arrival is due inverts the schedule's integral, for
+// steps, linear pieces (the root of the quadratic), after the last point
+// (the last rate), and with points before t = 0 (nothing is due before 0).
+TEST(RateSchedule, TheTimeOfACountInvertsTheIntegral) {
+  RateSchedule step;
+  step.points = {{0.0, 1.0}, {10.0, 3.0}, {20.0, 0.0}};
+  step.Prepare();
+  EXPECT_DOUBLE_EQ(step.TimeOfCumulative(4.0), 4.0);
+  EXPECT_DOUBLE_EQ(step.TimeOfCumulative(16.0), 12.0);
+  EXPECT_DOUBLE_EQ(step.TimeOfCumulative(0.0), 0.0);
+  EXPECT_EQ(step.TimeOfCumulative(41.0), std::numeric_limits<double>::infinity()) << "the rate ends at 0 after 40";
+  RateSchedule linear;
+  linear.points = {{0.0, 1.0}, {10.0, 3.0}};
+  linear.linear = true;
+  linear.Prepare();
+  for (double t : {0.5, 3.0, 7.25, 9.99, 10.0, 14.0})
+    EXPECT_NEAR(linear.TimeOfCumulative(linear.Cumulative(t)), t, 1e-12) << t;
+  RateSchedule down = linear;  // a falling ramp, and one from 0
+  down.points = {{0.0, 3.0}, {10.0, 0.0}, {12.0, 0.0}, {14.0, 2.0}};
+  down.Prepare();
+  for (double t : {0.1, 5.0, 9.5, 12.5, 13.9, 20.0})
+    EXPECT_NEAR(down.TimeOfCumulative(down.Cumulative(t)), t, 1e-9) << t;
+  // The k-th arrival: due when ArrivalsDue reaches k (10 people before t = 0
+  // are not due).
+  RateSchedule early;
+  early.points = {{-5.0, 2.0}, {3.0, 0.5}};
+  early.Prepare();
+  for (std::size_t k = 1; k <= 9; ++k) {
+    const double t = ArrivalDueTime(early, k);
+    EXPECT_EQ(ArrivalsDue(early, t + 1e-6), k) << k;
+    EXPECT_EQ(ArrivalsDue(early, t - 1e-6), k - 1) << k;
+  }
+  EXPECT_DOUBLE_EQ(ArrivalDueTime(early, 1), 0.5);
+  EXPECT_DOUBLE_EQ(ArrivalDueTime(early, 7), 3.0 + 1.0 / 0.5);
 }
 
 // An inflow held back ("max_rate_per_s", issue 43's design question): the
@@ -610,6 +648,101 @@ TEST(Timeline, AnArrivalInAnEmptySlotIsANewcomerThoughItsIdIsThePlaceholders) {
     ExpectConservation(run);
     EXPECT_EQ(run.census.back().census.walking, static_cast<std::int64_t>(run.Kind("enter").size())) << entry;
   }
+}
+
+// Two inflows, the second starting later and faster (a timeline as the
+// Itaewon evening's): a person's id and row do not depend on how long the
+// run is. The shorter run's people are the longer run's first ones, row for
+// row, they enter at the same times under the same ids, and ids are given in
+// the order the arrivals are due. (Ids numbered inflow by inflow gave every
+// arrival of the second inflow another id in the longer run.)
+TEST(Timeline, AnArrivalsIdDoesNotDependOnHowLongTheRunIs) {
+  const auto run = [&](int seconds) {
+    return Simulate(Hallway(R"({"count": 0, "target": "to_exit", "counter_target": "to_court", "seed": 11})",
+                            R"({"duration_s": )" + std::to_string(seconds) +
+                                R"(, "output_fps": 4, "checkpoint_interval_s": 0, "contacts": false})",
+                            R"({"inflows": [{"id": "court", "entry": "from_court", "rate_per_s": 1.5},
+                                            {"id": "street", "entry": "from_outside", "group": "counter",
+                                             "rate_per_s": [[0, 0], [1, 2.5]]}]})"),
+                    "ids-" + std::to_string(seconds) + "s");
+  };
+  const TimelineRun shorter = run(3), longer = run(6);
+  const std::vector<runfile::Person> a = runfile::RunFileReader(shorter.file).People();
+  const std::vector<runfile::Person> b = runfile::RunFileReader(longer.file).People();
+  const auto shapes_a = runfile::RunFileReader(shorter.file).Shapes();
+  const auto shapes_b = runfile::RunFileReader(longer.file).Shapes();
+  // 1.5 x 3 + 2.5 x 2 arrivals against 1.5 x 6 + 2.5 x 5.
+  ASSERT_EQ(a.size(), 4u + 5u);
+  ASSERT_EQ(b.size(), 9u + 12u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE("person " + std::to_string(i + 1));
+    EXPECT_EQ(a[i].group, b[i].group);
+    EXPECT_EQ(a[i].target, b[i].target);
+    EXPECT_EQ(a[i].mass_kg, b[i].mass_kg);
+    EXPECT_EQ(a[i].desired_speed_m_per_s, b[i].desired_speed_m_per_s);
+    EXPECT_EQ(shapes_a[a[i].shape].vertices, shapes_b[b[i].shape].vertices);
+  }
+  // Due: court 0.67, 1.33 s; street 1.4, 1.8; court 2.0; street 2.2, 2.6;
+  // court 2.67; street 3.0: the groups interleave in the table.
+  const std::uint32_t court = a[0].group, street = court == 0 ? 1 : 0;
+  const std::vector<std::uint32_t> due_order = {court, court, street, street, court, street, street, court, street};
+  std::vector<std::uint32_t> groups;
+  for (const runfile::Person& p : a) groups.push_back(p.group);
+  EXPECT_EQ(groups, due_order);
+  const std::vector<runfile::Event> enter_a = shorter.Kind("enter"), enter_b = longer.Kind("enter");
+  ASSERT_GE(enter_a.size(), 8u);
+  ASSERT_GT(enter_b.size(), enter_a.size());
+  for (std::size_t n = 0; n < enter_a.size(); ++n) {
+    EXPECT_EQ(enter_a[n].person, enter_b[n].person) << n;
+    EXPECT_EQ(enter_a[n].time_s, enter_b[n].time_s) << n;
+  }
+  // With the entries free, people enter in the order they are due: by id.
+  for (std::size_t n = 1; n < enter_b.size(); ++n) EXPECT_GT(enter_b[n].person, enter_b[n - 1].person) << n;
+}
+
+// A checkpoint of a build that numbered arrivals inflow by inflow is not
+// resumed by this one (its person table would not match), with a message
+// that says why and what to do.
+TEST(Timeline, ACheckpointThatNumberedArrivalsInflowByInflowIsNotResumed) {
+  const Scenario s = ParseScenario(
+      Hallway(R"({"count": 0, "target": "to_exit", "seed": 3})",
+              R"({"duration_s": 3, "output_fps": 4, "checkpoint_interval_s": 0.5, "contacts": false})",
+              R"({"inflows": [{"id": "in", "entry": "from_court", "rate_per_s": 1.5}]})"),
+      "old-checkpoint.json", kSource);
+  RunOptions options;
+  options.output = crowdrecon::testing::ScratchFile("old-checkpoint.sqlite");
+  std::filesystem::remove(options.output);
+  std::filesystem::remove(CheckpointPath(options.output));
+  options.stop_after_s = 1.0;
+  ASSERT_EQ(RunScenario(s, options).status, "interrupted");
+  // The timeline's state as the earlier build wrote it: its magic 001.
+  const std::filesystem::path checkpoint = CheckpointPath(options.output);
+  std::string bytes;
+  {
+    std::ifstream in(checkpoint, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t at = bytes.find("TLINE002");
+  ASSERT_NE(at, std::string::npos);
+  const auto write = [&](const std::string& b) {
+    std::ofstream out(checkpoint, std::ios::binary | std::ios::trunc);
+    out << b;
+  };
+  std::string earlier = bytes;
+  earlier[at + 7] = '1';
+  write(earlier);
+  options.resume = true;
+  options.stop_after_s = -1.0;
+  try {
+    RunScenario(s, options);
+    ADD_FAILURE() << "a 001 checkpoint was resumed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(checkpoint.string(), 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("inflow by inflow"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("without --resume"), std::string::npos) << e.what();
+  }
+  write(bytes);  // the same checkpoint as this build wrote it resumes
+  EXPECT_EQ(RunScenario(s, options).status, "complete");
 }
 
 // A run's wall time (run value wall_s) counts every invocation of a resumed

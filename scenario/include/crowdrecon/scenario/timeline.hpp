@@ -71,6 +71,10 @@ struct RateSchedule {
   double Cumulative(double t_s) const;
   // The integral over [a, b]: Cumulative(b) - Cumulative(a), 0 if b <= a.
   double Integral(double a_s, double b_s) const;
+  // The inverse of Cumulative: the first time by which the integral reaches
+  // `count` (the first point's time for count <= 0; +infinity where the
+  // rate after the last point is 0 and the schedule never brings it).
+  double TimeOfCumulative(double count) const;
 };
 
 struct InflowSpec {
@@ -201,5 +205,10 @@ RateSchedule ReadRateCsv(const std::filesystem::path& file);
 // The number of arrivals due by time t for a schedule always on: floor of
 // the integral from 0 (the pool the world is built with).
 std::size_t ArrivalsDue(const RateSchedule& rate, double t_s);
+// When the k-th arrival (k >= 1) of such a schedule is due: the time the
+// integral from 0 reaches k (where ArrivalsDue reaches k, but for its
+// tolerance of 1e-9 people). It does not depend on how long a run is (the order
+// in which a timeline numbers its arrivals, BuiltTimeline).
+double ArrivalDueTime(const RateSchedule& rate, std::size_t k);
 
 }  // namespace crowdrecon::scenario

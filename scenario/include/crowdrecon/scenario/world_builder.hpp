@@ -33,10 +33,13 @@ namespace crowdrecon::scenario {
 struct BuiltTimeline {
   std::size_t initial_people = 0;
   // Per inflow, each arrival in order (body, mass, desired speed, group,
-  // target; the pose is chosen when they enter), and the run id (person
-  // index) of its first: ids run on inflow by inflow after the initial people.
+  // target; the pose is chosen when they enter), and each arrival's run id
+  // (person index). Ids run on after the initial people in the order the
+  // arrivals are due (ArrivalDueTime; at one time, inflow by inflow), so
+  // that a person's id, like their body, does not depend on how long the
+  // run is: a longer run only adds people with higher ids.
   std::vector<std::vector<engine::PersonDef>> arrivals;
-  std::vector<std::uint32_t> first_id;
+  std::vector<std::vector<std::uint32_t>> arrival_id;
   std::vector<std::uint32_t> exit_wall;  // per venue exit: the engine wall of its door
 };
 
