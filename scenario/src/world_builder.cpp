@@ -391,6 +391,7 @@ void AddArrivals(const Scenario& scenario, const geometry::Body& reference,
   engine::WorldDef& def = built.world;
   BuiltTimeline& out = built.timeline;
   out.initial_people = def.people.size();
+  const std::size_t first_shape = def.shapes.size();  // the arrivals' shapes follow the world's
   std::size_t total = 0;
   double smallest = 1e300;  // the smallest arriving body's area (m^2)
   for (std::size_t j = 0; j < timeline.inflows.size(); ++j) {
@@ -433,6 +434,16 @@ void AddArrivals(const Scenario& scenario, const geometry::Body& reference,
     total += count;
   }
   NumberArrivals(timeline, out);
+  // Each arrival's shape at the place of its id, so that the shape table, as
+  // the person table, does not depend on how long the run is.
+  const std::vector<engine::BodyShape> drawn(def.shapes.begin() + static_cast<std::ptrdiff_t>(first_shape), def.shapes.end());
+  for (std::size_t f = 0; f < out.arrivals.size(); ++f)
+    for (std::size_t k = 0; k < out.arrivals[f].size(); ++k) {
+      engine::PersonDef& p = out.arrivals[f][k];
+      const std::size_t to = first_shape + (out.arrival_id[f][k] - out.initial_people);
+      def.shapes[to] = drawn[p.shape - first_shape];
+      p.shape = static_cast<std::uint32_t>(to);
+    }
   // Every target an event may give.
   for (const TimelineEvent& e : timeline.events)
     if (e.kind == TimelineEvent::Kind::kTarget) TargetIndex(venue, built, e.name);

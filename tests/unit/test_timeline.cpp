@@ -680,6 +680,7 @@ TEST(Timeline, AnArrivalsIdDoesNotDependOnHowLongTheRunIs) {
     EXPECT_EQ(a[i].target, b[i].target);
     EXPECT_EQ(a[i].mass_kg, b[i].mass_kg);
     EXPECT_EQ(a[i].desired_speed_m_per_s, b[i].desired_speed_m_per_s);
+    EXPECT_EQ(a[i].shape, b[i].shape);
     EXPECT_EQ(shapes_a[a[i].shape].vertices, shapes_b[b[i].shape].vertices);
   }
   // Due: court 0.67, 1.33 s; street 1.4, 1.8; court 2.0; street 2.2, 2.6;

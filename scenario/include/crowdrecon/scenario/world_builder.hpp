@@ -37,7 +37,8 @@ struct BuiltTimeline {
   // (person index). Ids run on after the initial people in the order the
   // arrivals are due (ArrivalDueTime; at one time, inflow by inflow), so
   // that a person's id, like their body, does not depend on how long the
-  // run is: a longer run only adds people with higher ids.
+  // run is: a longer run only adds people with higher ids. Their shapes
+  // follow the world's in the same order (shape = first + id - initial).
   std::vector<std::vector<engine::PersonDef>> arrivals;
   std::vector<std::vector<std::uint32_t>> arrival_id;
   std::vector<std::uint32_t> exit_wall;  // per venue exit: the engine wall of its door
