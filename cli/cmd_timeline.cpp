@@ -65,7 +65,7 @@ sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
     if (nd == 0 || nc == 0) continue;
     path.points.emplace_back(d / static_cast<double>(nd), c / static_cast<double>(nc));
     if (std::fmod(a - t0 + 1e-9, label_every) < step_s * 0.5)
-      path.labels.emplace_back(path.points.size() - 1, analysis::ClockText(s.clock_start, a));
+      path.labels.emplace_back(path.points.size() - 1, s.clock.Text(a));
   }
   path.caption = "path of " + s.run_file + ": density and counter-flow share, " + FormatNumber(step_s) +
                  "-s means (clamped to the diagram's range)";
@@ -166,8 +166,8 @@ void RunTimeline(const TimelineArgs& args) {
     std::printf("wrote %s\n", f.c_str());
   }
   std::printf("%zu frames from %s to %s; %zu avalanches and %zu falls in the run; %zu recorded marks\n",
-              s.time_s.size(), analysis::ClockText(s.clock_start, s.time_s.front()).c_str(),
-              analysis::ClockText(s.clock_start, s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
+              s.time_s.size(), s.clock.Text(s.time_s.front()).c_str(),
+              s.clock.Text(s.time_s.back()).c_str(), s.avalanches.size(), s.falls.size(),
               s.recorded.size());
   SayIfUnfinished(args.run);
   std::printf("validity: %s\n", s.validity.Statement(analysis::PlausibilityOptions{}).c_str());
@@ -175,13 +175,13 @@ void RunTimeline(const TimelineArgs& args) {
     const geometry::Venue venue =
         geometry::ParseVenue(runfile::RunFileReader(args.run).venue_json(), args.run + ": run value venue");
     for (const std::string& f : args.density_maps) {
-      viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock_start, f);
+      viz::DrawDensityMaps(maps, venue, "Density: " + (title.empty() ? args.run : title), s.clock, f);
       std::printf("wrote %s\n", f.c_str());
     }
     for (const analysis::DensityMap& m : maps)
       std::printf("density at %s: %zu people, densest %.2f persons/m2\n",
-                  s.clock_start.empty() ? ("t = " + FormatNumber(m.time_s) + " s").c_str()
-                                        : analysis::ClockText(s.clock_start, m.time_s).c_str(),
+                  s.clock.start.empty() ? ("t = " + FormatNumber(m.time_s) + " s").c_str()
+                                        : s.clock.Text(m.time_s).c_str(),
                   m.people, m.max_per_m2);
   }
 }

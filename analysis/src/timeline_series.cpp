@@ -65,16 +65,27 @@ double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit) {
   return 0.8 * total / (t90 - t10) / s.exit_width_m[exit];
 }
 
-std::string ClockText(const std::string& clock_start, double t_s) {
+std::string RunClock::Text(double t_s) const {
   char text[32];
-  if (clock_start.size() != 5) {
-    std::snprintf(text, sizeof text, "%.0f min", t_s / 60.0);
+  const double incident_s = t_s * scale;
+  if (start.size() != 5) {
+    std::snprintf(text, sizeof text, "%.0f min", incident_s / 60.0);
     return text;
   }
-  const int start = std::stoi(clock_start.substr(0, 2)) * 60 + std::stoi(clock_start.substr(3, 2));
-  const int minutes = (start + static_cast<int>(std::floor(t_s / 60.0 + 1e-9))) % (24 * 60);
+  const int first = std::stoi(start.substr(0, 2)) * 60 + std::stoi(start.substr(3, 2));
+  const int minutes = (first + static_cast<int>(std::floor(incident_s / 60.0 + 1e-9))) % (24 * 60);
   std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);
   return text;
+}
+
+std::string RunClock::TickText(double t_s, double tick_s) const {
+  return tick_s * scale >= 60.0 ? Text(t_s) : FormatNumber(t_s) + " s";
+}
+
+std::string RunClock::AxisLabel() const {
+  if (start.empty()) return "time of the run";
+  if (scale == 1.0) return "time of night (run time 0 = " + start + ")";
+  return "time of night (run time 0 = " + start + "; a second of the run stands for " + FormatNumber(scale) + " s)";
 }
 
 TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smooth_s) {
@@ -82,7 +93,13 @@ TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smo
   TimelineSeries s;
   s.run_file = run_file.string();
   s.smooth_s = smooth_s;
-  s.clock_start = reader.RunValue("timeline_clock_start");
+  s.clock.start = reader.RunValue("timeline_clock_start");
+  if (const std::string scale = reader.RunValue("timeline_clock_scale"); !scale.empty()) {
+    s.clock.scale = std::strtod(scale.c_str(), nullptr);
+    if (!(s.clock.scale > 0.0) || !std::isfinite(s.clock.scale))
+      throw InputError(run_file.string() + ": run value timeline_clock_scale \"" + scale +
+                       "\" is not a positive number of the incident's seconds per run second");
+  }
   const std::string venue = reader.venue_json();
   if (venue.empty()) throw InputError(run_file.string() + ": the run file holds no venue (written before format 2)");
   const geometry::Venue stored = geometry::ParseVenue(venue, run_file.string() + ": run value venue");

@@ -41,9 +41,9 @@ std::string LabelOf(const std::filesystem::path& file, const runfile::RunFileRea
   return seed.empty() ? file.filename().string() : "seed " + seed;
 }
 
-std::string Clock(const std::string& clock_start, double t) {
+std::string Clock(const analysis::RunClock& clock, double t) {
   if (std::isnan(t)) return "never";
-  return clock_start.empty() ? FormatFixed(t, 1) + " s" : analysis::ClockText(clock_start, t);
+  return clock.start.empty() ? FormatFixed(t, 1) + " s" : clock.Text(t);
 }
 
 std::string SpreadText(const Spread& s, int decimals, const std::string& unit = "") {
@@ -70,7 +70,7 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
     r.label = LabelOf(run_file, reader);
   }
   const analysis::TimelineSeries s = analysis::ComputeTimeline(run_file, options.smooth_s);
-  r.clock_start = s.clock_start;
+  r.clock = s.clock;
   r.end_s = s.time_s.empty() ? 0.0 : s.time_s.back();
   for (const analysis::TimelineMark& a : options.area_avalanches ? analysis::AvalanchesWithAreas(s) : s.avalanches) {
     r.avalanche_s.push_back(a.time_s);
@@ -115,7 +115,7 @@ EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions
     return true;
   };
   for (const EnsembleRun& r : runs)
-    if (!same_marks(r.recorded, runs.front().recorded) || r.clock_start != runs.front().clock_start)
+    if (!same_marks(r.recorded, runs.front().recorded) || r.clock != runs.front().clock)
       throw InputError(r.run_file + ": its recorded marks or clock differ from those of " + runs.front().run_file +
                        "; an ensemble is runs of one incident's scenario");
   EnsembleScore s;
@@ -167,7 +167,7 @@ EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions
 
 std::string EnsembleScore::Markdown() const {
   std::ostringstream o;
-  const std::string clock = runs.front().clock_start;
+  const analysis::RunClock clock = runs.front().clock;
   const std::size_t n = runs.size();
   o << "| recorded | at | runs with an avalanche within ±" << FormatNumber(options.tolerance_s) << " s |\n";
   o << "| --- | --- | --- |\n";
@@ -250,7 +250,7 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
   const double height = rows_top + static_cast<double>(n) * kRow + 70;
   viz::Canvas canvas(file, {0, 0}, {kWidth, height}, 1.0, 0.0);
   const auto P = [&](double x, double y) { return Vec2{x, height - y}; };
-  const std::string clock = score.runs.front().clock_start;
+  const analysis::RunClock clock = score.runs.front().clock;
   double t1 = 1.0;
   for (const EnsembleRun& r : score.runs) t1 = std::max(t1, r.end_s);
   const double t0 = 0.0;
@@ -352,10 +352,10 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
   for (double t = 0.0; t <= t1 + 1e-9; t += tick) {
     canvas.Line(P(X(t), rows_bottom), P(X(t), rows_bottom + 4), kInk, 1.0);
     canvas.Line(P(X(t), bottom), P(X(t), bottom + 4), kInk, 1.0);
-    canvas.TextPxAligned(X(t), rows_bottom + 8, tick >= 60.0 ? Clock(clock, t) : FormatNumber(t) + " s", 12, 0.5, 0.0, kInk);
+    canvas.TextPxAligned(X(t), rows_bottom + 8, clock.TickText(t, tick), 12, 0.5, 0.0, kInk);
   }
   canvas.TextPxAligned(0.5 * (kLeft + kRight), rows_bottom + 30,
-                       clock.empty() ? "time of the run" : "time of night (run time 0 = " + clock + ")", 13, 0.5, 0.0, kInk);
+                       clock.AxisLabel(), 13, 0.5, 0.0, kInk);
   // Legend, right of the density panel.
   double ly = top + 4;
   const double lx = kRight + 12;

@@ -479,6 +479,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     writer.SetRunValue("groups", groups);
     // What the figure marks (timeline.hpp: RecordedMark), as JSON.
     if (!scenario.timeline.clock_start.empty()) writer.SetRunValue("timeline_clock_start", scenario.timeline.clock_start);
+    if (scenario.timeline.clock_scale != 1.0)
+      writer.SetRunValue("timeline_clock_scale", FormatNumber(scenario.timeline.clock_scale));
     nlohmann::json marks = nlohmann::json::array();
     for (const RecordedMark& m : scenario.timeline.recorded) {
       marks.push_back({{"time_s", m.time_s}, {"label", m.label}, {"kind", m.kind}});

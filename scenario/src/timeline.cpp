@@ -425,6 +425,7 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
                     std::stoi(c.substr(0, 2)) < 24 && std::stoi(c.substr(3, 2)) < 60;
     if (!ok) clock->Fail("\"" + c + "\" is not a time of day; expected \"HH:MM\" (24-hour clock)");
   }
+  t.clock_scale = reader.Number("clock_scale", 1.0, 1e-3, 1e4);
   if (auto recorded = reader.Find("recorded")) {
     if (!recorded->IsArray()) recorded->Fail("expected a list of marks [{\"time_s\": ..., \"label\": ...}]");
     for (std::size_t k = 0; k < recorded->Size(); ++k) {

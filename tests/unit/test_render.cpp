@@ -425,7 +425,7 @@ TEST(TimelineFigure, EachKindOfRecordedMarkIsDrawnAndNamedAsItself) {
     ts.time_s.push_back(i);
     ts.density_per_m2.push_back(1.0 + 0.01 * i);
   }
-  ts.clock_start = "21:45";
+  ts.clock.start = "21:45";
   ts.recorded = {{60, "22:46 police call", "other"}, {120, "22:47 the crush", "fatal"}};
   const std::filesystem::path svg = dir.path() / "t.svg";
   viz::DrawTimelineFigure(ts, "marks", svg);

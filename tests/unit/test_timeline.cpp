@@ -527,6 +527,8 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
          "/timeline/inflows/0/rate_scale: scales inflow \"inflow1\"'s rate 200 persons/s at 0 s beyond 1000 persons/s");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": 1, "max_rate_per_s": "slow"}]})", "/timeline/inflows/0/max_rate_per_s");
   refuse(R"({"rate_scale": 11, "inflows": []})", "/timeline/rate_scale: value 11 is out of range");
+  refuse(R"({"clock_start": "21:45", "clock_scale": 0, "inflows": []})", "/timeline/clock_scale: value 0 is out of range");
+  refuse(R"({"clock_scale": "tenfold", "inflows": []})", "/timeline/clock_scale");
   refuse(R"({"rate_scale": 6, "inflows": [{"entry": "from_court", "rate_per_s": 200}]})",
          "/timeline/rate_scale: scales inflow \"inflow1\"'s rate 200 persons/s at 0 s beyond 1000 persons/s");
   refuse(R"({"rate_scale": 2, "inflows": [{"entry": "from_court", "rate_per_s": 200, "rate_scale": 3}]})",
@@ -647,6 +649,43 @@ TEST(Timeline, AnArrivalInAnEmptySlotIsANewcomerThoughItsIdIsThePlaceholders) {
     EXPECT_TRUE(run.Kind("exit").empty()) << entry << ": " << run.Kind("exit").size() << " left at once";
     ExpectConservation(run);
     EXPECT_EQ(run.census.back().census.walking, static_cast<std::int64_t>(run.Kind("enter").size())) << entry;
+  }
+}
+
+// A compressed scenario's clock (timeline.clock_scale): the figures, maps
+// and scores give the incident's time, run time x scale after the start.
+TEST(RunClock, ACompressedRunsClockGivesTheIncidentsTime) {
+  const analysis::RunClock night{"21:45", 10.0};
+  EXPECT_EQ(night.Text(0.0), "21:45");
+  EXPECT_EQ(night.Text(180.0), "22:15");
+  EXPECT_EQ(night.Text(269.9), "22:29");
+  EXPECT_EQ(night.TickText(30.0, 30.0), "21:50") << "a tick of 30 run seconds spans 5 minutes of the night";
+  EXPECT_EQ(night.AxisLabel(), "time of night (run time 0 = 21:45; a second of the run stands for 10 s)");
+  const analysis::RunClock plain{"02:00", 1.0};
+  EXPECT_EQ(plain.Text(37 * 60.0 + 59.0), "02:37");
+  EXPECT_EQ(plain.Text(23 * 3600.0), "01:00") << "past midnight";
+  EXPECT_EQ(plain.TickText(30.0, 30.0), "30 s");
+  EXPECT_EQ(plain.AxisLabel(), "time of night (run time 0 = 02:00)");
+  const analysis::RunClock none{"", 20.0};
+  EXPECT_EQ(none.Text(285.0), "95 min");
+  EXPECT_EQ(none.AxisLabel(), "time of the run");
+}
+
+// The scale travels through the run file (run value timeline_clock_scale,
+// written only where it is not 1) to the series the figures read.
+TEST(RunClock, TheScaleReachesTheSeriesThroughTheRunFile) {
+  for (const double scale : {1.0, 10.0}) {
+    const TimelineRun run = Simulate(
+        Hallway(R"({"count": 0, "target": "to_exit", "seed": 3})",
+                R"({"duration_s": 1, "output_fps": 4, "checkpoint_interval_s": 0, "contacts": false})",
+                R"({"clock_start": "21:45", "clock_scale": )" + FormatNumber(scale) +
+                    R"(, "inflows": [{"id": "in", "entry": "from_court", "rate_per_s": 1.5}]})"),
+        "clock-scale-" + FormatNumber(scale));
+    EXPECT_EQ(run.Value("timeline_clock_scale"), scale == 1.0 ? "" : "10");
+    const analysis::TimelineSeries series = analysis::ComputeTimeline(run.file, 0.0);
+    EXPECT_EQ(series.clock.start, "21:45");
+    EXPECT_EQ(series.clock.scale, scale);
+    EXPECT_EQ(series.clock.Text(6.0), scale == 1.0 ? "21:45" : "21:46");
   }
 }
 

@@ -28,7 +28,7 @@ Color Scale(double f) {
 }  // namespace
 
 void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geometry::Venue& venue,
-                     const std::string& title, const std::string& clock_start, const std::filesystem::path& file) {
+                     const std::string& title, const analysis::RunClock& clock, const std::filesystem::path& file) {
   if (maps.empty()) throw InputError(file.string() + ": no density map to draw");
   const analysis::DensityMap& first = maps.front();
   const double w = double(first.nx) * first.cell_m, h = double(first.ny) * first.cell_m;
@@ -71,8 +71,8 @@ void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geomet
       c.Line(s.a + shift, s.b + shift, Color::Hex(0x222222), std::max(1.5, 2.0 * s.radius_m * ppm));
     for (const geometry::Exit& e : venue.exits) c.Line(e.a + shift, e.b + shift, Color::Hex(0x1a9850), 4.0);
     char label[160];
-    const std::string when = clock_start.empty() ? "t = " + FormatNumber(std::round(m.time_s * 10.0) / 10.0) + " s"
-                                                 : analysis::ClockText(clock_start, m.time_s);
+    const std::string when = clock.start.empty() ? "t = " + FormatNumber(std::round(m.time_s * 10.0) / 10.0) + " s"
+                                                 : clock.Text(m.time_s);
     std::snprintf(label, sizeof label, "%s: %zu people, densest %.1f /m2", when.c_str(), m.people, m.max_per_m2);
     c.Text({ox, oy + h + 0.25 * title_m}, label, 15);
   }

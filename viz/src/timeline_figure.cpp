@@ -170,12 +170,11 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   if (span < 600.0) tick = span / 6.0 > 30.0 ? 60.0 : 10.0;
   for (double t = std::ceil(t0 / tick) * tick; t <= t1 + 1e-9; t += tick) {
     for (const Panel& q : p) s.canvas.Line(s.P(q.X(t), q.bottom), s.P(q.X(t), q.bottom + 4), kInk, 1.0);
-    const std::string text = tick >= 60.0 ? analysis::ClockText(ts.clock_start, t) : Number(t) + " s";
+    const std::string text = ts.clock.TickText(t, tick);
     s.canvas.TextPxAligned(p.back().X(t), p.back().bottom + 8, text, 12, 0.5, 0.0, kInk);
   }
   s.canvas.TextPxAligned(0.5 * (kLeft + kRight), p.back().bottom + 28,
-                         ts.clock_start.empty() ? "time of the run" : "time of night (run time 0 = " + ts.clock_start + ")",
-                         13, 0.5, 0.0, kInk);
+                         ts.clock.AxisLabel(), 13, 0.5, 0.0, kInk);
   // Legend.
   double ly = kTop + 4;
   const double lx = kRight + 16;

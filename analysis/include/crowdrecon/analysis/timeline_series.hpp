@@ -34,9 +34,30 @@ struct TimelineMark {
   double rise_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
+// The clock of a timeline's run (the scenario's timeline.clock_start and
+// timeline.clock_scale; run values timeline_clock_start, timeline_clock_scale):
+// t seconds of the run stand for t x scale seconds of the incident after
+// `start` (a compressed scenario's scale: 10 for a night told ten times
+// faster).
+struct RunClock {
+  std::string start;   // "HH:MM" of t = 0, or "" (no clock)
+  double scale = 1.0;  // seconds of the incident per second of the run
+  // "02:37" for the incident's time at run time t; without a start, the
+  // incident's minutes ("37 min").
+  std::string Text(double t_s) const;
+  // A time axis' label at run time t with ticks every tick_s: the clock
+  // (Text) where a tick spans a minute of the incident or more, the run's
+  // seconds otherwise ("30 s").
+  std::string TickText(double t_s, double tick_s) const;
+  // The words under such an axis: "time of the run" without a start, else
+  // "time of night (run time 0 = 21:45)", with the scale where it is not 1.
+  std::string AxisLabel() const;
+  bool operator==(const RunClock&) const = default;
+};
+
 struct TimelineSeries {
   std::string run_file;
-  std::string clock_start;  // "HH:MM" of t = 0, or ""
+  RunClock clock;
   double area_m2 = 0.0;
   std::vector<double> time_s;
   std::vector<double> density_per_m2;
@@ -113,7 +134,5 @@ double ClogForGood(const TimelineSeries& s, double smooth_s = 10.0,
 // than 10 left).
 double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit);
 
-// "02:37" for t seconds after clock_start "02:00"; "" clock: minutes ("37 min").
-std::string ClockText(const std::string& clock_start, double t_s);
 
 }  // namespace crowdrecon::analysis

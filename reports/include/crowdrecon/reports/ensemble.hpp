@@ -59,7 +59,7 @@ struct EnsembleOptions {
 struct EnsembleRun {
   std::string run_file;
   std::string label;  // "seed 3", or the file's name (also where seeds repeat: ScoreEnsemble)
-  std::string clock_start;
+  analysis::RunClock clock;
   double end_s = 0.0;
   std::vector<double> avalanche_s;  // the run's avalanche events
   std::vector<double> rise_time_s;  // their rise times (NaN where the event gives none)

@@ -185,6 +185,11 @@ struct TimelineSpec {
   // The wall-clock time of t = 0 ("02:00", for the figure's axis), and what
   // was recorded of the incident (the figure marks it; the run ignores it).
   std::string clock_start;
+  // Seconds of the incident a second of the run stands for: 1, or a
+  // compressed scenario's factor (10: the evening told ten times faster), so
+  // that its figures, maps and scores give the incident's clock times
+  // (analysis::RunClock). The run's physics does not read it.
+  double clock_scale = 1.0;
   std::vector<RecordedMark> recorded;
 
   bool HasInflow() const { return !inflows.empty(); }

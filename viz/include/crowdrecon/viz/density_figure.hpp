@@ -8,13 +8,14 @@
 #include <vector>
 
 #include "crowdrecon/analysis/density_map.hpp"
+#include "crowdrecon/analysis/timeline_series.hpp"
 #include "crowdrecon/geometry/venue.hpp"
 
 namespace crowdrecon::viz {
 
-// Times are written as clock times when `clock_start` ("HH:MM") is given.
+// Times are written as the incident's clock times when the clock has a start.
 // Throws InputError if the file cannot be written or there is no map.
 void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geometry::Venue& venue,
-                     const std::string& title, const std::string& clock_start, const std::filesystem::path& file);
+                     const std::string& title, const analysis::RunClock& clock, const std::filesystem::path& file);
 
 }  // namespace crowdrecon::viz
