@@ -134,5 +134,4 @@ double ClogForGood(const TimelineSeries& s, double smooth_s = 10.0,
 // than 10 left).
 double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit);
 
-
 }  // namespace crowdrecon::analysis
