@@ -23,6 +23,7 @@ void RegisterReportCommand(CLI::App& app);  // report (injury risk of runs: HTML
 void RegisterObserveCommands(CLI::App& app);  // observe trajectories / footage (observations)
 void RegisterExportCommand(CLI::App& app);  // export (a run's trajectories for tools unaware of periodic boxes)
 void RegisterCalibrateCommand(CLI::App& app);  // calibrate (scenario values fitted to observations)
+void RegisterValidateCommand(CLI::App& app);  // validate (the validation suite on model profiles: report)
 
 // The command line as given (for the records of reports), set by RunCommandLine.
 const std::string& CommandLine();

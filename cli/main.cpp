@@ -21,5 +21,6 @@ int main(int argc, char** argv) {
   crowdrecon::cli::RegisterObserveCommands(app);
   crowdrecon::cli::RegisterExportCommand(app);
   crowdrecon::cli::RegisterCalibrateCommand(app);
+  crowdrecon::cli::RegisterValidateCommand(app);
   return crowdrecon::cli::RunCommandLine(app, argc, argv);
 }

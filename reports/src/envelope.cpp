@@ -9,7 +9,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
-#include "svg.hpp"
+#include "crowdrecon/reports/svg.hpp"
 
 namespace crowdrecon::reports {
 

@@ -1,4 +1,4 @@
-#include "svg.hpp"
+#include "crowdrecon/reports/svg.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -171,9 +171,18 @@ std::string Chart::ToSvg() const {
       }
       last_y = py;
     }
-    if (path.empty()) continue;
-    s += "<path d=\"" + path + "\" fill=\"none\" stroke=\"" + ser.color + "\" stroke-width=\"" + Num(ser.width) + "\"" +
-         (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
+    if (ser.marker_radius > 0.0)
+      for (std::size_t i = 0; i < ser.x.size(); ++i) {
+        if (!std::isfinite(ser.x[i]) || !std::isfinite(ser.y[i]) || (log_x && ser.x[i] <= 0) || (log_y && ser.y[i] <= 0))
+          continue;
+        s += "<circle cx=\"" + Num(cx(ser.x[i])) + "\" cy=\"" + Num(cy(ser.y[i])) + "\" r=\"" + Num(ser.marker_radius) +
+             "\" fill=\"" + ser.color + "\" fill-opacity=\"0.75\"/>\n";
+      }
+    if (!ser.line) path.clear();
+    if (path.empty() && ser.marker_radius <= 0.0) continue;
+    if (!path.empty())
+      s += "<path d=\"" + path + "\" fill=\"none\" stroke=\"" + ser.color + "\" stroke-width=\"" + Num(ser.width) +
+           "\"" + (ser.dashed ? " stroke-dasharray=\"6 4\"" : "") + "/>\n";
     if (!ser.label.empty()) {
       const double lx = legend_x;
       legend += "<line x1=\"" + Num(lx) + "\" y1=\"" + Num(legend_y) + "\" x2=\"" + Num(lx + 24) + "\" y2=\"" + Num(legend_y) +

@@ -1,6 +1,6 @@
 // Small SVG figures for the report, written as text to inline in its HTML
 // (no external files): line charts with log or linear axes and shaded bands,
-// and plan maps in metres. Internal to reports.
+// and plan maps in metres. Used by the reports and the validation report.
 #pragma once
 
 #include <string>
@@ -25,6 +25,8 @@ struct Series {
   bool dashed = false;
   bool step = false;  // a staircase (CDFs, counts per frame)
   std::string label;  // legend entry ("" = none)
+  double marker_radius = 0.0;  // > 0: a dot of this radius (px) at every point
+  bool line = true;            // false: the dots alone (a scatter)
 };
 
 struct Band {

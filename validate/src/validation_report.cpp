@@ -1,0 +1,459 @@
+// The validation report (validation_report.hpp): a summary table at the top,
+// the split between fitted and held-out tests, then a section per test with
+// its setup drawn, its criteria judged per profile and its figure (the
+// model's spread over seeds beside the data), and the record of what made it.
+#include "validation_report.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/common/csv.hpp"
+#include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/sha256.hpp"
+#include "crowdrecon/observe/fundamental_diagram.hpp"
+#include "crowdrecon/reports/html_page.hpp"
+#include "crowdrecon/reports/svg.hpp"
+#include "crowdrecon/sweep/results.hpp"
+
+namespace crowdrecon::validate {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+namespace svg = reports::svg;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+const char* const kProfileColor[] = {"#1f4e79", "#c0392b"};
+const char* const kDataColor = "#7f7f7f";
+
+std::string Esc(const std::string& s) { return svg::Escape(s); }
+
+std::string VerdictCell(Verdict v) {
+  const char* color = v == Verdict::kPass ? "#2e8b57" : v == Verdict::kFail ? "#c0392b" : v == Verdict::kError ? "#8e44ad" : "#666";
+  return "<b style=\"color:" + std::string(color) + "\">" + ToString(v) + "</b>";
+}
+
+std::string CaseCell(const CaseVerdict& v) {
+  const std::string mark = !v.judged ? "&#8211;" : v.pass ? "<b style=\"color:#2e8b57\">pass</b>" : "<b style=\"color:#c0392b\">fail</b>";
+  return mark + " " + Esc(v.text) + "<br><span class=\"range\">expected " + Esc(v.expected) + "</span>";
+}
+
+std::vector<double> Values(const std::vector<Statistics>& runs, const std::string& statistic) {
+  std::vector<double> all;
+  for (const Statistics& s : runs) {
+    const auto it = s.find(statistic);
+    if (it != s.end())
+      for (double v : it->second)
+        if (std::isfinite(v)) all.push_back(v);
+  }
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The setup: the first profile's first run's walls and start positions.
+std::string SetupFigure(const ValidationTest& t, const TestResult& r) {
+  if (r.walls.empty()) return "";
+  svg::Plan plan;
+  plan.title = "Setup: walls and the people at the start (first run)";
+  Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+  for (const auto& w : r.walls)
+    for (const Vec2& p : w) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+  plan.min_m = lo - Vec2{0.5, 0.5};
+  plan.max_m = hi + Vec2{0.5, 0.5};
+  plan.walls = r.walls;
+  for (const Vec2& p : r.start_positions) plan.dots.push_back({p, kProfileColor[0], 0.2, ""});
+  const MeasureSpec& m = t.measure;
+  auto line = [&](const observe::Line& l) { plan.walls.push_back({l.a_m, l.b_m}); };
+  if (m.kind == MeasureKind::kTravel) {
+    line(m.from_line);
+    line(m.to_line);
+  }
+  if (m.kind == MeasureKind::kPassages) line(m.line);
+  if (m.has_area) {
+    std::vector<Vec2> ring = m.area.polygon_m;
+    ring.push_back(ring.front());
+    plan.area.push_back(ring);
+  }
+  plan.legend = {{kProfileColor[0], std::to_string(r.start_positions.size()) + " people at the start"},
+                 {"#f2f2ee", "measurement area (shaded), measurement lines drawn as walls"}};
+  return "<figure>" + plan.ToSvg() + "</figure>\n";
+}
+
+// The fundamental diagram: the data's frame samples, each run's mean, Weidmann.
+std::string FdFigure(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
+                     const std::vector<Profile>& profiles) {
+  svg::Chart c;
+  c.title = t.title + ": speed against density";
+  c.x_label = "density in the measurement area, persons/m2";
+  c.y_label = "mean speed, m/s";
+  c.x_min = 0;
+  c.y_min = 0;
+  c.y_max = 2.0;
+  double max_rho = 1.0;
+  if (per_profile.front()->data) {
+    const Statistics& d = *per_profile.front()->data;
+    svg::Series s;
+    s.label = "experiment (" + (t.data ? t.data->label : std::string("data")) + "), every 5th frame";
+    s.color = kDataColor;
+    s.line = false;
+    s.marker_radius = 1.6;
+    const auto& rho = d.at("fd_density_per_m2");
+    const auto& v = d.at("fd_speed_m_per_s");
+    for (std::size_t i = 0; i < rho.size() && i < v.size(); i += 1) {
+      s.x.push_back(rho[i]);
+      s.y.push_back(v[i]);
+      max_rho = std::max(max_rho, rho[i]);
+    }
+    c.series.push_back(s);
+  }
+  for (std::size_t p = 0; p < per_profile.size(); ++p) {
+    svg::Series s;
+    s.label = "model, profile " + profiles[p].name + " (each run's mean)";
+    s.color = kProfileColor[p % 2];
+    s.line = false;
+    s.marker_radius = 4.5;
+    for (const auto& runs : per_profile[p]->runs)
+      for (const Statistics& st : runs) {
+        const auto a = st.find("density_per_m2"), b = st.find("speed_m_per_s");
+        if (a == st.end() || b == st.end() || a->second.empty() || b->second.empty()) continue;
+        s.x.push_back(a->second[0]);
+        s.y.push_back(b->second[0]);
+        if (std::isfinite(a->second[0])) max_rho = std::max(max_rho, a->second[0]);
+      }
+    c.series.push_back(s);
+  }
+  svg::Series w;
+  w.label = "Weidmann (1993)";
+  w.color = "#000";
+  w.dashed = true;
+  const observe::WeidmannRelation weidmann;
+  for (double rho = 0.3; rho <= std::min(5.4, max_rho * 1.1); rho += 0.05) {
+    w.x.push_back(rho);
+    w.y.push_back(weidmann.SpeedAt(rho));
+  }
+  c.series.push_back(w);
+  c.x_max = std::ceil(max_rho * 1.1);
+  return "<figure>" + c.ToSvg() + "<figcaption>Grey: the experiment's frames (density and mean speed in the area); " +
+         "coloured: each run of the model measured by the same code.</figcaption></figure>\n";
+}
+
+// A statistic against the cases' x: each run's value (dots), the median over
+// seeds (line), the published values (dashed).
+std::string CasesFigure(const ValidationTest& t, const Criterion& crit, const std::vector<const TestResult*>& per_profile,
+                        const std::vector<Profile>& profiles) {
+  svg::Chart c;
+  c.title = t.title + ": " + crit.statistic;
+  c.x_label = t.x_label.empty() ? "case" : t.x_label;
+  c.y_label = crit.statistic;
+  c.legend_left = true;
+  for (std::size_t p = 0; p < per_profile.size(); ++p) {
+    svg::Series dots, median;
+    dots.color = median.color = kProfileColor[p % 2];
+    dots.line = false;
+    dots.marker_radius = 3;
+    median.label = "model, profile " + profiles[p].name + " (median over seeds; dots: runs)";
+    for (std::size_t k = 0; k < t.cases.size(); ++k) {
+      std::vector<double> per_run;
+      for (const Statistics& st : per_profile[p]->runs[k]) {
+        const auto it = st.find(crit.statistic);
+        if (it == st.end() || it->second.empty()) continue;
+        const double v = Median(it->second);
+        per_run.push_back(v);
+        dots.x.push_back(t.cases[k].x);
+        dots.y.push_back(v);
+      }
+      median.x.push_back(t.cases[k].x);
+      median.y.push_back(Median(per_run));
+    }
+    c.series.push_back(dots);
+    c.series.push_back(median);
+  }
+  svg::Series lo, hi;
+  lo.color = hi.color = "#000";
+  lo.dashed = hi.dashed = true;
+  lo.label = "published (lowest and highest value)";
+  for (const Case& k : t.cases) {
+    if (k.reference.empty()) continue;
+    lo.x.push_back(k.x);
+    hi.x.push_back(k.x);
+    lo.y.push_back(*std::min_element(k.reference.begin(), k.reference.end()));
+    hi.y.push_back(*std::max_element(k.reference.begin(), k.reference.end()));
+  }
+  if (!lo.x.empty()) {
+    c.series.push_back(lo);
+    c.series.push_back(hi);
+  }
+  c.y_min = 0;
+  return "<figure>" + c.ToSvg() + "</figure>\n";
+}
+
+// The distribution of a statistic's values (every seed pooled) per profile
+// and the data's, with the criterion's band.
+std::string DistributionFigure(const ValidationTest& t, const Criterion& crit,
+                               const std::vector<const TestResult*>& per_profile, const std::vector<Profile>& profiles) {
+  svg::Chart c;
+  c.title = t.title + ": " + crit.statistic + ", the share of values above";
+  c.x_label = crit.statistic;
+  c.y_label = "share of values above";
+  c.y_min = 0;
+  c.y_max = 1.02;
+  c.legend_left = false;
+  auto add = [&](std::vector<double> v, const std::string& label, const std::string& color, bool dashed) {
+    if (v.empty()) return;
+    svg::Series s;
+    s.label = label + " (" + std::to_string(v.size()) + " values)";
+    s.color = color;
+    s.dashed = dashed;
+    s.step = true;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      s.x.push_back(v[i]);
+      s.y.push_back(double(v.size() - i) / double(v.size()));
+    }
+    if (v.size() == 1) {  // a single value: a visible step
+      s.x.push_back(v[0]);
+      s.y.push_back(0.0);
+    }
+    c.series.push_back(s);
+  };
+  for (std::size_t p = 0; p < per_profile.size(); ++p) {
+    std::vector<Statistics> all;
+    for (const auto& runs : per_profile[p]->runs) all.insert(all.end(), runs.begin(), runs.end());
+    add(Values(all, crit.statistic), "model, profile " + profiles[p].name, kProfileColor[p % 2], false);
+  }
+  if (per_profile.front()->data) add(Values({*per_profile.front()->data}, crit.statistic), "experiment", kDataColor, true);
+  if (crit.kind == CriterionKind::kWithin) {
+    if (std::isfinite(crit.low)) c.x_marks.push_back({crit.low, "criterion " + svg::Short(crit.low)});
+    if (std::isfinite(crit.high)) c.x_marks.push_back({crit.high, "criterion " + svg::Short(crit.high)});
+  }
+  if (c.series.empty()) return "<p class=\"note\">No values to draw (every run failed or none measured it).</p>\n";
+  return "<figure>" + c.ToSvg() + "</figure>\n";
+}
+
+std::string Figures(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
+                    const std::vector<Profile>& profiles) {
+  if (t.measure.kind == MeasureKind::kFundamentalDiagram) return FdFigure(t, per_profile, profiles);
+  if (t.criteria.empty()) return "";
+  const Criterion& first = t.criteria.front();
+  const bool has_x = t.cases.size() > 1 &&
+                     std::all_of(t.cases.begin(), t.cases.end(), [](const Case& k) { return std::isfinite(k.x); });
+  if (has_x) return CasesFigure(t, first, per_profile, profiles);
+  return DistributionFigure(t, first, per_profile, profiles);
+}
+
+std::string FileDigest(const fs::path& f) { return Sha256Hex(ReadInputFile(f, "file")).substr(0, 16); }
+
+std::string Today() {
+  const std::time_t now = std::time(nullptr);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  return b;
+}
+
+std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
+  const std::size_t np = s.profiles.size();
+  std::string profiles_text;
+  for (const Profile& p : s.profiles) profiles_text += (profiles_text.empty() ? "" : " beside ") + p.name;
+  std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"generator\" content=\"crowdrecon validate\">\n<title>Validation: " +
+                  Esc(profiles_text) + "</title>\n<style>" + reports::html::Css() +
+                  "\nsection.test { page-break-before: always; }\n</style></head><body>\n";
+  h += "<h1>crowdrecon validation: profile " + Esc(profiles_text) + "</h1>\n";
+  char line[400];
+  std::snprintf(line, sizeof line, "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; %.0f s of wall time; build %s; %s.",
+                s.tests.size() * np, s.Count(Verdict::kPass), s.Count(Verdict::kFail), s.Count(Verdict::kDocuments),
+                s.Count(Verdict::kError), s.wall_s, sweep::BuildVersion().c_str(), Today().c_str());
+  h += "<p class=\"sub\">" + Esc(line) + "</p>\n";
+  h += "<p class=\"note\">Every test is a file of the suite (" + Esc(options.suite.string()) +
+       "): its source, setup, criterion and tolerance. Runs and experiments are measured by the same code; a criterion "
+       "pools its statistic over every seed of a case. <b>documents</b>: the standard gives no pass band (it documents "
+       "behaviour); such results are shown, not judged. How to read and how to validate a profile of your own: "
+       "docs/validation.md.</p>\n";
+
+  // Summary table.
+  std::vector<std::string> head = {"test", "source", "role", "criterion"};
+  for (const Profile& p : s.profiles) head.push_back("result, " + Esc(p.name));
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t i = 0; i < s.tests.size(); ++i) {
+    const ValidationTest& t = s.tests[i];
+    std::string crit;
+    for (const Criterion& c : t.criteria) crit += (crit.empty() ? "" : "<br>") + Esc(c.Describe());
+    if (crit.empty()) crit = "documents only";
+    std::vector<std::string> row = {"<a href=\"#" + t.id + "\">" + Esc(t.id) + "</a><br>" + Esc(t.title),
+                                    Esc(t.standard), ToString(t.role), crit};
+    for (std::size_t p = 0; p < np; ++p) {
+      const TestResult& r = s.results[p][i];
+      std::string cell = VerdictCell(r.verdict);
+      for (const CriterionVerdict& cv : r.criteria)
+        for (const CaseVerdict& v : cv.cases)
+          if (v.judged && !v.pass)
+            cell += "<br><span class=\"range\">" + Esc(cv.criterion.statistic) +
+                    (v.case_name == "base" || v.case_name == "all" ? "" : " @ " + Esc(v.case_name)) + ": " +
+                    Esc(v.text.substr(0, v.text.find(','))) + "</span>";
+      if (!r.failures.empty()) cell += "<br><span class=\"range\">" + std::to_string(r.failures.size()) + " runs failed</span>";
+      row.push_back(cell);
+    }
+    rows.push_back(row);
+  }
+  h += "<h2>Summary</h2>\n" + reports::html::Table(head, rows);
+
+  // The split.
+  h += "<h2>Fitted and held out</h2>\n<p>Decided before any profile was fitted (docs/validation.md, \"Fitted and held "
+       "out\"): <b>fit</b> experiments may be used to choose a profile's values; <b>held-out</b> experiments only test "
+       "it; <b>verification</b> tests are the standards' and must pass whatever was fitted.</p>\n<ul>\n";
+  for (Role role : {Role::kFit, Role::kHeldOut, Role::kVerification}) {
+    std::string ids;
+    for (const ValidationTest& t : s.tests)
+      if (t.role == role) ids += (ids.empty() ? "" : ", ") + t.id;
+    h += "<li><b>" + ToString(role) + "</b>: " + (ids.empty() ? "none in this run" : Esc(ids)) + "</li>\n";
+  }
+  h += "</ul>\n";
+
+  // A section per test.
+  std::size_t figures = 0;
+  for (std::size_t i = 0; i < s.tests.size(); ++i) {
+    const ValidationTest& t = s.tests[i];
+    std::vector<const TestResult*> per_profile;
+    for (std::size_t p = 0; p < np; ++p) per_profile.push_back(&s.results[p][i]);
+    h += "<section class=\"test\" id=\"" + t.id + "\"><h2>" + Esc(t.id) + ": " + Esc(t.title) + "</h2>\n";
+    h += "<p><b>Source.</b> " + Esc(t.source) + "</p>\n<p><b>Setup.</b> " + Esc(t.setup) + "</p>\n";
+    if (!t.notes.empty()) {
+      h += "<ul class=\"note\">";
+      for (const std::string& n : t.notes) h += "<li>" + Esc(n) + "</li>";
+      h += "</ul>\n";
+    }
+    std::string seeds = std::to_string(s.results[0][i].runs.empty() ? 0 : s.results[0][i].runs[0].size());
+    h += "<p class=\"note\">Role: " + ToString(t.role) + ". Cases: " + std::to_string(t.cases.size()) + ", seeds per case: " +
+         seeds + ". Measure: " + ToString(t.measure.kind) + ". Test file " + Esc(t.file.filename().string()) +
+         " (SHA-256 " + FileDigest(t.file) + "...).</p>\n";
+    const std::string setup = SetupFigure(t, *per_profile.front());
+    if (!setup.empty()) ++figures;
+    h += setup;
+    std::vector<std::string> chead = {"criterion", "why this tolerance"};
+    for (const Profile& p : s.profiles) chead.push_back(Esc(p.name));
+    std::vector<std::vector<std::string>> crows;
+    for (std::size_t c = 0; c < t.criteria.size(); ++c) {
+      std::vector<std::string> row = {Esc(t.criteria[c].Describe()), Esc(t.criteria[c].why)};
+      for (std::size_t p = 0; p < np; ++p) {
+        std::string cell;
+        for (const CaseVerdict& v : s.results[p][i].criteria[c].cases)
+          cell += (cell.empty() ? "" : "<br>") +
+                  (v.case_name == "base" || v.case_name == "all" ? "" : "<i>" + Esc(v.case_name) + "</i>: ") + CaseCell(v);
+        row.push_back(cell);
+      }
+      crows.push_back(row);
+    }
+    if (!crows.empty()) h += reports::html::Table(chead, crows);
+    for (std::size_t p = 0; p < np; ++p) {
+      const TestResult& r = s.results[p][i];
+      if (!r.failures.empty()) {
+        h += "<p class=\"note\">" + Esc(s.profiles[p].name) + ": ";
+        for (const std::string& f : r.failures) h += Esc(f) + "; ";
+        h += "</p>\n";
+      }
+    }
+    const std::string fig = Figures(t, per_profile, s.profiles);
+    if (fig.find("<svg") != std::string::npos) ++figures;
+    h += fig + "</section>\n";
+  }
+
+  // What made it.
+  h += "<section class=\"test\"><h2>Profiles, build and checksums</h2>\n";
+  for (const Profile& p : s.profiles)
+    h += "<h3>" + Esc(p.name) + "</h3><p>" + Esc(p.description) + "</p><pre>" + Esc(p.canonical_json) + "</pre><p class=\"note\">" +
+         Esc(p.file.string()) + ", SHA-256 " + FileDigest(p.file) + "...</p>\n";
+  h += "<p class=\"note\">Build " + Esc(sweep::BuildVersion()) + ". Runs and their measures: " +
+       Esc((options.output_dir / "runs").string()) + " (run the same command again to reuse them).</p></section>\n";
+  h += reports::html::SelfCheckScript(figures);
+  h += "</body></html>\n";
+  return h;
+}
+
+std::string ResultsJson(const ValidateOptions& options, const ValidateSummary& s) {
+  json j = {{"format", "crowdrecon-validation-results"}, {"version", 1}, {"build", sweep::BuildVersion()},
+            {"suite", fs::absolute(options.suite).string()}, {"wall_s", s.wall_s}};
+  j["profiles"] = json::array();
+  for (const Profile& p : s.profiles) j["profiles"].push_back(json::parse(p.canonical_json));
+  j["tests"] = json::array();
+  for (std::size_t i = 0; i < s.tests.size(); ++i) {
+    const ValidationTest& t = s.tests[i];
+    json jt = {{"id", t.id}, {"title", t.title}, {"standard", t.standard}, {"role", ToString(t.role)}, {"results", json::object()}};
+    for (std::size_t p = 0; p < s.profiles.size(); ++p) {
+      const TestResult& r = s.results[p][i];
+      json jr = {{"verdict", ToString(r.verdict)}, {"wall_s", r.wall_s}, {"failures", r.failures}, {"criteria", json::array()}};
+      for (const CriterionVerdict& cv : r.criteria) {
+        json jc = {{"criterion", cv.criterion.Describe()}, {"why", cv.criterion.why}, {"judged", cv.judged}, {"pass", cv.pass},
+                   {"cases", json::array()}};
+        for (const CaseVerdict& v : cv.cases)
+          jc["cases"].push_back({{"case", v.case_name}, {"value", std::isfinite(v.value) ? json(v.value) : json(nullptr)},
+                                 {"text", v.text}, {"expected", v.expected}, {"judged", v.judged}, {"pass", v.pass}});
+        jr["criteria"].push_back(jc);
+      }
+      jt["results"][s.profiles[p].name] = jr;
+    }
+    j["tests"].push_back(jt);
+  }
+  return j.dump(1);
+}
+
+std::string ResultsCsv(const ValidateSummary& s) {
+  std::string csv = "profile,test,role,verdict,criterion,case,value,expected,judged,pass\n";
+  auto q = [](const std::string& x) {
+    std::string o = "\"";
+    for (char ch : x) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return o + "\"";
+  };
+  for (std::size_t p = 0; p < s.profiles.size(); ++p)
+    for (std::size_t i = 0; i < s.tests.size(); ++i) {
+      const TestResult& r = s.results[p][i];
+      for (const CriterionVerdict& cv : r.criteria)
+        for (const CaseVerdict& v : cv.cases) {
+          char value[40];
+          std::snprintf(value, sizeof value, "%.6g", v.value);
+          csv += s.profiles[p].name + "," + s.tests[i].id + "," + ToString(s.tests[i].role) + "," + ToString(r.verdict) + "," +
+                 q(cv.criterion.Describe()) + "," + v.case_name + "," + (std::isfinite(v.value) ? value : "") + "," +
+                 q(v.expected) + "," + (v.judged ? "1" : "0") + "," + (v.pass ? "1" : "0") + "\n";
+        }
+      if (r.criteria.empty())
+        csv += s.profiles[p].name + "," + s.tests[i].id + "," + ToString(s.tests[i].role) + "," + ToString(r.verdict) + ",,,,,0,0\n";
+    }
+  return csv;
+}
+
+}  // namespace
+
+void WriteValidationReport(const ValidateOptions& options, const std::string& chromium, ValidateSummary* summary) {
+  const fs::path dir = options.output_dir;
+  WriteFileAtomically(dir / "results.json", ResultsJson(options, *summary));
+  summary->json = dir / "results.json";
+  WriteFileAtomically(dir / "results.csv", ResultsCsv(*summary));
+  summary->csv = dir / "results.csv";
+  WriteFileAtomically(dir / "report.html", Html(options, *summary));
+  summary->html = dir / "report.html";
+  if (options.pdf) {
+    // Printed beside, then renamed: a browser that fails leaves no PDF that
+    // looks complete.
+    const fs::path partial = dir / ".report.pdf.partial";
+    reports::html::PrintPdf(chromium, summary->html, partial);
+    fs::rename(partial, dir / "report.pdf");
+    summary->pdf = dir / "report.pdf";
+  }
+}
+
+}  // namespace crowdrecon::validate
