@@ -26,6 +26,7 @@ const std::vector<std::pair<MeasureKind, const char*>>& KindNames() {
       {MeasureKind::kWalls, "walls"},
       {MeasureKind::kWalkingSpeed, "walking_speed"},
       {MeasureKind::kPassages, "passages"},
+      {MeasureKind::kClearance, "clearance"},
       {MeasureKind::kFundamentalDiagram, "fundamental_diagram"},
       {MeasureKind::kHeadway, "headway"},
       {MeasureKind::kRunState, "run_state"}};
@@ -137,6 +138,7 @@ void MeasureWalkingSpeed(const observe::Trajectories& t, const std::vector<obser
     speeds.push_back(v);
     const std::string name =
         track.group < group_names.size() ? group_names[track.group] : "group" + std::to_string(track.group);
+    // (an experiment's people have no group: "group0")
     by_group[name].push_back(v);
   }
   (*out)["speed_m_per_s"] = speeds;
@@ -185,6 +187,19 @@ void MeasurePassages(const observe::Trajectories& t, const std::vector<observe::
   double sum = 0;
   for (const auto& [f, c] : counts) sum += c;
   if (!counts.empty()) (*out)["front_density_per_m2"] = {sum / double(counts.size()) / spec.area.Area_m2()};
+}
+
+void MeasureClearance(const observe::Trajectories& t, const std::vector<observe::Track>& tracks, Statistics* out) {
+  std::vector<double> left;
+  for (const observe::Track& track : tracks)
+    if (!track.frame.empty() && track.frame.back() < t.last_frame)
+      left.push_back(double(track.frame.back() - t.first_frame) / t.fps);
+  std::sort(left.begin(), left.end());
+  const std::size_t n = tracks.size();
+  (*out)["left_share"] = {n ? double(left.size()) / double(n) : kNaN};
+  (*out)["time_to_all_s"] = {n && left.size() == n ? left.back() : kNaN};
+  const std::size_t n95 = std::size_t(std::ceil(0.95 * double(n)));
+  (*out)["time_to_95_s"] = {n95 >= 1 && left.size() >= n95 ? left[n95 - 1] : kNaN};
 }
 
 void MeasureFundamentalDiagram(const observe::Trajectories& t, const MeasureSpec& spec, Statistics* out) {
@@ -242,7 +257,10 @@ void MeasureHeadway(const observe::Trajectories& t, const std::vector<observe::T
   (*out)["density_per_m2"] = {densities.empty() ? kNaN : sum / double(densities.size())};
 }
 
+// A run's group names by index: a timeline's (run value groups), else the
+// population's two (main, counter).
 std::vector<std::string> SplitGroups(const std::string& text) {
+  if (text.empty()) return {"main", "counter"};
   std::vector<std::string> names;
   std::stringstream in(text);
   std::string name;
@@ -255,7 +273,13 @@ Statistics Measure(const observe::Trajectories& t, const MeasureSpec& spec, cons
   std::string error;
   if (!spec.IsValid(&error)) throw InputError("validation measure: " + error);
   if (!(t.fps > 0)) throw InputError(t.source + ": no frame rate; expected trajectories with one");
-  const std::vector<observe::Track> tracks = observe::TracksOf(t);
+  std::vector<observe::Track> tracks = observe::TracksOf(t);
+  if (!spec.group.empty()) {
+    const auto name_of = [&](std::uint32_t g) {
+      return g < group_names.size() ? group_names[g] : "group" + std::to_string(g);
+    };
+    std::erase_if(tracks, [&](const observe::Track& track) { return name_of(track.group) != spec.group; });
+  }
   Statistics out;
   switch (spec.kind) {
     case MeasureKind::kTravel: MeasureTravel(t, tracks, spec, &out); break;
@@ -265,6 +289,7 @@ Statistics Measure(const observe::Trajectories& t, const MeasureSpec& spec, cons
       break;
     case MeasureKind::kWalkingSpeed: MeasureWalkingSpeed(t, tracks, spec, group_names, &out); break;
     case MeasureKind::kPassages: MeasurePassages(t, tracks, spec, &out); break;
+    case MeasureKind::kClearance: MeasureClearance(t, tracks, &out); break;
     case MeasureKind::kFundamentalDiagram: MeasureFundamentalDiagram(t, spec, &out); break;
     case MeasureKind::kHeadway: MeasureHeadway(t, tracks, spec, &out); break;
     case MeasureKind::kRunState:

@@ -55,14 +55,29 @@ const json& RawAt(const JsonDocument& doc, const JsonReader& r) {
   return doc.Json().at(json::json_pointer(r.path()));
 }
 
-std::vector<sweep::Override> ReadOverrides(const JsonDocument& doc, const JsonReader& r) {
+// Whether an override's value is a file path (resolved against the test's
+// folder, where it was written, not the sweep's that the runner writes).
+bool IsPathKey(const std::string& key) {
+  const auto ends = [&](const std::string& tail) {
+    return key.size() >= tail.size() && key.compare(key.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return key == "venue" || ends(".reference") || ends(".anthropometry") || ends(".rate_csv");
+}
+
+std::vector<sweep::Override> ReadOverrides(const JsonDocument& doc, const JsonReader& r, const fs::path& base_dir) {
   if (!r.IsObject()) r.Fail("expected an object of overrides {\"dotted.path\": value, ...}");
   std::vector<sweep::Override> out;
   for (const std::string& key : r.Keys()) {
     const JsonReader v = r.At(key);
     if (key.empty() || key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos)
       v.Fail("expected a dotted scenario path such as \"population.count\"");
-    out.push_back({key, RawAt(doc, v).dump()});
+    json value = RawAt(doc, v);
+    if (IsPathKey(key) && value.is_string()) {
+      const fs::path file = fs::absolute(base_dir / value.get<std::string>()).lexically_normal();
+      CheckInputFile(file, "the file of override " + key + " (" + v.Where() + ")");
+      value = file.string();
+    }
+    out.push_back({key, value.dump()});
   }
   return out;
 }
@@ -103,6 +118,7 @@ MeasureSpec ReadMeasure(const JsonReader& r) {
   m.lane_half_width_m = r.Number("lane_half_width_m", m.lane_half_width_m, 0.01, 5.0);
   m.max_headway_m = r.Number("max_headway_m", m.max_headway_m, 0.01, 100.0);
   m.frame_step = int(r.Integer("frame_step", m.frame_step, 1, 1000));
+  m.group = r.String("group", "");
   r.Finish();
   std::string error;
   if (!m.IsValid(&error)) r.Fail(error);
@@ -272,7 +288,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
   const JsonReader sc = r.At("scenario");
   t.scenario = fs::absolute(base_dir / sc.AsString()).lexically_normal();
   CheckInputFile(t.scenario, "the test's scenario (" + sc.Where() + ")");
-  if (const auto set = r.Find("set")) t.set = ReadOverrides(doc, *set);
+  if (const auto set = r.Find("set")) t.set = ReadOverrides(doc, *set, base_dir);
   t.seeds = r.Has("seeds") ? ReadSeeds(r.At("seeds")) : std::vector<std::uint64_t>{1};
   t.x_label = r.String("x_label", "");
   std::set<std::string> case_names;
@@ -286,7 +302,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
       if (!case_names.insert(k.name).second) c.At("name").Fail("a second case of this name");
       k.label = c.String("label", k.name);
       k.x = c.Number("x", std::numeric_limits<double>::quiet_NaN(), -kHuge, kHuge);
-      if (const auto set = c.Find("set")) k.set = ReadOverrides(doc, *set);
+      if (const auto set = c.Find("set")) k.set = ReadOverrides(doc, *set, base_dir);
       if (const auto ref = c.Find("reference")) {
         for (std::size_t j = 0; j < ref->Size(); ++j) k.reference.push_back(ref->Element(j).AsNumber(-kHuge, kHuge));
         if (k.reference.empty()) ref->Fail("expected at least one published value");
@@ -357,6 +373,14 @@ Profile ParseProfile(const std::string& text, const std::string& origin, const f
         b[key] = fs::absolute(base_dir / b[key].get<std::string>()).lexically_normal().string();
     for (const std::string& key : body->Keys()) body->At(key);  // (checked by the scenario reader)
     p.set.push_back({"population.body", b.dump()});
+  }
+  if (const auto v0 = r.Find("desired_speed_m_per_s")) {
+    // The crowd's free speeds where a test does not prescribe them (a test
+    // case that sets them comes after the profile).
+    const std::vector<Vec2> one = {v0->AsPoint()};
+    if (!(one[0].x >= 0.0 && one[0].x <= one[0].y && one[0].y <= 10.0))
+      v0->Fail("expected [low, high] m/s with 0 <= low <= high <= 10");
+    p.set.push_back({"population.desired_speed_m_per_s", RawAt(doc, *v0).dump()});
   }
   r.Finish();
   p.canonical_json = doc.Json().dump();

@@ -22,6 +22,9 @@
 //                        time_to_all_s (the last passage), time_to_95_s, front_density_per_m2
 //                        (people in `area` / its area, mean over the frames between the first
 //                        and the last passage; with an area)
+//   clearance            left_share (people whose track ends before the last frame: removed at an
+//                        exit, or out of an experiment's view), time_to_all_s (the last of them,
+//                        when everyone left), time_to_95_s
 //   fundamental_diagram  density_per_m2, speed_m_per_s (means over the frames after `skip_s`
 //                        with somebody in `area`), specific_flow_per_m_s (their product),
 //                        fd_density_per_m2 and fd_speed_m_per_s (one per frame sample, for the
@@ -44,7 +47,7 @@
 
 namespace crowdrecon::validate {
 
-enum class MeasureKind { kTravel, kWalls, kWalkingSpeed, kPassages, kFundamentalDiagram, kHeadway, kRunState };
+enum class MeasureKind { kTravel, kWalls, kWalkingSpeed, kPassages, kClearance, kFundamentalDiagram, kHeadway, kRunState };
 std::string ToString(MeasureKind kind);
 // False (and *kind untouched) for a name that is not a measure.
 bool FromString(const std::string& name, MeasureKind* kind);
@@ -63,6 +66,10 @@ struct MeasureSpec {
   double lane_half_width_m = 0.3;    // headway: how far off a walker's line a person still counts as ahead
   double max_headway_m = 5.0;        // headway: farther than this, nobody is ahead
   int frame_step = 5;                // fundamental_diagram, headway: every n-th frame (frames of one person are nearly alike)
+  // Every kind: only the people of this group ("main", "counter" or a
+  // timeline's own group name; "" = everyone). An experiment's people have
+  // no group: a group given there keeps none.
+  std::string group;
 
   bool IsValid(std::string* error) const;
 };

@@ -120,12 +120,14 @@ ValidationTest LoadValidationTest(const std::filesystem::path& file);
 ValidationTest ParseValidationTest(const std::string& text, const std::string& origin,
                                    const std::filesystem::path& base_dir);
 
-// A model profile: overrides of the scenario's model block (by key) and its
-// body block (as a whole), applied after a test's own overrides.
+// A model profile: overrides of the scenario's model block (by key), its
+// body block (as a whole) and the crowd's free speeds, applied after a test's
+// own overrides and before its cases' (a case that prescribes speeds, as
+// RiMEA's corridor does, keeps them).
 //
 //   {"format": "crowdrecon-profile", "version": 1, "name": "paper",
 //    "description": "...", "model": {"restitution": 0.4}, "body": {"mode": "paper",
-//    "reference": "../../bodies/thorax-18.json"}}
+//    "reference": "../../bodies/thorax-18.json"}, "desired_speed_m_per_s": [0.8, 1.2]}
 struct Profile {
   std::filesystem::path file;
   std::string name, description;
