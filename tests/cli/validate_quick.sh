@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# The validation suite's quick subset (issue 62) as `make test` runs it: the
+# tests marked quick on the default profile (the paper's model as the
+# reconstructions run it), each criterion judged on its real runs, and the
+# verdicts checked against what this model gives (docs/validation.md):
+# RiMEA 1 (corridor speeds) and RiMEA 6 (corner, no one through a wall) pass;
+# RiMEA 7 (walking speeds by group) fails, because people who do not avoid
+# each other are pushed out of their group's band. A second run on the same
+# folder runs nothing again and gives the same table; a folder that is not a
+# validation's is refused.
+#   validate_quick.sh CROWDRECON SOURCE_DIR
+set -euo pipefail
+exe=$1; src=$2
+d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
+cd "$src"
+start=$(date +%s.%N)
+set +e
+"$exe" validate --quick -o "$d/v" --no-pdf --jobs 2 > "$d/out.txt" 2> "$d/err.txt"
+rc=$?
+set -e
+end=$(date +%s.%N)
+cat "$d/out.txt"
+echo "exit $rc; wall $(python3 -c "print(round($end - $start, 1))") s"
+[ "$rc" -eq 1 ] || { echo "expected exit 1 (a criterion fails)"; cat "$d/err.txt"; exit 1; }
+python3 - "$d/v/results.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+verdicts = {t["id"]: t["results"]["paper"]["verdict"] for t in r["tests"]}
+print("verdicts:", verdicts)
+expected = {"rimea-01-corridor": "pass", "rimea-06-corner": "pass", "rimea-07-demographics": "fail"}
+assert verdicts == expected, f"expected {expected}"
+t1 = next(t for t in r["tests"] if t["id"] == "rimea-01-corridor")["results"]["paper"]
+for c in t1["criteria"]:
+    for k in c["cases"]:
+        # 40 m at 1.33 m/s is 30.1 s; at 1.0 m/s 40 s: the model walks at its desired speed.
+        assert abs(k["value"] - (30.08 if k["case"] == "rimea" else 40.0)) < 0.5, k
+t7 = next(t for t in r["tests"] if t["id"] == "rimea-07-demographics")["results"]["paper"]
+failed = [c["criterion"] for c in t7["criteria"] if c["judged"] and not c["pass"]]
+print("RiMEA 7 fails on:", failed)
+assert failed, "RiMEA 7 was expected to fail on some group"
+PY
+grep -q "2 passed, 1 failed, 0 documented, 0 errors" "$d/out.txt"
+for f in report.html results.csv validation.json; do test -s "$d/v/$f"; done
+test ! -e "$d/v/report.pdf"
+# Again on the same folder: nothing is run again, the same results.
+cp "$d/v/results.csv" "$d/first.csv"
+"$exe" validate --quick -o "$d/v" --no-pdf -q > "$d/out2.txt" || true
+cmp "$d/first.csv" "$d/v/results.csv"
+grep -q "2 passed, 1 failed" "$d/out2.txt"
+# A folder that is not a validation's is refused, and left alone.
+mkdir "$d/other"; echo keep > "$d/other/notes.txt"
+if "$exe" validate --quick -o "$d/other" --no-pdf -q > "$d/out3.txt" 2>&1; then echo "expected a refusal"; exit 1; fi
+grep -q "other" "$d/out3.txt"; cat "$d/out3.txt"
+test "$(cat "$d/other/notes.txt")" = keep
+echo "validate_quick.sh: ok"
