@@ -1,6 +1,8 @@
 # The two commands of crowdrecon (see README.md):
 #   make demo   install what is missing, build, run the Madrid Arena case into out/
 #   make test   install what is missing, build, run the whole suite with ctest
+#   make validate  the validation suite on the paper's model (thorax and circle
+#               bodies) into out/validation (docs/validation.md)
 #   make fuzz   build the libFuzzer harnesses (clang) and run each for
 #               FUZZ_SECONDS (default 60) s; FUZZ_HARNESSES picks some (docs/fuzzing.md)
 PRESET ?= release
@@ -10,7 +12,7 @@ CROWDRECON := $(BUILD)/cli/crowdrecon
 FUZZ_SECONDS ?= 60
 FUZZ_HARNESSES ?=
 
-.PHONY: all deps build test test-long demo clean sanitize fuzz
+.PHONY: all deps build test test-long demo clean sanitize fuzz validate
 
 all: build
 
@@ -30,6 +32,12 @@ test-long: build
 
 demo: build
 	@bash scripts/demo.sh $(CROWDRECON) out
+
+# The whole validation suite (docs/validation.md): every test on each profile,
+# side by side; run again to continue or to reuse the runs done.
+VALIDATION_PROFILES ?= venues/validation/profiles/paper.json venues/validation/profiles/paper-circle.json
+validate: build
+	@$(CROWDRECON) validate $(foreach p,$(VALIDATION_PROFILES),--profile $(p)) -o out/validation --jobs $(JOBS)
 
 # The unit and command-line tests (all but `long`; there the whole-scenario
 # tests count as long, tests/CMakeLists.txt) under AddressSanitizer and
