@@ -22,6 +22,7 @@
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
+#include "premovement.hpp"
 #include "run_systems.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
 
@@ -462,9 +463,12 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   engine::Simulation sim(built.world);
   // The incident timeline's shared state; its doors as at t = 0.
   std::unique_ptr<detail::TimelineState> timeline;
+  std::vector<double> premovement;  // the people of the start's times (premovement.hpp)
   if (scenario.timeline.enabled) {
     timeline = std::make_unique<detail::TimelineState>(scenario, built);
     detail::OpenDoorsAtStart(sim, *timeline);
+    premovement = detail::PremovementTimes(scenario, built.timeline.initial_people);
+    detail::HoldUntilPremovement(sim, premovement);
   }
 
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
@@ -550,6 +554,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   };
   if (timeline) {  // the incident timeline's systems, around the steps (timeline_systems.hpp)
     loop.Add(detail::MakeTimelineEventSystem(*timeline));
+    if (scenario.timeline.premovement.enabled)
+      loop.Add(detail::MakePremovementSystem(*timeline, built, std::move(premovement)));
     loop.Add(detail::MakeInflowSystem(*timeline));
     loop.Add(detail::MakeExitSystem(*timeline));
     loop.Add(detail::MakeFallSystem(*timeline));

@@ -414,6 +414,24 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     falls->Finish();
   }
   t.max_present = static_cast<std::size_t>(reader.Integer("max_present", 0, 0, 200000));
+  if (auto pre = reader.Find("premovement")) {
+    PremovementSpec& p = t.premovement;
+    p.enabled = true;
+    p.where = pre->Where();
+    if (pre->Has("uniform_s") == pre->Has("times_s")) pre->Fail("expected exactly one of uniform_s [low, high] and times_s [t, ...]");
+    if (auto u = pre->Find("uniform_s")) {
+      if (!u->IsArray() || u->Size() != 2) u->Fail("expected [low, high] in seconds");
+      p.low_s = u->Element(0).AsNumber(0.0, 1e6);
+      p.high_s = u->Element(1).AsNumber(0.0, 1e6);
+      if (p.low_s > p.high_s) u->Fail("expected low <= high");
+    } else {
+      const JsonReader times = pre->At("times_s");
+      if (!times.IsArray() || times.Size() == 0) times.Fail("expected a list of times in seconds, one per person of the start");
+      if (times.Size() > 200000) times.Fail("more times than the largest head count (200000)");
+      for (std::size_t k = 0; k < times.Size(); ++k) p.times_s.push_back(times.Element(k).AsNumber(0.0, 1e6));
+    }
+    pre->Finish();
+  }
   t.entry_clearance_m = reader.Number("entry_clearance_m", t.entry_clearance_m, 0.0, 2.0);
   t.stop_when_left_fraction = reader.Number("stop_when_left_fraction", 0.0, 0.0, 1.0);
   if (auto clock = reader.Find("clock_start")) {

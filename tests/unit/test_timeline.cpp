@@ -785,6 +785,92 @@ TEST(Timeline, ACheckpointThatNumberedArrivalsInflowByInflowIsNotResumed) {
   EXPECT_EQ(RunScenario(s, options).status, "complete");
 }
 
+// Pre-movement times (RiMEA test 5; timeline.premovement): each person of
+// the start stands until their time, sets off at the first step at or after
+// it with their own desired speed, and a run stopped and resumed between
+// two starts gives the same tables.
+TEST(Timeline, PeopleOfTheStartSetOffAtTheirPremovementTimes) {
+  const std::string json =
+      Hallway(R"({"count": 4, "target": "to_exit", "placement": {"region": "entries"}, "seed": 5})",
+              R"({"duration_s": 4, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+              R"({"premovement": {"times_s": [1.0, 0.5, 2.55, 3.0]}})");
+  const TimelineRun run = Simulate(json, "premovement");
+  const std::vector<runfile::Event> starts = run.Kind("start");
+  ASSERT_EQ(starts.size(), 4u);
+  const double expected[] = {1.0, 0.5, 2.55, 3.0};
+  for (const runfile::Event& e : starts) {
+    ASSERT_GE(e.person, 0);
+    ASSERT_LT(e.person, 4);
+    // The first step that starts at or after the time (steps are about a millisecond).
+    EXPECT_GE(e.time_s, expected[e.person] - 1e-9);
+    EXPECT_LT(e.time_s, expected[e.person] + 0.01);
+  }
+  // Nobody moves before the first time (later, a walker may push a person
+  // who still stands: the validation suite counts that, rimea-05); everyone
+  // walks after their time.
+  const runfile::RunFileReader reader(run.file);
+  runfile::PersonFrame f, first;
+  auto stream = reader.PersonFrames(40);
+  ASSERT_TRUE(stream.Next(&first));
+  while (stream.Next(&f)) {
+    const double t = double(f.frame) / 10.0;
+    for (std::size_t i = 0; i < f.person.size(); ++i) {
+      const double moved = Length(f.position_m[i] - first.position_m[i]);
+      if (t <= 0.5) {
+        EXPECT_EQ(moved, 0.0) << "person " << f.person[i] << " at " << t << " s";
+      }
+      if (t >= expected[f.person[i]] + 0.5) {
+        EXPECT_GT(moved, 0.05) << "person " << f.person[i] << " at " << t << " s";
+      }
+    }
+  }
+  // Stopped at 2 s (between two starts) and resumed: the same tables.
+  const Scenario s = ParseScenario(json, "premovement-resumed.json", kSource);
+  RunOptions options;
+  options.output = crowdrecon::testing::ScratchFile("premovement-resumed.sqlite");
+  std::filesystem::remove(options.output);
+  std::filesystem::remove(CheckpointPath(options.output));
+  options.stop_after_s = 2.0;
+  ASSERT_EQ(RunScenario(s, options).status, "interrupted");
+  options.resume = true;
+  options.stop_after_s = -1.0;
+  ASSERT_EQ(RunScenario(s, options).status, "complete");
+  EXPECT_EQ(runfile::RunFileReader(options.output).TablesDigest(), reader.TablesDigest());
+  // Drawn times: one per person of the start, inside the range, from the seed.
+  const TimelineRun drawn = Simulate(
+      Hallway(R"({"count": 6, "target": "to_exit", "placement": {"region": "entries"}, "seed": 5})",
+              R"({"duration_s": 0.5, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})",
+              R"({"premovement": {"uniform_s": [0.1, 0.4]}})"),
+      "premovement-drawn");
+  ASSERT_EQ(drawn.Kind("start").size(), 6u);
+  for (const runfile::Event& e : drawn.Kind("start")) {
+    EXPECT_GE(e.time_s, 0.1);
+    EXPECT_LT(e.time_s, 0.41);
+  }
+}
+
+TEST(Timeline, PremovementTimesThatDoNotFitAreRefused) {
+  const auto refuse = [](const std::string& timeline, const std::string& expected) {
+    try {
+      const Scenario s = ParseScenario(
+          Hallway(R"({"count": 3, "target": "to_exit", "placement": {"region": "entries"}})", R"({"duration_s": 1})", timeline),
+          "bad-premovement.json", kSource);
+      RunOptions options;
+      options.output = crowdrecon::testing::ScratchFile("bad-premovement.sqlite");
+      std::filesystem::remove(options.output);
+      RunScenario(s, options);
+      ADD_FAILURE() << "accepted: " << timeline;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refuse(R"({"premovement": {"uniform_s": [5, 1]}})", "/timeline/premovement/uniform_s: expected low <= high");
+  refuse(R"({"premovement": {"uniform_s": [1, 5], "times_s": [1]}})", "exactly one of uniform_s");
+  refuse(R"({"premovement": {"times_s": [1, -2, 3]}})", "/timeline/premovement/times_s/1");
+  refuse(R"({"premovement": {"times_s": [1, 2]}})", "/timeline/premovement/times_s: 2 times for 3 people of the start");
+  refuse(R"({"premovement": {"uniform_s": [1, 5], "shape": "gamma"}})", "shape");
+}
+
 // A run's wall time (run value wall_s) counts every invocation of a resumed
 // run, so that a sweep's results and a long run's statement of what it cost
 // are not the last part's alone.

@@ -29,6 +29,7 @@ const std::vector<std::pair<MeasureKind, const char*>>& KindNames() {
       {MeasureKind::kClearance, "clearance"},
       {MeasureKind::kFundamentalDiagram, "fundamental_diagram"},
       {MeasureKind::kHeadway, "headway"},
+      {MeasureKind::kStartTimes, "start_times"},
       {MeasureKind::kRunState, "run_state"}};
   return names;
 }
@@ -259,6 +260,53 @@ void MeasureHeadway(const observe::Trajectories& t, const std::vector<observe::T
 
 // A run's group names by index: a timeline's (run value groups), else the
 // population's two (main, counter).
+// Each person's observed start against their pre-movement time: the first
+// frame from one second before their time at which their centre is 0.01 m
+// from where it was then (a person standing in place does not move at all in
+// the model; 0.01 m is far above rounding and far below a step). Measured
+// from a second before, so that a push long before (people walking past a
+// standing person move them) is counted apart, as moved_early.
+Statistics MeasureStartTimes(const observe::Trajectories& t, const std::vector<runfile::Event>& events) {
+  constexpr double kMoved_m = 0.01, kBefore_s = 1.0;
+  std::map<std::uint32_t, double> due;  // id -> the time the run started them
+  double gone = 0;                      // not walking at their time (pushed out, fallen)
+  for (const runfile::Event& e : events) {
+    if (e.kind != "start" || e.person < 0) continue;
+    if (e.detail.find("not walking") != std::string::npos) {
+      gone += 1;
+      continue;
+    }
+    due[static_cast<std::uint32_t>(e.person + 1)] = e.time_s;
+  }
+  std::vector<double> premovement, delay;
+  double early = 0, never = 0;
+  for (const observe::Track& track : observe::TracksOf(t)) {
+    const auto it = due.find(track.id);
+    if (it == due.end() || track.position_m.empty()) continue;
+    premovement.push_back(it->second);
+    const auto time_of = [&](std::size_t k) { return double(track.frame[k] - t.first_frame) / t.fps; };
+    std::size_t from = 0;
+    while (from + 1 < track.position_m.size() && time_of(from + 1) <= it->second - kBefore_s) ++from;
+    if (Length(t.box.MinimumImage(track.position_m[from] - track.position_m[0])) > kMoved_m) early += 1;
+    double started = kNaN;
+    for (std::size_t k = from; k < track.position_m.size(); ++k)
+      if (Length(t.box.MinimumImage(track.position_m[k] - track.position_m[from])) > kMoved_m) {
+        started = time_of(k);
+        break;
+      }
+    if (!std::isfinite(started)) never += 1;
+    delay.push_back(started - it->second);
+  }
+  Statistics out;
+  out["premovement_s"] = premovement;
+  out["start_delay_s"] = delay;
+  out["moved_early"] = {early};
+  out["never_started"] = {never};
+  out["started_people"] = {double(due.size())};
+  out["gone_before_start"] = {gone};
+  return out;
+}
+
 std::vector<std::string> SplitGroups(const std::string& text) {
   if (text.empty()) return {"main", "counter"};
   std::vector<std::string> names;
@@ -292,8 +340,9 @@ Statistics Measure(const observe::Trajectories& t, const MeasureSpec& spec, cons
     case MeasureKind::kClearance: MeasureClearance(t, tracks, &out); break;
     case MeasureKind::kFundamentalDiagram: MeasureFundamentalDiagram(t, spec, &out); break;
     case MeasureKind::kHeadway: MeasureHeadway(t, tracks, spec, &out); break;
+    case MeasureKind::kStartTimes:
     case MeasureKind::kRunState:
-      throw InputError(t.source + ": the run_state measure needs a crowdrecon run file");
+      throw InputError(t.source + ": the " + ToString(spec.kind) + " measure needs a crowdrecon run file");
   }
   return out;
 }
@@ -377,6 +426,11 @@ Statistics MeasureRun(const std::filesystem::path& run_file, const MeasureSpec& 
     return out;
   }
   const observe::Trajectories t = observe::ReadTrajectories(run_file);
+  if (spec.kind == MeasureKind::kStartTimes) {
+    out = MeasureStartTimes(t, reader.Events());
+    out["completed"] = {complete ? 1.0 : 0.0};
+    return out;
+  }
   const std::vector<runfile::Wall> walls = reader.Walls();
   // (A run's frames start at 0, so times are the run's own.)
   out = Measure(t, spec, SplitGroups(reader.RunValue("groups")), &walls);

@@ -19,6 +19,7 @@
 //       {"time_s": 900, "close_exit": "court"}, {"time_s": 950, "stop_inflow": "arriving"},
 //       {"time_s": 1000, "fall": {"at": [6, 1.5], "count": 5, "within_m": 3}}
 //     ],
+//     "premovement": {"uniform_s": [10, 100]},  (the people of the start set off at their times)
 //     "falls": {"criterion": "acceleration", "threshold_m_per_s2": 5, "window_s": 0.5}
 //              (or "criterion": "load"; with "acceleration", "trip_over_fallen": true)
 //   }
@@ -161,8 +162,23 @@ struct RecordedMark {
   bool HasMaxSpeed() const { return std::isfinite(max_speed_m_per_s); }
 };
 
+// Pre-movement times (RiMEA test 5, IMO MSC.1/Circ.1238 test 5, NIST TN 1822
+// Verif.1.1): each person of the start stands (desired speed 0) until their
+// time, then walks at their own desired speed (or their group's, if an event
+// set one before). Arrivals through inflows walk at once. Key
+// "premovement": {"uniform_s": [10, 100]} (drawn per person from the
+// population's seed, in id order) or {"times_s": [10, 20, ...]} (one per
+// person of the start, in id order).
+struct PremovementSpec {
+  bool enabled = false;
+  double low_s = 0.0, high_s = 0.0;  // uniform_s
+  std::vector<double> times_s;       // or one time per person of the start
+  std::string where;                 // JSON path, for messages
+};
+
 struct TimelineSpec {
   bool enabled = false;  // a "timeline" key is present
+  PremovementSpec premovement;
   std::vector<InflowSpec> inflows;
   std::vector<std::string> exits;         // where people are removed (default: every exit)
   std::vector<std::string> closed_exits;  // closed at t = 0

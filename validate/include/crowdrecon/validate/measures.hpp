@@ -32,6 +32,12 @@
 //   headway              headway_m (per sample: distance to the nearest person ahead in the
 //                        same file, within `lane_half_width_m` of the walking direction and
 //                        `max_headway_m`), density_per_m2
+//   start_times          (from the run file: its `start` events, timeline.premovement) premovement_s
+//                        (each person's time), start_delay_s (per person: the first frame from 1 s
+//                        before their time at which they are 0.01 m from where they stood then, less
+//                        their time), moved_early (people pushed 0.01 m from where they stood more
+//                        than 1 s before their time), never_started, started_people, gone_before_start
+//                        (not walking at their time: pushed out of the venue, or fallen)
 //   run_state            (from the run file; not for experiments) completed, peak_local_density_per_m2,
 //                        peak_local_density_real_per_m2, largest_overlap_m
 #pragma once
@@ -47,7 +53,9 @@
 
 namespace crowdrecon::validate {
 
-enum class MeasureKind { kTravel, kWalls, kWalkingSpeed, kPassages, kClearance, kFundamentalDiagram, kHeadway, kRunState };
+enum class MeasureKind {
+  kTravel, kWalls, kWalkingSpeed, kPassages, kClearance, kFundamentalDiagram, kHeadway, kStartTimes, kRunState
+};
 std::string ToString(MeasureKind kind);
 // False (and *kind untouched) for a name that is not a measure.
 bool FromString(const std::string& name, MeasureKind* kind);
