@@ -165,6 +165,42 @@ TEST(ValidationMeasures, FundamentalDiagramGivesTheAreasDensityAndSpeed) {
   EXPECT_NEAR(s.at("specific_flow_per_m_s")[0], 1.1, 1e-9);
 }
 
+TEST(ValidationMeasures, LanesThatMixAreCountedAsBroken) {
+  // Twenty walkers each way, 1 m apart, in a periodic box 20 m long: in two
+  // lanes (y = 1 and y = 3) for 10 s, then all in one file (y = 1, each
+  // seeing as many walkers the other way as its own within 1.5 m) for 10 s,
+  // then in lanes again.
+  observe::Trajectories t = Empty(5.0);
+  for (std::int64_t f = 0; f <= 150; ++f) {
+    const bool mixed = f > 50 && f <= 100;
+    for (std::uint32_t id = 1; id <= 40; ++id) {
+      const bool east = id <= 20;
+      const double x0 = double((id - 1) % 20) + (east ? 0.0 : 0.5);
+      const double x = x0 + (east ? 1.0 : -1.0) * double(f) / 5.0;
+      const double y = mixed ? 1.0 : (east ? 1.0 : 3.0);
+      t.points.push_back({id, f, {std::fmod(x + 1000.0, 20.0), y}, 0.0});
+    }
+  }
+  t.first_frame = 0;
+  t.last_frame = 150;
+  t.box.x = true;
+  t.box.min_m = {0, 0};
+  t.box.max_m = {20, 4};
+  MeasureSpec m;
+  m.kind = MeasureKind::kLanes;
+  m.has_area = true;
+  m.area.polygon_m = {{0, 0}, {20, 0}, {20, 4}, {0, 4}};
+  m.direction = {1, 0};
+  m.frame_step = 1;
+  const Statistics s = MeasureTrajectories(t, m);
+  EXPECT_DOUBLE_EQ(s.at("lane_breaks")[0], 1.0);
+  EXPECT_DOUBLE_EQ(s.at("lane_reformations")[0], 1.0);
+  EXPECT_DOUBLE_EQ(s.at("organized_at_end")[0], 1.0);
+  EXPECT_GT(s.at("organized_share")[0], 0.6);
+  EXPECT_LT(s.at("organized_share")[0], 0.72);
+  EXPECT_NEAR(s.at("longest_organized_s")[0], 10.0, 0.5);
+}
+
 // --- Judging ----------------------------------------------------------------
 
 ValidationTest TwoCaseTest() {

@@ -162,7 +162,12 @@ CaseVerdict JudgeCase(const Criterion& c, const Case& k, const std::vector<Stati
       v.pass = failed == 0 && std::abs(v.value - mean) <= c.band_sd * sd;
       break;
     }
-    case CriterionKind::kDocuments: v.expected = "documented only"; break;
+    case CriterionKind::kDocuments: {
+      v.expected = "documented only";
+      const std::vector<double> d = data ? Pooled({*data}, c.statistic) : std::vector<double>{};
+      if (!d.empty()) v.expected += "; the experiment: " + Num(AggregateOf(d, c.aggregate == Aggregate::kEvery ? Aggregate::kMedian : c.aggregate));
+      break;
+    }
     case CriterionKind::kIncreasing:
     case CriterionKind::kRatio: break;  // (over cases: in Judge)
   }

@@ -29,6 +29,7 @@ const std::vector<std::pair<MeasureKind, const char*>>& KindNames() {
       {MeasureKind::kClearance, "clearance"},
       {MeasureKind::kFundamentalDiagram, "fundamental_diagram"},
       {MeasureKind::kHeadway, "headway"},
+      {MeasureKind::kLanes, "lanes"},
       {MeasureKind::kStartTimes, "start_times"},
       {MeasureKind::kRunState, "run_state"}};
   return names;
@@ -307,6 +308,67 @@ Statistics MeasureStartTimes(const observe::Trajectories& t, const std::vector<r
   return out;
 }
 
+// Lane order frame by frame, after the band order parameter of driven binary
+// mixtures (Rex and Löwen 2007): each walker's neighbours in a band along the
+// walking axis, by direction of travel, (same - opposite) / (same + opposite),
+// averaged over the walkers (not squared as there: a walker among people
+// coming the other way is the opposite of a lane, -1, not another lane).
+// Organized at 0.8 and above; a lane counts as broken once the order falls
+// below 0.6 (the gap keeps a flicker at the threshold from counting).
+void MeasureLanes(const observe::Trajectories& t, const std::vector<observe::Track>& tracks, const MeasureSpec& spec,
+                  Statistics* out) {
+  constexpr double kAlong_m = 1.5, kOrganized = 0.8, kBroken = 0.6, kMoving_m_per_s = 0.1;
+  const auto by_frame = SamplesByFrame(t, tracks, spec);
+  const Vec2 axis = Normalized(spec.direction);
+  std::vector<double> order, times;
+  for (const auto& [frame, samples] : by_frame) {
+    double sum = 0;
+    std::size_t counted = 0;
+    for (const Sample& a : samples) {
+      if (!spec.area.Contains(a.position_m)) continue;
+      const double va = Dot(a.velocity_m_per_s, axis);
+      if (std::abs(va) < kMoving_m_per_s) continue;
+      double same = 0, opposite = 0;
+      for (const Sample& b : samples) {
+        if (&a == &b) continue;
+        const double vb = Dot(b.velocity_m_per_s, axis);
+        if (std::abs(vb) < kMoving_m_per_s) continue;
+        const Vec2 d = t.box.MinimumImage(b.position_m - a.position_m);
+        if (std::abs(Dot(d, axis)) > kAlong_m || std::abs(Cross(axis, d)) > spec.lane_half_width_m) continue;
+        ((va > 0) == (vb > 0) ? same : opposite) += 1;
+      }
+      if (same + opposite == 0) continue;
+      sum += (same - opposite) / (same + opposite);
+      ++counted;
+    }
+    if (counted == 0) continue;
+    order.push_back(sum / double(counted));
+    times.push_back(double(frame - t.first_frame) / t.fps);
+  }
+  double organized = 0, breaks = 0, reformations = 0, longest = 0, run_start = kNaN;
+  bool in_lanes = false, broken_once = false;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (order[k] >= kOrganized) organized += 1;
+    if (!in_lanes && order[k] >= kOrganized) {
+      in_lanes = true;
+      run_start = times[k];
+      if (broken_once) reformations += 1;
+    } else if (in_lanes && order[k] < kBroken) {
+      in_lanes = false;
+      broken_once = true;
+      breaks += 1;
+      longest = std::max(longest, times[k] - run_start);
+    }
+  }
+  if (in_lanes && !times.empty()) longest = std::max(longest, times.back() - run_start);
+  (*out)["lane_order"] = order;
+  (*out)["organized_share"] = {order.empty() ? kNaN : organized / double(order.size())};
+  (*out)["lane_breaks"] = {breaks};
+  (*out)["lane_reformations"] = {reformations};
+  (*out)["longest_organized_s"] = {longest};
+  (*out)["organized_at_end"] = {in_lanes ? 1.0 : 0.0};
+}
+
 std::vector<std::string> SplitGroups(const std::string& text) {
   if (text.empty()) return {"main", "counter"};
   std::vector<std::string> names;
@@ -340,6 +402,7 @@ Statistics Measure(const observe::Trajectories& t, const MeasureSpec& spec, cons
     case MeasureKind::kClearance: MeasureClearance(t, tracks, &out); break;
     case MeasureKind::kFundamentalDiagram: MeasureFundamentalDiagram(t, spec, &out); break;
     case MeasureKind::kHeadway: MeasureHeadway(t, tracks, spec, &out); break;
+    case MeasureKind::kLanes: MeasureLanes(t, tracks, spec, &out); break;
     case MeasureKind::kStartTimes:
     case MeasureKind::kRunState:
       throw InputError(t.source + ": the " + ToString(spec.kind) + " measure needs a crowdrecon run file");
@@ -376,7 +439,7 @@ bool MeasureSpec::IsValid(std::string* error) const {
     return false;
   };
   const bool needs_area = kind == MeasureKind::kWalkingSpeed || kind == MeasureKind::kFundamentalDiagram ||
-                          kind == MeasureKind::kHeadway;
+                          kind == MeasureKind::kHeadway || kind == MeasureKind::kLanes;
   if (needs_area && !has_area) return fail(ToString(kind) + " needs an area");
   if (has_area && (area.polygon_m.size() < 3 || !(area.Area_m2() > 0.0)))
     return fail("the area must be a polygon of at least 3 points with an area > 0");

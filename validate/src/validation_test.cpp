@@ -101,8 +101,8 @@ MeasureSpec ReadMeasure(const JsonReader& r) {
     m.from_line = ReadLine(r.At("from"), "from");
     m.to_line = ReadLine(r.At("to"), "to");
   }
-  if (m.kind == MeasureKind::kPassages) {
-    m.line = ReadLine(r.At("line"), "line");
+  if (m.kind == MeasureKind::kPassages) m.line = ReadLine(r.At("line"), "line");
+  if (m.kind == MeasureKind::kPassages || m.kind == MeasureKind::kLanes) {
     m.direction = r.At("direction").AsPoint();
     if (!(Length(m.direction) > 0.0)) r.At("direction").Fail("expected a direction [dx, dy] of length > 0");
     m.direction = Normalized(m.direction);

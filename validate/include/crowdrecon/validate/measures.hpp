@@ -32,6 +32,13 @@
 //   headway              headway_m (per sample: distance to the nearest person ahead in the
 //                        same file, within `lane_half_width_m` of the walking direction and
 //                        `max_headway_m`), density_per_m2
+//   lanes                lane_order (per sampled frame: the mean over walkers in `area` of
+//                        (same - opposite) / (same + opposite), counting the walkers within
+//                        `lane_half_width_m` across and 1.5 m along `direction` of each, by the sign
+//                        of their velocity along it; 1: everyone in lanes), organized_share (of
+//                        frames at or above 0.8), lane_breaks (organized runs that fell below 0.6:
+//                        lanes that broke), lane_reformations (broken lanes that became organized
+//                        again), longest_organized_s, organized_at_end
 //   start_times          (from the run file: its `start` events, timeline.premovement) premovement_s
 //                        (each person's time), start_delay_s (per person: the first frame from 1 s
 //                        before their time at which they are 0.01 m from where they stood then, less
@@ -54,7 +61,7 @@
 namespace crowdrecon::validate {
 
 enum class MeasureKind {
-  kTravel, kWalls, kWalkingSpeed, kPassages, kClearance, kFundamentalDiagram, kHeadway, kStartTimes, kRunState
+  kTravel, kWalls, kWalkingSpeed, kPassages, kClearance, kFundamentalDiagram, kHeadway, kLanes, kStartTimes, kRunState
 };
 std::string ToString(MeasureKind kind);
 // False (and *kind untouched) for a name that is not a measure.
