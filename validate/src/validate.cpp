@@ -93,10 +93,11 @@ struct TestRun {
 TestRun RunTest(const ValidationTest& test, const Profile& profile, const ValidateOptions& options) {
   const json sweep_json = SweepOf(test, profile, options.seeds);
   const std::string sweep_text = sweep_json.dump(1);
-  // The folder is named by the sweep's text (and the build's measure code
-  // would be another folder's only through the text): a changed test or
-  // profile is a new sweep, never one refused as "a different sweep".
-  const std::string key = Sha256Hex(sweep_text + MeasureKindNames()).substr(0, 12);
+  // The folder is named by the sweep's text and the build (a sweep's runs
+  // are one build's: sweep/results.hpp): a changed test or profile, or
+  // another build, is a new sweep, never one refused as "a different sweep"
+  // or mixed with another build's runs.
+  const std::string key = Sha256Hex(sweep_text + sweep::BuildVersion()).substr(0, 12);
   const fs::path dir = options.output_dir / "runs" / profile.name / (test.id + "-" + key);
   CreateOutputFolder(dir);
   CreateOutputFolder(dir / "measures");

@@ -78,6 +78,9 @@ std::string SetupFigure(const ValidationTest& t, const TestResult& r) {
     }
   plan.min_m = lo - Vec2{0.5, 0.5};
   plan.max_m = hi + Vec2{0.5, 0.5};
+  // At most about 460 px tall: a tall venue is drawn narrower.
+  const Vec2 span = plan.max_m - plan.min_m;
+  plan.width = std::clamp(460.0 * span.x / std::max(span.y, 1e-6), 300.0, 760.0);
   plan.walls = r.walls;
   for (const Vec2& p : r.start_positions) plan.dots.push_back({p, kProfileColor[0], 0.2, ""});
   const MeasureSpec& m = t.measure;
@@ -207,19 +210,22 @@ std::string CasesFigure(const ValidationTest& t, const Criterion& crit, const st
 
 // The distribution of a statistic's values (every seed pooled) per profile
 // and the data's, with the criterion's band.
-std::string DistributionFigure(const ValidationTest& t, const Criterion& crit,
+std::string DistributionFigure(const ValidationTest& t, const Criterion& crit, const std::string& statistic, bool log,
                                const std::vector<const TestResult*>& per_profile, const std::vector<Profile>& profiles) {
   svg::Chart c;
-  c.title = t.title + ": " + crit.statistic + ", the share of values above";
-  c.x_label = crit.statistic;
+  c.title = statistic + ": the share of values above each value (every seed)";
+  c.x_label = statistic;
   c.y_label = "share of values above";
-  c.y_min = 0;
-  c.y_max = 1.02;
+  c.log_x = c.log_y = log;
+  if (!log) {
+    c.y_min = 0;
+    c.y_max = 1.02;
+  }
   c.legend_left = false;
   auto add = [&](std::vector<double> v, const std::string& label, const std::string& color, bool dashed) {
     if (v.empty()) return;
     svg::Series s;
-    s.label = label + " (" + std::to_string(v.size()) + " values)";
+    s.label = label + ", " + std::to_string(v.size()) + " values";
     s.color = color;
     s.dashed = dashed;
     s.step = true;
@@ -236,10 +242,12 @@ std::string DistributionFigure(const ValidationTest& t, const Criterion& crit,
   for (std::size_t p = 0; p < per_profile.size(); ++p) {
     std::vector<Statistics> all;
     for (const auto& runs : per_profile[p]->runs) all.insert(all.end(), runs.begin(), runs.end());
-    add(Values(all, crit.statistic), "model, profile " + profiles[p].name, kProfileColor[p % 2], false);
+    add(Values(all, statistic), "model, " + profiles[p].name, kProfileColor[p % 2], false);
   }
-  if (per_profile.front()->data) add(Values({*per_profile.front()->data}, crit.statistic), "experiment", kDataColor, true);
-  if (crit.kind == CriterionKind::kWithin) {
+  if (per_profile.front()->data)
+    add(Values({*per_profile.front()->data}, statistic), "experiment", kDataColor, true);
+  if (per_profile.front()->data && t.data) c.title += "; experiment: " + t.data->label;
+  if (crit.kind == CriterionKind::kWithin && crit.statistic == statistic) {
     if (std::isfinite(crit.low)) c.x_marks.push_back({crit.low, "criterion " + svg::Short(crit.low)});
     if (std::isfinite(crit.high)) c.x_marks.push_back({crit.high, "criterion " + svg::Short(crit.high)});
   }
@@ -247,15 +255,69 @@ std::string DistributionFigure(const ValidationTest& t, const Criterion& crit,
   return "<figure>" + c.ToSvg() + "</figure>\n";
 }
 
+// Passages counted over time, each run a line (from its lapses), and the
+// experiment's: a clog is a plateau, the flow the slope.
+std::string CumulativeFigure(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
+                             const std::vector<Profile>& profiles) {
+  svg::Chart c;
+  c.title = "People through the line against time since the first passage";
+  c.x_label = "time since the first passage, s";
+  c.y_label = "people through";
+  c.legend_left = true;
+  c.x_min = 0;
+  c.y_min = 0;
+  auto add = [&](const Statistics& s, const std::string& color, const std::string& label, bool dashed, double width) {
+    const auto it = s.find("lapse_s");
+    if (it == s.end()) return false;
+    svg::Series line;
+    line.color = color;
+    line.label = label;
+    line.dashed = dashed;
+    line.width = width;
+    line.step = true;
+    double time = 0;
+    line.x.push_back(0);
+    line.y.push_back(1);
+    for (std::size_t k = 0; k < it->second.size(); ++k) {
+      time += it->second[k];
+      line.x.push_back(time);
+      line.y.push_back(double(k + 2));
+    }
+    const auto open = s.find("open_lapse_s");
+    if (open != s.end() && !open->second.empty() && open->second[0] > 0) {  // a clog to the end
+      line.x.push_back(time + open->second[0]);
+      line.y.push_back(line.y.back());
+    }
+    c.series.push_back(line);
+    return true;
+  };
+  for (std::size_t p = 0; p < per_profile.size(); ++p) {
+    bool labelled = false;
+    for (std::size_t k = 0; k < per_profile[p]->runs.size(); ++k)
+      for (const Statistics& s : per_profile[p]->runs[k])
+        labelled = add(s, kProfileColor[p % 2], labelled ? "" : "model, profile " + profiles[p].name + " (each run)", false,
+                       1.0) || labelled;
+  }
+  if (per_profile.front()->data)
+    add(*per_profile.front()->data, "#000", "experiment (" + (t.data ? t.data->label : std::string("data")) + ")", true, 2.4);
+  if (c.series.empty()) return "<p class=\"note\">No passages to draw.</p>\n";
+  return "<figure>" + c.ToSvg() + "<figcaption>Each step one person through the line; a flat stretch is a clog, and a " +
+         "line that ends flat is a clog that lasted to the end of the run.</figcaption></figure>\n";
+}
+
 std::string Figures(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
                     const std::vector<Profile>& profiles) {
   if (t.measure.kind == MeasureKind::kFundamentalDiagram) return FdFigure(t, per_profile, profiles);
   if (t.criteria.empty()) return "";
   const Criterion& first = t.criteria.front();
+  if (t.figure.kind == FigureSpec::Kind::kCumulative) return CumulativeFigure(t, per_profile, profiles);
+  if (t.figure.kind == FigureSpec::Kind::kDistribution)
+    return DistributionFigure(t, first, t.figure.statistic.empty() ? first.statistic : t.figure.statistic, t.figure.log,
+                              per_profile, profiles);
   const bool has_x = t.cases.size() > 1 &&
                      std::all_of(t.cases.begin(), t.cases.end(), [](const Case& k) { return std::isfinite(k.x); });
   if (has_x) return CasesFigure(t, first, per_profile, profiles);
-  return DistributionFigure(t, first, per_profile, profiles);
+  return DistributionFigure(t, first, first.statistic, false, per_profile, profiles);
 }
 
 std::string FileDigest(const fs::path& f) { return Sha256Hex(ReadInputFile(f, "file")).substr(0, 16); }
@@ -273,7 +335,7 @@ std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
   for (const Profile& p : s.profiles) profiles_text += (profiles_text.empty() ? "" : " beside ") + p.name;
   std::string h = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"generator\" content=\"crowdrecon validate\">\n<title>Validation: " +
                   Esc(profiles_text) + "</title>\n<style>" + reports::html::Css() +
-                  "\nsection.test { page-break-before: always; }\n</style></head><body>\n";
+                  "\nsection.test { page-break-before: always; }\ntd, th { text-align: left; }\n</style></head><body>\n";
   h += "<h1>crowdrecon validation: profile " + Esc(profiles_text) + "</h1>\n";
   char line[400];
   std::snprintf(line, sizeof line, "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; %.0f s of wall time; build %s; %s.",

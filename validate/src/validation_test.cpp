@@ -336,6 +336,15 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
       for (const Case& k : t.cases)
         if ((c.cases.empty() || std::count(c.cases.begin(), c.cases.end(), k.name)) && k.reference.empty())
           r.At("criteria").Fail("near_reference needs published values (\"reference\") in case \"" + k.name + "\"");
+  if (const auto fig = r.Find("figure")) {
+    const std::string kind = fig->Choice("kind", "distribution", {"distribution", "cumulative"});
+    t.figure.kind = kind == "cumulative" ? FigureSpec::Kind::kCumulative : FigureSpec::Kind::kDistribution;
+    t.figure.statistic = fig->String("statistic", "");
+    t.figure.log = fig->Bool("log", false);
+    if (t.figure.kind == FigureSpec::Kind::kCumulative && t.measure.kind != MeasureKind::kPassages)
+      fig->At("kind").Fail("a cumulative figure counts passages; the test's measure is " + ToString(t.measure.kind));
+    fig->Finish();
+  }
   t.quick = r.Bool("quick", false);
   r.Finish();
   return t;

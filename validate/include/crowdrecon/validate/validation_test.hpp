@@ -100,6 +100,16 @@ struct DataReference {
   MeasureSpec measure;
 };
 
+// The test's figure in the report: by default a fundamental diagram for that
+// measure, the first criterion's statistic against the cases' x where every
+// case has one, or else the distribution of its values.
+struct FigureSpec {
+  enum class Kind { kDefault, kDistribution, kCumulative };
+  Kind kind = Kind::kDefault;
+  std::string statistic;  // distribution: this statistic ("" = the first criterion's)
+  bool log = false;       // distribution: log axes (lapses, the tail of Zuriguel et al.)
+};
+
 struct ValidationTest {
   std::filesystem::path file;
   std::string id, title, standard, source, setup;
@@ -113,6 +123,7 @@ struct ValidationTest {
   MeasureSpec measure;
   std::optional<DataReference> data;
   std::vector<Criterion> criteria;     // none: the test only documents
+  FigureSpec figure;
   bool quick = false;                  // in the quick subset (make test)
 };
 
