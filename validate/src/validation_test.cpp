@@ -45,6 +45,20 @@ std::vector<std::string> NamesOf(const std::vector<Named<Enum>>& table) {
 }
 
 template <typename Enum>
+std::string NameIn(const std::vector<Named<Enum>>& table, Enum value) {
+  for (const auto& n : table)
+    if (n.value == value) return n.name;
+  return "?";
+}
+
+template <typename Enum>
+bool ValueIn(const std::vector<Named<Enum>>& table, const std::string& name, Enum* value) {
+  for (const auto& n : table)
+    if (name == n.name) return *value = n.value, true;
+  return false;
+}
+
+template <typename Enum>
 Enum ValueOf(const std::vector<Named<Enum>>& table, const std::string& name) {
   for (const auto& n : table)
     if (name == n.name) return n.value;
@@ -216,31 +230,11 @@ std::vector<std::uint64_t> ReadSeeds(const JsonReader& r) {
 
 }  // namespace
 
-std::string ToString(Role role) {
-  for (const auto& n : kRoles)
-    if (n.value == role) return n.name;
-  return "?";
-}
-bool FromString(const std::string& name, Role* role) {
-  for (const auto& n : kRoles)
-    if (name == n.name) return *role = n.value, true;
-  return false;
-}
-std::string ToString(Aggregate aggregate) {
-  for (const auto& n : kAggregates)
-    if (n.value == aggregate) return n.name;
-  return "?";
-}
-bool FromString(const std::string& name, Aggregate* aggregate) {
-  for (const auto& n : kAggregates)
-    if (name == n.name) return *aggregate = n.value, true;
-  return false;
-}
-std::string ToString(CriterionKind kind) {
-  for (const auto& n : kCriterionKeys)
-    if (n.value == kind) return n.name;
-  return "?";
-}
+std::string ToString(Role role) { return NameIn(kRoles, role); }
+bool FromString(const std::string& name, Role* role) { return ValueIn(kRoles, name, role); }
+std::string ToString(Aggregate aggregate) { return NameIn(kAggregates, aggregate); }
+bool FromString(const std::string& name, Aggregate* aggregate) { return ValueIn(kAggregates, name, aggregate); }
+std::string ToString(CriterionKind kind) { return NameIn(kCriterionKeys, kind); }
 
 std::string Criterion::Describe() const {
   auto num = [](double v) {
