@@ -50,11 +50,15 @@ PY
 grep -q "2 passed, 2 failed, 0 documented, 0 errors" "$d/out.txt"
 for f in report.html results.csv validation.json; do test -s "$d/v/$f"; done
 test ! -e "$d/v/report.pdf"
-# Again on the same folder: nothing is run again, the same results.
+# Again on the same folder: nothing is run again, the same results; a PDF
+# left by an earlier validation is removed when this one prints none.
+echo "%PDF earlier" > "$d/v/report.pdf"
 cp "$d/v/results.csv" "$d/first.csv"
 "$exe" validate --quick -o "$d/v" --no-pdf -q > "$d/out2.txt" || true
 cmp "$d/first.csv" "$d/v/results.csv"
 grep -q "2 passed, 2 failed" "$d/out2.txt"
+grep -q "removed the previous report.pdf" "$d/out2.txt"
+test ! -e "$d/v/report.pdf"
 # A folder that is not a validation's is refused, and left alone.
 mkdir "$d/other"; echo keep > "$d/other/notes.txt"
 if "$exe" validate --quick -o "$d/other" --no-pdf -q > "$d/out3.txt" 2>&1; then echo "expected a refusal"; exit 1; fi

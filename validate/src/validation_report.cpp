@@ -508,7 +508,11 @@ void WriteValidationReport(const ValidateOptions& options, const std::string& ch
   summary->csv = dir / "results.csv";
   WriteFileAtomically(dir / "report.html", Html(options, *summary));
   summary->html = dir / "report.html";
-  if (options.pdf) {
+  if (!options.pdf) {
+    // A previous validation's PDF would pass for this one's.
+    std::error_code ec;
+    if (fs::remove(dir / "report.pdf", ec)) summary->notes.push_back("removed the previous report.pdf (--no-pdf)");
+  } else {
     // Printed beside, then renamed: a browser that fails leaves no PDF that
     // looks complete.
     const fs::path partial = dir / ".report.pdf.partial";
