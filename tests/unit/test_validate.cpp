@@ -72,6 +72,7 @@ TEST(ValidationMeasures, PassagesGiveFlowLapsesAndTheOpenLapseOfAClog) {
   EXPECT_DOUBLE_EQ(s.at("passed")[0], 5.0);
   EXPECT_NEAR(s.at("passed_share")[0], 5.0 / 6.0, 1e-12);
   EXPECT_NEAR(s.at("flow_per_s")[0], 4.0 / 9.0, 1e-9);
+  EXPECT_NEAR(s.at("sustained_flow_per_s")[0], 4.0 / 19.0, 1e-9);  // the clog to the end (20 s) counts
   EXPECT_NEAR(s.at("max_lapse_s")[0], 5.0, 1e-9);
   EXPECT_NEAR(s.at("median_lapse_s")[0], 1.5, 1e-9);
   EXPECT_NEAR(s.at("open_lapse_s")[0], 10.0, 1e-9);  // from the last passage to the end: a clog

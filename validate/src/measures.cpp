@@ -169,6 +169,10 @@ void MeasurePassages(const observe::Trajectories& t, const std::vector<observe::
   const double span = passages.back() - passages.front();
   (*out)["span_s"] = {span};
   (*out)["flow_per_s"] = {span > 0 ? double(n - 1) / span : kNaN};
+  // Over the whole run: a clog that lasts to the end counts as time without
+  // passages (the flow while people pass flatters a run that clogged early).
+  const double until = everyone ? passages.back() : end_s;
+  (*out)["sustained_flow_per_s"] = {until > passages.front() ? double(n - 1) / (until - passages.front()) : kNaN};
   analysis::PassageOptions options;
   const analysis::PassageStatistics p = analysis::AnalyzePassages(passages, passages.front(), passages.back(), options);
   (*out)["lapse_s"] = p.lapses_s;

@@ -17,6 +17,8 @@
 //   walking_speed        speed_m_per_s (per person: path length / time inside `area`), with
 //                        the person's group: speed_m_per_s@GROUP for each group name
 //   passages             passed, passed_share, flow_per_s ((N-1) / (last - first passage)),
+//                        sustained_flow_per_s ((N-1) / (the end - first passage), the end being
+//                        the last passage when everyone passed, else the run's end),
 //                        span_s, median_lapse_s, max_lapse_s, open_lapse_s (last passage to the
 //                        end while people are left; 0 when everyone passed), tail_exponent,
 //                        time_to_all_s (the last passage), time_to_95_s, front_density_per_m2
