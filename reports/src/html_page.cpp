@@ -111,4 +111,10 @@ std::string SelfCheckScript(std::size_t figures) {
          "  document.body.setAttribute('data-figures', String(n));\n});\n</script>\n";
 }
 
+std::string ChromiumOrError(const std::string& given) {
+  const std::string chromium = FindChromium(given);
+  if (chromium.empty()) PrintPdf(chromium, {}, {});
+  return chromium;
+}
+
 }  // namespace crowdrecon::reports::html

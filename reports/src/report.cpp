@@ -52,7 +52,6 @@ Spread SpreadOf(std::vector<double> v) {
 namespace {
 
 using html::Css;
-using html::FindChromium;
 using html::PrintPdf;
 using html::SelfCheckScript;
 using html::Table;
@@ -220,10 +219,7 @@ std::string CdfChart(const std::string& title, const std::string& x_label,
 // The browser that prints the PDF ("" without --pdf); without one, the clear
 // error before any work.
 std::string ChromiumFor(const ReportOptions& options) {
-  if (!options.pdf) return "";
-  const std::string chromium = FindChromium(options.chromium);
-  if (chromium.empty()) PrintPdf(chromium, {}, {});
-  return chromium;
+  return options.pdf ? html::ChromiumOrError(options.chromium) : "";
 }
 
 // Writes the report's folder as a whole (common/staged_folder.hpp):

@@ -148,14 +148,12 @@ TestRun RunTest(const ValidationTest& test, const Profile& profile, const Valida
   return tr;
 }
 
-// The experiment measured with the test's measure, cached by the data
-// file's checksum and the measure.
-std::optional<Statistics> MeasureData(const ValidationTest& test, const fs::path& output_dir) {
+// The experiment measured with the test's measure.
+std::optional<Statistics> MeasureData(const ValidationTest& test) {
   if (!test.data) return std::nullopt;
   const DataReference& d = *test.data;
   CheckInputFile(d.trajectories, "the experiment's trajectories of test " + test.id);
   const observe::Trajectories t = observe::ReadTrajectories(d.trajectories, 0.0, d.unit);
-  (void)output_dir;
   return MeasureTrajectories(t, d.measure);
 }
 
@@ -280,18 +278,14 @@ ValidateSummary RunValidation(const ValidateOptions& options) {
       sweep::ValidateRuns(spec, sweep::ExpandRuns(spec));
     }
   // The chromium before any work.
-  std::string chromium;
-  if (options.pdf) {
-    chromium = reports::html::FindChromium(options.chromium);
-    if (chromium.empty()) reports::html::PrintPdf(chromium, {}, {});
-  }
+  const std::string chromium = options.pdf ? reports::html::ChromiumOrError(options.chromium) : "";
   CreateOutputFolder(options.output_dir);
   json marker = {{"format", kFolderFormat}, {"suite", fs::absolute(options.suite).string()}, {"profiles", json::array()}};
   for (const Profile& p : summary.profiles) marker["profiles"].push_back(json::parse(p.canonical_json));
   WriteFileAtomically(options.output_dir / "validation.json", marker.dump(1));
 
   std::map<std::string, std::optional<Statistics>> data;
-  for (const ValidationTest& t : summary.tests) data[t.id] = MeasureData(t, options.output_dir);
+  for (const ValidationTest& t : summary.tests) data[t.id] = MeasureData(t);
   summary.results.assign(summary.profiles.size(), {});
   for (std::size_t p = 0; p < summary.profiles.size(); ++p)
     for (const ValidationTest& t : summary.tests) {

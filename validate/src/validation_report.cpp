@@ -21,6 +21,7 @@
 #include "crowdrecon/reports/html_page.hpp"
 #include "crowdrecon/reports/svg.hpp"
 #include "crowdrecon/sweep/results.hpp"
+#include "pooled.hpp"
 
 namespace crowdrecon::validate {
 
@@ -44,25 +45,6 @@ std::string VerdictCell(Verdict v) {
 std::string CaseCell(const CaseVerdict& v) {
   const std::string mark = !v.judged ? "&#8211;" : v.pass ? "<b style=\"color:#2e8b57\">pass</b>" : "<b style=\"color:#c0392b\">fail</b>";
   return mark + " " + Esc(v.text) + "<br><span class=\"range\">expected " + Esc(v.expected) + "</span>";
-}
-
-std::vector<double> Values(const std::vector<Statistics>& runs, const std::string& statistic) {
-  std::vector<double> all;
-  for (const Statistics& s : runs) {
-    const auto it = s.find(statistic);
-    if (it != s.end())
-      for (double v : it->second)
-        if (std::isfinite(v)) all.push_back(v);
-  }
-  std::sort(all.begin(), all.end());
-  return all;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // The setup: the first profile's first run's walls and start positions.
@@ -178,13 +160,13 @@ std::string CasesFigure(const ValidationTest& t, const Criterion& crit, const st
       for (const Statistics& st : per_profile[p]->runs[k]) {
         const auto it = st.find(crit.statistic);
         if (it == st.end() || it->second.empty()) continue;
-        const double v = Median(it->second);
+        const double v = AggregateOf(Finite(it->second), Aggregate::kMedian);
         per_run.push_back(v);
         dots.x.push_back(t.cases[k].x);
         dots.y.push_back(v);
       }
       median.x.push_back(t.cases[k].x);
-      median.y.push_back(Median(per_run));
+      median.y.push_back(AggregateOf(Finite(per_run), Aggregate::kMedian));
     }
     c.series.push_back(dots);
     c.series.push_back(median);
@@ -242,10 +224,10 @@ std::string DistributionFigure(const ValidationTest& t, const Criterion& crit, c
   for (std::size_t p = 0; p < per_profile.size(); ++p) {
     std::vector<Statistics> all;
     for (const auto& runs : per_profile[p]->runs) all.insert(all.end(), runs.begin(), runs.end());
-    add(Values(all, statistic), "model, " + profiles[p].name, kProfileColor[p % 2], false);
+    add(Pooled(all, statistic), "model, " + profiles[p].name, kProfileColor[p % 2], false);
   }
   if (per_profile.front()->data)
-    add(Values({*per_profile.front()->data}, statistic), "experiment", kDataColor, true);
+    add(Pooled({*per_profile.front()->data}, statistic), "experiment", kDataColor, true);
   if (per_profile.front()->data && t.data) c.title += "; experiment: " + t.data->label;
   if (crit.kind == CriterionKind::kWithin && crit.statistic == statistic) {
     if (std::isfinite(crit.low)) c.x_marks.push_back({crit.low, "criterion " + svg::Short(crit.low)});

@@ -21,6 +21,9 @@ std::string SelfCheckScript(std::size_t figures);
 // `given`, or the first of chromium, chromium-browser, google-chrome on PATH
 // ("" if none).
 std::string FindChromium(const std::string& given);
+// The browser that will print (FindChromium), or the clear error (PrintPdf's,
+// saying how to install one) before any work is done.
+std::string ChromiumOrError(const std::string& given);
 // Prints `html` to `pdf` with `chromium` (its profile and log beside the PDF,
 // removed whatever happens). InputError naming the browser and its log's
 // start if it fails; a clear one, saying how to install it, when `chromium`
