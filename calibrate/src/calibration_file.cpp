@@ -450,8 +450,9 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
 
   // The fingerprint: what a run's outputs depend on besides the values and
   // the seed (the observation specs key the cache's files themselves).
-  // The build counts too: runs of different builds are never mixed (as in sweeps).
-  std::string f = "crowdrecon " + sweep::BuildVersion() + "\n" + c.base.scenario_canonical_json + "\n";
+  // The build's sources count too: runs of different sources are never
+  // mixed (as in sweeps: sweep::SourceFingerprint).
+  std::string f = "crowdrecon sources " + sweep::SourceFingerprint() + "\n" + c.base.scenario_canonical_json + "\n";
   for (const sweep::Override& o : c.base.set) f += o.path + "=" + o.json + "\n";
   for (const Parameter& p : c.parameters)
     f += "param " + p.path + (p.is_range ? " range of width " + FormatNumber(p.width) : std::string()) + "\n";

@@ -44,6 +44,7 @@ bool JsonReader::IsObject() const { return value_->is_object(); }
 bool JsonReader::IsArray() const { return value_->is_array(); }
 bool JsonReader::IsNumber() const { return value_->is_number(); }
 bool JsonReader::IsString() const { return value_->is_string(); }
+bool JsonReader::IsNull() const { return value_->is_null(); }
 
 JsonReader JsonReader::Child(std::string_view key, const nlohmann::json* value) const {
   return JsonReader(root_, value, origin_, path_ + "/" + detail::EscapeToken(key));

@@ -82,9 +82,12 @@ std::vector<double> PremovementTimes(const Scenario& scenario, std::size_t initi
   // A stream of its own, apart from the bodies', placements' and inflows'.
   std::mt19937_64 rng(scenario.population.seed ^ 0x9e3779b97f4a7c15ull);
   std::vector<double> times(initial_people);
+  const bool uniform = p.distribution.kind == Distribution::Kind::kUniform;
   for (double& t : times) {
-    const double u = double(rng() >> 11) * 0x1.0p-53;  // [0, 1), the same on every standard library
-    t = p.low_s + u * (p.high_s - p.low_s);
+    // [0, 1), the same on every standard library; for the shapes with a tail
+    // the middle of its 2^-53 interval, in (0, 1): never a time of 0.
+    const double u = (double(rng() >> 11) + (uniform ? 0.0 : 0.5)) * 0x1.0p-53;
+    t = std::min(p.distribution.Quantile(u), 1e6);
   }
   return times;
 }

@@ -418,12 +418,11 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     PremovementSpec& p = t.premovement;
     p.enabled = true;
     p.where = pre->Where();
-    if (pre->Has("uniform_s") == pre->Has("times_s")) pre->Fail("expected exactly one of uniform_s [low, high] and times_s [t, ...]");
-    if (auto u = pre->Find("uniform_s")) {
-      if (!u->IsArray() || u->Size() != 2) u->Fail("expected [low, high] in seconds");
-      p.low_s = u->Element(0).AsNumber(0.0, 1e6);
-      p.high_s = u->Element(1).AsNumber(0.0, 1e6);
-      if (p.low_s > p.high_s) u->Fail("expected low <= high");
+    if (HasDistribution(*pre) == pre->Has("times_s"))
+      pre->Fail("expected exactly one of a distribution (uniform_s [low, high], gamma, lognormal, weibull) and "
+                "times_s [t, ...]");
+    if (HasDistribution(*pre)) {
+      p.distribution = ReadDistribution(*pre);
     } else {
       const JsonReader times = pre->At("times_s");
       if (!times.IsArray() || times.Size() == 0) times.Fail("expected a list of times in seconds, one per person of the start");

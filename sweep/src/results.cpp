@@ -67,7 +67,8 @@ std::map<std::string, std::string> SweepValues(const SweepSpec& spec, const std:
           {"diagram_x", spec.diagram_x},
           {"diagram_y", spec.diagram_y},
           {"runs_total", std::to_string(spec.RunCount())},
-          {"crowdrecon_version", CROWDRECON_GIT_VERSION}};
+          {"crowdrecon_version", CROWDRECON_GIT_VERSION},
+          {"source_fingerprint", CROWDRECON_SOURCE_FINGERPRINT}};
 }
 
 // Appends raw bytes of trivially copyable values and strings.
@@ -206,11 +207,18 @@ ResultsStore::ResultsStore(const fs::path& dir, const SweepSpec& spec, const std
                          " changed since it was started); use a new output folder (-o), or delete " +
                          dir.string() + " to start over");
     };
-    // Runs of another build may differ (the engine may have changed): a sweep
-    // is finished by the crowdrecon that started it.
-    if (stored["crowdrecon_version"] != values.at("crowdrecon_version"))
+    // Runs of other sources may differ (the engine may have changed): a sweep
+    // is finished by a crowdrecon built from the sources that started it
+    // (the same source fingerprint: another commit of documents or results
+    // continues it). A sweep stored before fingerprints: the same version.
+    const bool same_build = stored.count("source_fingerprint")
+                                ? stored["source_fingerprint"] == values.at("source_fingerprint")
+                                : stored["crowdrecon_version"] == values.at("crowdrecon_version");
+    if (!same_build)
       throw InputError(file.string() + " holds runs made by crowdrecon " + stored["crowdrecon_version"] +
-                       "; this is crowdrecon " + values.at("crowdrecon_version") +
+                       (stored.count("source_fingerprint") ? " (sources " + stored["source_fingerprint"] + ")" : std::string()) +
+                       "; this is crowdrecon " + values.at("crowdrecon_version") + " (sources " +
+                       values.at("source_fingerprint") + ")" +
                        ", whose results may differ and are not mixed with them; use a new output folder (-o), or "
                        "delete " + dir.string() + " to start over");
     differs("sweep", "the sweep file");
@@ -337,6 +345,8 @@ ResultsTable ReadResults(const fs::path& dir_or_file) {
 }
 
 std::string BuildVersion() { return CROWDRECON_GIT_VERSION; }
+
+std::string SourceFingerprint() { return CROWDRECON_SOURCE_FINGERPRINT; }
 
 OutputKind SweepFolderOutput() {
   return {"a sweep folder (results.sqlite of a crowdrecon sweep)", true, [](const fs::path& dir) {

@@ -77,14 +77,28 @@ if [[ $mode == local ]]; then
   fi
   grep -q "holds the results of a different sweep (the sweep file changed" "$out/other.txt" ||
     { echo "FAIL: unclear message"; cat "$out/other.txt"; exit 1; }
-  # A sweep started by another build is not continued (its runs may differ).
+  # A sweep started by a build of other sources is not continued (its runs
+  # may differ); one of another commit of the same sources is.
   cp -r "$out/resume" "$out/other-build"
-  sqlite3 "$out/other-build/results.sqlite" "UPDATE sweep SET value = 'v0.0-other' WHERE key = 'crowdrecon_version'"
+  sqlite3 "$out/other-build/results.sqlite" "UPDATE sweep SET value = '0123456789abcdef' WHERE key = 'source_fingerprint'"
   if "$exe" sweep "$sweep" -o "$out/other-build" -q >"$out/other-build.txt" 2>&1; then
+    echo "FAIL: a sweep of other sources was continued"; exit 1
+  fi
+  grep -q "holds runs made by crowdrecon .* (sources 0123456789abcdef); this is crowdrecon .*not mixed" "$out/other-build.txt" ||
+    { echo "FAIL: unclear message"; cat "$out/other-build.txt"; exit 1; }
+  # A sweep stored before fingerprints: its version decides.
+  cp -r "$out/resume" "$out/old-build"
+  sqlite3 "$out/old-build/results.sqlite" "DELETE FROM sweep WHERE key = 'source_fingerprint'; UPDATE sweep SET value = 'v0.0-other' WHERE key = 'crowdrecon_version'"
+  if "$exe" sweep "$sweep" -o "$out/old-build" -q >"$out/old-build.txt" 2>&1; then
     echo "FAIL: a sweep of another build was continued"; exit 1
   fi
-  grep -q "holds runs made by crowdrecon v0.0-other; this is crowdrecon .*not mixed" "$out/other-build.txt" ||
-    { echo "FAIL: unclear message"; cat "$out/other-build.txt"; exit 1; }
+  grep -q "holds runs made by crowdrecon v0.0-other; this is crowdrecon .*not mixed" "$out/old-build.txt" ||
+    { echo "FAIL: unclear message"; cat "$out/old-build.txt"; exit 1; }
+  cp -r "$out/resume" "$out/other-commit"
+  sqlite3 "$out/other-commit/results.sqlite" "UPDATE sweep SET value = 'v0.0-other-commit' WHERE key = 'crowdrecon_version'"
+  "$exe" sweep "$sweep" -o "$out/other-commit" -q >"$out/other-commit.txt" 2>&1 ||
+    { echo "FAIL: a sweep of the same sources (another commit) was not continued"; cat "$out/other-commit.txt"; exit 1; }
+  same "$out/j1" "$out/other-commit" "continued by another commit of the same sources"
   echo "sweeps, local: OK"
 elif [[ $mode == mpi ]]; then
   command -v mpirun >/dev/null || { echo "mpirun not found: skipped"; exit 77; }

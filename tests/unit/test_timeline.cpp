@@ -13,6 +13,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/analysis/timeline_series.hpp"
+#include "crowdrecon/common/distribution.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -847,6 +849,31 @@ TEST(Timeline, PeopleOfTheStartSetOffAtTheirPremovementTimes) {
     EXPECT_GE(e.time_s, 0.1);
     EXPECT_LT(e.time_s, 0.41);
   }
+  // NIST TN 1822 Verif.1.1's shapes: the times are the distribution's
+  // quantiles of the same stream (here a Weibull of scale 0.2 s: each start
+  // at the first step at or after its time).
+  const std::string weibull = R"({"premovement": {"weibull": {"shape": 1.195, "scale_s": 0.2}}})";
+  // The draw as documented (timeline.hpp): the population's seed's own
+  // stream, one uniform number per person in id order, moved to the middle
+  // of its 2^-53 interval, through the distribution's quantile.
+  const Distribution w{Distribution::Kind::kWeibull, 1.195, 0.2};
+  std::mt19937_64 rng(5 ^ 0x9e3779b97f4a7c15ull);
+  std::vector<double> times(6);
+  for (double& t : times) t = w.Quantile((double(rng() >> 11) + 0.5) * 0x1.0p-53);
+  const TimelineRun shaped = Simulate(
+      Hallway(R"({"count": 6, "target": "to_exit", "placement": {"region": "entries"}, "seed": 5})",
+              R"({"duration_s": 3, "output_fps": 10, "checkpoint_interval_s": 0, "contacts": false})", weibull),
+      "premovement-weibull");
+  std::vector<double> started;
+  for (const runfile::Event& e : shaped.Kind("start")) started.push_back(e.time_s);
+  std::vector<double> sorted = times;
+  std::sort(sorted.begin(), sorted.end());
+  std::sort(started.begin(), started.end());
+  ASSERT_EQ(started.size(), sorted.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    EXPECT_GE(started[i], sorted[i] - 1e-9);
+    EXPECT_LT(started[i], sorted[i] + 0.011);  // within a step (dt <= 0.01 s)
+  }
 }
 
 TEST(Timeline, PremovementTimesThatDoNotFitAreRefused) {
@@ -865,7 +892,8 @@ TEST(Timeline, PremovementTimesThatDoNotFitAreRefused) {
     }
   };
   refuse(R"({"premovement": {"uniform_s": [5, 1]}})", "/timeline/premovement/uniform_s: expected low <= high");
-  refuse(R"({"premovement": {"uniform_s": [1, 5], "times_s": [1]}})", "exactly one of uniform_s");
+  refuse(R"({"premovement": {"uniform_s": [1, 5], "times_s": [1]}})", "exactly one of a distribution");
+  refuse(R"({"premovement": {"gamma": {"shape": 1.3, "scale_s": 0}}})", "/timeline/premovement/gamma/scale_s");
   refuse(R"({"premovement": {"times_s": [1, -2, 3]}})", "/timeline/premovement/times_s/1");
   refuse(R"({"premovement": {"times_s": [1, 2]}})", "/timeline/premovement/times_s: 2 times for 3 people of the start");
   refuse(R"({"premovement": {"uniform_s": [1, 5], "shape": "gamma"}})", "shape");

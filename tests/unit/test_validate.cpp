@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/scenario/runner.hpp"
+#include "crowdrecon/scenario/scenario.hpp"
 #include "crowdrecon/validate/measures.hpp"
 #include "crowdrecon/validate/validate.hpp"
 #include "crowdrecon/validate/validation_test.hpp"
@@ -202,6 +204,41 @@ TEST(ValidationMeasures, LanesThatMixAreCountedAsBroken) {
   EXPECT_NEAR(s.at("longest_organized_s")[0], 10.0, 0.5);
 }
 
+// A run that ends once everyone has left writes a last frame without people:
+// the last to leave has left too (RiMEA 15's clearance), and every start event
+// counts in the pre-movement sample (NIST Verif.1.1).
+TEST(ValidationMeasures, ARunsClearanceAndStartsCountEveryone) {
+  const fs::path dir = fs::temp_directory_path() / "crowdrecon-validate-run";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path venue = fs::path(CROWDRECON_SOURCE_DIR) / "venues/validation/venues/corner.json";
+  const std::string text = R"({"format": "crowdrecon-scenario", "version": 1, "name": "t", "venue": ")" + venue.string() +
+                           R"(", "population": {"count": 4, "target": "leave", "placement": {"region": "entries"},
+      "desired_speed_m_per_s": [1.2, 1.4], "seed": 3},
+      "run": {"duration_s": 60, "output_fps": 5, "checkpoint_interval_s": 0, "contacts": false},
+      "timeline": {"stop_when_left_fraction": 1, "premovement": {"uniform_s": [0.5, 2]}}})";
+  const scenario::Scenario sc = scenario::ParseScenario(text, (dir / "t.json").string(), dir);
+  scenario::RunOptions options;
+  options.output = dir / "run.sqlite";
+  ASSERT_EQ(scenario::RunScenario(sc, options).status, "complete");
+  MeasureSpec clearance;
+  clearance.kind = MeasureKind::kClearance;
+  const Statistics c = MeasureRun(options.output, clearance);
+  EXPECT_EQ(c.at("left_share")[0], 1.0);
+  EXPECT_TRUE(std::isfinite(c.at("time_to_all_s")[0]));
+  EXPECT_LT(c.at("time_to_all_s")[0], 60.0);
+  MeasureSpec starts;
+  starts.kind = MeasureKind::kStartTimes;
+  const Statistics st = MeasureRun(options.output, starts);
+  EXPECT_EQ(st.at("premovement_s").size(), 4u);
+  EXPECT_EQ(st.at("started_people")[0], 4.0);
+  for (double t : st.at("premovement_s")) {
+    EXPECT_GE(t, 0.5);
+    EXPECT_LT(t, 2.05);
+  }
+  fs::remove_all(dir);
+}
+
 // --- Judging ----------------------------------------------------------------
 
 ValidationTest TwoCaseTest() {
@@ -317,6 +354,38 @@ TEST(ValidationJudge, QuantilesOfTheDataBoundTheAggregate) {
   EXPECT_FALSE(Judge(t, "p", {{RunOf({{"headway_m", {0.6, 0.8}}})}}, data).criteria[0].pass);
 }
 
+TEST(ValidationJudge, FollowsIsAKolmogorovSmirnovTestOfThePooledValues) {
+  ValidationTest t;
+  t.id = "pre";
+  t.cases = {Case{"base", "", 0, {}, {}}};
+  Criterion c;
+  c.statistic = "premovement_s";
+  c.kind = CriterionKind::kFollows;
+  c.distribution.kind = Distribution::Kind::kWeibull;
+  c.distribution.a = 1.195;
+  c.distribution.b = 139.285;
+  t.criteria = {c};
+  // 100 values at the distribution's quantiles, split over two seeds: D is
+  // at most 1/100, far below the critical value (about 0.134).
+  std::vector<double> a, b;
+  for (int i = 0; i < 100; ++i) (i % 2 ? a : b).push_back(c.distribution.Quantile((i + 0.5) / 100.0));
+  TestResult r = Judge(t, "p", {{RunOf({{"premovement_s", a}}), RunOf({{"premovement_s", b}})}}, std::nullopt);
+  EXPECT_TRUE(r.criteria[0].pass) << r.criteria[0].cases[0].text;
+  EXPECT_LE(r.criteria[0].cases[0].value, 0.0101);
+  // The same values half as late again: rejected (the CDFs differ by up to 0.18).
+  for (double& x : a) x *= 1.5;
+  for (double& x : b) x *= 1.5;
+  r = Judge(t, "p", {{RunOf({{"premovement_s", a}}), RunOf({{"premovement_s", b}})}}, std::nullopt);
+  EXPECT_FALSE(r.criteria[0].pass);
+  EXPECT_GT(r.criteria[0].cases[0].value, 0.134);
+  EXPECT_NE(r.criteria[0].cases[0].expected.find("Weibull"), std::string::npos);
+  // Uniform values judged against the gamma distribution of NIST's case: rejected.
+  t.criteria[0].distribution = Distribution{Distribution::Kind::kGamma, 1.291, 103.901};
+  std::vector<double> u;
+  for (int i = 0; i < 100; ++i) u.push_back(10.0 + 90.0 * (i + 0.5) / 100.0);
+  EXPECT_FALSE(Judge(t, "p", {{RunOf({{"premovement_s", u}})}}, std::nullopt).criteria[0].pass);
+}
+
 // --- Files ------------------------------------------------------------------
 
 std::string TestText(const std::string& extra, const std::string& criteria = "") {
@@ -356,6 +425,17 @@ TEST(ValidationFiles, BadTestsAreRefusedWithTheirJsonPath) {
                 .find("\"a\" is not a case"),
             std::string::npos);
   EXPECT_NE(ErrorOf(TestText(R"(, "cases": [{"name": "a b"}])", ok)).find("/cases/0/name"), std::string::npos);
+  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "s", "follows": {"gamma": {"shape": 1.3, "scale_s": 104}}, "alpha": 0.05, "why": "w"})")), "");
+  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "s", "within": [1, null], "why": "w"})")), "");
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "within_data": [null, 0.5], "why": "w"})")).find("quantiles"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "follows": {"gamma": {"shape": -1, "scale_s": 104}}, "why": "w"})"))
+                .find("/criteria/0/follows/gamma/shape"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "follows": {"beta": {}}, "why": "w"})")).find("exactly one distribution"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "within": [1, 2], "alpha": 0.1, "why": "w"})")).find("/criteria/0/alpha"),
+            std::string::npos);
   const std::string bad_measure = R"({"format": "crowdrecon-validation-test", "version": 1, "id": "x", "title": "t",
       "standard": "s", "role": "fit", "source": "s", "setup": "s", "scenario": "../scenarios/corridor-40m.json",
       "measure": {"kind": "teleport"}})";

@@ -127,6 +127,29 @@ CaseVerdict JudgeCase(const Criterion& c, const Case& k, const std::vector<Stati
       if (!d.empty()) v.expected += "; the experiment: " + Num(AggregateOf(d, c.aggregate == Aggregate::kEvery ? Aggregate::kMedian : c.aggregate));
       break;
     }
+    case CriterionKind::kFollows: {
+      // Kolmogorov-Smirnov: the largest distance between the values' empirical
+      // CDF and the distribution's, against the critical value at alpha
+      // (the asymptotic one with Stephens' correction for small n).
+      v.expected = "D <= critical value at alpha " + Num(c.alpha) + " (" + c.distribution.Describe() + ")";
+      v.judged = true;
+      if (values.empty()) {
+        v.pass = false;
+        v.text = "no value (" + over + ")";
+        break;
+      }
+      const double n = double(values.size());
+      double d = 0.0;
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const double f = c.distribution.Cdf(values[i]);
+        d = std::max({d, double(i + 1) / n - f, f - double(i) / n});
+      }
+      const double critical = std::sqrt(-0.5 * std::log(c.alpha / 2.0)) / (std::sqrt(n) + 0.12 + 0.11 / std::sqrt(n));
+      v.value = d;
+      v.text = "D " + Num(d) + " (critical " + Num(critical) + "), " + std::to_string(values.size()) + " values over " + over;
+      v.pass = failed == 0 && d <= critical;
+      break;
+    }
     case CriterionKind::kIncreasing:
     case CriterionKind::kRatio: break;  // (over cases: in Judge)
   }

@@ -275,20 +275,20 @@ Statistics MeasureStartTimes(const observe::Trajectories& t, const std::vector<r
   constexpr double kMoved_m = 0.01, kBefore_s = 1.0;
   std::map<std::uint32_t, double> due;  // id -> the time the run started them
   double gone = 0;                      // not walking at their time (pushed out, fallen)
+  std::vector<double> premovement, delay;
   for (const runfile::Event& e : events) {
     if (e.kind != "start" || e.person < 0) continue;
+    premovement.push_back(e.time_s);  // everyone's time, there at it or not
     if (e.detail.find("not walking") != std::string::npos) {
       gone += 1;
       continue;
     }
     due[static_cast<std::uint32_t>(e.person + 1)] = e.time_s;
   }
-  std::vector<double> premovement, delay;
   double early = 0, never = 0;
   for (const observe::Track& track : observe::TracksOf(t)) {
     const auto it = due.find(track.id);
     if (it == due.end() || track.position_m.empty()) continue;
-    premovement.push_back(it->second);
     const auto time_of = [&](std::size_t k) { return double(track.frame[k] - t.first_frame) / t.fps; };
     std::size_t from = 0;
     while (from + 1 < track.position_m.size() && time_of(from + 1) <= it->second - kBefore_s) ++from;
@@ -307,7 +307,7 @@ Statistics MeasureStartTimes(const observe::Trajectories& t, const std::vector<r
   out["start_delay_s"] = delay;
   out["moved_early"] = {early};
   out["never_started"] = {never};
-  out["started_people"] = {double(due.size())};
+  out["started_people"] = {double(due.size()) + gone};
   out["gone_before_start"] = {gone};
   return out;
 }
@@ -449,8 +449,8 @@ bool MeasureSpec::IsValid(std::string* error) const {
     return fail("the area must be a polygon of at least 3 points with an area > 0");
   if (kind == MeasureKind::kTravel && (from_line.Length_m() <= 0.0 || to_line.Length_m() <= 0.0))
     return fail("travel needs two lines of length > 0 (from, to)");
-  if (kind == MeasureKind::kPassages && (line.Length_m() <= 0.0 || !(Length(direction) > 0.0)))
-    return fail("passages needs a line of length > 0 and a direction");
+  if (kind == MeasureKind::kPassages && line.Length_m() <= 0.0) return fail("passages needs a line of length > 0");
+  if (kind == MeasureKind::kLanes && !(Length(direction) > 0.0)) return fail("lanes needs a direction");
   if (!(skip_s >= 0.0 && skip_s <= 1e6)) return fail("skip_s must be in [0, 1e6]");
   if (!(velocity_span_s > 0.0 && velocity_span_s <= 10.0)) return fail("velocity_span_s must be in (0, 10]");
   if (!(lane_half_width_m > 0.0 && lane_half_width_m <= 5.0)) return fail("lane_half_width_m must be in (0, 5]");
@@ -492,7 +492,12 @@ Statistics MeasureRun(const std::filesystem::path& run_file, const MeasureSpec& 
     out["duration_s"] = {reader.Frames().empty() ? 0.0 : double(reader.Frames().back()) / reader.fps()};
     return out;
   }
-  const observe::Trajectories t = observe::ReadTrajectories(run_file);
+  observe::Trajectories t = observe::ReadTrajectories(run_file);
+  // The run's last frame, whether or not anyone is in it (a run that ends
+  // once everyone has left writes a last frame without people): whoever's
+  // track ends before it has left.
+  const std::vector<std::int64_t> frames = reader.Frames();
+  if (!frames.empty()) t.last_frame = std::max<std::int64_t>(t.last_frame, frames.back());
   if (spec.kind == MeasureKind::kStartTimes) {
     out = MeasureStartTimes(t, reader.Events());
     out["completed"] = {complete ? 1.0 : 0.0};

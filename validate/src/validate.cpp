@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -64,6 +65,40 @@ json SweepOf(const ValidationTest& test, const Profile& profile, int max_seeds) 
           {"keep_runs", false}};
 }
 
+// The files a sweep reads besides its own text (the scenario, its venue,
+// bodies and tables, the cases' venues): every string of the scenario and of
+// the sweep that names a file, relative to the file that names it, followed
+// into JSON files two levels down. Their content names the runs' folder, so
+// that an edited venue is never measured with the runs of the old one.
+void DigestInputs(const json& j, const fs::path& base, int depth, std::set<fs::path>* seen, std::string* out) {
+  if (j.is_object() || j.is_array()) {
+    for (const json& v : j) DigestInputs(v, base, depth, seen, out);
+    return;
+  }
+  if (!j.is_string()) return;
+  const std::string& text = j.get_ref<const std::string&>();
+  if (text.empty() || text.size() > 4096) return;
+  std::error_code ec;
+  const fs::path file = fs::path(text).is_absolute() ? fs::path(text) : base / text;
+  if (!fs::is_regular_file(file, ec)) return;
+  const fs::path key = fs::weakly_canonical(file, ec);
+  if (!seen->insert(key).second) return;
+  const std::string content = ReadInputFile(file, "input file");
+  *out += key.filename().string() + " " + Sha256Hex(content) + "\n";
+  if (depth > 0 && file.extension() == ".json") {
+    const json inner = json::parse(content, nullptr, false);
+    if (!inner.is_discarded()) DigestInputs(inner, file.parent_path(), depth - 1, seen, out);
+  }
+}
+
+std::string InputsDigest(const json& sweep_json, const fs::path& scenario) {
+  std::set<fs::path> seen;
+  std::string out;
+  DigestInputs(json(scenario.string()), scenario.parent_path(), 2, &seen, &out);
+  DigestInputs(sweep_json, scenario.parent_path(), 2, &seen, &out);
+  return Sha256Hex(out);
+}
+
 // What the report draws of the setup: the first run's walls and start.
 json SetupOf(const fs::path& run_file) {
   const runfile::RunFileReader reader(run_file);
@@ -93,11 +128,15 @@ struct TestRun {
 TestRun RunTest(const ValidationTest& test, const Profile& profile, const ValidateOptions& options) {
   const json sweep_json = SweepOf(test, profile, options.seeds);
   const std::string sweep_text = sweep_json.dump(1);
-  // The folder is named by the sweep's text and the build (a sweep's runs
-  // are one build's: sweep/results.hpp): a changed test or profile, or
-  // another build, is a new sweep, never one refused as "a different sweep"
-  // or mixed with another build's runs.
-  const std::string key = Sha256Hex(sweep_text + sweep::BuildVersion()).substr(0, 12);
+  // The folder is named by the sweep's text, the test's measure, the
+  // content of the files the runs read and the build's sources (a sweep's runs are one source fingerprint's:
+  // sweep/results.hpp): a changed test, measure or profile, or other
+  // sources, is a new sweep, never one refused as "a different sweep" or
+  // mixed with other sources' runs; a commit of documents or results reuses
+  // the runs (and so does another machine building the same sources).
+  const std::string key = Sha256Hex(sweep_text + "\nmeasure " + test.measure_json + "\ninputs " +
+                                    InputsDigest(sweep_json, test.scenario) + "\nsources " + sweep::SourceFingerprint())
+                              .substr(0, 12);
   const fs::path dir = options.output_dir / "runs" / profile.name / (test.id + "-" + key);
   CreateOutputFolder(dir);
   CreateOutputFolder(dir / "measures");

@@ -237,6 +237,65 @@ std::string DistributionFigure(const ValidationTest& t, const Criterion& crit, c
   return "<figure>" + c.ToSvg() + "</figure>\n";
 }
 
+// For each "follows" criterion: the survival function of the values of its
+// cases (every seed pooled) per profile beside the distribution's.
+std::string FollowsFigures(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
+                           const std::vector<Profile>& profiles) {
+  std::string out = "<div style=\"display:flex;flex-wrap:wrap;gap:8px\">";
+  for (const Criterion& crit : t.criteria) {
+    if (crit.kind != CriterionKind::kFollows) continue;
+    svg::Chart c;
+    std::string cases;
+    for (const Case& k : t.cases)
+      if (crit.cases.empty() || std::count(crit.cases.begin(), crit.cases.end(), k.name))
+        cases += (cases.empty() ? "" : ", ") + k.label;
+    c.title = cases;  // (a case's label names its distribution; the criterion table gives it in full)
+    c.x_label = crit.statistic;
+    c.y_label = "share of values above";
+    c.width = 340;
+    c.height = 260;
+    c.x_min = 0;
+    c.y_min = 0;
+    c.y_max = 1.02;
+    c.legend_left = true;  // the curves fall from the top left: the bottom left is free
+    c.legend_bottom = true;
+    double x_max = 0;
+    for (std::size_t p = 0; p < per_profile.size(); ++p) {
+      std::vector<Statistics> all;
+      for (std::size_t i = 0; i < t.cases.size(); ++i)
+        if (crit.cases.empty() || std::count(crit.cases.begin(), crit.cases.end(), t.cases[i].name))
+          all.insert(all.end(), per_profile[p]->runs[i].begin(), per_profile[p]->runs[i].end());
+      const std::vector<double> v = Pooled(all, crit.statistic);
+      if (v.empty()) continue;
+      svg::Series s;
+      s.label = "model, " + profiles[p].name + " (" + std::to_string(v.size()) + ")";
+      s.color = kProfileColor[p % 2];
+      s.step = true;
+      s.x.push_back(0);
+      s.y.push_back(1);
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        s.x.push_back(v[i]);
+        s.y.push_back(double(v.size() - i - 1) / double(v.size()));
+      }
+      x_max = std::max(x_max, v.back());
+      c.series.push_back(s);
+    }
+    if (c.series.empty()) continue;
+    svg::Series d;
+    d.label = "the distribution";
+    d.color = kDataColor;
+    d.dashed = true;
+    for (int i = 0; i <= 200; ++i) {
+      const double x = 1.05 * x_max * i / 200.0;
+      d.x.push_back(x);
+      d.y.push_back(1.0 - crit.distribution.Cdf(x));
+    }
+    c.series.push_back(d);
+    out += "<figure style=\"margin:0\">" + c.ToSvg() + "</figure>";
+  }
+  return out + "</div>\n";
+}
+
 // Passages counted over time, each run a line (from its lapses), and the
 // experiment's: a clog is a plateau, the flow the slope.
 std::string CumulativeFigure(const ValidationTest& t, const std::vector<const TestResult*>& per_profile,
@@ -292,6 +351,8 @@ std::string Figures(const ValidationTest& t, const std::vector<const TestResult*
   if (t.measure.kind == MeasureKind::kFundamentalDiagram) return FdFigure(t, per_profile, profiles);
   if (t.criteria.empty()) return "";
   const Criterion& first = t.criteria.front();
+  if (std::any_of(t.criteria.begin(), t.criteria.end(), [](const Criterion& c) { return c.kind == CriterionKind::kFollows; }))
+    return FollowsFigures(t, per_profile, profiles);
   if (t.figure.kind == FigureSpec::Kind::kCumulative) return CumulativeFigure(t, per_profile, profiles);
   if (t.figure.kind == FigureSpec::Kind::kDistribution)
     return DistributionFigure(t, first, t.figure.statistic.empty() ? first.statistic : t.figure.statistic, t.figure.log,
@@ -320,9 +381,10 @@ std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
                   "\nsection.test { page-break-before: always; }\ntd, th { text-align: left; }\n</style></head><body>\n";
   h += "<h1>crowdrecon validation: profile " + Esc(profiles_text) + "</h1>\n";
   char line[400];
-  std::snprintf(line, sizeof line, "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; %.0f s of wall time; build %s; %s.",
+  std::snprintf(line, sizeof line, "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; %.0f s of wall time; build %s (sources %s); %s.",
                 s.tests.size() * np, s.Count(Verdict::kPass), s.Count(Verdict::kFail), s.Count(Verdict::kDocuments),
-                s.Count(Verdict::kError), s.wall_s, sweep::BuildVersion().c_str(), Today().c_str());
+                s.Count(Verdict::kError), s.wall_s, sweep::BuildVersion().c_str(), sweep::SourceFingerprint().c_str(),
+                Today().c_str());
   h += "<p class=\"sub\">" + Esc(line) + "</p>\n";
   h += "<p class=\"note\">Every test is a file of the suite (" + Esc(options.suite.string()) +
        "): its source, setup, criterion and tolerance. Runs and experiments are measured by the same code; a criterion "
@@ -422,7 +484,8 @@ std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
   for (const Profile& p : s.profiles)
     h += "<h3>" + Esc(p.name) + "</h3><p>" + Esc(p.description) + "</p><pre>" + Esc(p.canonical_json) + "</pre><p class=\"note\">" +
          Esc(p.file.string()) + ", SHA-256 " + FileDigest(p.file) + "...</p>\n";
-  h += "<p class=\"note\">Build " + Esc(sweep::BuildVersion()) + ". Runs and their measures: " +
+  h += "<p class=\"note\">Build " + Esc(sweep::BuildVersion()) + ", source fingerprint " + Esc(sweep::SourceFingerprint()) +
+       " (the runs are reused by it: docs/validation.md). Runs and their measures: " +
        Esc((options.output_dir / "runs").string()) + " (run the same command again to reuse them).</p></section>\n";
   h += reports::html::SelfCheckScript(figures);
   h += "</body></html>\n";
@@ -431,7 +494,7 @@ std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
 
 std::string ResultsJson(const ValidateOptions& options, const ValidateSummary& s) {
   json j = {{"format", "crowdrecon-validation-results"}, {"version", 1}, {"build", sweep::BuildVersion()},
-            {"suite", fs::absolute(options.suite).string()}, {"wall_s", s.wall_s}};
+            {"sources", sweep::SourceFingerprint()}, {"suite", fs::absolute(options.suite).string()}, {"wall_s", s.wall_s}};
   j["profiles"] = json::array();
   for (const Profile& p : s.profiles) j["profiles"].push_back(json::parse(p.canonical_json));
   j["tests"] = json::array();

@@ -35,7 +35,8 @@ const std::vector<Named<CriterionKind>> kCriterionKeys = {
     {CriterionKind::kWithin, "within"},           {CriterionKind::kNearReference, "near_reference"},
     {CriterionKind::kWithinData, "within_data"},  {CriterionKind::kNearData, "near_data"},
     {CriterionKind::kDataBand, "data_band"},      {CriterionKind::kIncreasing, "increasing"},
-    {CriterionKind::kRatio, "ratio"},             {CriterionKind::kDocuments, "documents"}};
+    {CriterionKind::kRatio, "ratio"},             {CriterionKind::kDocuments, "documents"},
+    {CriterionKind::kFollows, "follows"}};
 
 template <typename Enum>
 std::vector<std::string> NamesOf(const std::vector<Named<Enum>>& table) {
@@ -117,9 +118,16 @@ MeasureSpec ReadMeasure(const JsonReader& r) {
   }
   if (m.kind == MeasureKind::kPassages) m.line = ReadLine(r.At("line"), "line");
   if (m.kind == MeasureKind::kPassages || m.kind == MeasureKind::kLanes) {
-    m.direction = r.At("direction").AsPoint();
-    if (!(Length(m.direction) > 0.0)) r.At("direction").Fail("expected a direction [dx, dy] of length > 0");
-    m.direction = Normalized(m.direction);
+    const JsonReader d = r.At("direction");
+    if (m.kind == MeasureKind::kPassages && d.IsString()) {
+      // Passages either way: the total flow of a counter-flow.
+      if (d.AsString() != "both") d.Fail("expected a direction [dx, dy] of length > 0, or \"both\"");
+      m.direction = {0.0, 0.0};
+    } else {
+      m.direction = d.AsPoint();
+      if (!(Length(m.direction) > 0.0)) d.Fail("expected a direction [dx, dy] of length > 0");
+      m.direction = Normalized(m.direction);
+    }
   }
   if (const auto area = r.Find("area")) {
     m.has_area = true;
@@ -140,8 +148,13 @@ MeasureSpec ReadMeasure(const JsonReader& r) {
 }
 
 std::pair<double, double> ReadRange(const JsonReader& r) {
-  if (!r.IsArray() || r.Size() != 2) r.Fail("expected [low, high]");
-  const double lo = r.Element(0).AsNumber(-kHuge, kHuge), hi = r.Element(1).AsNumber(-kHuge, kHuge);
+  if (!r.IsArray() || r.Size() != 2) r.Fail("expected [low, high] (null for an open end)");
+  const auto bound = [&](std::size_t i, double open) {
+    const JsonReader e = r.Element(i);
+    return e.IsNull() ? open : e.AsNumber(-kHuge, kHuge);
+  };
+  const double lo = bound(0, -std::numeric_limits<double>::infinity());
+  const double hi = bound(1, std::numeric_limits<double>::infinity());
   if (!(lo <= hi)) r.Fail("expected low <= high");
   return {lo, hi};
 }
@@ -158,7 +171,7 @@ Criterion ReadCriterion(const JsonReader& r, const std::set<std::string>& case_n
     }
   if (kinds != 1)
     r.Fail("expected exactly one of within, near_reference, within_data, near_data, data_band, increasing, ratio, "
-           "documents");
+           "documents, follows");
   switch (c.kind) {
     case CriterionKind::kWithin: std::tie(c.low, c.high) = ReadRange(r.At("within")); break;
     case CriterionKind::kNearReference: c.relative = r.Number("near_reference", 0.0, 10.0); break;
@@ -193,7 +206,16 @@ Criterion ReadCriterion(const JsonReader& r, const std::set<std::string>& case_n
       if (!r.Bool("documents", true)) r.At("documents").Fail("expected true");
       break;
     }
+    case CriterionKind::kFollows: {
+      const JsonReader f = r.At("follows");
+      if (!f.IsObject()) f.Fail("expected a distribution: {\"gamma\": {\"shape\": a, \"scale_s\": b}} and the like");
+      c.distribution = ReadDistribution(f);
+      f.Finish();
+      c.alpha = r.Number("alpha", c.alpha, 0.001, 0.5);
+      break;
+    }
   }
+  if (c.kind != CriterionKind::kFollows && r.Has("alpha")) r.At("alpha").Fail("applies to \"follows\" only");
   const bool needs_data = c.kind == CriterionKind::kWithinData || c.kind == CriterionKind::kNearData ||
                           c.kind == CriterionKind::kDataBand;
   if (needs_data && !has_data) r.Fail("this criterion compares with the data; the test has no \"data\"");
@@ -256,8 +278,13 @@ std::string Criterion::Describe() const {
       return "mean speed within " + num(band_sd) + " SD of the data's at the same density (+-" +
              num(band_width_per_m2 / 2) + " /m2)";
     case CriterionKind::kIncreasing: return what + " rises from case to case";
-    case CriterionKind::kRatio: return what + ": " + case_b + " / " + case_a + " in [" + num(low) + ", " + num(high) + "]";
+    case CriterionKind::kRatio:
+      return what + ": " + case_b + " / " + case_a +
+             (std::isinf(high) ? " >= " + num(low)
+                               : std::isinf(low) ? " <= " + num(high) : " in [" + num(low) + ", " + num(high) + "]");
     case CriterionKind::kDocuments: return what + " (documented, no pass band)";
+    case CriterionKind::kFollows:
+      return statistic + " follows " + distribution.Describe() + " (Kolmogorov-Smirnov, alpha " + num(alpha) + ")";
   }
   return what;
 }
@@ -309,6 +336,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
     case_names.insert("base");
   }
   t.measure = ReadMeasure(r.At("measure"));
+  t.measure_json = doc.Json().at("measure").dump();
   if (const auto data = r.Find("data")) {
     DataReference d;
     const JsonReader file = data->At("trajectories");

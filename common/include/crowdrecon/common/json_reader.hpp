@@ -62,6 +62,7 @@ class JsonReader {
   bool IsArray() const;
   bool IsNumber() const;
   bool IsString() const;
+  bool IsNull() const;
 
   // --- objects ---------------------------------------------------------
   bool Has(std::string_view key) const;

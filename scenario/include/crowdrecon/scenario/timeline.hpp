@@ -40,6 +40,8 @@
 #include <utility>
 #include <vector>
 
+#include "crowdrecon/common/distribution.hpp"
+
 namespace crowdrecon {
 class JsonReader;
 }  // namespace crowdrecon
@@ -166,12 +168,14 @@ struct RecordedMark {
 // Verif.1.1): each person of the start stands (desired speed 0) until their
 // time, then walks at their own desired speed (or their group's, if an event
 // set one before). Arrivals through inflows walk at once. Key
-// "premovement": {"uniform_s": [10, 100]} (drawn per person from the
-// population's seed, in id order) or {"times_s": [10, 20, ...]} (one per
-// person of the start, in id order).
+// "premovement": a distribution (common/distribution.hpp: {"uniform_s": [10,
+// 100]}, {"gamma": {"shape": 1.291, "scale_s": 103.901}}, {"lognormal":
+// {"mu": 4.586, "sigma": 0.967}}, {"weibull": {"shape": 1.195, "scale_s":
+// 139.285}}; drawn per person from the population's seed, in id order) or
+// {"times_s": [10, 20, ...]} (one per person of the start, in id order).
 struct PremovementSpec {
   bool enabled = false;
-  double low_s = 0.0, high_s = 0.0;  // uniform_s
+  Distribution distribution;         // without times_s
   std::vector<double> times_s;       // or one time per person of the start
   std::string where;                 // JSON path, for messages
 };

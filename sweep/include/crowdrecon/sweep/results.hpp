@@ -11,7 +11,8 @@
 //        format, version, name, sweep (the sweep JSON, compact), sweep_file,
 //        scenario (the base scenario JSON, compact), scenario_file,
 //        analysis_options (JSON), axes, variants, seeds (JSON lists),
-//        diagram_x, diagram_y, runs_total, crowdrecon_version
+//        diagram_x, diagram_y, runs_total, crowdrecon_version,
+//        source_fingerprint
 //
 // status is "complete" or "failed: <message>" (the run could not be placed,
 // or went numerically wrong); a failed run has no regime and NULL metrics.
@@ -111,9 +112,15 @@ struct ResultsTable {
 // Throws InputError if it is missing or not a sweep's results.
 ResultsTable ReadResults(const std::filesystem::path& dir_or_file);
 
-// The build's version as stored with results (`git describe` at build time):
-// results of different builds are never mixed.
+// The build's version as stored with results (`git describe` at build time),
+// for people.
 std::string BuildVersion();
+
+// What runs are reused by: a digest of the sources compiled into the tools,
+// the compiler and its flags (cmake/WriteVersion.cmake). Runs of different
+// fingerprints are never mixed; builds of different commits with the same
+// sources (a commit of documents or results) share them.
+std::string SourceFingerprint();
 
 // A previous sweep folder: its results.sqlite holds a crowdrecon sweep's
 // results (or is still empty, a sweep killed while starting); `sweep -o`

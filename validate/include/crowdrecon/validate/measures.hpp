@@ -42,10 +42,10 @@
 //                        lanes that broke), lane_reformations (broken lanes that became organized
 //                        again), longest_organized_s, organized_at_end
 //   start_times          (from the run file: its `start` events, timeline.premovement) premovement_s
-//                        (each person's time), start_delay_s (per person: the first frame from 1 s
+//                        (each person's time, there at it or not), start_delay_s (per person: the first frame from 1 s
 //                        before their time at which they are 0.01 m from where they stood then, less
 //                        their time), moved_early (people pushed 0.01 m from where they stood more
-//                        than 1 s before their time), never_started, started_people, gone_before_start
+//                        than 1 s before their time), never_started, started_people (start events: times that came), gone_before_start
 //                        (not walking at their time: pushed out of the venue, or fallen)
 //   run_state            (from the run file; not for experiments) completed, peak_local_density_per_m2,
 //                        peak_local_density_real_per_m2, largest_overlap_m
@@ -75,7 +75,8 @@ struct MeasureSpec {
   MeasureKind kind = MeasureKind::kRunState;
   observe::Line from_line, to_line;  // travel
   observe::Line line;                // passages
-  Vec2 direction{1.0, 0.0};          // passages: a crossing counts when it goes this way (normalised)
+  Vec2 direction{1.0, 0.0};          // passages: a crossing counts when it goes this way (normalised;
+                                     // zero, "both" in a test file: either way); lanes: the walking axis
   bool has_area = false;
   observe::Region area;              // walking_speed, fundamental_diagram, headway; passages (optional: front density)
   double skip_s = 0.0;               // fundamental_diagram, headway: the start-up left out (s)

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/distribution.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
 #include "crowdrecon/validate/measures.hpp"
 
@@ -62,6 +63,7 @@ enum class CriterionKind {
   kIncreasing,     // the aggregate rises from case to case, in the cases' order
   kRatio,          // aggregate(case_b) / aggregate(case_a) in [low, high]
   kDocuments,      // no verdict: the standard documents behaviour only; shown
+  kFollows,        // the pooled values follow a distribution: a Kolmogorov-Smirnov test at `alpha`
 };
 std::string ToString(CriterionKind kind);
 
@@ -75,6 +77,8 @@ struct Criterion {
   double quantile_low = 0.25, quantile_high = 0.75;
   double band_sd = 2.0, band_width_per_m2 = 0.5;
   std::string case_a, case_b;       // ratio
+  Distribution distribution;        // follows
+  double alpha = 0.05;              // follows: the test's level
   std::vector<std::string> cases;   // the cases judged (empty: every case)
   std::string why;                  // the tolerance and its reason
   // One line: "travel_time_s (every) in [26, 34]".
@@ -121,6 +125,7 @@ struct ValidationTest {
   std::vector<Case> cases;             // at least one ("base")
   std::string x_label;                 // the cases' axis in the figure ("" without one)
   MeasureSpec measure;
+  std::string measure_json;            // as read, compact (what a run's stored measures depend on)
   std::optional<DataReference> data;
   std::vector<Criterion> criteria;     // none: the test only documents
   FigureSpec figure;
