@@ -2,13 +2,15 @@
 # - CROWDRECON_GIT_VERSION as `git describe --always --dirty` of SOURCE_DIR
 #   ("unknown" without git): what the build is called, for people;
 # - CROWDRECON_SOURCE_FINGERPRINT: the first 16 hex digits of a SHA-256 over
-#   the content of every source file that computes results (the folders in
+#   the content of every source file of the tools (the folders in
 #   SOURCE_FOLDERS, comma-separated, with the top CMakeLists.txt and
 #   CMakePresets.json, less the files in SOURCE_EXCLUDE), the compiler and the
-#   flags (BUILD_INFO): what a run's results depend on. The modules that only
-#   present results (reports, viz, media: pages, pictures, videos) and the
-#   validation report's writer are left out, so that a better page or picture
-#   is drawn from the runs there are. Two
+#   flags (BUILD_INFO): what a run's results depend on. Only files that write
+#   pages from results already judged are left out (the validation report's
+#   writer), so that a better page is drawn from the runs there are; the
+#   presentation modules stay in, as computations use them too (the chest
+#   load is in reports, synthetic footage is drawn by viz and read by media).
+#   Two
 #   builds with the same fingerprint give the same runs, whatever their
 #   commits (a commit of documents, results or tests changes the version,
 #   not the fingerprint), and a build with uncommitted edits has its own.
