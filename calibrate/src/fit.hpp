@@ -166,6 +166,10 @@ class Quadratic {
   std::vector<std::vector<double>> coefficients_;  // [statistic][basis]
 };
 
+// The rows (statistics) the surrogate can fit: finite at its centre, with a
+// positive sigma.
+std::vector<std::size_t> FittedRows(const Quadratic& q, const Objective& o);
+
 struct Minimum {
   std::vector<double> u;
   double chi2 = 0.0;

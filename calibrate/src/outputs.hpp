@@ -97,6 +97,10 @@ struct CalibrationResult {
 // v with `digits` significant digits ("-" when not finite), for reports.
 std::string Fixed(double v, int digits = 3);
 
+// Fills the summary's parameters: values, intervals, determination
+// (calibration_summary.cpp).
+void Summarise(const CalibrationSpec& spec, CalibrationResult& r);
+
 // Writes every output into `dir` and fills summary.json_file / report_file.
 void WriteOutputs(const std::filesystem::path& dir, const Evaluator& evaluator, CalibrationResult* result);
 

@@ -1,5 +1,5 @@
 // Internal: what every JuPedSim trajectory file this library writes shares --
-// the run file (run_file.cpp) and the plain export (trajectory_export.cpp):
+// the run file (run_file_writer.cpp) and the plain export (trajectory_export.cpp):
 // JuPedSim's version-2 tables, the geometry hash and how numbers are stored
 // as metadata text. One source, so that both stay what PedPy reads.
 #pragma once

@@ -79,6 +79,7 @@ if [[ $mode == local ]]; then
     { echo "FAIL: unclear message"; cat "$out/other.txt"; exit 1; }
   # A sweep started by a build of other sources is not continued (its runs
   # may differ); one of another commit of the same sources is.
+  rm -rf "$out/other-build" "$out/old-build" "$out/other-commit"  # (cp -r into an existing folder nests)
   cp -r "$out/resume" "$out/other-build"
   sqlite3 "$out/other-build/results.sqlite" "UPDATE sweep SET value = '0123456789abcdef' WHERE key = 'source_fingerprint'"
   if "$exe" sweep "$sweep" -o "$out/other-build" -q >"$out/other-build.txt" 2>&1; then

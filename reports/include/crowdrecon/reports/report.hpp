@@ -99,8 +99,4 @@ ReportSummary WriteReport(const ReportOptions& options);
 // people.csv, and nothing else), which report -o may write into.
 OutputKind ReportFolderOutput();
 
-// Expands inputs into run files (folders: every *.sqlite run file below,
-// sorted); throws InputError naming an input that is neither.
-std::vector<std::filesystem::path> RunFilesOf(const std::vector<std::filesystem::path>& inputs);
-
 }  // namespace crowdrecon::reports

@@ -1,0 +1,407 @@
+// Writing run files (run_file.hpp): the writer, its frames, events and run values, the writer thread.
+#include "crowdrecon/runfile/run_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/sha256.hpp"
+#include "crowdrecon/common/fnv.hpp"
+#include "crowdrecon/runfile/sqlite.hpp"
+#include "jupedsim_tables.hpp"
+
+namespace crowdrecon::runfile {
+
+namespace {
+
+using sqlite::Database;
+using sqlite::Statement;
+
+using detail::GeometryHash;
+using detail::NumberText;
+
+std::string PointsJson(const std::vector<Vec2>& points) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const Vec2& p : points) j.push_back({p.x, p.y});
+  return j.dump();
+}
+
+// The writer's connection is used by one thread at a time (the caller, or
+// FrameWriterThread's thread between handoffs under its mutex), so SQLite
+// need not lock it around every call (a tenth of the time of writing frames).
+constexpr int kWriterMutexMode = SQLITE_OPEN_NOMUTEX;
+
+// While a run is written, the file is in write-ahead-log mode: a frame's
+// commit appends to RUN.sqlite-wal without waiting for the disk (with
+// synchronous=NORMAL a crash of the machine may lose the last frames, never
+// the file's consistency; a crash of the program loses nothing committed).
+// Rollback journalling synced every commit: at 400 people that was half the
+// time of writing a frame. Closing the writer returns the file to rollback
+// journalling, so a finished run is one plain file; a run killed outright
+// leaves its -wal and -shm files, which SQLite (and every reader) folds back
+// in when the file is next opened.
+constexpr const char* kJournal = "PRAGMA journal_mode=WAL";
+
+// crowdrecon's own tables, after the JuPedSim ones (jupedsim_tables.hpp).
+constexpr const char* kSchema = R"SQL(
+CREATE INDEX frame_id_idx ON trajectory_data(frame, id);
+CREATE TABLE run(key TEXT NOT NULL PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE shape(id INTEGER PRIMARY KEY, radius_m REAL NOT NULL, vertices TEXT NOT NULL);
+CREATE TABLE person(id INTEGER PRIMARY KEY, shape INTEGER NOT NULL, mass_kg REAL NOT NULL,
+  inertia_kg_m2 REAL NOT NULL, desired_speed_m_per_s REAL NOT NULL, grp INTEGER NOT NULL, target TEXT NOT NULL);
+CREATE TABLE wall(id INTEGER PRIMARY KEY, closed INTEGER NOT NULL, radius_m REAL NOT NULL, points TEXT NOT NULL);
+CREATE TABLE frame_time(frame INTEGER PRIMARY KEY, time_s REAL NOT NULL);
+CREATE TABLE person_state(frame INTEGER NOT NULL, id INTEGER NOT NULL, vel_x REAL NOT NULL, vel_y REAL NOT NULL,
+  angle_rad REAL NOT NULL, omega_rad_per_s REAL NOT NULL, state INTEGER NOT NULL, load_n REAL NOT NULL);
+CREATE INDEX person_state_idx ON person_state(frame, id);
+CREATE TABLE contact(frame INTEGER NOT NULL, a INTEGER NOT NULL, b INTEGER NOT NULL, wall INTEGER NOT NULL,
+  point_x REAL NOT NULL, point_y REAL NOT NULL, normal_x REAL NOT NULL, normal_y REAL NOT NULL,
+  overlap_m REAL NOT NULL, normal_force_n REAL NOT NULL, tangential_force_n REAL NOT NULL);
+CREATE INDEX contact_frame_idx ON contact(frame);
+CREATE TABLE person_load(frame INTEGER NOT NULL, id INTEGER NOT NULL, chest_n REAL NOT NULL, lateral_n REAL NOT NULL);
+CREATE INDEX person_load_idx ON person_load(frame, id);
+CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT NULL, person INTEGER NOT NULL,
+  other INTEGER NOT NULL, detail TEXT NOT NULL);
+)SQL";
+
+}  // namespace
+
+struct RunFileWriter::Impl {
+  std::unique_ptr<Database> db;
+  // The frame tables' inserts, prepared once (WriteFrame).
+  std::unique_ptr<sqlite::BatchInsert> trajectory, person_state, contact, person_load;
+  bool has_person_load = true;  // false for a resumed run file written before the table existed
+  std::int64_t geometry_hash = 0;
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
+  double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
+};
+
+RunFileWriter::RunFileWriter() : impl_(std::make_unique<Impl>()) {}
+RunFileWriter::RunFileWriter(RunFileWriter&&) noexcept = default;
+RunFileWriter& RunFileWriter::operator=(RunFileWriter&&) noexcept = default;
+RunFileWriter::~RunFileWriter() {
+  if (!impl_ || !impl_->db) return;  // moved from
+  impl_->trajectory.reset();
+  impl_->person_state.reset();
+  impl_->person_load.reset();
+  impl_->contact.reset();
+  try {
+    impl_->db->Exec("PRAGMA journal_mode=DELETE");  // see kJournal
+  } catch (const std::exception&) {
+    // Still a valid file in WAL mode; readers fold the log in.
+  }
+}
+
+RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
+                                    const RunSetup& setup) {
+  // The caller checked the path (CheckOutputs: a previous run file, or a
+  // file --force lets us replace); a folder is never removed here.
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(file.string() + ": exists and is " + DescribeExisting(file) +
+                     ", not a crowdrecon run file; a folder is never replaced by a file");
+  std::filesystem::remove(file, ec);
+  sqlite::RemoveSidecars(file);
+  RunFileWriter w;
+  // A file that could not be made whole (a full disk, a file-size limit) is
+  // removed with its logs: nothing is left that looks like a run.
+  try {
+    w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
+    Database& db = *w.impl_->db;
+    db.Exec(kJournal);
+    db.Exec("PRAGMA synchronous=NORMAL");
+    db.Exec("BEGIN");
+    db.Exec(detail::kJuPedSimSchema);
+    db.Exec(kSchema);
+    w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
+    {
+      Statement meta(db, "INSERT INTO metadata VALUES(?, ?)");
+      meta.Bind(1, std::string("version")).Bind(2, std::string("2")).Run();
+      meta.Bind(1, std::string("fps")).Bind(2, NumberText(header.output_fps)).Run();
+      Statement geo(db, "INSERT INTO geometry VALUES(?, ?)");
+      geo.Bind(1, w.impl_->geometry_hash).Bind(2, header.walkable_wkt).Run();
+      Statement run(db, "INSERT INTO run VALUES(?, ?)");
+      const auto put = [&](const std::string& k, const std::string& v) { run.Bind(1, k).Bind(2, v).Run(); };
+      put("format", "crowdrecon-run");
+      put("format_version", "2");  // 2: the venue is stored (key venue)
+      put("scenario", header.scenario_json);
+      put("scenario_file", header.scenario_origin);
+      put("seed", std::to_string(header.seed));
+      put("time_step_s", NumberText(header.time_step_s));
+      put("output_fps", NumberText(header.output_fps));
+      put("status", "running");
+      if (!header.venue_json.empty()) put("venue", header.venue_json);
+      const PeriodicBox& box = header.periodic_box;
+      if (box.any()) {
+        const nlohmann::json j = {{"x", box.x}, {"y", box.y}, {"min_m", {box.min_m.x, box.min_m.y}},
+                                  {"max_m", {box.max_m.x, box.max_m.y}}};
+        put("periodic_box", j.dump());
+      }
+    }
+    {
+      Statement shape(db, "INSERT INTO shape VALUES(?, ?, ?)");
+      for (std::size_t s = 0; s < setup.shapes.size(); ++s)
+        shape.Bind(1, static_cast<std::int64_t>(s)).Bind(2, setup.shapes[s].radius_m).Bind(3, PointsJson(setup.shapes[s].vertices)).Run();
+      Statement person(db, "INSERT INTO person VALUES(?, ?, ?, ?, ?, ?, ?)");
+      for (std::size_t i = 0; i < setup.people.size(); ++i) {
+        const Person& p = setup.people[i];
+        person.Bind(1, static_cast<std::int64_t>(i + 1))
+            .Bind(2, static_cast<std::int64_t>(p.shape))
+            .Bind(3, p.mass_kg)
+            .Bind(4, p.inertia_kg_m2)
+            .Bind(5, p.desired_speed_m_per_s)
+            .Bind(6, static_cast<std::int64_t>(p.group))
+            .Bind(7, p.target)
+            .Run();
+      }
+      Statement wall(db, "INSERT INTO wall VALUES(?, ?, ?, ?)");
+      for (std::size_t k = 0; k < setup.walls.size(); ++k)
+        wall.Bind(1, static_cast<std::int64_t>(k))
+            .Bind(2, static_cast<std::int64_t>(setup.walls[k].closed))
+            .Bind(3, setup.walls[k].radius_m)
+            .Bind(4, PointsJson(setup.walls[k].points))
+            .Run();
+    }
+    db.Exec("COMMIT");
+  } catch (...) {
+    w.impl_->db.reset();  // closes the file
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+    sqlite::RemoveSidecars(file);
+    throw;
+  }
+  return w;
+}
+
+RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int64_t last_frame) {
+  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": run file to resume does not exist");
+  RunFileWriter w;
+  w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | kWriterMutexMode);
+  Database& db = *w.impl_->db;
+  db.Exec(kJournal);
+  db.Exec("PRAGMA synchronous=NORMAL");
+  db.Exec("BEGIN");
+  const std::string after = std::to_string(last_frame);
+  for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
+    db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
+  w.impl_->has_person_load = sqlite::HasTable(db, "person_load");
+  if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
+  if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);
+  {
+    Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
+    if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
+    w.impl_->geometry_hash = geo.Int(0);
+    Statement bounds(db, "SELECT MIN(pos_x), MAX(pos_x), MIN(pos_y), MAX(pos_y), COUNT(*) FROM trajectory_data");
+    if (bounds.Next() && bounds.Int(4) > 0) {
+      w.impl_->xmin = bounds.Double(0);
+      w.impl_->xmax = bounds.Double(1);
+      w.impl_->ymin = bounds.Double(2);
+      w.impl_->ymax = bounds.Double(3);
+    }
+  }
+  db.Exec("INSERT OR REPLACE INTO run VALUES('status', 'running')");
+  db.Exec("COMMIT");
+  return w;
+}
+
+void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
+  Database& db = *impl_->db;
+  const std::int64_t frame = f.frame;
+  db.Exec("BEGIN");
+  {
+    if (!impl_->trajectory) {
+      impl_->trajectory = std::make_unique<sqlite::BatchInsert>(db, "trajectory_data", 6);
+      impl_->person_state = std::make_unique<sqlite::BatchInsert>(db, "person_state", 8);
+      impl_->contact = std::make_unique<sqlite::BatchInsert>(db, "contact", 11);
+      if (impl_->has_person_load) impl_->person_load = std::make_unique<sqlite::BatchInsert>(db, "person_load", 4);
+    }
+    sqlite::BatchInsert& traj = *impl_->trajectory;
+    sqlite::BatchInsert& state = *impl_->person_state;
+    for (sqlite::BatchInsert* batch : {&traj, &state, impl_->contact.get()}) batch->Discard();
+    if (impl_->person_load) impl_->person_load->Discard();
+    for (std::size_t k = 0; k < f.person.size(); ++k) {
+      const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
+      const Vec2 x = f.position_m[k];
+      const double angle = f.angle_rad[k];
+      traj.Add(frame).Add(id).Add(x.x).Add(x.y).Add(std::cos(angle)).Add(std::sin(angle));
+      state.Add(frame).Add(id)
+          .Add(f.velocity_m_per_s[k].x).Add(f.velocity_m_per_s[k].y)
+          .Add(angle).Add(f.angular_velocity_rad_per_s[k])
+          .Add(static_cast<std::int64_t>(f.state[k])).Add(f.load_n[k]);
+      impl_->xmin = std::min(impl_->xmin, x.x);
+      impl_->xmax = std::max(impl_->xmax, x.x);
+      impl_->ymin = std::min(impl_->ymin, x.y);
+      impl_->ymax = std::max(impl_->ymax, x.y);
+    }
+    traj.Finish();
+    state.Finish();
+    if (impl_->person_load && f.chest_load_n.size() == f.person.size() && f.lateral_load_n.size() == f.person.size()) {
+      sqlite::BatchInsert& loads = *impl_->person_load;
+      for (std::size_t k = 0; k < f.person.size(); ++k)
+        if (f.chest_load_n[k] != 0.0 || f.lateral_load_n[k] != 0.0)
+          loads.Add(frame).Add(static_cast<std::int64_t>(f.person[k]) + 1).Add(f.chest_load_n[k]).Add(f.lateral_load_n[k]);
+      loads.Finish();
+    }
+    if (f.with_contacts) {
+      sqlite::BatchInsert& contact = *impl_->contact;
+      for (const Contact& c : f.contacts)
+        contact.Add(frame).Add(static_cast<std::int64_t>(c.a + 1))
+            .Add(static_cast<std::int64_t>(c.wall ? c.b : c.b + 1))
+            .Add(static_cast<std::int64_t>(c.wall))
+            .Add(c.point_m.x).Add(c.point_m.y).Add(c.normal.x).Add(c.normal.y)
+            .Add(c.overlap_m).Add(c.normal_force_n).Add(c.tangential_force_n);
+      contact.Finish();
+    }
+    Statement ft(db, "INSERT INTO frame_time VALUES(?, ?)");
+    ft.Bind(1, frame).Bind(2, f.time_s).Run();
+    Statement fd(db, "INSERT INTO frame_data VALUES(?, ?)");
+    fd.Bind(1, frame).Bind(2, impl_->geometry_hash).Run();
+    if (f.with_census) {
+      db.Exec("CREATE TABLE IF NOT EXISTS census(frame INTEGER PRIMARY KEY, time_s REAL NOT NULL, "
+              "walking INTEGER NOT NULL, fallen INTEGER NOT NULL, removed INTEGER NOT NULL, queued INTEGER NOT NULL, "
+              "entered INTEGER NOT NULL)");
+      Statement c(db, "INSERT INTO census VALUES(?, ?, ?, ?, ?, ?, ?)");
+      c.Bind(1, frame).Bind(2, f.time_s).Bind(3, f.census.walking).Bind(4, f.census.fallen)
+          .Bind(5, f.census.removed).Bind(6, f.census.queued).Bind(7, f.census.entered).Run();
+    }
+    Statement ev(db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
+    for (const Event& e : f.events)
+      ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
+          .Bind(4, e.person >= 0 ? e.person + 1 : std::int64_t{0})
+          .Bind(5, e.other >= 0 ? e.other + 1 : std::int64_t{0}).Bind(6, e.detail).Run();
+    Statement meta(db, "INSERT OR REPLACE INTO metadata VALUES(?, ?)");
+    if (std::isfinite(impl_->xmin)) {
+      meta.Bind(1, std::string("xmin")).Bind(2, NumberText(impl_->xmin)).Run();
+      meta.Bind(1, std::string("xmax")).Bind(2, NumberText(impl_->xmax)).Run();
+      meta.Bind(1, std::string("ymin")).Bind(2, NumberText(impl_->ymin)).Run();
+      meta.Bind(1, std::string("ymax")).Bind(2, NumberText(impl_->ymax)).Run();
+    }
+  }
+  db.Exec("COMMIT");
+}
+
+// ---------------------------------------------------------------------------
+
+struct FrameWriterThread::Impl {
+  RunFileWriter& writer;
+  bool background;
+  std::size_t capacity;
+  FrameSnapshot direct;  // the frame being written when not on a thread
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<std::unique_ptr<FrameSnapshot>> queued;  // oldest first
+  std::vector<std::unique_ptr<FrameSnapshot>> spare;  // written, storage kept for reuse
+  bool busy = false;                                  // the thread is writing one
+  bool stopping = false;
+  std::exception_ptr error;
+  std::thread thread;
+
+  Impl(RunFileWriter& w, bool on_thread, std::size_t queue)
+      : writer(w), background(on_thread), capacity(std::max<std::size_t>(1, queue)) {}
+
+  void Loop() {
+    std::unique_lock<std::mutex> lock(mutex);
+    for (;;) {
+      changed.wait(lock, [&] { return stopping || !queued.empty(); });
+      if (queued.empty()) return;  // stopping, nothing left
+      std::unique_ptr<FrameSnapshot> frame = std::move(queued.front());
+      queued.pop_front();
+      busy = true;
+      lock.unlock();
+      std::exception_ptr failure;
+      if (!error) {  // after a failure, later frames are dropped (the run is stopping)
+        try {
+          writer.WriteFrame(*frame);
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      }
+      lock.lock();
+      busy = false;
+      if (failure && !error) error = failure;
+      spare.push_back(std::move(frame));
+      changed.notify_all();
+    }
+  }
+
+  void RethrowLocked(std::unique_lock<std::mutex>& lock) {
+    if (!error) return;
+    std::exception_ptr e = error;
+    lock.unlock();
+    std::rethrow_exception(e);
+  }
+};
+
+FrameWriterThread::FrameWriterThread(RunFileWriter& writer, bool background, std::size_t queue)
+    : impl_(std::make_unique<Impl>(writer, background, queue)) {
+  if (impl_->background) impl_->thread = std::thread([this] { impl_->Loop(); });
+}
+
+FrameWriterThread::~FrameWriterThread() {
+  if (!impl_->background) return;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->changed.notify_all();
+  impl_->thread.join();
+}
+
+void FrameWriterThread::Write(const std::function<void(FrameSnapshot&)>& fill) {
+  if (!impl_->background) {
+    fill(impl_->direct);
+    impl_->writer.WriteFrame(impl_->direct);
+    return;
+  }
+  std::unique_ptr<FrameSnapshot> snapshot;
+  {
+    std::unique_lock<std::mutex> lock(impl_->mutex);
+    impl_->changed.wait(lock, [&] { return impl_->error || impl_->queued.size() < impl_->capacity; });
+    impl_->RethrowLocked(lock);
+    if (!impl_->spare.empty()) {
+      snapshot = std::move(impl_->spare.back());
+      impl_->spare.pop_back();
+    }
+  }
+  if (!snapshot) snapshot = std::make_unique<FrameSnapshot>();
+  fill(*snapshot);  // outside the lock: the thread may be writing
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->queued.push_back(std::move(snapshot));
+  }
+  impl_->changed.notify_all();
+}
+
+void FrameWriterThread::Flush() {
+  if (!impl_->background) return;
+  std::unique_lock<std::mutex> lock(impl_->mutex);
+  impl_->changed.wait(lock, [&] { return impl_->error || (impl_->queued.empty() && !impl_->busy); });
+  impl_->RethrowLocked(lock);
+}
+
+void RunFileWriter::WriteEvent(std::int64_t frame, const Event& e) {
+  Statement ev(*impl_->db, "INSERT INTO event VALUES(?, ?, ?, ?, ?, ?)");
+  ev.Bind(1, frame).Bind(2, e.time_s).Bind(3, e.kind)
+      .Bind(4, e.person >= 0 ? e.person + 1 : std::int64_t{0})
+      .Bind(5, e.other >= 0 ? e.other + 1 : std::int64_t{0}).Bind(6, e.detail).Run();
+}
+
+void RunFileWriter::SetStatus(const std::string& status) { SetRunValue("status", status); }
+
+void RunFileWriter::SetRunValue(const std::string& key, const std::string& value) {
+  Statement s(*impl_->db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
+  s.Bind(1, key).Bind(2, value).Run();
+}
+
+}  // namespace crowdrecon::runfile
