@@ -1,7 +1,9 @@
 """An SVG drawn by a script, as a headless browser draws it: the PNG beside it.
 
-Shared by the scripts that draw their own SVG figures (itaewon-envelope.py,
-night-cheap-model.py). Does nothing where no Chromium is installed
+Shared by the scripts that draw their own SVG figures
+(studies/itaewon-design-envelope/itaewon-envelope.py,
+studies/night-cheap-model/night-cheap-model.py, which import it from this
+folder). Does nothing where no Chromium is installed
 (scripts/install-deps.sh installs it).
 """
 import os

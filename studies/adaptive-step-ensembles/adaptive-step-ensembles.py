@@ -31,10 +31,10 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+ROOT = pathlib.Path(__file__).resolve().parents[2]  # studies/NAME/ is two levels down
+sys.path.insert(0, str(ROOT / "scripts"))
 from ensemble_stats import mean_sd, permutation_p  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE = ROOT / "venues/madrid-arena/scenarios/hallway-5pm2-30cf.json"
 
 

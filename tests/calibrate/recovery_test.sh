@@ -13,7 +13,7 @@
 #     only what is missing and gives the same result.
 # The recordings are made with the calibration's own seeds (common random
 # numbers with the observation), so that this cheap version tests the
-# machinery; the full study (scripts/calibration-recovery.sh) uses recordings
+# machinery; the full study (studies/calibration-recovery/calibration-recovery.sh) uses recordings
 # of other seeds.
 #
 #   recovery_test.sh CROWDRECON DATA_DIR SPEC

@@ -5,7 +5,7 @@
 # release found within 1 s, the mean speeds per direction within 20 %, the
 # counter-flow share within 0.05, no event the trajectories do not have.
 # The thresholds are the study's measured accuracies with a margin
-# (results/observations/footage-study/README.md).
+# (studies/footage-study/results/README.md).
 # Usage: footage_end_to_end.sh CROWDRECON SCENARIO SPEC
 set -euo pipefail
 crowdrecon=$1 scenario=$2 spec=$3

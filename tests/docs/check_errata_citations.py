@@ -28,7 +28,7 @@ WORD = "ERR" + "ATA"  # spelt in two parts so that this file does not cite anyth
 # skipped (calibrate/ does not exist in every checkout).
 SCAN_DIRS = [
     "engine", "geometry", "scenario", "analysis", "sweep", "viz", "cli", "common",
-    "calibrate", "bench", "docs", "tests", "scripts", "venues", "fuzz", "cmake",
+    "calibrate", "bench", "docs", "tests", "scripts", "studies", "venues", "fuzz", "cmake",
 ]
 SCAN_TOP_FILES = ["README.md", "CMakeLists.txt", "Makefile"]
 SKIP_DIRS = {"build", "out", ".git", ".cache", "__pycache__"}

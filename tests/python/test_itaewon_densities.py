@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""scripts/itaewon-densities.py on a run file whose answer is known.
+"""studies/itaewon-evening-ensemble/itaewon-densities.py on a run file whose answer is known.
 
 A run file with the tables the script reads (the Itaewon venue in `run`, the
 bodies' shapes, the frames, the positions): people placed at the centres of
