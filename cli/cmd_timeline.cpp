@@ -84,9 +84,13 @@ std::string ScenarioNameOf(const std::string& run) {
 // Several runs of one incident (seeds): one row per run beside the recorded
 // marks, and the score table (reports/ensemble.hpp).
 void RunEnsemble(const TimelineArgs& args) {
-  if (!args.phase.empty()) throw InputError("--phase draws one run's path: give one run file, not " + std::to_string(args.runs.size()));
-  if (!args.density_maps.empty())
-    throw InputError("--density-maps draws one run's maps: give one run file, not " + std::to_string(args.runs.size()));
+  // (With one run, --scores made this an ensemble of one: the figures of one
+  // run are another call's.)
+  const std::string instead = args.runs.size() == 1
+                                  ? "with --scores the run is scored as an ensemble (of one); draw it in a call without --scores"
+                                  : "give one run file, not " + std::to_string(args.runs.size());
+  if (!args.phase.empty()) throw InputError("--phase draws one run's path: " + instead);
+  if (!args.density_maps.empty()) throw InputError("--density-maps draws one run's maps: " + instead);
   reports::EnsembleOptions options;
   options.tolerance_s = args.tolerance_s;
   options.smooth_s = args.smooth_s;

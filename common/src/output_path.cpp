@@ -97,6 +97,13 @@ void CheckOne(const PlannedOutput& out, const std::vector<NamedInput>& inputs, b
       throw InputError(where + ": is " + in.what + " (" + Shortened(in.path.string(), 200) +
                        "), an input of this command; an input is never overwritten, not even with --force; "
                        "choose another name");
+  // A file's name that ends with a separator (or is . or ..) names a folder:
+  // the file would be written beside it under another name (issue 65:
+  // simulate -o x/ wrote a run file "x" and failed at its first checkpoint).
+  const std::string name = out.path.filename().string();
+  if (!out.kind.folder && (name.empty() || name == "." || name == ".."))
+    throw InputError(where + ": names a folder, not " + out.kind.name + "; give a file name (such as " +
+                     Shortened((out.path / "out").string(), 200) + " with its extension)");
   std::error_code ec;
   const fs::file_status link = fs::symlink_status(out.path, ec);
   if (!fs::exists(link)) return;  // nothing there: nothing to lose

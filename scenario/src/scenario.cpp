@@ -180,13 +180,15 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     const auto due_by_end = [&](const InflowSpec& f) { return double(ArrivalsDue(f.rate, s.run.duration_s)); };
     double arrivals = 0.0;
     for (const InflowSpec& f : s.timeline.inflows) arrivals += due_by_end(f);
-    // An event after the run's end would never happen (issue 40: it was
-    // accepted without a word).
+    // An event at or after the run's end would never happen (issue 40: it
+    // was accepted without a word; issue 65: at the end itself, too: the
+    // last step ends there, and an event acts before a step).
     for (const TimelineEvent& e : s.timeline.events)
-      if (e.time_s > s.run.duration_s)
-        throw InputError(e.where + "/time_s: " + FormatNumber(e.time_s) +
-                         " s lies after the run's end (run.duration_s = " + FormatNumber(s.run.duration_s) +
-                         " s), so the event would never happen; expected a time within the run");
+      if (e.time_s >= s.run.duration_s)
+        throw InputError(e.where + "/time_s: " + FormatNumber(e.time_s) + " s lies " +
+                         (e.time_s == s.run.duration_s ? "at" : "after") + " the run's end (run.duration_s = " +
+                         FormatNumber(s.run.duration_s) +
+                         " s), so the event would never happen; expected a time before the run's end");
     if (arrivals > static_cast<double>(geometry::kMaxPeople))
       timeline->At("inflows").Fail("the inflows bring " + FormatNumber(arrivals) + " people in " +
                                    FormatNumber(s.run.duration_s) + " s; expected at most " +

@@ -19,6 +19,9 @@ set(NO_FOLDER "a folder is never replaced by a file")
 # --- simulate ------------------------------------------------------------------
 crowdrecon_output_test(simulate.o_is_scenario fail "-o scenario.json: is the scenario \\(scenario.json\\), an input of this command. ${NOT_EVEN_FORCE}"
                        make_scenario . simulate scenario.json -o scenario.json -q)
+# Issue 65: a file name ending with a separator names a folder (it wrote a run file "x" and failed later).
+crowdrecon_output_test(simulate.o_names_a_folder fail "-o x/: names a folder, not a crowdrecon run file. give a file name"
+                       make_scenario . simulate scenario.json -o x/ -q)
 crowdrecon_output_test(simulate.o_is_venue fail "-o venue.json: is the venue \\(.*venue.json\\)"
                        make_scenario . simulate scenario.json -o venue.json -q)
 crowdrecon_output_test(simulate.o_is_body fail "-o body.json: is the reference body \\(.*body.json\\)"
@@ -180,6 +183,10 @@ crowdrecon_output_test(timeline.bad_density_time_writes_nothing fail
                        "--density-times / --density-cell / --density-sigma: time -1 s, expected a time at or after the start"
                        "make_scenario && make_run" "."
                        timeline run.sqlite -o t.png --density-maps d.png --density-times -1)
+crowdrecon_output_test(timeline.scores_and_density_maps_of_one_run fail
+                       "--density-maps draws one run.s maps: with --scores the run is scored as an ensemble \\(of one\\). draw it in a call without --scores"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png --scores s.md --density-maps d.png)
 crowdrecon_output_test(timeline.bad_second_extension_writes_nothing fail
                        "-o t.bmp: unknown picture format .*bmp.*expected .png, .svg or .pdf"
                        "make_scenario && make_run" "."

@@ -558,6 +558,10 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   // Issue 40: an event after the run's end (10 s) would never happen.
   refuse(R"({"events": [{"time_s": 1, "close_exit": "court"}, {"time_s": 12.5, "close_exit": "exit"}]})",
          "bad.json: /timeline/events/1/time_s: 12.5 s lies after the run's end (run.duration_s = 10 s)");
+  // Issue 65: nor one at the end itself (a recorded fall at 10 s was accepted and never happened).
+  refuse(R"({"events": [{"time_s": 10, "fall": {"at": [6, 1.5], "count": 2}}]})",
+         "bad.json: /timeline/events/0/time_s: 10 s lies at the run's end (run.duration_s = 10 s), so the event would "
+         "never happen");
   // A speed read at a recorded mark comes with its uncertainty.
   refuse(R"({"recorded": [{"time_s": 5, "label": "a", "max_speed_m_per_s": 3}]})",
          "/timeline/recorded/0: missing required key \"max_speed_uncertainty_m_per_s\"");
