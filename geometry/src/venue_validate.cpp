@@ -134,6 +134,7 @@ class Checker {
                          "/measurement_lines/" + Index(i) + "/segment", "measurement line");
     CheckTargets();
     CheckPeriodic();
+    CheckSlopeRegion();
     return problems_;
   }
 
@@ -177,6 +178,7 @@ class Checker {
     for (std::size_t i = 0; i < v_.measurement_lines.size(); ++i)
       ok &= CheckPoints({v_.measurement_lines[i].a, v_.measurement_lines[i].b},
                         "/measurement_lines/" + Index(i) + "/segment");
+    if (v_.slope && !v_.slope->region.empty()) ok &= CheckPoints(v_.slope->region, "/slope/region");
     return ok;
   }
 
@@ -373,6 +375,24 @@ class Checker {
                           PointText(*p) + "; expected the zone inside it");
         return;
       }
+  }
+
+  // A slope's region (issue 65: it was never checked): a simple polygon of
+  // positive area that overlaps the walkable area; it may reach beyond it
+  // (the floor slopes where both are), but one wholly outside would make the
+  // slope act nowhere.
+  void CheckSlopeRegion() {
+    if (!v_.slope || v_.slope->region.empty()) return;
+    const Ring& region = v_.slope->region;
+    if (!CheckRing(region, "/slope/region", "slope region")) return;
+    bool overlaps = false;
+    for (std::size_t i = 0; i < region.size() && !overlaps; ++i)
+      overlaps = DistanceOutside(region[i]) == 0.0 || CrossesBoundary(region[i], region[(i + 1) % region.size()]);
+    for (const Ring& r : v_.walkable_area)
+      for (std::size_t i = 0; i < r.size() && !overlaps; ++i) overlaps = StrictlyInside(region, r[i]);
+    if (!overlaps)
+      Problem("/slope/region", "the slope region lies wholly outside the walkable area, so the floor would slope "
+                               "nowhere; expected a region that covers part of it");
   }
 
   template <typename Items>

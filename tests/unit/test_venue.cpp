@@ -258,6 +258,22 @@ TEST(Venue, InlineErrors) {
             std::string::npos);
 }
 
+// Issue 65: a slope's region was never checked ("venue OK" for any of these).
+TEST(Venue, ASlopeRegionIsChecked) {
+  const auto slope = [](const std::string& region) {
+    return ParseError(std::string(kRoom) + R"(, "slope": {"direction": [1, 0], "gradient": 0.1, "region": )" + region + "}");
+  };
+  EXPECT_EQ(slope("[[2, 0], [6, 0], [6, 4], [2, 4]]"), "(no error)");
+  EXPECT_EQ(slope("[[8, -2], [14, -2], [14, 6], [8, 6]]"), "(no error)");  // reaching beyond the area is fine
+  EXPECT_EQ(slope("[[-5, -5], [20, -5], [20, 20], [-5, 20]]"), "(no error)");  // around it all
+  EXPECT_NE(slope("[[2, 0], [6, 4], [6, 0], [2, 4]]").find("/slope/region: slope region is self-intersecting"),
+            std::string::npos);
+  EXPECT_NE(slope("[[20, 0], [30, 0], [30, 4], [20, 4]]").find("/slope/region: the slope region lies wholly outside"),
+            std::string::npos);
+  EXPECT_NE(slope("[[2, 1], [4, 1], [6, 1]]").find("/slope/region: slope region has zero area"), std::string::npos);
+  EXPECT_NE(slope("[[0, 0], [1e30, 0], [1e30, 4], [0, 4]]").find("/slope/region/1: coordinate"), std::string::npos);
+}
+
 TEST(Venue, AllProblemsAreReportedTogether) {
   const std::string message = ParseError(std::string(kRoom) + R"(,
       "obstacles": [{"id": "far", "polygon": [[20, 20], [21, 20], [21, 21], [20, 21]]}],
