@@ -333,6 +333,13 @@ CalibrationSpec ParseCalibration(const std::string& json_text, const std::string
       if (auto r = root.Find(key)) sweep[key] = Raw(document, *r);
     if (!sweep.contains("scenario")) root.At("scenario");  // the error names the missing key
     c.base = sweep::ParseSweep(sweep.dump(), origin, dir);
+    // The objective weighs each statistic by the seeds' spread of it (the
+    // seeds' covariance, docs/calibration.md "The objective"): one seed has
+    // none (issue 65: it crashed the calibration).
+    if (c.base.seeds.size() < 2)
+      throw InputError(origin + ": /seeds: " + std::to_string(c.base.seeds.size()) +
+                       " seed; expected at least 2 (the objective weighs each statistic by its spread over the "
+                       "seeds; 8 or more give its correlations to about +-0.13)");
   }
   json base_scenario = json::parse(sweep::RunScenarioJson(c.base, sweep::RunPlan{0, "base", 0, {}, c.base.seeds[0], ""}));
 

@@ -266,16 +266,19 @@ SeedCovariance PooledSeedCovariance(const std::vector<const std::vector<std::vec
     }
   double lambda = signal > 0 ? std::clamp(noise / signal, 0.0, 1.0) : 1.0;
   Matrix shrunk;
-  for (;; lambda = std::min(1.0, lambda + 0.02)) {
+  // No value varies over the seeds (h = 0): nothing to shrink (Eigen's
+  // solver is not asked about an empty matrix: it crashed, issue 65).
+  for (; h > 0; lambda = std::min(1.0, lambda + 0.02)) {
     shrunk = (1.0 - lambda) * r;
     shrunk.diagonal().setOnes();
     const Eigen::SelfAdjointEigenSolver<Matrix> eig(shrunk);
-    if (h == 0 || eig.eigenvalues().minCoeff() > 1e-6 || lambda >= 1.0) {
-      const Eigen::VectorXd e = h ? Eigen::VectorXd(eig.eigenvalues()) : Eigen::VectorXd();
-      out.effective_values = h ? e.sum() * e.sum() / e.squaredNorm() : 0.0;
+    if (eig.eigenvalues().minCoeff() > 1e-6 || lambda >= 1.0) {
+      const Eigen::VectorXd e = eig.eigenvalues();
+      out.effective_values = e.sum() * e.sum() / e.squaredNorm();
       break;
     }
   }
+  if (h == 0) out.effective_values = 0.0;
   out.shrinkage = lambda;
   std::vector<long> row(g, -1);  // value -> row of `shrunk`
   for (std::size_t x = 0; x < h; ++x) row[live[x]] = static_cast<long>(x);

@@ -724,6 +724,13 @@ TEST(Objective, TheSeedsCovarianceIsPooledAndShrunk) {
     for (int seed = 0; seed < 4; ++seed) s.push_back({normal(rng), normal(rng), normal(rng), normal(rng), normal(rng)});
   const SeedCovariance noise = PooledSeedCovariance({&few[0], &few[1]}, {0, 1, 2, 3, 4});
   EXPECT_GT(noise.shrinkage, 0.5);
+  // Issue 65: no value varies over the seeds (a recorded fatal clog that no
+  // run reaches, every seed at the window's end): no covariance, no crash.
+  std::vector<std::vector<std::vector<double>>> still(2, std::vector<std::vector<double>>(3, {30.0, 30.0}));
+  const SeedCovariance none = PooledSeedCovariance({&still[0], &still[1]}, {0, 1});
+  EXPECT_EQ(none.values, 0u);
+  EXPECT_EQ(none.effective_values, 0.0);
+  for (double v : none.covariance) EXPECT_EQ(v, 0.0);
   Objective o;
   o.statistics.resize(5);
   o.WeighCovariance(noise.covariance, 4.0);  // positive definite: whitened
@@ -1133,6 +1140,12 @@ TEST(CalibrationFile, BadFilesAreRefusedWithThePathAndTheValue) {
   expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "options": {"posterior_steps": -1})"),
          "/options/posterior_steps");
   expect(Calibration(obs, R"([{"path": "model.back_force_gamma"}])", R"(, "extra": 1)"), "unknown key");
+  // Issue 65: one seed has no spread to weigh the statistics by (it crashed the calibration).
+  {
+    std::string one = Calibration(obs, R"([{"path": "model.back_force_gamma"}])");
+    one.replace(one.find("\"count\": 3"), 10, "\"count\": 1");
+    expect(one, "cal.json: /seeds: 1 seed; expected at least 2");
+  }
   expect(Calibration("/nonexistent/obs.json", R"([{"path": "model.back_force_gamma"}])"),
          "/observations/0/file: cannot use the observation");
   // A series the observation does not have: the ones it has are listed.
