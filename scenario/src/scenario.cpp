@@ -10,6 +10,7 @@
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
 #include "crowdrecon/geometry/population_table.hpp"
+#include "timeline_systems.hpp"
 
 namespace crowdrecon::scenario {
 
@@ -189,6 +190,22 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
                          (e.time_s == s.run.duration_s ? "at" : "after") + " the run's end (run.duration_s = " +
                          FormatNumber(s.run.duration_s) +
                          " s), so the event would never happen; expected a time before the run's end");
+    // Every event's values as if applied, in time order (issue 65: a value
+    // that leaves the parameters invalid, as a jitter band whose low end
+    // passes its high one, failed only when it fired, leaving a run marked
+    // running). Per-group values (Gamma, lambda, speeds) are range-checked
+    // when read; the model's own are checked here together.
+    {
+      engine::ModelParameters p = s.model;
+      for (const TimelineEvent& e : s.timeline.events) {
+        if (e.kind != TimelineEvent::Kind::kSetParameters || !e.group.empty()) continue;
+        detail::ApplyEventToModel(e, &p);
+        std::string error;
+        if (!p.IsValid(&error))
+          throw InputError(e.where + "/set: the model as this event at " + FormatNumber(e.time_s) +
+                           " s leaves it: " + error);
+      }
+    }
     if (arrivals > static_cast<double>(geometry::kMaxPeople))
       timeline->At("inflows").Fail("the inflows bring " + FormatNumber(arrivals) + " people in " +
                                    FormatNumber(s.run.duration_s) + " s; expected at most " +

@@ -79,8 +79,7 @@ class TimelineEventSystem : public RunSystem {
     switch (e.kind) {
       case TimelineEvent::Kind::kSetParameters: {
         engine::ModelParameters p = sim.definition().parameters;
-        bool global = false, wall_given = false;
-        for (const auto& [name, value] : e.parameters) wall_given = wall_given || name == "wall_restitution";
+        bool global = false;
         for (const auto& [name, value] : e.parameters) {
           detail += (detail.empty() ? "" : ", ") + name + " = " + FormatNumber(value);
           if (name == "desired_speed_m_per_s") {
@@ -93,9 +92,6 @@ class TimelineEventSystem : public RunSystem {
             (name == "back_force_gamma" ? s_.group_gamma : s_.group_lambda)[g] = value;
             sim.SetGroupDrive(static_cast<std::uint32_t>(g), s_.group_gamma[g], s_.group_lambda[g]);
           } else {
-            p.*(engine::FindModelParameter(name)->number) = value;
-            // The wall's restitution follows the restitution unless given (as when read).
-            if (name == "restitution" && !wall_given) p.wall_restitution = value;
             global = true;
             // Everyone's: a group's own value of it ends.
             if (name == "back_force_gamma" || name == "torsion_stiffness_lambda") {
@@ -109,6 +105,7 @@ class TimelineEventSystem : public RunSystem {
           }
         }
         if (global) {
+          ApplyEventToModel(e, &p);
           try {
             sim.SetParameters(p);
           } catch (const InputError& error) {
@@ -679,6 +676,17 @@ void TimelineState::LoadState(const std::string& state) {
   if (!r.AtEnd() || next_event > spec.events.size()) r.Fail();
   for (std::size_t f = 0; f < inflows; ++f)
     if (placed[f] > built.arrivals[f].size()) r.Fail();
+}
+
+void ApplyEventToModel(const TimelineEvent& e, engine::ModelParameters* p) {
+  if (e.kind != TimelineEvent::Kind::kSetParameters || !e.group.empty()) return;
+  bool wall_given = false;
+  for (const auto& [name, value] : e.parameters) wall_given = wall_given || name == "wall_restitution";
+  for (const auto& [name, value] : e.parameters)
+    if (const engine::ParameterInfo* info = engine::FindModelParameter(name)) {
+      p->*(info->number) = value;
+      if (name == "restitution" && !wall_given) p->wall_restitution = value;
+    }
 }
 
 std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& s) { return std::make_unique<TimelineEventSystem>(s); }

@@ -86,6 +86,14 @@ struct TimelineState {
 constexpr std::uint32_t kNoOne = UINT32_MAX;
 void SlotHolders(const engine::BodyState& bodies, std::vector<std::uint32_t>* holders);  // reuses its storage
 
+// The model parameters of everyone as a global "set" event leaves them: its
+// values by the parameter table, the wall's restitution following the
+// restitution unless the event gives it (as when a scenario is read). Group
+// values and desired speeds are not the model's and are left out. The
+// scenario's check of its events (scenario.cpp) and their application
+// (the timeline's event system) both use it.
+void ApplyEventToModel(const TimelineEvent& e, engine::ModelParameters* p);
+
 std::unique_ptr<RunSystem> MakeTimelineEventSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeInflowSystem(TimelineState& state);
 std::unique_ptr<RunSystem> MakeExitSystem(TimelineState& state);

@@ -541,6 +541,13 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
   // The step's settings are chosen once for the run (issue 42).
   for (const char* step : {"time_step_s", "time_step_safety", "adaptive_max_safety", "adaptive_reference_speed_m_per_s"})
     refuse(std::string(R"({"events": [{"time_s": 1, "set": {")") + step + R"(": 0.1}}]})", "cannot change during a run");
+  // Issue 65: the values together, as the event leaves the model, are checked
+  // when the scenario is read (a band whose low end passes its high one failed
+  // only when the event fired, leaving a run marked running).
+  refuse(R"({"events": [{"time_s": 1, "set": {"gait_jitter_band_low_hz": 1.8}}]})",
+         "bad.json: /timeline/events/0/set: the model as this event at 1 s leaves it: ");
+  refuse(R"({"events": [{"time_s": 1, "set": {"gait_jitter_band_high_hz": 3}}, {"time_s": 2, "set": {"gait_jitter_band_low_hz": 3.5}}]})",
+         "/timeline/events/1/set: the model as this event at 2 s leaves it");
   refuse(R"({"events": [{"time_s": 1}]})", "expected exactly one of");
   refuse(R"({"events": [{"time_s": 1, "stop_inflow": "x"}]})", "no inflow \"x\"");
   refuse(R"({"falls": {"criterion": "trip"}})", "/timeline/falls/criterion");
