@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "crowdrecon/analysis/run_analysis.hpp"
+#include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
@@ -127,6 +128,7 @@ void RunAnalyze(const AnalyzeArgs& args) {
     std::printf("json: %s\n", args.json.c_str());
   }
   if (args.write) {
+    const runfile::RunFileLock lock(args.run_file);  // not into a run another process is writing
     analysis::WriteAnalysis(args.run_file, result, options);
     std::printf("wrote metric_series, metric_summary, metric_avalanche, metric_load_histogram and run.regime into %s\n",
                 args.run_file.c_str());

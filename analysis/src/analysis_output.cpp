@@ -376,6 +376,11 @@ void WriteAnalysis(const std::filesystem::path& run_file, const RunAnalysis& a, 
       put.Bind(1, std::string("regime_reason")).Bind(2, a.regime.reason).Run();
       put.Bind(1, std::string("regime_classifier")).Bind(2, std::to_string(kRegimeClassifierVersion)).Run();
       put.Bind(1, std::string("analysis_options")).Bind(2, OptionsToJson(options)).Run();
+      // Derived from the frames: a resumed run drops them with the metric_*
+      // tables (runfile::RunFileWriter::Resume).
+      put.Bind(1, std::string("derived_keys"))
+          .Bind(2, std::string(R"(["regime", "regime_reason", "regime_classifier", "analysis_options"])"))
+          .Run();
     }
     db.Exec("COMMIT");
   } catch (...) {

@@ -1,7 +1,12 @@
 // Writing run files (run_file.hpp): the writer, its frames, events and run values, the writer thread.
 #include "crowdrecon/runfile/run_file.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -75,6 +80,31 @@ CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT N
   other INTEGER NOT NULL, detail TEXT NOT NULL);
 )SQL";
 
+// What was derived from the run's frames (an analysis stored with analyze
+// --write: tables metric_*, and the run values it lists under
+// "derived_keys") no longer describes a run whose frames change (issue 65: a
+// resumed run kept the analysis of its first half): dropped.
+void ForgetDerived(Database& db) {
+  std::vector<std::string> tables;
+  {
+    Statement s(db, "SELECT name FROM sqlite_master WHERE type = 'table' AND name LIKE 'metric\\_%' ESCAPE '\\'");
+    while (s.Next()) tables.push_back(s.Text(0));
+  }
+  for (const std::string& t : tables) db.Exec("DROP TABLE IF EXISTS \"" + t + "\"");
+  std::string listed;
+  {
+    Statement s(db, "SELECT value FROM run WHERE key = 'derived_keys'");
+    if (s.Next()) listed = s.Text(0);
+  }
+  if (listed.empty()) return;
+  const nlohmann::json keys = nlohmann::json::parse(listed, nullptr, false);
+  Statement erase(db, "DELETE FROM run WHERE key = ?");
+  if (keys.is_array())
+    for (const nlohmann::json& k : keys)
+      if (k.is_string()) erase.Bind(1, k.get<std::string>()).Run();
+  erase.Bind(1, std::string("derived_keys")).Run();
+}
+
 }  // namespace
 
 struct RunFileWriter::Impl {
@@ -101,6 +131,33 @@ RunFileWriter::~RunFileWriter() {
   } catch (const std::exception&) {
     // Still a valid file in WAL mode; readers fold the log in.
   }
+}
+
+std::filesystem::path RunFileLock::PathOf(const std::filesystem::path& run_file) {
+  return run_file.string() + ".lock";
+}
+
+RunFileLock::RunFileLock(const std::filesystem::path& run_file) : path_(PathOf(run_file)) {
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // A folder that cannot hold the lock cannot hold the run either: the
+  // writer's own message says so (a missing folder, no permission).
+  if (fd_ < 0) return;
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (error == EWOULDBLOCK)
+      throw InputError(run_file.string() + ": being written by another crowdrecon process (it holds " +
+                       path_.filename().string() + "); wait until it ends, or choose another output");
+  }
+}
+
+RunFileLock::~RunFileLock() {
+  if (fd_ < 0) return;
+  std::error_code ignored;
+  std::filesystem::remove(path_, ignored);  // (while held: a newcomer locks a file of its own)
+  ::flock(fd_, LOCK_UN);
+  ::close(fd_);
 }
 
 RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const RunHeader& header,
@@ -195,6 +252,7 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   const std::string after = std::to_string(last_frame);
   for (const char* table : {"trajectory_data", "frame_data", "frame_time", "person_state", "contact", "event"})
     db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
+  ForgetDerived(db);
   w.impl_->has_person_load = sqlite::HasTable(db, "person_load");
   if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
   if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);

@@ -473,6 +473,9 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
 
   const std::uint64_t fingerprint = ScenarioFingerprint(scenario);
   const std::filesystem::path checkpoint = CheckpointPath(options.output);
+  // No other process writes this run while this one does (before anything
+  // of an earlier run there is removed).
+  const runfile::RunFileLock lock(options.output);
   OpenedRun opened = OpenRunFile(scenario, options, built, sim, fingerprint, say);
   runfile::RunFileWriter& writer = opened.writer;
   std::int64_t last_frame = opened.last_frame;

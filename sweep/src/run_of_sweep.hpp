@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 // What a run file in runs/ may have beside it.
 inline constexpr const char* kRunFileSidecars[] = {"-journal", "-wal", "-shm", ".checkpoint", ".checkpoint.tmp",
-                                                   ".failed-state", ".failed-state.tmp"};
+                                                   ".failed-state", ".failed-state.tmp", ".lock"};
 
 // Removes a run file and what it has beside it.
 void RemoveRunFiles(const fs::path& file);

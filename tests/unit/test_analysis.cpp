@@ -438,6 +438,16 @@ TEST(AnalyzeRun, WritesTablesIntoTheRunFile) {
   EXPECT_EQ(count("SELECT value FROM metric_summary WHERE name = 'crossings_forward'"), 2);
   EXPECT_EQ(count("SELECT COUNT(*) FROM metric_load_histogram"), 21);
   sqlite3_close(db);
+  // Issue 65: a run continued after its analysis was stored drops it (a
+  // resumed run kept the analysis of its first half).
+  { runfile::RunFileWriter::Resume(file, 50); }
+  const runfile::RunFileReader resumed(file);
+  EXPECT_EQ(resumed.RunValue("regime"), "");
+  EXPECT_EQ(resumed.RunValue("analysis_options"), "");
+  EXPECT_EQ(resumed.RunValue("derived_keys"), "");
+  ASSERT_EQ(sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  EXPECT_EQ(count("SELECT COUNT(*) FROM sqlite_master WHERE name LIKE 'metric%'"), 0);
+  sqlite3_close(db);
 }
 
 // A run file whose frames are written by hand (header from RunFileWriter):

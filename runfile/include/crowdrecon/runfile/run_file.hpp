@@ -163,12 +163,36 @@ struct FrameSnapshot {
   Census census;
 };
 
+// Held while a run file is written (simulate, a resume, analyze --write):
+// an advisory lock (flock) on RUN.lock beside it, taken before anything is
+// removed or written. A second writer is refused with a message instead of
+// replacing a run in progress under the first (issue 65: two simulate with
+// the same -o both said "complete", the file held the second). The lock file
+// is removed when the lock is let go; one left by a killed writer holds no
+// lock and is taken over.
+class RunFileLock {
+ public:
+  // Throws InputError naming the run file if another process holds its lock.
+  explicit RunFileLock(const std::filesystem::path& run_file);
+  ~RunFileLock();
+  RunFileLock(const RunFileLock&) = delete;
+  RunFileLock& operator=(const RunFileLock&) = delete;
+  // RUN.lock.
+  static std::filesystem::path PathOf(const std::filesystem::path& run_file);
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
+
 class RunFileWriter {
  public:
   // Creates (truncating) the file and writes the header, shapes, people and walls.
   static RunFileWriter Create(const std::filesystem::path& file, const RunHeader& header, const RunSetup& setup);
   // Reopens an existing run to continue after a checkpoint: frames after
-  // `last_frame` are deleted (they will be written again identically).
+  // `last_frame` are deleted (they will be written again identically), and
+  // what was derived from the frames is dropped: tables metric_* and the run
+  // values listed (a JSON list) under the run value "derived_keys".
   static RunFileWriter Resume(const std::filesystem::path& file, std::int64_t last_frame);
   RunFileWriter(RunFileWriter&&) noexcept;
   RunFileWriter& operator=(RunFileWriter&&) noexcept;
