@@ -111,6 +111,7 @@ void RunEnsemble(const TimelineArgs& args) {
   for (const std::string& r : args.runs) inputs.push_back({"a run file", r});
   CheckOutputs(outputs, inputs, args.force);
   RefuseRepeatedFiles({args.runs.begin(), args.runs.end()}, "each run counts once in an ensemble");
+  reports::CheckSeedsOfOneScenario({args.runs.begin(), args.runs.end()}, "an ensemble");
   std::vector<reports::EnsembleRun> runs;
   for (std::size_t k = 0; k < args.runs.size(); ++k) {
     std::fprintf(stderr, "reading %s (%zu of %zu)\n", args.runs[k].c_str(), k + 1, args.runs.size());

@@ -9,6 +9,8 @@
 #include <map>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
@@ -56,6 +58,62 @@ std::string SpreadText(const Spread& s, int decimals, const std::string& unit = 
 std::string Num(double v, int decimals) { return std::isnan(v) ? "" : FormatFixed(v, decimals); }
 
 }  // namespace
+
+namespace {
+
+// A file named in a scenario by its name alone: the same scenario written
+// with relative paths in one folder and absolute ones in another is the
+// same (the venue itself is compared as the run stored it).
+void FileNamesOnly(nlohmann::json& j) {
+  if (j.is_object() || j.is_array()) {
+    for (nlohmann::json& v : j) FileNamesOnly(v);
+  } else if (j.is_string()) {
+    const std::filesystem::path p(j.get<std::string>());
+    const std::string ext = p.extension().string();
+    if (ext == ".json" || ext == ".csv" || ext == ".txt") j = p.filename().string();
+  }
+}
+
+}  // namespace
+
+void CheckSeedsOfOneScenario(const std::vector<std::filesystem::path>& runs, const std::string& what,
+                             const std::string& apart) {
+  nlohmann::json first;
+  std::string first_venue;
+  std::map<std::uint64_t, std::filesystem::path> seed_of;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const runfile::RunFileReader reader(runs[k]);
+    nlohmann::json scenario = nlohmann::json::parse(reader.RunValue("scenario"), nullptr, false);
+    if (!scenario.is_object())
+      throw InputError(runs[k].string() + ": the run holds no scenario of its own (run value \"scenario\"); "
+                       "expected a run file written by crowdrecon simulate");
+    std::uint64_t seed = 0;
+    if (scenario.contains("population") && scenario["population"].is_object()) {
+      nlohmann::json& population = scenario["population"];
+      if (population.contains("seed") && population["seed"].is_number_unsigned())
+        seed = population["seed"].get<std::uint64_t>();
+      population.erase("seed");
+    }
+    FileNamesOnly(scenario);
+    const std::string venue = reader.walkable_wkt();
+    if (k == 0) {
+      first = std::move(scenario);
+      first_venue = venue;
+    } else if (venue != first_venue) {
+      throw InputError(runs[k].string() + ": not a seed of the scenario of " + runs[0].string() +
+                       " (their walkable areas differ); " + what + " is the seeds of one scenario: " + apart);
+    } else if (scenario != first) {
+      const nlohmann::json patch = nlohmann::json::diff(first, scenario);
+      const std::string path = patch.empty() ? "/" : patch[0].value("path", "/");
+      throw InputError(runs[k].string() + ": not a seed of the scenario of " + runs[0].string() + " (they differ at " +
+                       path + "); " + what + " is the seeds of one scenario: " + apart);
+    }
+    const auto [at, added] = seed_of.emplace(seed, runs[k]);
+    if (!added)
+      throw InputError(runs[k].string() + ": the same run as " + at->second.string() + " (seed " +
+                       std::to_string(seed) + " of the same scenario): each run counts once in " + what);
+  }
+}
 
 EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options) {
   if (!runfile::IsRunFile(run_file)) throw InputError(run_file.string() + ": not a crowdrecon run file");

@@ -30,6 +30,7 @@
 #include "crowdrecon/sweep/version.hpp"
 #include "envelope.hpp"
 #include "report_parts.hpp"
+#include "crowdrecon/reports/ensemble.hpp"
 #include "crowdrecon/reports/svg.hpp"
 
 namespace crowdrecon::reports {
@@ -99,6 +100,11 @@ ReportSummary WriteReport(const ReportOptions& options) {
   const std::vector<fs::path> main_files = RunFilesOf(options.inputs, &input_notes);
   const std::vector<fs::path> other_files =
       options.compare.empty() ? std::vector<fs::path>{} : RunFilesOf(options.compare, &input_notes);
+  // An ensemble is seeds of one scenario, by content: runs of another (or a
+  // copy of one run) pooled into it would be averaged as if they were seeds
+  // (issues 40, 65). Another scenario's runs go with --compare.
+  CheckSeedsOfOneScenario(main_files, "the ensemble", "give another scenario's runs with --compare");
+  CheckSeedsOfOneScenario(other_files, "the --compare ensemble");
   const std::string chromium = ChromiumFor(options);
   const auto say = [&](const std::string& text) {
     if (options.progress) options.progress(text);
@@ -123,14 +129,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
   };
   const std::vector<RunRisk> main_runs = analyse(main_files);
   const std::vector<RunRisk> other_runs = analyse(other_files);
-  // An ensemble is seeds of one scenario: runs of another pooled into it
-  // would be averaged as if they were (issue 40).
-  for (const std::vector<RunRisk>* runs : {&main_runs, &other_runs})
-    for (const RunRisk& r : *runs)
-      if (r.scenario_name != runs->front().scenario_name)
-        throw InputError(r.file.string() + ": a run of scenario \"" + r.scenario_name + "\" in an ensemble of \"" +
-                         runs->front().scenario_name + "\" (" + runs->front().file.string() +
-                         "); expected the seeds of one scenario (give another scenario's runs with --compare)");
+  // (Each set was checked to be the seeds of one scenario before it was read.)
   ReportSummary summary;
   summary.notes = input_notes;
   summary.main = Summarise(options.label, main_runs);

@@ -80,6 +80,18 @@ struct EnsembleRun {
 // timeline run).
 EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options);
 
+// An ensemble is the seeds of one scenario: runs whose stored scenarios
+// (the run value "scenario", with its overrides; files by their names, the
+// venue by the walkable area each run stored) differ in anything but
+// population.seed are refused, naming both runs and the first JSON path
+// where they differ (a sweep's paper variant beside an extension's), and so
+// are two runs of one seed (a copy of a run under another name would count
+// twice). By content, not by name (issue 65). `what` names the ensemble in
+// messages ("the ensemble"), `apart` says where other runs go ("give
+// another scenario's runs with --compare").
+void CheckSeedsOfOneScenario(const std::vector<std::filesystem::path>& runs, const std::string& what,
+                             const std::string& apart = "give another scenario's runs apart");
+
 struct RecordedScore {
   analysis::TimelineMark mark;
   std::size_t runs_matching = 0;   // runs with an avalanche within +-tolerance
