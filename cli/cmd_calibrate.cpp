@@ -34,6 +34,7 @@ int RunCalibrateCommand(const CalibrateArgs& args) {
   options.output_dir = args.output;
   options.jobs = args.jobs;
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
+  options.show_stages = !args.quiet;
   const calibrate::Summary s = calibrate::Calibrate(options);
   // MPI ranks other than 0 say nothing, but exit as rank 0 does (every rank
   // learns from it whether the calibration was interrupted).

@@ -1,7 +1,9 @@
 #include "crowdrecon/calibrate/calibrate.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -28,9 +30,39 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // quadratic over the whole box), chosen among by leave-one-out error.
 const std::vector<double> kBandwidths{0.15, 0.25, 0.4, 0.7, std::numeric_limits<double>::infinity()};
 
+// SIGINT or SIGTERM during the calibration, however it was started (a
+// background job of a script inherits SIGINT ignored: issue 65, it sampled
+// on for ten minutes). The sweeps of its evaluations install their own
+// handlers while they run and hand these back; the stages between them
+// (bootstrap, profiles, the posterior, the footage) poll the flag.
+std::atomic<bool> g_stop_calibration{false};
+extern "C" void OnCalibrationSignal(int) { g_stop_calibration.store(true); }
+
+class CalibrationSignals {
+ public:
+  CalibrationSignals() : int_(std::signal(SIGINT, OnCalibrationSignal)), term_(std::signal(SIGTERM, OnCalibrationSignal)) {
+    g_stop_calibration.store(false);
+  }
+  ~CalibrationSignals() {
+    std::signal(SIGINT, int_);
+    std::signal(SIGTERM, term_);
+  }
+  CalibrationSignals(const CalibrationSignals&) = delete;
+  CalibrationSignals& operator=(const CalibrationSignals&) = delete;
+
+ private:
+  void (*int_)(int);
+  void (*term_)(int);
+};
+
 // An evaluation was interrupted (Ctrl-C, SIGTERM): the calibration stops
 // and resumes from its cache when run again.
 struct Interrupted {};
+
+// Between evaluations: a signal stops the calibration here.
+void StopIfAsked() {
+  if (g_stop_calibration.load()) throw Interrupted{};
+}
 
 using Point = std::vector<double>;  // unit coordinates
 
@@ -101,9 +133,13 @@ class Calibration {
     if (spec_.options.measure_noise) MeasureNoise();
     if (spec_.approach == Approach::kSurrogate) SearchWithSurrogates();
     else SearchWithGradients();
+    StopIfAsked();
     Uncertainty();
+    StopIfAsked();
     Profiles();
+    StopIfAsked();
     Posterior();
+    StopIfAsked();
     Footage();
   }
 
@@ -375,6 +411,7 @@ class Calibration {
     std::uniform_int_distribution<std::size_t> pick(0, k - 1);
     std::normal_distribution<double> normal(0.0, 1.0);
     for (int rep = 0; rep < spec_.options.bootstrap; ++rep) {
+      StopIfAsked();
       std::vector<std::size_t> draw(k);
       for (std::size_t& d : draw) d = pick(rng);
       Objective o = r_.objective;
@@ -406,6 +443,7 @@ class Calibration {
     std::vector<double> surrogate_chi2;
     for (std::size_t i = 0; i < p; ++i)
       for (int k = 0; k < n; ++k) {
+        StopIfAsked();
         Point u = best;
         u[i] = static_cast<double>(k) / (n - 1);
         double predicted = kNaN;
@@ -423,6 +461,7 @@ class Calibration {
     r_.profiles_refitted = refit && p > 1;
     const std::vector<SetResult> sets = Eval(pts, "profiles");
     for (std::size_t i = 0; i < p; ++i) {
+      StopIfAsked();
       std::vector<const std::vector<std::vector<double>>*> along;
       for (int k = 0; k < n; ++k)
         along.push_back(&sets[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(k)].per_seed);
@@ -525,7 +564,11 @@ class Calibration {
       for (std::size_t s = 0; s < k; ++s) w[s] = NormalQuantile(x[p + s]);
       return likelihood.WithOffset(u, surfaces.Offset(u, w));
     };
-    const PosteriorSamples ps = SamplePosterior(density, starts, spec_.options.posterior_steps, 20121104);
+    Say("the posterior: " + std::to_string(starts.size()) + " chains of " +
+        std::to_string(spec_.options.posterior_steps) + " steps");
+    const PosteriorSamples ps = SamplePosterior(density, starts, spec_.options.posterior_steps, 20121104,
+                                                [] { return g_stop_calibration.load(); });
+    if (ps.interrupted) throw Interrupted{};
     post.samples.clear();
     for (const Point& x : ps.u) post.samples.push_back(ev_.FromUnit(Point(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(p))));
     post.chains = ps.chains;
@@ -612,8 +655,9 @@ Summary Calibrate(const Options& options) {
   r.summary.approach = ToString(spec.approach);
   const std::vector<Statistic> statistics = ObservedStatistics(spec);
   Evaluator evaluator(spec, statistics, options.output_dir, options.jobs, options.show_progress);
+  const CalibrationSignals signals;
   try {
-    Calibration(spec, evaluator, r, options.show_progress).Run();
+    Calibration(spec, evaluator, r, options.show_stages).Run();
   } catch (const Interrupted&) {
     r.summary.interrupted = true;
     r.summary.coordinator = evaluator.coordinator();

@@ -326,10 +326,13 @@ struct PosteriorSamples {
   std::size_t chains = 0;
   double acceptance = 0.0;             // of the kept steps, over every chain
   std::vector<double> r_hat;           // per coordinate: Gelman and Rubin's potential scale reduction (NaN: one chain)
+  bool interrupted = false;            // `stop` said so: the samples are incomplete
 };
 using LogDensity = std::function<double(const std::vector<double>& u)>;
+// `stop` (if given) is asked every 100 steps: when it says so, the sampling
+// ends at once with `interrupted` set.
 PosteriorSamples SamplePosterior(const LogDensity& log_density, const std::vector<std::vector<double>>& starts,
-                                 int steps, std::uint64_t seed);
+                                 int steps, std::uint64_t seed, const std::function<bool()>& stop = {});
 
 // The sample standard deviation of v (at least two values).
 double SampleSd(const std::vector<double>& v);

@@ -262,7 +262,7 @@ double NormalQuantile(double p) {
 }
 
 PosteriorSamples SamplePosterior(const LogDensity& density, const std::vector<std::vector<double>>& starts, int steps,
-                                 std::uint64_t seed) {
+                                 std::uint64_t seed, const std::function<bool()>& stop) {
   PosteriorSamples out;
   if (starts.empty() || steps < 8) return out;
   const std::size_t p = starts[0].size();
@@ -288,6 +288,10 @@ PosteriorSamples SamplePosterior(const LogDensity& density, const std::vector<st
     std::vector<Eigen::VectorXd> kept;
     std::vector<Eigen::VectorXd> burnt;
     for (int step = 0; step < steps; ++step) {
+      if (stop && step % 100 == 0 && stop()) {
+        out.interrupted = true;
+        return out;
+      }
       if (step < burn && step > 0 && step % 200 == 0 && burnt.size() >= 2 * p + 2) {
         // Adapt to the spread of the chain's second half so far (past its
         // walk from the start).

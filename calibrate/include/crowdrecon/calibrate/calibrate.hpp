@@ -33,7 +33,8 @@ struct Options {
   std::filesystem::path calibration_file;
   std::filesystem::path output_dir;
   int jobs = 0;                // runs at a time (0: every core; under MPI 1 per rank)
-  bool show_progress = false;  // progress lines on stderr
+  bool show_progress = false;  // the sweeps' live progress line on stderr (a terminal)
+  bool show_stages = false;    // a line on stderr as each stage begins (a log too: long work says where it is)
   bool IsValid(std::string* error) const;
 };
 

@@ -1,0 +1,55 @@
+#!/bin/bash
+# A calibration started as a background job of a script (which starts it
+# with SIGINT ignored) answers SIGINT within seconds in a stage between its
+# evaluations, here the posterior's sampling, and says how to continue
+# (issue 65: it sampled on for over ten minutes); SIGTERM likewise.
+#   sigint_background.sh CROWDRECON SOURCE_DIR
+set -uo pipefail
+crowdrecon=$1
+src=$(cd "$2" && pwd)
+d=$(mktemp -d)
+trap 'kill $pid 2>/dev/null; [[ -n ${KEEP:-} ]] || rm -rf "$d"' EXIT
+python3 - "$src" "$d" <<'PY'
+import json, sys
+src, d = sys.argv[1:3]
+s = json.load(open(src + "/tests/data/scenarios/sweep-tiny.json"))
+s["venue"] = src + "/venues/madrid-arena/hallway-periodic.json"
+s["population"]["body"]["reference"] = src + "/venues/bodies/thorax-18.json"
+s["population"]["density_per_m2"] = 2.0
+s["run"]["duration_s"] = 2.0
+json.dump(s, open(d + "/scenario.json", "w"))
+s["model"] = {"back_force_gamma": 2.5}
+s["population"]["seed"] = 9
+json.dump(s, open(d + "/truth.json", "w"))
+c = {"format": "crowdrecon-calibration", "version": 1, "name": "sigint", "scenario": "scenario.json",
+     "parameters": [{"path": "model.back_force_gamma", "min": 0.5, "max": 4.5}],
+     "observations": [{"file": "truth.observation.json", "series": [
+         {"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0.4, "to_s": 2, "window_s": 0.8}]}],
+     "seeds": {"first": 1, "count": 2}, "starts": [{"model.back_force_gamma": 2}],
+     "options": {"refinements": 1, "bootstrap": 5, "profile_points": 0, "posterior_steps": 10000000}}
+json.dump(c, open(d + "/calibration.json", "w"))
+PY
+"$crowdrecon" simulate "$d/truth.json" -o "$d/truth.sqlite" -q > /dev/null
+"$crowdrecon" observe trajectories "$d/truth.sqlite" --spec "$src/venues/madrid-arena/observations/hallway.json" \
+  -o "$d/truth.observation.json" -q > /dev/null
+for signal in INT TERM; do
+  rm -rf "$d/out"
+  # (A background job of a non-interactive shell starts with SIGINT ignored.)
+  "$crowdrecon" calibrate "$d/calibration.json" -o "$d/out" --jobs 1 > "$d/out.txt" 2> "$d/err.txt" &
+  pid=$!
+  for _ in $(seq 1200); do
+    grep -q "the posterior:" "$d/err.txt" && break
+    kill -0 $pid 2>/dev/null || break
+    sleep 0.1
+  done
+  grep -q "the posterior:" "$d/err.txt" || { cat "$d/err.txt"; echo "sigint_background.sh: never reached the posterior"; exit 1; }
+  sleep 1
+  kill -s $signal $pid
+  for _ in $(seq 50); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done
+  if kill -0 $pid 2>/dev/null; then echo "sigint_background.sh: SIG$signal not answered within 5 s"; kill -9 $pid; exit 1; fi
+  wait $pid; rc=$?
+  echo "SIG$signal in the posterior: exit $rc"
+  [[ $rc -eq 130 ]] || { cat "$d/err.txt" "$d/out.txt"; echo "sigint_background.sh: exit $rc, expected 130"; exit 1; }
+  grep -q "interrupted: run the same command again to continue" "$d/out.txt" || { cat "$d/out.txt"; echo "sigint_background.sh: no hint"; exit 1; }
+done
+echo "calibrate answers SIGINT and SIGTERM as a background job: OK"
