@@ -78,6 +78,13 @@ std::vector<DensityMap> ComputeDensityMaps(const std::filesystem::path& run_file
       }
   std::vector<double> times = options.times_s;
   const double t0 = frames.front().time_s, t1 = frames.back().time_s;
+  // A time after the run's end would draw its last frame under another time
+  // (issue 65); half a frame's interval of rounding is allowed.
+  const double half_frame = frames.size() > 1 ? 0.5 * (t1 - t0) / double(frames.size() - 1) : 0.0;
+  for (double t : times)
+    if (t > t1 + half_frame + 1e-9)
+      throw InputError(run_file.string() + ": density map time " + FormatNumber(t) + " s lies after the run's end (" +
+                       FormatNumber(t1) + " s); expected times within the run");
   if (times.empty())
     for (int q = 0; q <= 3; ++q) times.push_back(t0 + (t1 - t0) * q / 4.0);
   std::vector<DensityMap> maps;

@@ -66,15 +66,22 @@ double ExitSpecificFlow(const TimelineSeries& s, std::size_t exit) {
 }
 
 std::string RunClock::Text(double t_s) const {
-  char text[32];
-  const double incident_s = t_s * scale;
+  char text[40];
+  // To the second: minutes alone where the time is a whole minute (issue 65:
+  // with a scale of 10 a tick at 21:46:40 read "21:46", and two maps 50 s
+  // apart were both "21:45").
+  const long incident = std::lround(t_s * scale);
+  const long minutes_in = incident >= 0 ? incident / 60 : -((-incident + 59) / 60);
+  const long seconds = incident - 60 * minutes_in;
   if (start.size() != 5) {
-    std::snprintf(text, sizeof text, "%.0f min", incident_s / 60.0);
+    if (seconds == 0) std::snprintf(text, sizeof text, "%ld min", minutes_in);
+    else std::snprintf(text, sizeof text, "%ld min %ld s", minutes_in, seconds);
     return text;
   }
-  const int first = std::stoi(start.substr(0, 2)) * 60 + std::stoi(start.substr(3, 2));
-  const int minutes = (first + static_cast<int>(std::floor(incident_s / 60.0 + 1e-9))) % (24 * 60);
-  std::snprintf(text, sizeof text, "%02d:%02d", minutes / 60, minutes % 60);
+  const long first = std::stol(start.substr(0, 2)) * 60 + std::stol(start.substr(3, 2));
+  const long minutes = ((first + minutes_in) % (24 * 60) + 24 * 60) % (24 * 60);
+  if (seconds == 0) std::snprintf(text, sizeof text, "%02ld:%02ld", minutes / 60, minutes % 60);
+  else std::snprintf(text, sizeof text, "%02ld:%02ld:%02ld", minutes / 60, minutes % 60, seconds);
   return text;
 }
 

@@ -187,6 +187,10 @@ crowdrecon_output_test(timeline.scores_and_density_maps_of_one_run fail
                        "--density-maps draws one run.s maps: with --scores the run is scored as an ensemble \\(of one\\). draw it in a call without --scores"
                        "make_scenario && make_run" "."
                        timeline run.sqlite -o t.png --scores s.md --density-maps d.png)
+crowdrecon_output_test(timeline.density_time_after_the_end_writes_nothing fail
+                       "density map time 99 s lies after the run.s end \\(.* s\\). expected times within the run"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png --density-maps d.png --density-times 0,99)
 crowdrecon_output_test(timeline.bad_second_extension_writes_nothing fail
                        "-o t.bmp: unknown picture format .*bmp.*expected .png, .svg or .pdf"
                        "make_scenario && make_run" "."

@@ -671,16 +671,21 @@ TEST(RunClock, ACompressedRunsClockGivesTheIncidentsTime) {
   const analysis::RunClock night{"21:45", 10.0};
   EXPECT_EQ(night.Text(0.0), "21:45");
   EXPECT_EQ(night.Text(180.0), "22:15");
-  EXPECT_EQ(night.Text(269.9), "22:29");
+  EXPECT_EQ(night.Text(269.9), "22:29:59");
   EXPECT_EQ(night.TickText(30.0, 30.0), "21:50") << "a tick of 30 run seconds spans 5 minutes of the night";
+  // Issue 65: to the second where the time is not a whole minute (a tick at
+  // 21:46:40 read "21:46").
+  EXPECT_EQ(night.TickText(10.0, 10.0), "21:46:40");
   EXPECT_EQ(night.AxisLabel(), "time of night (run time 0 = 21:45; a second of the run stands for 10 s)");
   const analysis::RunClock plain{"02:00", 1.0};
-  EXPECT_EQ(plain.Text(37 * 60.0 + 59.0), "02:37");
+  EXPECT_EQ(plain.Text(37 * 60.0 + 59.0), "02:37:59");
+  EXPECT_EQ(plain.Text(50.0), "02:00:50") << "two maps 50 s apart were both titled 02:00";
   EXPECT_EQ(plain.Text(23 * 3600.0), "01:00") << "past midnight";
   EXPECT_EQ(plain.TickText(30.0, 30.0), "30 s");
   EXPECT_EQ(plain.AxisLabel(), "time of night (run time 0 = 02:00)");
   const analysis::RunClock none{"", 20.0};
   EXPECT_EQ(none.Text(285.0), "95 min");
+  EXPECT_EQ(none.Text(1.0), "0 min 20 s");
   EXPECT_EQ(none.AxisLabel(), "time of the run");
 }
 
@@ -698,7 +703,7 @@ TEST(RunClock, TheScaleReachesTheSeriesThroughTheRunFile) {
     const analysis::TimelineSeries series = analysis::ComputeTimeline(run.file, 0.0);
     EXPECT_EQ(series.clock.start, "21:45");
     EXPECT_EQ(series.clock.scale, scale);
-    EXPECT_EQ(series.clock.Text(6.0), scale == 1.0 ? "21:45" : "21:46");
+    EXPECT_EQ(series.clock.Text(6.0), scale == 1.0 ? "21:45:06" : "21:46");
   }
 }
 
