@@ -23,9 +23,15 @@ every statistic has one definition:
               lapses (all seeds pooled) and the experiment's, with its
               asymptotic p-value
 
-usage: scripts/bottleneck-study.py CROWDRECON OUT_DIR [--seeds 10] [--variants a,b,...] [--jobs 2]
+usage: scripts/bottleneck-study.py CROWDRECON OUT_DIR [--seeds 10] [--variants a,b,...] [--jobs 2] [--force]
 Writes OUT_DIR/runs/VARIANT-sSEED.sqlite (reused when complete), OUT_DIR/results.csv
-and OUT_DIR/study.md. Standard library only.
+and OUT_DIR/study.md. Standard library only. Needs the experiment's trajectories
+in the data folder ../shared/data beside the repository (../shared/data/README.md)
+and says so when they are missing. Every output is checked before any run
+(scripts/script_guard.py): OUT_DIR new, empty or a previous study's folder
+(else --force, which writes into it and deletes nothing), each file in it new
+or a previous output of its kind; results.csv and study.md are written whole.
+A bad argument (a variant, a count, a missing program) is one line, exit 2.
 """
 import argparse
 import collections
@@ -39,6 +45,7 @@ import sys
 import time
 
 import petrack  # (this folder: the scripts are run as files, so it is on the path)
+import script_guard as guard
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -59,6 +66,26 @@ AREA_M2 = 0.8 * 0.8
 DEFAULT_VARIANTS = ['paper', 'anthropometric', 'circle', 'paper+jitter', 'anthropometric+jitter', 'circle+jitter']
 
 
+# The ranges of the model's parameter table (engine/src/parameter_table.cpp) for the numbers of a variant.
+RANGES = {'jitter=': (0.0, 5.0, 'm/s'), 'creep=': (1e-3, 1e4, 's'), 'yield=': (0.0, 1.0, ''),
+          'turn=': (0.0, 90.0, 'deg'), 'lag=': (0.01, 10.0, 's')}
+
+
+def variant_number(name, part):
+    """The number of a variant's part such as jitter=0.3, checked against its range (ValueError)."""
+    prefix = part[:part.index('=') + 1]
+    low, high, unit = RANGES[prefix]
+    text = part[len(prefix):]
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (low <= value <= high):
+        raise ValueError(f'variant {name!r}: {part!r}; expected {prefix}NUMBER from {low:g} to {high:g}'
+                         + (f' {unit}' if unit else ''))
+    return value
+
+
 def parse_variant(name):
     parts = name.split('+')
     body, model = parts[0], {}
@@ -69,24 +96,24 @@ def parse_variant(name):
             model['gait_jitter'] = 'isotropic'
         elif part.startswith('jitter='):
             model['gait_jitter'] = 'isotropic'
-            model['gait_jitter_velocity_m_per_s'] = float(part[len('jitter='):])
+            model['gait_jitter_velocity_m_per_s'] = variant_number(name, part)
         elif part == 'no-spring':
             model['tangential_spring'] = 'none'
         elif part.startswith('creep='):
             model['tangential_spring'] = 'creeping'
-            model['tangential_spring_relaxation_time_s'] = float(part[len('creep='):])
+            model['tangential_spring_relaxation_time_s'] = variant_number(name, part)
         elif part == 'face-desired':
             model['facing_target'] = 'desired_direction'
         elif part.startswith('yield='):
             model['yielding'] = 'when_blocked'
-            model['yielding_push_share'] = float(part[len('yield='):])
+            model['yielding_push_share'] = variant_number(name, part)
         elif part == 'turn' or part.startswith('turn='):
             model['shoulder_turn'] = 'when_blocked'
             if part.startswith('turn='):
-                model['shoulder_turn_angle_deg'] = float(part[len('turn='):])
+                model['shoulder_turn_angle_deg'] = variant_number(name, part)
         elif part.startswith('lag='):
             model['drive_reaction'] = 'lagged'
-            model['drive_reaction_time_s'] = float(part[len('lag='):])
+            model['drive_reaction_time_s'] = variant_number(name, part)
         else:
             raise ValueError(f'variant {name!r}: {part!r}; expected jitter, jitter=SIGMA, face-desired, no-spring, '
                              'creep=T, yield=SHARE, turn, turn=DEG or lag=T')
@@ -175,8 +202,7 @@ def scenario_for(variant, seed, work):
     if model:
         s['model'] = dict(model)
     path = os.path.join(work, f'{variant}-s{seed}.json')
-    with open(path, 'w') as f:
-        json.dump(s, f, indent=1)
+    guard.write_whole(path, json.dumps(s, indent=1))
     return path
 
 
@@ -209,21 +235,56 @@ def fmt(values, digits=2):
     return f'{mean:.{digits}f} ± {sd:.{digits}f}'
 
 
+RESULTS_HEAD = 'variant,seed,passed,stuck,'
+STUDY_HEAD = '# The Wuppertal bottleneck against the model'
+
+
+def check_outputs(args, variants):
+    """Every path the study writes, checked before any run (scripts/script_guard.py)."""
+    runs = os.path.join(args.out, 'runs')
+    names = [f'{v}-s{s}' for v in variants for s in range(1, args.seeds + 1)]
+    runs_previous = guard.folder_with({'*.sqlite': guard.is_run_file,
+                                       '*.json': guard.is_json_with('format', 'crowdrecon-scenario')})
+    outputs = [
+        guard.Output('OUT_DIR', args.out, 'a folder of bottleneck-study.py', folder=True, is_previous=guard.folder_with(
+            {'results.csv': guard.starts_with(RESULTS_HEAD), 'study.md': guard.starts_with(STUDY_HEAD),
+             'runs': runs_previous})),
+        guard.Output('', runs, 'a folder of run files of bottleneck-study.py', folder=True, is_previous=runs_previous),
+        guard.Output('', os.path.join(args.out, 'results.csv'), 'a table of bottleneck-study.py',
+                     guard.starts_with(RESULTS_HEAD)),
+        guard.Output('', os.path.join(args.out, 'study.md'), 'a report of bottleneck-study.py',
+                     guard.starts_with(STUDY_HEAD))]
+    for n in names:
+        outputs.append(guard.Output('', os.path.join(runs, n + '.sqlite'), 'a crowdrecon run file',
+                                    guard.is_run_file))
+        outputs.append(guard.Output('', os.path.join(runs, n + '.json'), 'a crowdrecon scenario',
+                                    guard.is_json_with('format', 'crowdrecon-scenario')))
+    guard.check_outputs(outputs, [('the crowdrecon executable', args.crowdrecon), ('the experiment\'s trajectories', DATA),
+                                  ('the shipped scenario', SCENARIO)], args.force)
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument('crowdrecon')
+    ap = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('crowdrecon', type=guard.executable)
     ap.add_argument('out')
-    ap.add_argument('--seeds', type=int, default=10)
-    ap.add_argument('--variants', default=','.join(DEFAULT_VARIANTS),
+    ap.add_argument('--seeds', type=guard.positive_int, default=10)
+    ap.add_argument('--variants', default=','.join(DEFAULT_VARIANTS), type=guard.nonempty_list,
                     help='comma-separated BODY[+jitter|+jitter=SIGMA][+face-desired][+no-spring|+creep=T][+yield=SHARE] (default: %(default)s)')
-    ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--jobs', type=guard.positive_int, default=2)
+    guard.add_force(ap)
     args = ap.parse_args()
-    variants = args.variants.split(',')
+    variants = args.variants
     for v in variants:
         try:
             parse_variant(v)
         except ValueError as e:
-            sys.exit(str(e))
+            raise guard.ScriptError(f'--variants: {e}') from None
+    if not os.path.isfile(DATA):
+        data = os.path.normpath(os.path.join(ROOT, '..', 'shared', 'data'))
+        raise guard.ScriptError(f'{os.path.normpath(DATA)}: no such file: the data folder ../shared/data beside the '
+                                f'repository ({data}) is missing or incomplete; expected the Wuppertal bottleneck '
+                                'trajectories there (../shared/data/README.md)')
+    check_outputs(args, variants)
     os.makedirs(os.path.join(args.out, 'runs'), exist_ok=True)
 
     data_tracks, data_frame_s = read_petrack(DATA)
@@ -246,7 +307,7 @@ def main():
 
     keys = ['passed', 'stuck', 'flow_per_s', 'span_s', 'density_per_m2', 'lapse_median_s', 'lapse_p90_s', 'lapse_max_s',
             'share_over_1s', 'clogs_over_2s']
-    with open(os.path.join(args.out, 'results.csv'), 'w') as f:
+    with guard.whole_file(os.path.join(args.out, 'results.csv'), 'w') as f:
         f.write('variant,seed,' + ','.join(keys) + ',wall_s\n')
         f.write('experiment,,' + ','.join(str(data_stats.get(k, '')) for k in keys) + ',\n')
         for v in variants:
@@ -282,10 +343,9 @@ def main():
         for seed, st, _, wall in sorted(results[v], key=lambda r: r[0]):
             lines.append(f'| {v} | {seed} | {st["passed"]} | {st.get("flow_per_s", float("nan")):.2f} | '
                          f'{st.get("lapse_max_s", float("nan")):.1f} | {st.get("clogs_over_2s", "")} | {wall:.0f} |')
-    with open(os.path.join(args.out, 'study.md'), 'w') as f:
-        f.write('\n'.join(lines) + '\n')
+    guard.write_whole(os.path.join(args.out, 'study.md'), '\n'.join(lines) + '\n')
     print('\n'.join(lines[:6 + len(variants) + 3]))
 
 
 if __name__ == '__main__':
-    main()
+    guard.run_main(main)

@@ -19,11 +19,17 @@ under the same u, so sigma_u is too low by the crowd's resistance.  Both are
 stated with the result, neither is corrected.
 
 usage: scripts/gait-jitter-from-data.py [TRAJECTORIES.txt]  (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)
+The default needs the data folder ../shared/data beside the repository (its
+README says where the files come from); without it, or with a file that is not
+a PeTrack trajectory file or has no standing windows, the script says so in
+one line (exit status 2; scripts/script_guard.py).
 """
 import importlib.util
 import math
 import os
 import sys
+
+import script_guard as guard  # (this folder: the scripts are run as files, so it is on the path)
 
 TAU_S = 2.0 / 3.0          # relaxation time of eq. 3 (paper)
 FPS = 25.0
@@ -63,8 +69,17 @@ def periodogram(values):
 
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
-    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, '..', '..', 'shared', 'data', 'juelich-bottleneck',
-                                                                 '040_c_56_h-.txt')
+    default = os.path.join(here, '..', '..', 'shared', 'data', 'juelich-bottleneck', '040_c_56_h-.txt')
+    p = guard.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument('trajectories', nargs='?', type=guard.existing_file,
+                   help='a PeTrack trajectory file (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)')
+    args = p.parse_args()
+    path = args.trajectories or default
+    if args.trajectories is None and not os.path.isfile(path):
+        data = os.path.normpath(os.path.join(here, '..', '..', 'shared', 'data'))
+        raise guard.ScriptError(f'{os.path.normpath(path)}: no such file: the data folder ../shared/data beside the '
+                                f'repository ({data}) is missing or incomplete; expected the Jülich bottleneck '
+                                'trajectories there (../shared/data/README.md), or a PeTrack file as the argument')
     people = load(path)
     sums = {'across': None, 'along': None}
     windows = 0
@@ -79,6 +94,10 @@ def main():
             for axis, series in (('across', x), ('along', y)):  # the flow is along -y
                 p = periodogram(detrended(series))
                 sums[axis] = p if sums[axis] is None else [a + b for a, b in zip(sums[axis], p)]
+    if windows == 0:
+        raise guard.ScriptError(f'{path}: no window of {WINDOW / FPS:.0f} s in which a person stands (net speed < '
+                                f'{STANDING_M_PER_S} m/s); expected trajectories of a waiting crowd, such as the '
+                                'Wuppertal bottleneck\'s')
     df = FPS / WINDOW
     print(f'{path}: {len(people)} people, {windows} windows of {WINDOW / FPS:.0f} s standing (net speed < {STANDING_M_PER_S} m/s)')
     print('f (Hz)   S_y across, along (m^2/Hz)   S_u across, along ((m/s)^2/Hz)')
@@ -105,4 +124,4 @@ def main():
 
 
 if __name__ == '__main__':
-    main()
+    guard.run_main(main)

@@ -12,6 +12,9 @@ lanes (the lanes boundary) and the lowest whose majority is clogging. Reads
 the sweep's `diagram` axes from the stored sweep file. --x/--y keep only the
 listed axis values (to compare a fine sweep with a coarse one); --metric adds
 a grid of that results column, averaged over seeds. Python standard library only.
+Each DIR must be a sweep folder (results.sqlite) with runs and diagram axes;
+--x/--y are comma-separated numbers and --metric a column of every sweep's
+runs table (scripts/script_guard.py: a bad argument is one line, exit 2).
 """
 import argparse
 import collections
@@ -19,6 +22,8 @@ import json
 import os
 import sqlite3
 import sys
+
+import script_guard as guard  # (this folder: the scripts are run as files, so it is on the path)
 
 LETTER = {"lanes": "L", "avalanches": "A", "clogging": "C", "unclassified": "U"}
 
@@ -50,18 +55,46 @@ def regime_of(status, regime):
     return LETTER.get(regime, "U")
 
 
+def check_sweep(folder, metric):
+    """The sweep's diagram axes and --metric are columns of its runs table, and it holds runs."""
+    db = os.path.join(folder, "results.sqlite")
+    con = guard.open_readonly(db)
+    try:
+        meta = dict(con.execute("SELECT key, value FROM sweep").fetchall())
+        runs = con.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+    finally:
+        con.close()
+    columns = guard.table_columns(db, "runs")
+    for key in ("diagram_x", "diagram_y"):
+        if key not in meta:
+            raise guard.ScriptError(f"{folder}: its sweep has no {key}; expected a sweep with a phase diagram's axes")
+        if meta[key] not in columns:
+            raise guard.ScriptError(f"{folder}: its {key} {meta[key]!r} is not a column of its runs; "
+                                    "expected the results of a crowdrecon sweep")
+    for key in ("variant", "status", "regime", "run_index", "wall_s"):
+        if key not in columns:
+            raise guard.ScriptError(f"{folder}: its runs table has no column {key}; expected the results of a crowdrecon sweep")
+    if metric is not None and metric.replace('"', '') not in columns:
+        raise guard.ScriptError(f"--metric {metric}: not a column of {folder}'s runs table; "
+                                "expected one such as mean_speed_m_per_s")
+    if runs == 0:
+        raise guard.ScriptError(f"{folder}: its runs table is empty; expected a sweep that has run")
+
+
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("dirs", nargs="+", help="sweep output folders (results.sqlite)")
-    p.add_argument("--x", help="comma-separated x values to keep")
-    p.add_argument("--y", help="comma-separated y values to keep")
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("dirs", nargs="+", type=guard.sweep_dir, help="sweep output folders (results.sqlite)")
+    p.add_argument("--x", type=guard.float_list, help="comma-separated x values to keep")
+    p.add_argument("--y", type=guard.float_list, help="comma-separated y values to keep")
     p.add_argument("--metric", help="a results column to tabulate too (mean over seeds)")
     args = p.parse_args()
+    for folder in args.dirs:
+        check_sweep(folder, args.metric)
     global METRIC
     if args.metric:
         METRIC = '"' + args.metric.replace('"', '') + '"'
-    keep_x = {float(v) for v in args.x.split(",")} if args.x else None
-    keep_y = {float(v) for v in args.y.split(",")} if args.y else None
+    keep_x = set(args.x) if args.x else None
+    keep_y = set(args.y) if args.y else None
     for folder in args.dirs:
         sweep, x, y, rows, wall = load(folder)
         print(f"## {sweep.get('name', folder)}\n")
@@ -114,4 +147,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    guard.run_main(main)

@@ -108,6 +108,11 @@ usage: scripts/reaction-time-from-data.py [TRAJECTORIES.txt ...] [RUN.sqlite ...
   (default: ../shared/data/juelich-uni/traj_UNI_CORR_500_01.txt and ../shared/data/juelich-bfr/bi_corr_400_b_03.txt;
   prints a plain-text report; -o writes the same as markdown).  Standard library only; one process, ~15 s
   for the two files, ~2 min per sweep variant of 10 runs of 120 s (39 people).
+  The default files need the data folder ../shared/data beside the repository (said by name when it is
+  missing). -o is checked before any work and written whole (scripts/script_guard.py): never an input,
+  an existing file that is not a previous report only with --force. A bad argument or input (a file that
+  is not a trajectory file, a folder that is not a sweep, --bootstrap 0, --variants without --sweep) is
+  one line, exit status 2.
 """
 import argparse
 import collections
@@ -120,6 +125,7 @@ import sqlite3
 import sys
 
 from petrack import read_petrack  # (this folder: the scripts are run as files, so it is on the path)
+import script_guard as guard
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, '..', '..', 'shared', 'data')
@@ -166,12 +172,10 @@ def read_sqlite(path, from_s=0.0):
     the periodic box along x as (x_min, x_max) or None, the walkable area's bounding box (x0, x1, y0, y1)
     and notes.  Frames before from_s are dropped.  In a periodic box the positions are unwrapped: each step
     is the minimum image of the stored one, so a track is continuous across the seams."""
-    if not os.path.exists(path):
-        raise SystemExit(f'{path}: no such file')
+    guard.require_tables(path, ['trajectory_data'], 'a JuPedSim trajectory file (a crowdrecon run file, its export, '
+                         'or another JuPedSim SQLite file)')
     con = sqlite3.connect(f'file:{os.path.abspath(path)}?mode=ro', uri=True)
     tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-    if 'trajectory_data' not in tables:
-        raise SystemExit(f'{path}: no trajectory_data table (not a JuPedSim trajectory file)')
     notes = []
     meta = dict(con.execute('SELECT key, value FROM metadata')) if 'metadata' in tables else {}
     fps = float(meta.get('fps', 0) or 0)
@@ -189,7 +193,7 @@ def read_sqlite(path, from_s=0.0):
     if box_json:
         box = json.loads(box_json)
         if box.get('y'):
-            raise SystemExit(f'{path}: periodic along y: only corridors periodic along x are read')
+            raise guard.ScriptError(f'{path}: periodic along y; expected a corridor periodic along x (or not periodic)')
         if box.get('x'):
             period = (float(box['min_m'][0]), float(box['max_m'][0]))
     # first frame kept
@@ -272,7 +276,7 @@ class Person:
         h = w // 2
         frames = [p[0] for p in track]
         if frames[-1] - frames[0] + 1 != len(frames):
-            raise SystemExit(f'person {pid}: frames not contiguous')
+            raise guard.ScriptError(f'person {pid}: frames not contiguous; expected a track in every frame from its first to its last')
         sx = moving_average([p[1] for p in track], w)
         sy = moving_average([p[2] for p in track], w)
         # velocity valid at smoothed index 1 .. len-2, i.e. frame frames[0] + h + 1 ...
@@ -757,7 +761,8 @@ def report_runs(rep, label, paths, n_boot, from_s, periodic_area):
     runs = [read_sqlite(p, from_s) for p in paths]
     fps = runs[0][1]
     if any(abs(r[1] - fps) > 1e-9 for r in runs):
-        raise SystemExit(f'{label}: the runs have different frame rates ({sorted({r[1] for r in runs})})')
+        raise guard.ScriptError(f'{label}: the runs have different frame rates ({sorted({r[1] for r in runs})}); '
+                                'expected runs of one frame rate to pool')
     setups = []
     for tracks, _fps, period, area, _kind, _notes in runs:
         corridor, wrap = simulated_corridor(tracks, period, area, periodic_area)
@@ -804,8 +809,7 @@ def report_runs(rep, label, paths, n_boot, from_s, periodic_area):
 def sweep_variants(folder):
     """variant -> run files of a crowdrecon sweep folder (kept runs), in run order; complete runs only."""
     db = os.path.join(folder, 'results.sqlite')
-    if not os.path.exists(db):
-        raise SystemExit(f'{folder}: no results.sqlite (not a crowdrecon sweep folder)')
+    guard.check_sweep_dir(folder)
     con = sqlite3.connect(f'file:{os.path.abspath(db)}?mode=ro', uri=True)
     groups = collections.OrderedDict()
     for run_id, variant, status in con.execute('SELECT run_id, variant, status FROM runs ORDER BY run_index'):
@@ -813,7 +817,8 @@ def sweep_variants(folder):
         if status != 'complete':
             continue
         if not os.path.exists(path):
-            raise SystemExit(f'{path}: missing (run the sweep with "keep_runs": true)')
+            raise guard.ScriptError(f'{path}: missing; expected the sweep\'s kept runs (run the sweep with '
+                                    '"keep_runs": true)')
         groups.setdefault(variant, []).append(path)
     con.close()
     return groups
@@ -824,7 +829,7 @@ def summary_table(summaries):
     for sm in summaries:
         res = sm['res']
         if not res['segments']:
-            rows.append([sm['label'], 'no pairs', '', '', '', '0 / 0', '', ''])
+            rows.append([sm['label'], 'no pairs', '', '', '', '0 / 0', '', '', ''])
             continue
         pd_, sp, hw = sm['pair_dens'], sm['speeds'], sm['hw']
         few = ' (too few)' if res['followers'] < FEW_FOLLOWERS else ''
@@ -840,37 +845,65 @@ def summary_table(summaries):
              'headway median (m)'], rows)
 
 
+REPORT_HEAD = '# Reaction time'
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('files', nargs='*', help='PeTrack .txt files and simulated runs (.sqlite: crowdrecon run '
+    ap = guard.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('files', nargs='*', type=guard.existing_file,
+                    help='PeTrack .txt files and simulated runs (.sqlite: crowdrecon run '
                     'files, their exports, JuPedSim trajectory files); default: the two Jülich corridors')
     ap.add_argument('-o', '--output', help='write the report as markdown to this file')
-    ap.add_argument('--bootstrap', type=int, default=2000, help='bootstrap resamples (default 2000)')
+    ap.add_argument('--bootstrap', type=guard.positive_int, default=2000, help='bootstrap resamples (default 2000)')
     ap.add_argument('--unit', choices=('m', 'cm', 'mm'), help='override the unit read from the header')
-    ap.add_argument('--sweep', help='a crowdrecon sweep folder with kept runs: one section per variant, its '
-                    'seeds pooled')
-    ap.add_argument('--variants', help='with --sweep: only these variants (comma-separated)')
+    ap.add_argument('--sweep', type=guard.sweep_dir, help='a crowdrecon sweep folder with kept runs: one section '
+                    'per variant, its seeds pooled')
+    ap.add_argument('--variants', type=guard.nonempty_list, help='with --sweep: only these variants (comma-separated)')
     ap.add_argument('--pool', action='store_true', help='the .sqlite files given as one section (seeds pooled)')
-    ap.add_argument('--from-s', type=float, default=0.0,
+    ap.add_argument('--from-s', type=guard.nonnegative_float, default=0.0,
                     help='simulated runs: drop the frames before this time (s), the start from rest')
     ap.add_argument('--periodic-area', choices=('cut', 'whole'), default='cut',
                     help='periodic runs: measurement area the box minus END_CUT_M at each end, leaders within '
                          'it, as in the data (cut, default), or the whole box, leaders across the seam (whole)')
+    guard.add_force(ap)
     args = ap.parse_args()
+    if args.variants and not args.sweep:
+        raise guard.ScriptError('--variants: given without --sweep; expected --sweep DIR --variants A,B')
+    guard.refuse_repeated(args.files, 'file')
     petrack = [f for f in args.files if not f.endswith(('.sqlite', '.db'))]
     sims = [f for f in args.files if f.endswith(('.sqlite', '.db'))]
     if not args.files and not args.sweep:
         petrack = DEFAULT_FILES
+        for f in petrack:
+            if not os.path.isfile(f):
+                raise guard.ScriptError(f'{os.path.normpath(f)}: no such file: the data folder ../shared/data beside '
+                                        f'the repository ({os.path.normpath(DATA)}) is missing or incomplete; expected '
+                                        'the Jülich corridor trajectories there (../shared/data/README.md), or files '
+                                        'given as arguments')
+    for f in sims:
+        guard.require_tables(f, ['trajectory_data'], 'a JuPedSim trajectory file (a crowdrecon run file, its export, '
+                             'or another JuPedSim SQLite file)')
+    inputs = [('a trajectory file', f) for f in petrack + sims]
+    inputs += [('a corridor beside a trajectory file', os.path.join(os.path.dirname(f), 'walkable_area.wkt'))
+               for f in petrack]
+    variants = {}
+    if args.sweep:
+        inputs += guard.sweep_inputs(args.sweep)
+        variants = sweep_variants(args.sweep)
+        for v in args.variants or []:
+            if v not in variants:
+                raise guard.ScriptError(f'--variants: {args.sweep} has no complete runs of variant {v!r}; expected '
+                                        f'one of {", ".join(variants)}')
+        inputs += [('a run of the sweep', f) for paths in variants.values() for f in paths]
+    guard.check_outputs([guard.Output('-o', args.output, 'a report of reaction-time-from-data.py',
+                                      guard.starts_with(REPORT_HEAD))], inputs, args.force)
     groups = []
     if sims:
         groups += [(os.path.basename(sims[0]) + f' … ({len(sims)} runs)' if len(sims) > 1 else
                     os.path.basename(sims[0]), sims)] if args.pool else [(os.path.basename(f), [f]) for f in sims]
     if args.sweep:
-        variants = sweep_variants(args.sweep)
-        wanted = args.variants.split(',') if args.variants else list(variants)
+        wanted = args.variants if args.variants else list(variants)
         for v in wanted:
-            if v not in variants:
-                raise SystemExit(f'{args.sweep}: no complete runs of variant {v!r} (variants: {", ".join(variants)})')
             groups.append((f'model: {v} ({len(variants[v])} runs)', variants[v]))
     root = os.path.join(HERE, '..')
     rep = Report()
@@ -887,7 +920,7 @@ def main():
              + ' '.join(os.path.relpath(f, root) for f in (petrack + sims if args.files else petrack))
              + (' --pool' if args.pool else '')
              + (f' --sweep {os.path.relpath(args.sweep, root)}' if args.sweep else '')
-             + (f' --variants {args.variants}' if args.variants else '')
+             + (f' --variants {",".join(args.variants)}' if args.variants else '')
              + (f' --from-s {args.from_s:g}' if args.from_s else '')
              + (f' --periodic-area {args.periodic_area}' if args.periodic_area != 'cut' else '')
              + (f' -o {os.path.relpath(args.output, root)}' if args.output else '')
@@ -908,10 +941,8 @@ def main():
             ('t', head, rows)]
     sys.stdout.write(rep.text())
     if args.output:
-        os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)
-        with open(args.output, 'w') as f:
-            f.write(rep.markdown())
+        guard.write_whole(args.output, rep.markdown())
 
 
 if __name__ == '__main__':
-    main()
+    guard.run_main(main)

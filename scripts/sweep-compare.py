@@ -12,16 +12,39 @@ usage: sweep-compare.py A_DIR:VARIANT B_DIR:VARIANT [--metric M]
 
 A_DIR and B_DIR may be the same folder (two variants of one sweep) or two
 sweeps over grids that share points (a coarse grid inside a fine one); only
-points present in both are compared. Exit status 1 if none are.
+points present in both are compared. Exit status 1 if none are. A bad
+argument (a folder that is not a sweep, a variant or metric it does not hold,
+a minimum above its maximum) is one line and exit status 2
+(scripts/script_guard.py).
 """
 import argparse
 import math
+import os
 import sqlite3
 import sys
+
+import script_guard as guard  # (this folder: the scripts are run as files, so it is on the path)
+
+
+def sweep_variant(spec):
+    """argparse type=: DIR:VARIANT, DIR a sweep folder holding VARIANT."""
+    folder, colon, variant = spec.rpartition(":")
+    if not colon or not folder or not variant:
+        raise argparse.ArgumentTypeError(f"{spec!r} is not DIR:VARIANT; expected a sweep folder and one of its "
+                                               "variants, such as results/sweeps/madrid-arena/hallway-gamma:gamma-0.6")
+    guard.sweep_dir(folder)
+    variants = guard.sweep_variants(folder)
+    if variant not in variants:
+        raise argparse.ArgumentTypeError(f"{spec}: {folder} has no variant {variant!r}; expected one of "
+                                               + ", ".join(variants))
+    return spec
 
 
 def load(spec, metric):
     folder, variant = spec.rsplit(":", 1)
+    if metric not in guard.table_columns(os.path.join(folder, "results.sqlite"), "runs"):
+        raise guard.ScriptError(f"--metric {metric}: not a column of {folder}'s runs table; "
+                                "expected one such as mean_speed_m_per_s")
     con = sqlite3.connect(f"file:{folder}/results.sqlite?mode=ro", uri=True)  # never creates one
     meta = dict(con.execute("SELECT key, value FROM sweep"))
     x, y = meta["diagram_x"], meta["diagram_y"]
@@ -37,15 +60,20 @@ def load(spec, metric):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("a")
-    p.add_argument("b")
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("a", type=sweep_variant)
+    p.add_argument("b", type=sweep_variant)
     p.add_argument("--metric", default="mean_speed_m_per_s")
-    p.add_argument("--min-x", type=float, default=-math.inf)
-    p.add_argument("--max-x", type=float, default=math.inf)
-    p.add_argument("--min-y", type=float, default=-math.inf)
-    p.add_argument("--max-y", type=float, default=math.inf)
+    p.add_argument("--min-x", type=guard.finite_float, default=-math.inf)
+    p.add_argument("--max-x", type=guard.finite_float, default=math.inf)
+    p.add_argument("--min-y", type=guard.finite_float, default=-math.inf)
+    p.add_argument("--max-y", type=guard.finite_float, default=math.inf)
     args = p.parse_args()
+    for axis in ("x", "y"):
+        low, high = getattr(args, f"min_{axis}"), getattr(args, f"max_{axis}")
+        if low > high:
+            raise guard.ScriptError(f"--min-{axis} {low:g} is above --max-{axis} {high:g}; expected a minimum at or "
+                                    "below the maximum")
     a, b = load(args.a, args.metric), load(args.b, args.metric)
     keys = sorted(k for k in a if k in b and args.min_x <= k[0] <= args.max_x and args.min_y <= k[1] <= args.max_y)
     if not keys:
@@ -59,4 +87,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

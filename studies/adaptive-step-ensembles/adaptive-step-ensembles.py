@@ -19,7 +19,13 @@ permutation test of the difference of their means (every split of the
 (one row per run) and OUT/ensembles.md (the table).
 
 usage: adaptive-step-ensembles.py CROWDRECON OUT [--seeds K] [--duration S]
-       [--points 3:0.3,5:0.3,6.5:0.4] [--threads T]
+       [--points 3:0.3,5:0.3,6.5:0.4] [--threads T] [--force]
+
+Every output (OUT, OUT/runs and each file in them) is checked before any run
+(scripts/script_guard.py): new, empty or a previous output of this script,
+else --force (a folder is then written into, nothing in it deleted);
+ensembles.csv and .md are written whole. A bad argument (a point that is not
+DENSITY:COUNTER-FLOW, a count below 1) is one line, exit status 2.
 """
 import argparse
 import json
@@ -34,6 +40,7 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[2]  # studies/NAME/ is two levels down
 sys.path.insert(0, str(ROOT / "scripts"))
 from ensemble_stats import mean_sd, permutation_p  # noqa: E402
+import script_guard as guard  # noqa: E402
 
 BASE = ROOT / "venues/madrid-arena/scenarios/hallway-5pm2-30cf.json"
 
@@ -49,7 +56,7 @@ def scenario(density, counter, seed, mode, duration, path):
     d["run"]["duration_s"] = duration
     d["run"]["checkpoint_interval_s"] = 0
     d["name"] = f"hallway {density}/m2 {counter} counter-flow, seed {seed}, {mode} step"
-    path.write_text(json.dumps(d, indent=1))
+    guard.write_whole(path, json.dumps(d, indent=1))
 
 
 def statistics(run, duration):
@@ -83,20 +90,59 @@ def statistics(run, duration):
     }
 
 
+def point_list(text):
+    """argparse type=: DENSITY:COUNTER-FLOW,... (density > 0 /m², counter-flow fraction 0 ... 1), none twice."""
+    points = []
+    for item in text.split(","):
+        density, colon, counter = item.partition(":")
+        try:
+            point = (float(density), float(counter))
+        except ValueError:
+            point = None
+        if not colon or point is None or not (0 < point[0] < 1e3) or not (0 <= point[1] <= 1):
+            raise argparse.ArgumentTypeError(f"{item!r} is not DENSITY:COUNTER-FLOW; expected a density above 0 /m² "
+                                             "and a counter-flow fraction from 0 to 1, such as 5:0.3")
+        if point in points:
+            raise argparse.ArgumentTypeError(f"{item!r} is given twice; expected each point once")
+        points.append(point)
+    return points
+
+
+CSV_HEAD = "density,counter,seed,mode,"
+MD_HEAD = "Fixed against adaptive step"
+
+
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("crowdrecon")
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("crowdrecon", type=guard.executable)
     p.add_argument("out")
-    p.add_argument("--seeds", type=int, default=6)
-    p.add_argument("--duration", type=float, default=60.0)
-    p.add_argument("--points", default="3:0.3,5:0.3,6.5:0.4")
-    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--seeds", type=guard.positive_int, default=6)
+    p.add_argument("--duration", type=guard.positive_float, default=60.0)
+    p.add_argument("--points", default="3:0.3,5:0.3,6.5:0.4", type=point_list)
+    p.add_argument("--threads", type=guard.positive_int, default=1)
+    guard.add_force(p)
     a = p.parse_args()
     out = pathlib.Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
     work = out / "runs"
+    points = a.points
+    names = [f"d{density}-c{counter}-s{seed}-{mode}" for density, counter in points
+             for seed in range(1, a.seeds + 1) for mode in ("fixed", "adaptive")]
+    runs_previous = guard.folder_with({"*.json": guard.is_json_with("format", "crowdrecon-scenario"),
+                                       "*.sqlite": guard.is_run_file})
+    outputs = [
+        guard.Output("OUT", out, "a folder of adaptive-step-ensembles.py", folder=True, is_previous=guard.folder_with(
+            {"ensembles.csv": guard.starts_with(CSV_HEAD), "ensembles.md": guard.starts_with(MD_HEAD),
+             "runs": runs_previous})),
+        guard.Output("", work, "a folder of runs of adaptive-step-ensembles.py", folder=True, is_previous=runs_previous),
+        guard.Output("", out / "ensembles.csv", "a table of adaptive-step-ensembles.py", guard.starts_with(CSV_HEAD)),
+        guard.Output("", out / "ensembles.md", "a table of adaptive-step-ensembles.py", guard.starts_with(MD_HEAD))]
+    for name in names:
+        outputs.append(guard.Output("", work / f"{name}.json", "a crowdrecon scenario",
+                                    guard.is_json_with("format", "crowdrecon-scenario")))
+        outputs.append(guard.Output("", work / f"{name}.sqlite", "a crowdrecon run file", guard.is_run_file))
+    guard.check_outputs(outputs, [("the crowdrecon executable", a.crowdrecon), ("the scenario", BASE)], a.force)
+    out.mkdir(parents=True, exist_ok=True)
     work.mkdir(exist_ok=True)
-    points = [tuple(float(x) for x in s.split(":")) for s in a.points.split(",")]
     rows = []
     started = time.time()
     for density, counter in points:
@@ -111,7 +157,7 @@ def main():
                                     "--threads", str(a.threads)], capture_output=True, text=True)
                 wall = time.time() - t0
                 if r.returncode != 0:
-                    sys.exit(f"{name}: exit {r.returncode}\n{r.stderr}")
+                    sys.exit(f"{name}: exit {r.returncode}\n{r.stderr}")  # (the run's own message, several lines)
                 text = r.stdout + r.stderr
                 st = statistics(run, a.duration)
                 m = re.search(r"adaptive step: (.*?); mean step ([0-9.]+) h", text)
@@ -122,7 +168,7 @@ def main():
                 print(json.dumps(row), flush=True)
                 run.unlink()
     keys = ["speed_forward", "speed_counter", "stopped_share", "load_mean", "load_p99", "mean_step_h", "wall_s"]
-    with open(out / "ensembles.csv", "w") as f:
+    with guard.whole_file(out / "ensembles.csv", "w") as f:
         cols = ["density", "counter", "seed", "mode"] + keys
         f.write(",".join(cols) + "\n")
         for r in rows:
@@ -141,9 +187,9 @@ def main():
             judged = key not in ("mean_step_h", "wall_s")
             lines.append(f"| {density:g} /m², {counter:g} | {key} | {mf:.4g} ± {sf:.2g} | {ma:.4g} ± {sa:.2g} | "
                          f"{pv:.3f} | {('yes' if pv >= 0.05 else '**no**') if judged else '(cost)'} |")
-    (out / "ensembles.md").write_text("\n".join(lines) + "\n")
+    guard.write_whole(out / "ensembles.md", "\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

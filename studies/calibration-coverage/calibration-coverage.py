@@ -35,6 +35,14 @@ Writes OUT/coverage.csv (one row per truth and parameter), OUT/coverage.md
 (the table), OUT/ranks.svg (the rank histograms) and keeps each truth's
 calibration in OUT/truth-NN/. Resumable: a truth whose calibration.json
 exists is read, not run again.
+
+Before any work (scripts/script_guard.py): the counts are checked against the
+design (at least one truth, at most 100, so that no truth's calibration seeds
+reach the recordings' seeds; recordings from 1 to 100; K from 2 to 1000), the
+crowdrecon executable must exist, and OUT must be new, empty or a previous
+coverage folder (else --force, which writes into it and deletes nothing);
+coverage.csv, coverage.md and ranks.svg are written whole. A truth's folder is
+started afresh only when it holds this script's files alone.
 """
 import argparse
 import csv
@@ -48,6 +56,8 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
 DATA = os.path.join(ROOT, "tests", "data", "calibration")
 SPEC = os.path.join(ROOT, "venues", "madrid-arena", "observations", "hallway.json")
 
@@ -76,6 +86,12 @@ def truth_values(seed, n):
     return [{path: rng.uniform(lo, hi) for path, (lo, hi) in PRIOR.items()} for _ in range(n)]
 
 
+# What calibrate_truth writes in a truth's folder: the only entries it deletes when it starts a truth afresh.
+TRUTH_ENTRIES = ("truth.json", "truth", "log.txt", "calibration.json", "calibration", "*.observation.json",
+                 "*.observation.csv")
+is_truth_folder = guard.folder_of(*TRUTH_ENTRIES)
+
+
 def calibrate_truth(args, k, truth):
     d = os.path.join(args.out, f"truth-{k:02d}")
     result = os.path.join(d, "calibration", "calibration.json")
@@ -83,6 +99,9 @@ def calibrate_truth(args, k, truth):
         return json.load(open(result)), 0.0
     t0 = time.time()
     if os.path.exists(d):
+        if not os.path.isdir(d) or not is_truth_folder(d):
+            raise guard.ScriptError(f"{d}: is {guard.describe_existing(d)}, not an unfinished truth of this script; "
+                                    "expected another OUT (nothing in it is deleted)")
         shutil.rmtree(d)
     os.makedirs(d)
     log = os.path.join(d, "log.txt")
@@ -174,23 +193,67 @@ def rank_svg(rows, paths, bins, file):
     svg.append(f'<text x="8" y="{h + 34}" fill="#555">bars: truths per bin; dashed: the uniform expectation; '
                f'band: where a uniform bin count falls 95 % of the time</text>')
     svg.append("</svg>")
-    open(file, "w").write("\n".join(svg) + "\n")
+    guard.write_whole(file, "\n".join(svg) + "\n")
+
+
+CSV_HEAD = "truth,path,true,"
+MD_HEAD = "# Coverage of the calibration's intervals"
+FOOTAGE_HEAD = "# The footage design against actual calibrations"
+
+
+def out_folder(option, path, force, files):
+    """Checks a coverage-style OUT folder and its truth folders before any work (also for
+    calibration-footage-check.py). files: {name: predicate} of the files written in it."""
+    truth = {"truth-*": lambda d: os.path.isdir(d) and is_truth_folder(d)}
+    outputs = [guard.Output(option, path, "a folder of the calibration coverage scripts", folder=True,
+                            is_previous=guard.folder_with(dict(files, **truth)))]
+    outputs += [guard.Output("", os.path.join(path, name), f"a {name} of the calibration coverage scripts", check)
+                for name, check in files.items()]
+    guard.check_outputs(outputs, [], force)
+
+
+def check_truth_folders(out, indices, force):
+    """Each truth folder that will be run: new, complete (reused), or an unfinished one of ours."""
+    outputs = []
+    for k in indices:
+        d = os.path.join(out, f"truth-{k:02d}")
+        if os.path.exists(os.path.join(d, "calibration", "calibration.json")):
+            continue
+        outputs.append(guard.Output("", d, "an unfinished truth of this script (which it starts afresh)", folder=True,
+                                    is_previous=is_truth_folder))
+    for o in outputs:
+        if os.path.isdir(o.path) and os.listdir(o.path) and not is_truth_folder(o.path):
+            raise guard.ScriptError(f"{o.path}: exists and is {guard.describe_existing(o.path)}, not {o.kind}; "
+                                    "expected another OUT (a truth's folder is started afresh, and nothing else is "
+                                    "deleted, not even with --force)")
+    guard.check_outputs(outputs, [], force)
+
+
+def add_common_arguments(p):
+    p.add_argument("--jobs", type=guard.positive_int, default=2)
+    p.add_argument("--crowdrecon", type=guard.executable,
+                   default=os.path.join(ROOT, "build", "release", "cli", "crowdrecon"))
+    guard.add_force(p)
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("out")
-    p.add_argument("--truths", type=int, default=20)
-    p.add_argument("--recordings", type=int, default=3)
-    p.add_argument("--seeds", type=int, default=3)
-    p.add_argument("--seed", type=int, default=41, help="of the prior's draws")
-    p.add_argument("--jobs", type=int, default=2)
-    p.add_argument("--bins", type=int, default=5)
-    p.add_argument("--crowdrecon", default=os.path.join(ROOT, "build", "release", "cli", "crowdrecon"))
+    p.add_argument("--truths", type=guard.int_between(1, 100, "each truth's calibration seeds stay below the "
+                                                       "recordings' seeds 100001 ..."), default=20)
+    p.add_argument("--recordings", type=guard.int_between(1, 100, "a truth's recording seeds stay its own"), default=3)
+    p.add_argument("--seeds", type=guard.int_between(2, 1000, "K: a calibration needs two seeds at least, and a "
+                                                     "truth's seeds stay its own"), default=3)
+    p.add_argument("--seed", type=guard.int_between(), default=41, help="of the prior's draws")
+    p.add_argument("--bins", type=guard.int_between(1, 1000), default=5)
     p.add_argument("--check", action="store_true",
                    help="exit 1 unless every parameter's posterior intervals (68 %% and 95 %%) cover their nominal "
                         "share within two binomial standard errors of it")
+    add_common_arguments(p)
     args = p.parse_args()
+    out_folder("OUT", args.out, args.force, {"coverage.csv": guard.starts_with(CSV_HEAD),
+                                             "coverage.md": guard.starts_with(MD_HEAD), "ranks.svg": guard.is_svg})
+    check_truth_folders(args.out, range(args.truths), args.force)
     args.crowdrecon = os.path.abspath(args.crowdrecon)
     args.out = os.path.abspath(args.out)
     os.makedirs(args.out, exist_ok=True)
@@ -223,7 +286,7 @@ def main():
                                             f"[{r['posterior68_low']:.3f}, {r['posterior68_high']:.3f}], 95 % "
                                             f"[{r['posterior95_low']:.3f}, {r['posterior95_high']:.3f}], u {r['rank_u']:.2f}"
                                             for r in rows if r["truth"] == k), flush=True)
-    with open(os.path.join(args.out, "coverage.csv"), "w", newline="") as f:
+    with guard.whole_file(os.path.join(args.out, "coverage.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
@@ -256,7 +319,7 @@ def main():
                      f"{frac('inside68')} | {frac('inside95')} | {frac('inside_bootstrap95')} |")
     lines += ["", "Each fraction's ± is its binomial standard error. Rank u: the share of the truth's posterior "
               "samples below it: uniform when the posterior is right; piled at 0 and 1 when it is too narrow.", ""]
-    open(os.path.join(args.out, "coverage.md"), "w").write("\n".join(lines))
+    guard.write_whole(os.path.join(args.out, "coverage.md"), "\n".join(lines))
     rank_svg(rows, paths, args.bins, os.path.join(args.out, "ranks.svg"))
     print("\n".join(lines))
     if args.check:
@@ -276,4 +339,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

@@ -20,6 +20,14 @@ Writes OUT_DIR/envelope.md (the table), envelope.csv (one row per run) and
 envelope.svg / envelope.png (the alley's peak density and the people above
 400 N per design). Plain Python and sqlite3; the PNG drawn by headless
 Chromium where it is installed.
+
+Before any work (scripts/script_guard.py): SWEEP_DIR must be a finished sweep
+(results.sqlite, results.csv with the analysis' columns, its kept runs) of the
+Itaewon alley: every run's own venue must have the --venue's measurement areas
+(a sweep of another venue, such as the hallway, is refused instead of giving an
+envelope of zeros); OUT_DIR must be new, empty or a previous envelope's folder
+(else --force, which writes into it and deletes nothing), never the sweep
+folder; every file is written whole. A bad argument is one line, exit status 2.
 """
 import argparse
 import csv
@@ -33,6 +41,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from svg_png import svg_to_png  # noqa: E402
+import script_guard as guard  # noqa: E402
 
 FOOT_Y = 1.0           # the alley's foot line (venue: alley_foot_line)
 FOOT_X = (-0.1, 3.3)   # ... across the alley's width there
@@ -99,15 +108,80 @@ def run_metrics(path, areas, alley):
     return out
 
 
+AREAS = ("alley_foot", "alley_middle", "alley_top", "junction")  # the areas the table and the figure name
+COLUMNS = ("run_id", "variant", "seed", "status", "max_load_n", "people_ever_above_load", "longest_above_load_s",
+           "peak_density_per_m2", "wall_s")
+EXPECTED_SWEEP = ("a finished sweep of the Itaewon alley (studies/itaewon-design-envelope/design-envelope*.json or "
+                  "arrival-ranges*.json, with keep_runs)")
+
+
+def check_venue(path):
+    """The --venue: a venue with the areas the table names and the slope's region (the alley)."""
+    venue = guard.read_json_file(path, "a crowdrecon venue (JSON)")
+    areas = {a.get("id"): a.get("polygon") for a in venue.get("measurement_areas", [])} if isinstance(venue, dict) else {}
+    missing = [a for a in AREAS if a not in areas]
+    if missing or not (venue.get("slope") or {}).get("region"):
+        raise guard.ScriptError(f"--venue {path}: has no " + (f"measurement area {', '.join(missing)}" if missing else
+                                                               "slope region") +
+                                "; expected the Itaewon alley's venue (venues/itaewon/alley.json)")
+    return venue
+
+
+def check_sweep(sweep, rows):
+    """Every run complete, kept, with the tables read, and run in a venue with the alley's areas (else its counts
+    are zeros: a hallway sweep gave an envelope of zeros)."""
+    if not rows:
+        raise guard.ScriptError(f"{sweep}: its results.csv holds no runs; expected {EXPECTED_SWEEP}")
+    for r in rows:
+        if r["status"] != "complete":
+            raise guard.ScriptError(f"{sweep}: run {r['run_id']} did not complete ({r['status']}); expected "
+                                    f"{EXPECTED_SWEEP}")
+        run = os.path.join(sweep, "runs", r["run_id"] + ".sqlite")
+        if not os.path.exists(run):
+            raise guard.ScriptError(f"{run}: missing; expected {EXPECTED_SWEEP}")
+        guard.check_run_file(run, ("census", "trajectory_data", "person_load"))
+        db = guard.open_readonly(run)
+        try:
+            row = db.execute("select value from run where key = 'venue'").fetchone()
+        finally:
+            db.close()
+        try:
+            own = json.loads(row[0]) if row else None
+        except ValueError:
+            own = None
+        name = (own or {}).get("metadata", {}).get("name", "unnamed") if isinstance(own, dict) else "unknown"
+        own_areas = {a.get("id"): a.get("polygon") for a in own.get("measurement_areas", [])} if isinstance(own, dict) else {}
+        if any(a not in own_areas for a in AREAS):
+            raise guard.ScriptError(f"{sweep}: run {r['run_id']} is not of the Itaewon alley (its venue "
+                                    f"{name[:60]!r} has no measurement areas {', '.join(AREAS)}); "
+                                    f"expected {EXPECTED_SWEEP}")
+
+
+CSV_HEAD = "alley_up,alley_down,"
+MD_HEAD = "| design | station inflow held to (persons/s) |"
+
+
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("sweep")
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("sweep", type=guard.sweep_dir)
     p.add_argument("-o", "--out", required=True)
-    p.add_argument("--venue", default=os.path.join(ROOT, "venues", "itaewon", "alley.json"))
+    p.add_argument("--venue", default=os.path.join(ROOT, "venues", "itaewon", "alley.json"), type=guard.existing_file)
+    guard.add_force(p)
     args = p.parse_args()
+    guard.check_sweep_dir(args.sweep, sqlite=True, csv_table=True)
+    guard.require_csv_columns(os.path.join(args.sweep, "results.csv"), COLUMNS, EXPECTED_SWEEP)
+    venue = check_venue(args.venue)
+    rows = list(csv.DictReader(open(os.path.join(args.sweep, "results.csv"))))
+    check_sweep(args.sweep, rows)
+    files = {"envelope.md": guard.starts_with(MD_HEAD), "envelope.csv": guard.starts_with(CSV_HEAD),
+             "envelope.svg": guard.is_svg, "envelope.png": guard.is_png}
+    guard.check_outputs(
+        [guard.Output("-o", args.out, "a folder of itaewon-envelope.py", folder=True, is_previous=guard.folder_with(files))]
+        + [guard.Output("", os.path.join(args.out, name), f"an {name} of itaewon-envelope.py", check)
+           for name, check in files.items()],
+        guard.sweep_inputs(args.sweep) + [("the sweep", args.sweep), ("--venue", args.venue)], args.force)
     venue = json.load(open(args.venue))
     areas = {a["id"]: (a["polygon"], area(a["polygon"])) for a in venue["measurement_areas"]}
-    rows = list(csv.DictReader(open(os.path.join(args.sweep, "results.csv"))))
     cap = "timeline.inflows.0.max_rate_per_s"
     table = []
     for r in rows:
@@ -125,7 +199,7 @@ def main():
               f"{m['most_above_400n_at_once']} above 400 N at once", file=sys.stderr)
     os.makedirs(args.out, exist_ok=True)
     keys = list(table[0].keys())
-    with open(os.path.join(args.out, "envelope.csv"), "w", newline="") as f:
+    with guard.whole_file(os.path.join(args.out, "envelope.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         w.writerows(table)
@@ -158,7 +232,7 @@ def main():
     lines += ["", "Each cell: the median over the seeds, then every seed's value in brackets.",
               f"Wall time of the sweep's runs: {sum(t['wall_s'] for t in table):.0f} s of run time "
               f"({len(table)} runs, {statistics.mean(t['wall_s'] for t in table):.0f} s each on average)."]
-    open(os.path.join(args.out, "envelope.md"), "w").write("\n".join(lines) + "\n")
+    guard.write_whole(os.path.join(args.out, "envelope.md"), "\n".join(lines) + "\n")
     print("\n".join(lines))
     name = sqlite3.connect(f"file:{os.path.join(args.sweep, 'results.sqlite')}?mode=ro", uri=True).execute(
         "select value from sweep where key = 'name'").fetchone()[0]
@@ -221,8 +295,8 @@ def draw(table, designs, file, name):
             out.append(f'<text x="{cx}" y="{top + ph + 34}" font-size="8.5" text-anchor="middle" fill="#555">'
                        f'{v}</text>')
     out.append("</svg>")
-    open(file, "w").write("\n".join(out) + "\n")
+    guard.write_whole(file, "\n".join(out) + "\n")
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

@@ -11,15 +11,22 @@ median bodies, 0.0868 m², the runs' validity statements' measure).
     studies/itaewon-evening-ensemble/itaewon-densities.py RUN.sqlite... -o DENSITIES.md [--csv DENSITIES.csv]
 
 A run that ended before a time (or, still running, has not reached it) gives no
-figure for it (said in the table).
+figure for it (said in the table). The outputs are checked before any work and
+written whole (scripts/script_guard.py): never a run file given, never a file
+that is not a previous table of this script unless --force; --scale is a
+positive number.
 """
-import argparse
 import csv
 import json
 import math
+import os
 import sqlite3
 import statistics
 import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
 
 # The National Forensic Service's densities in the alley (CCTV and simulation
 # analysis in the police special investigation, as reported; docs/itaewon.md).
@@ -81,17 +88,56 @@ def read_run(path, scale):
     return run.get("seed", "?"), rows, [name for name, _ in areas]
 
 
+MD_HEAD = "| run (seed) | time | recorded /m² (NFS) |"
+CSV_HEAD = ("run", "seed", "clock", "area", "area_m2")
+
+
+def venue_areas(path):
+    """The areas read_run measures in a run file (ScriptError if the run is not of a venue with any)."""
+    guard.check_run_file(path, ("shape", "person", "frame_time", "trajectory_data"))
+    db = guard.open_readonly(path)
+    try:
+        row = db.execute("select value from run where key = 'venue'").fetchone()
+    finally:
+        db.close()
+    expected = "a run of the Itaewon alley (venues/itaewon/alley.json: measurement areas and the slope's region)"
+    if row is None:
+        raise guard.ScriptError(f"{path}: its run table holds no venue; expected {expected}")
+    try:
+        venue = json.loads(row[0])
+    except ValueError:
+        raise guard.ScriptError(f"{path}: its venue is not JSON; expected {expected}") from None
+    names = [a.get("id") for a in venue.get("measurement_areas", [])] if isinstance(venue, dict) else []
+    if isinstance(venue, dict) and venue.get("slope", {}).get("region"):
+        names.append("whole alley")
+    if not names:
+        raise guard.ScriptError(f"{path}: its venue has no measurement areas and no slope region; expected {expected}")
+    return names
+
+
 def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("runs", nargs="+")
+    p = guard.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("runs", nargs="+", type=guard.run_file, help="run files of the evening")
     p.add_argument("-o", "--output", required=True, help="Markdown table")
     p.add_argument("--csv", help="one row per run, time and area")
-    p.add_argument("--scale", type=float, default=1.0,
-                   help="run time per evening time (the shortened evening's clock: 0.1)")
+    p.add_argument("--scale", type=guard.float_between(0.0, low_open=True, what="run time per evening time, "
+                                                                              "such as 0.1 for the shortened evening"),
+                   default=1.0, help="run time per evening time (the shortened evening's clock: 0.1)")
+    guard.add_force(p)
     args = p.parse_args()
-    for out in [args.output, args.csv]:
-        if out and any(out == r for r in args.runs):
-            sys.exit(f"itaewon-densities: {out} is an input; refusing to overwrite it")
+    guard.refuse_repeated(args.runs, "run file")
+    first = None
+    for path in args.runs:
+        names = venue_areas(path)
+        if first is None:
+            first = (path, names)
+        elif names != first[1]:
+            raise guard.ScriptError(f"{path}: its venue's areas ({', '.join(names)}) are not those of {first[0]} "
+                                    f"({', '.join(first[1])}); expected runs of one venue")
+    guard.check_outputs([
+        guard.Output("-o", args.output, "a Markdown table of itaewon-densities.py", guard.starts_with(MD_HEAD)),
+        guard.Output("--csv", args.csv, "a CSV table of itaewon-densities.py", guard.csv_starting(*CSV_HEAD)),
+    ], [("a run file", r) for r in args.runs], args.force)
     table = []
     names = None
     for path in args.runs:
@@ -119,10 +165,9 @@ def main():
             f"the same floor covered by real-size people ({REFERENCE_BODY_M2} m² each). 'whole alley' is the slope's region "
             "(the alley from the sidewalk to the food street). Recorded: the National Forensic Service's densities in the "
             "alley (docs/itaewon.md).\n")
-    with open(args.output, "w") as f:
-        f.write("\n".join(lines) + "\n" + note)
+    guard.write_whole(args.output, "\n".join(lines) + "\n" + note)
     if args.csv:
-        with open(args.csv, "w", newline="") as f:
+        with guard.whole_file(args.csv, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["run", "seed", "clock", "area", "area_m2", "model_per_m2", "real_size_per_m2", "recorded_low_per_m2",
                         "recorded_high_per_m2", "frames"])
@@ -130,4 +175,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

@@ -26,6 +26,13 @@ run, from the run file:
 
 Writes OUT_DIR/recorded-falls.md (the table and the check) and
 recorded-falls.csv (one row per run). Plain Python and sqlite3.
+
+Before any work (scripts/script_guard.py): SWEEP_DIR (and --baseline) must be
+sweep folders (results.csv) whose runs are complete and kept, and every run's
+scenario must hold a timeline fall event (a sweep without one is refused, not
+read); OUT_DIR must be new, empty or a previous table's folder (else --force,
+which writes into it and deletes nothing), never a sweep's folder; the files
+are written whole. A bad argument is one line, exit status 2.
 """
 import argparse
 import csv
@@ -36,6 +43,10 @@ import os
 import sqlite3
 import statistics
 import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
 
 LOAD_N = 400.0
 NEAR_M = 3.0  # "at the fall's place": within this of its point
@@ -150,13 +161,65 @@ def run_metrics(path):
     }
 
 
+EXPECTED_SWEEP = ("a finished sweep of studies/itaewon-recorded-falls/recorded-falls*.json (results.csv and its kept "
+                  "runs)")
+RUN_TABLES = ("frame_time", "event", "trajectory_data", "person_load", "person", "contact")
+
+
+def check_runs(sweep, rows, fall):
+    """Every complete run kept, a run file with the tables read; with `fall`, its scenario has a fall event."""
+    for r in rows:
+        if r["status"] != "complete":
+            if fall:
+                raise guard.ScriptError(f"{sweep}: run {r['run_id']} did not complete ({r['status']}); expected "
+                                        f"{EXPECTED_SWEEP}")
+            continue
+        run = os.path.join(sweep, "runs", r["run_id"] + ".sqlite")
+        if not os.path.exists(run):
+            raise guard.ScriptError(f"{run}: missing; expected {EXPECTED_SWEEP}")
+        guard.check_run_file(run, RUN_TABLES)
+        if not fall:
+            continue
+        db = open_run(run)
+        try:
+            row = db.execute("select value from run where key = 'scenario'").fetchone()
+        finally:
+            db.close()
+        try:
+            scenario = json.loads(row[0]) if row else None
+            fall_point(scenario)
+        except (ValueError, TypeError, KeyError, AttributeError, StopIteration):
+            raise guard.ScriptError(f"{sweep}: run {r['run_id']}'s scenario has no timeline fall event; expected "
+                                    f"{EXPECTED_SWEEP}") from None
+
+
+CSV_HEAD = "run_id,variant,asked,seed,"
+MD_HEAD = "# Itaewon: the falls the accounts record"
+
+
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("sweep")
+    p = guard.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("sweep", type=guard.sweep_dir_csv)
     p.add_argument("-o", "--out", required=True)
-    p.add_argument("--baseline", help="a sweep of the same scenario without the recorded fall (same seeds, same build)")
+    p.add_argument("--baseline", type=guard.sweep_dir_csv,
+                   help="a sweep of the same scenario without the recorded fall (same seeds, same build)")
+    guard.add_force(p)
     args = p.parse_args()
     rows = list(csv.DictReader(open(os.path.join(args.sweep, "results.csv"))))
+    if not rows:
+        raise guard.ScriptError(f"{args.sweep}: its results.csv holds no runs; expected {EXPECTED_SWEEP}")
+    check_runs(args.sweep, rows, True)
+    if args.baseline:
+        check_runs(args.baseline, list(csv.DictReader(open(os.path.join(args.baseline, "results.csv")))), False)
+    files = {"recorded-falls.md": guard.starts_with(MD_HEAD), "recorded-falls.csv": guard.starts_with(CSV_HEAD)}
+    inputs = guard.sweep_inputs(args.sweep) + [("the sweep", args.sweep)]
+    if args.baseline:
+        inputs += guard.sweep_inputs(args.baseline) + [("the baseline sweep", args.baseline)]
+    guard.check_outputs(
+        [guard.Output("-o", args.out, "a folder of itaewon-recorded-falls.py", folder=True,
+                      is_previous=guard.folder_with(files))]
+        + [guard.Output("", os.path.join(args.out, name), f"a {name} of itaewon-recorded-falls.py", check)
+           for name, check in files.items()], inputs, args.force)
     base = {}
     if args.baseline:
         for r in csv.DictReader(open(os.path.join(args.baseline, "results.csv"))):
@@ -185,7 +248,7 @@ def main():
             "later_counter_flow", "fallen_max_load_n", "fallen_median_max_load_n",
             "fallen_longest_above_400n_s", "fallen_most_pressed_n", "near_at_fall", "near_peak_after", "near_above_400n_peak",
             "above_400n_most_after", "baseline_above_400n_most_after", "baseline_same_before_fall", "wall_s"]
-    with open(os.path.join(args.out, "recorded-falls.csv"), "w", newline="") as f:
+    with guard.whole_file(os.path.join(args.out, "recorded-falls.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
         w.writerows(table)
@@ -223,8 +286,8 @@ def main():
     if any(m["before_fall_falls"] for m in table):
         lines += ["", "Falls before the recorded one (the model's own): " +
                   ", ".join(f"{m['run_id']} {m['before_fall_falls']}" for m in table if m["before_fall_falls"])]
-    open(os.path.join(args.out, "recorded-falls.md"), "w").write("\n".join(lines) + "\n")
+    guard.write_whole(os.path.join(args.out, "recorded-falls.md"), "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

@@ -36,6 +36,12 @@ Usage:
 
 Writes OUT/cheap-model.md (the tables), OUT/cheap-runs.csv (each cheap run's
 first jam and exposure), OUT/cheap-model.svg and .png (with chromium).
+
+Before any work (scripts/script_guard.py): the CSVs must be night-path.py's
+paths, each --sweep a sweep folder (results.csv), the scales and times
+positive; OUT must be new, empty or a previous cheap model's folder (else
+--force, which writes into it and deletes nothing), never an input; every file
+is written whole. A bad argument is one line, exit status 2.
 """
 import argparse
 import collections
@@ -50,6 +56,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))  # studies/NAME/ is two levels down
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from svg_png import svg_to_png  # noqa: E402
+import script_guard as guard  # noqa: E402
 
 spec = importlib.util.spec_from_file_location("night_path", os.path.join(HERE, "night-path.py"))
 night_path = importlib.util.module_from_spec(spec)
@@ -484,26 +491,76 @@ def read_nights(paths):
     return {run: first_jam([(t, v) for t, v, _, _ in rows], NIGHT_AFTER_S) for run, rows in paths.items()}
 
 
+PATHS_COLUMNS = ("run", "time_s", "mean_speed_m_per_s", "density_per_m2", "counter_flow_share")
+PATHS_EXPECTED = "night-path.py's CSV of whole nights (studies/night-cheap-model/night-path.py -o paths.csv)"
+OUTPUTS = {"cheap-model.md": "# The Madrid night's cheap forward model", "cheap-runs.csv": "run,variant,seed,",
+           "cheap-model.svg": None, "cheap-model.png": None}
+
+
+def check_sweep_runs(folder):
+    """The runs read_sweep reads are run files of the open hallway fed at two constant rates (night-path-point.json)."""
+    expected = "a sweep of studies/night-cheap-model/night-path-points*.json (two inflows at constant rates, keep_runs)"
+    for row in csv.DictReader(open(os.path.join(folder, "results.csv"))):
+        run_file = os.path.join(folder, "runs", row["run_id"] + ".sqlite")
+        if row["status"] != "complete" or not os.path.exists(run_file):
+            continue
+        guard.check_run_file(run_file, night_path.TABLES)
+        scenario = night_path.read_scenario(run_file)
+        try:
+            inflows = scenario["timeline"]["inflows"]
+            float(inflows[0]["rate_per_s"]), float(inflows[1]["rate_per_s"])
+            if not isinstance(scenario["model"], dict):
+                raise TypeError
+        except (KeyError, IndexError, TypeError, ValueError):
+            raise guard.ScriptError(f"{folder}: run {row['run_id']}'s scenario lacks two inflows with rate_per_s or "
+                                    f"a model; expected {expected}") from None
+
+
+def check_arguments(args):
+    """Inputs readable and of their kind, outputs never an input nor foreign (scripts/script_guard.py)."""
+    csvs = [("--paths", args.paths)] + ([("--confirm", args.confirm)] if args.confirm else []) + \
+        [("--fitted", f) for f in args.fitted]
+    for option, path in csvs:
+        try:
+            guard.require_csv_columns(path, PATHS_COLUMNS, PATHS_EXPECTED)
+        except guard.ScriptError as e:
+            raise guard.ScriptError(f"{option} {e}") from None
+    inputs = [(f"the {option} CSV", path) for option, path in csvs]
+    for folder in args.sweep:
+        guard.check_sweep_dir(folder, sqlite=False, csv_table=True)
+        check_sweep_runs(folder)
+        inputs += guard.sweep_inputs(folder) + [("a --sweep folder", folder)]
+    checks = {name: guard.starts_with(head) if head else (guard.is_svg if name.endswith(".svg") else guard.is_png)
+              for name, head in OUTPUTS.items()}
+    guard.check_outputs(
+        [guard.Output("-o", args.out, "a folder of night-cheap-model.py", folder=True, is_previous=guard.folder_with(checks))]
+        + [guard.Output("", os.path.join(args.out, name), f"a {name} of night-cheap-model.py", check)
+           for name, check in checks.items()], inputs, args.force)
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = guard.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--paths", required=True, help="night-path.py's CSV of the whole nights")
     ap.add_argument("--sweep", action="append", required=True, help="a night-path-points sweep's output folder (keep_runs)")
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--confirm", help="night-path.py's CSV of whole nights run at another inflow scale (the confirmation)")
-    ap.add_argument("--confirm-scale", type=float, default=0.85, help="the inflow scale of those nights (and of the prediction)")
-    ap.add_argument("--confirm-end-s", type=float, default=5700.0, help="how far those nights were run (a night not jammed by then is censored)")
+    ap.add_argument("--confirm-scale", type=guard.positive_float, default=0.85, help="the inflow scale of those nights (and of the prediction)")
+    ap.add_argument("--confirm-end-s", type=guard.positive_float, default=5700.0, help="how far those nights were run (a night not jammed by then is censored)")
     ap.add_argument("--fitted", action="append", default=[], help="night-path.py's CSV of whole nights run at the fitted scale "
                     "(the check of the corrected model's prediction; repeatable; each night censored at its last sample)")
-    ap.add_argument("--fitted-scale", type=float, default=1.12, help="the inflow scale of those nights")
+    ap.add_argument("--fitted-scale", type=guard.positive_float, default=1.12, help="the inflow scale of those nights")
+    guard.add_force(ap)
     args = ap.parse_args()
+    check_arguments(args)
     os.makedirs(args.out, exist_ok=True)
 
     paths = read_paths(args.paths)
     nights = read_nights(paths)
     runs = [r for folder in args.sweep for r in read_sweep(folder)]
     if not runs:
-        sys.exit("night-cheap-model.py: no complete cheap runs in the sweeps given")
-    with open(os.path.join(args.out, "cheap-runs.csv"), "w", newline="") as f:
+        raise guard.ScriptError(f"--sweep {', '.join(args.sweep)}: no complete cheap runs with their run files; "
+                                "expected night-path-points sweeps run with keep_runs")
+    with guard.whole_file(os.path.join(args.out, "cheap-runs.csv"), "w", newline="") as f:
         keys = [k for k in runs[0] if k != "x"]
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
@@ -728,8 +785,7 @@ def main():
         lines += corrected_section(fit_adaptive[0], use_rates, whole, args.confirm_scale, fitted_nights,
                                    "the cheap model in the nights' step (adaptive runs only)")
 
-    with open(os.path.join(args.out, "cheap-model.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    guard.write_whole(os.path.join(args.out, "cheap-model.md"), "\n".join(lines) + "\n")
     delta, _ = night_offset(b_paper, use_rates, whole)
     draw(os.path.join(args.out, "cheap-model.svg"), cells, b_paper, use_rates, curve, nights, band, paths,
          survival_curve(fit_adaptive[0], use_rates) if fit_adaptive else None,
@@ -851,9 +907,8 @@ def draw(file, cells, beta, use, curve, nights, median_band, paths, curve_adapti
             out.append(f'<polyline fill="none" stroke="{colours[k % len(colours)]}" stroke-width="1.2" points="{pts}"/>')
     out.append(f'<text x="{x0}" y="{y2 + ph2 + 40}" fill="#444">one line per whole night (seeds 1-8, paper\'s model); grey dashes: the recorded avalanches and the fatal clog</text>')
     out.append("</svg>")
-    with open(file, "w") as f:
-        f.write("\n".join(out) + "\n")
+    guard.write_whole(file, "\n".join(out) + "\n")
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

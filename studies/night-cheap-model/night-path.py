@@ -17,6 +17,11 @@ Usage: night-path.py RUN.sqlite [RUN.sqlite ...] -o paths.csv [--every-s 10]
 
 Only the frames sampled are read (the run files' (frame, id) indexes), so a
 2-3 GB night takes well under a minute.
+
+Before any work (scripts/script_guard.py): each RUN must be a run file with
+the tables read, --every-s a positive number, and -o never a run (also by
+another name or link), an existing file that is not a previous paths CSV only
+with --force; the CSV is written whole. A bad argument is one line, exit 2.
 """
 import argparse
 import csv
@@ -25,6 +30,10 @@ import math
 import os
 import sqlite3
 import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
 
 HALLWAY = (0.0, 12.0, 0.0, 3.0)
 AREA_M2 = (HALLWAY[1] - HALLWAY[0]) * (HALLWAY[3] - HALLWAY[2])
@@ -36,7 +45,7 @@ def read_scenario(path):
     row = db.execute("SELECT value FROM run WHERE key = 'scenario'").fetchone()
     db.close()
     if row is None:
-        sys.exit(f"night-path.py: {path}: the run file has no scenario")
+        raise guard.ScriptError(f"{path}: the run file has no scenario; expected a run file of crowdrecon simulate")
     return json.loads(row[0])
 
 
@@ -45,7 +54,7 @@ def read_run(path, every_s):
     group = dict(db.execute("SELECT id, grp FROM person"))
     frames = db.execute("SELECT frame, time_s FROM frame_time ORDER BY frame").fetchall()
     if not frames:
-        sys.exit(f"night-path.py: {path}: the run has no frames")
+        raise guard.ScriptError(f"{path}: the run has no frames; expected a run that has begun")
     rows = []
     next_t = 0.0
     for frame, t in frames:
@@ -76,16 +85,23 @@ def read_run(path, every_s):
     return rows
 
 
+TABLES = ("person", "frame_time", "trajectory_data", "person_state")
+CSV_HEAD = "run,time_s,inside,"
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = guard.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+")
     ap.add_argument("-o", "--output", required=True)
-    ap.add_argument("--every-s", type=float, default=10.0)
+    ap.add_argument("--every-s", type=guard.positive_float, default=10.0)
+    guard.add_force(ap)
     args = ap.parse_args()
-    if os.path.abspath(args.output) in {os.path.abspath(r) for r in args.runs}:
-        sys.exit("night-path.py: the output would overwrite an input")
-    tmp = args.output + ".part"
-    with open(tmp, "w", newline="") as f:
+    guard.refuse_repeated(args.runs, "run file")
+    for run in args.runs:
+        guard.check_run_file(run, TABLES)
+    guard.check_outputs([guard.Output("-o", args.output, "a paths CSV of night-path.py", guard.starts_with(CSV_HEAD))],
+                        [("a run file", r) for r in args.runs], args.force)
+    with guard.whole_file(args.output, "w", newline="") as f:
         w = None
         for run in args.runs:
             name = os.path.splitext(os.path.basename(run))[0]
@@ -97,8 +113,7 @@ def main():
                     w = csv.DictWriter(f, fieldnames=list(r))
                     w.writeheader()
                 w.writerow(r)
-    os.replace(tmp, args.output)
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

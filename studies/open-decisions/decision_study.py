@@ -5,9 +5,17 @@ of the sweep studies/open-decisions/hallway-decisions.json, and the check
 of the early-stop criteria (`crowdrecon analyze RUN --settle-check`) on every
 kept run (simulated to its full length).
 
-usage: decision_study.py CROWDRECON SWEEP_DIR OUT_DIR
+usage: decision_study.py CROWDRECON SWEEP_DIR OUT_DIR [--force]
   SWEEP_DIR  the sweep's output folder (results.csv, runs/ kept)
-  OUT_DIR    where study.md and settle_check.csv are written
+  OUT_DIR    where study.md and settle_check.csv are written (settle_check.csv
+             is read again: the runs it holds are not checked again)
+
+Before any work (scripts/script_guard.py): CROWDRECON must be a program,
+SWEEP_DIR a sweep folder whose results.csv has the columns read and whose
+complete runs are kept; OUT_DIR must be new, empty or a folder holding a
+previous study.md or settle_check.csv (else --force, which writes into it and
+deletes nothing), and its two files new or previous outputs, never the
+sweep's own files; both are written whole. A bad argument is one line, exit 2.
 
 Regenerate:
   crowdrecon sweep studies/open-decisions/hallway-decisions.json -o /tmp/dec --jobs 2
@@ -21,6 +29,10 @@ import subprocess
 import sys
 from collections import OrderedDict
 
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
+
 REGIME = {0: "lanes", 1: "avalanches", 2: "clogging", 3: "unclassified"}
 SHORT = {"lanes": "L", "avalanches": "A", "clogging": "C", "unclassified": "U"}
 
@@ -31,7 +43,12 @@ def number(row, key):
 
 
 def settle_check(exe, run_file):
-    out = subprocess.run([exe, "analyze", run_file, "--settle-check"], capture_output=True, text=True, check=True).stdout
+    proc = subprocess.run([exe, "analyze", run_file, "--settle-check"], capture_output=True, text=True)
+    if proc.returncode != 0:
+        said = (proc.stderr.strip() or proc.stdout.strip() or "nothing").splitlines()[-1]
+        raise guard.ScriptError(f"{run_file}: `{exe} analyze --settle-check` exited {proc.returncode} ({said}); "
+                                "expected a run file crowdrecon can analyse")
+    out = proc.stdout
     lines = [l for l in out.splitlines() if l.startswith("settle check:")]
     if any("does not settle" in l for l in lines):
         return {"settles": "no", "stop_s": "", "kind": "", "verdict_at_stop": "", "same": ""}
@@ -42,11 +59,42 @@ def settle_check(exe, run_file):
             "verdict_at_stop": m2.group(1), "same": m2.group(3)}
 
 
+COLUMNS = ("run_id", "variant", "seed", "status", "regime", "population.density_per_m2",
+           "population.counter_flow_fraction", "wall_s")
+CHECKS_HEAD = "run_id,settles,stop_s,kind,verdict_at_stop,same"
+STUDY_HEAD = "# Issue 19: the model's open decisions"
+
+
 def main():
-    exe, sweep_dir, out_dir = sys.argv[1:4]
+    p = guard.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    p.add_argument("crowdrecon", type=guard.executable)
+    p.add_argument("sweep_dir", type=guard.sweep_dir_csv)
+    p.add_argument("out_dir")
+    guard.add_force(p)
+    args = p.parse_args()
+    exe, sweep_dir, out_dir = args.crowdrecon, args.sweep_dir, args.out_dir
+    expected = "the sweep of studies/open-decisions/hallway-decisions.json (results.csv and its kept runs)"
+    guard.require_csv_columns(os.path.join(sweep_dir, "results.csv"), COLUMNS, expected)
     rows = list(csv.DictReader(open(os.path.join(sweep_dir, "results.csv"))))
-    os.makedirs(out_dir, exist_ok=True)
+    if not rows:
+        raise guard.ScriptError(f"{sweep_dir}: its results.csv holds no runs; expected {expected}")
+    files = {"study.md": guard.starts_with(STUDY_HEAD), "settle_check.csv": guard.starts_with(CHECKS_HEAD)}
+    guard.check_outputs(
+        [guard.Output("OUT_DIR", out_dir, "a folder of decision_study.py", folder=True, is_previous=guard.folder_with(files))]
+        + [guard.Output("", os.path.join(out_dir, name), f"a {name} of decision_study.py", check)
+           for name, check in files.items()],
+        guard.sweep_inputs(sweep_dir) + [("the crowdrecon executable", exe)], args.force)
     checks_file = os.path.join(out_dir, "settle_check.csv")
+    if os.path.exists(checks_file) and os.path.getsize(checks_file) > 0:
+        guard.require_csv_columns(checks_file, CHECKS_HEAD.split(","), "a settle_check.csv of decision_study.py")
+    done = set()
+    if os.path.exists(checks_file):
+        done = {c["run_id"] for c in csv.DictReader(open(checks_file))}
+    for r in rows:
+        run_file = os.path.join(sweep_dir, "runs", r["run_id"] + ".sqlite")
+        if r["status"] == "complete" and r["run_id"] not in done and not os.path.exists(run_file):
+            raise guard.ScriptError(f"{run_file}: missing; expected {expected}")
+    os.makedirs(out_dir, exist_ok=True)
     checks = {}
     if os.path.exists(checks_file):
         for c in csv.DictReader(open(checks_file)):
@@ -54,7 +102,7 @@ def main():
     fields = ["run_id", "settles", "stop_s", "kind", "verdict_at_stop", "same"]
 
     def save():
-        with open(checks_file, "w", newline="") as f:
+        with guard.whole_file(checks_file, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=fields)
             w.writeheader()
             for r in rows:
@@ -137,9 +185,9 @@ def main():
     walls = [number(r, "wall_s") for r in rows if r["status"] == "complete"]
     md.append(f"Wall time of the sweep's runs: {sum(walls) / 60:.1f} min of run time in all "
               f"(one thread per run, two runs at a time).")
-    open(os.path.join(out_dir, "study.md"), "w").write("\n".join(md + detail) + "\n")
+    guard.write_whole(os.path.join(out_dir, "study.md"), "\n".join(md + detail) + "\n")
     print("\n".join(md))
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

@@ -14,24 +14,34 @@ matrix (how many independent statistics they amount to).
 
   block-scatter.py 'blockA/*.observation.csv' 'blockB/*.observation.csv' ...
 
-Needs numpy (python3-numpy).
+Needs numpy (python3-numpy): said in one line where it is missing. Bad
+arguments (fewer than two globs, a glob of fewer than three files, a file that
+is not an observation CSV) are one line, exit status 2 (scripts/script_guard.py).
 """
 import glob, importlib.util, math, os, sys
-
-import numpy as np
 
 here = os.path.dirname(os.path.abspath(__file__))
 spec = importlib.util.spec_from_file_location("truth_spread", os.path.join(here, "truth-spread.py"))
 ts = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(ts)
+guard = ts.guard  # scripts/script_guard.py, put on the path by truth-spread.py
 
 
 def main():
-    groups = [sorted(glob.glob(pattern)) for pattern in sys.argv[1:]]
-    if len(groups) < 2 or any(len(g) < 3 for g in groups):
-        sys.exit("block-scatter.py: give at least two globs of at least three observation CSVs each")
-    keys = list(ts.statistics(groups[0][0]).keys())
-    blocks = [np.array([[s[k] for k in keys] for s in map(ts.statistics, g)]) for g in groups]
+    p = guard.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("globs", nargs="+", help="globs of observation CSVs (quoted), one block of seeds each")
+    args = p.parse_args()
+    if len(args.globs) < 2:
+        raise guard.ScriptError(f"{len(args.globs)} glob; expected at least two globs of at least three "
+                                "observation CSVs each")
+    groups = [ts.files_of(pattern, 3) for pattern in args.globs]
+    stats = [[ts.statistics(f) for f in g] for g in groups]
+    try:
+        import numpy as np
+    except ImportError:
+        raise guard.ScriptError("numpy is not installed; expected python3-numpy (apt) or numpy (pip)") from None
+    keys = list(stats[0][0].keys())
+    blocks = [np.array([[s[k] for k in keys] for s in g]) for g in stats]
     b = len(blocks)
     means = np.array([np.nanmean(x, axis=0) for x in blocks])
     counts = np.array([np.sum(~np.isnan(x), axis=0) for x in blocks])
@@ -63,4 +73,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

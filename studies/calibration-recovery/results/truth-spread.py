@@ -12,8 +12,19 @@ error (z), then the mean, rms and largest |z| over the statistics.
   for r in other/runs/*.sqlite; do crowdrecon observe trajectories "$r" \\
       --spec venues/madrid-arena/observations/hallway.json -o "other/${r##*/}.observation.json" -q; done
   truth-spread.py 'other/*.observation.csv' 'OUT-truth/observations/*.csv'
+
+Two globs, each of two or more observation CSVs (columns quantity, where,
+direction, value, time_s); anything else is one line, exit status 2
+(scripts/script_guard.py).
 """
-import csv, glob, math, statistics as S, sys
+import csv, glob, math, os, statistics as S, sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # studies/NAME/results/
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
+
+COLUMNS = ("quantity", "where", "direction", "value", "time_s")
+EXPECTED = "an observation CSV of `crowdrecon observe` (columns quantity, where, direction, value, time_s)"
 
 SERIES = [("speed", "hallway", "forward"), ("speed", "hallway", "backward"),
           ("share_moving", "hallway", "forward"), ("share_moving", "hallway", "backward"),
@@ -21,7 +32,15 @@ SERIES = [("speed", "hallway", "forward"), ("speed", "hallway", "backward"),
 
 
 def statistics(path):
+    guard.require_csv_columns(path, COLUMNS, EXPECTED)
     rows = list(csv.DictReader(open(path)))
+    try:
+        for r in rows:
+            if r["value"]:
+                float(r["value"])
+            float(r["time_s"])
+    except (TypeError, ValueError):
+        raise guard.ScriptError(f"{path}: a row whose value or time_s is not a number; expected {EXPECTED}") from None
     out = {}
     for q, w, d in SERIES:
         for a in (5, 10, 15):
@@ -31,8 +50,22 @@ def statistics(path):
     return out
 
 
+def files_of(pattern, least):
+    """The files a glob matches (sorted); ScriptError if fewer than `least`."""
+    files = sorted(glob.glob(pattern))
+    if len(files) < least:
+        raise guard.ScriptError(f"{pattern!r}: matches {len(files)} file{'s' if len(files) != 1 else ''}; expected a "
+                                f"glob of at least {least} observation CSVs (quoted, so that the script expands it)")
+    return files
+
+
 def main():
-    sets = [[statistics(f) for f in sorted(glob.glob(pattern))] for pattern in sys.argv[1:3]]
+    p = guard.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("a", help="a glob of observation CSVs (quoted)")
+    p.add_argument("b", help="another glob of observation CSVs (quoted)")
+    args = p.parse_args()
+    groups = [files_of(pattern, 2) for pattern in (args.a, args.b)]
+    sets = [[statistics(f) for f in files] for files in groups]
     zs = []
     for key in sets[0][0]:
         a, b = ([s[key] for s in group if not math.isnan(s[key])] for group in sets)
@@ -46,4 +79,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    guard.run_main(main)

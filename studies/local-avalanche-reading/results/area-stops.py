@@ -9,15 +9,39 @@ files' tables directly (standard library; the group's direction taken as
 within 1e-3).
 
     area-stops.py RUN.sqlite...
+
+Each argument must be a run file with the tables read (person, frame_time,
+trajectory_data, person_state); anything else is one line, exit status 2
+(scripts/script_guard.py).
 """
 import collections
+import os
 import sqlite3
 import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # studies/NAME/results/
+sys.path.insert(0, os.path.join(ROOT, 'scripts'))
+import script_guard as guard  # noqa: E402
 
 AREAS = {'court_end': (1.5, 4.5), 'centre': (5.0, 7.0), 'exit_end': (7.5, 10.5)}  # x ranges, y 0..3
 CONTACT, STOP = 3.6, 0.1
 
-for f in sys.argv[1:]:
+
+def arguments():
+    p = guard.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    p.add_argument('runs', nargs='+', metavar='RUN.sqlite', help='run files of the open hallway')
+    args = p.parse_args()
+    for f in args.runs:
+        guard.check_run_file(f, ('person', 'frame_time', 'trajectory_data', 'person_state'))
+    return args.runs
+
+
+def main():
+    for f in arguments():
+        report(f)
+
+
+def report(f):
     db = sqlite3.connect(f'file:{f}?mode=ro', uri=True)
     group = dict(db.execute('SELECT id, grp FROM person'))
     times = dict(db.execute('SELECT frame, time_s FROM frame_time'))
@@ -49,3 +73,7 @@ for f in sys.argv[1:]:
         parts.append(f'{a}: peak {peak:.1f} /m2, longest dense stop {longest:.1f} s'
                      + (f' from {longest_from:.0f} s' if longest_from is not None else ''))
     print(f, '|', '; '.join(parts))
+
+
+if __name__ == '__main__':
+    guard.run_main(main)

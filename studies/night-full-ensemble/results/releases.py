@@ -13,9 +13,20 @@ Reads the tables `event`, `person`, `census`, `person_state` (docs/scenarios.md,
 "The run file").
 
 usage: releases.py RUN.sqlite... > releases.md
+
+Each argument must be a run file with those tables (and frame_time,
+trajectory_data); anything else is one line, exit status 2
+(scripts/script_guard.py).
 """
+import os
 import sqlite3
 import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # studies/NAME/results/
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import script_guard as guard  # noqa: E402
+
+TABLES = ("event", "person", "census", "person_state", "frame_time", "trajectory_data")
 
 
 def clock(t):
@@ -70,7 +81,15 @@ def main(paths):
               f"| {face} |")
 
 
+def arguments():
+    p = guard.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    p.add_argument("runs", nargs="+", metavar="RUN.sqlite", help="run files of whole nights")
+    args = p.parse_args()
+    for path in args.runs:
+        guard.check_run_file(path, TABLES, "the run file of a whole night (a run with a timeline: its census "
+                                           "and events)")
+    return args.runs
+
+
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    main(sys.argv[1:])
+    guard.run_main(lambda: main(arguments()))

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# The Python scripts users run protect their inputs and outputs as crowdrecon
+# does and answer bad arguments in one line (issue 65, scripts/script_guard.py):
+# each hostile command below must exit with status 2, say what is wrong in one
+# line "SCRIPT: error: ..." (no traceback), and leave every file of the scratch
+# folder as it was (names and sha256 before and after). A few good commands
+# must still work, a rerun replacing their previous outputs.
+#   script_outputs.sh PYTHON ROOT
+# ROOT: the repository whose scripts/ and studies/ are run (and whose venues/
+# the stand-in inputs use). The inputs are made by make_script_inputs.py with
+# sqlite3 alone (no simulation).
+set -u
+py=$1; root=$(cd "$2" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+s=$work/scratch; log=$work/log.txt
+mkdir "$s" && cd "$s" || exit 1
+
+# --- the inputs
+make() { "$py" "$here/make_script_inputs.py" "$@" || { echo "script_outputs.sh: cannot make the inputs ($*)"; exit 1; }; }
+make run run.sqlite "$root/venues/itaewon/alley.json"
+make sweep hallway-sweep "$root/venues/madrid-arena/hallway-open.json" --runs 6
+ln -s run.sqlite link.sqlite
+ln run.sqlite hard.sqlite
+cp "$root/tests/data/scenarios/hallway-short.json" scenario.json
+mkdir anthro notes
+for f in ANSURIIMALEPublic.csv ANSURIIFEMALEPublic.csv; do
+  sex=$([[ $f == *FEMALE* ]] && echo Female || echo Male)
+  printf 'subjectid,Gender,chestbreadth,chestdepth,biacromialbreadth,bideltoidbreadth,weightkg,stature\n1,%s,300,250,400,450,700,1750\n' "$sex" > "anthro/$f"
+done
+echo "my own notes" > notes/notes.txt
+echo "my own notes" > notes.txt
+# A copy of the scripts without the data folder ../shared/data beside it.
+mkdir -p norepo/main && cp -r "$root/scripts" norepo/main/
+
+snapshot() {  # every entry (type, name, link target) and every file's sha256
+  (cd "$s" && find . -mindepth 1 -printf '%y %p %l\n' | LC_ALL=C sort &&
+     find . -type f -print0 | LC_ALL=C sort -z | xargs -0 -r sha256sum)
+}
+
+fails=0
+report() {  # report LABEL PROBLEMS...
+  local label=$1; shift
+  if (($#)); then
+    echo "FAIL $label: $*"; head -c 1500 "$log" | sed 's/^/    | /'; fails=$((fails + 1))
+  else
+    echo "ok   $label: $(head -1 "$log")"
+  fi
+}
+
+refused() {  # refused LABEL REGEX -- COMMAND...: status 2, one line matching REGEX, nothing changed
+  local label=$1 regex=$2; shift 3
+  local before after rc problems=()
+  before=$(snapshot)
+  "$@" > "$log" 2>&1; rc=$?
+  after=$(snapshot)
+  [[ $rc -eq 2 ]] || problems+=("exit status $rc, expected 2;")
+  grep -q "Traceback" "$log" && problems+=("a traceback;")
+  [[ $(wc -l < "$log") -eq 1 ]] && grep -Eq '^[A-Za-z_.-]+\.py: error: ' "$log" ||
+    problems+=("not one line \"SCRIPT: error: ...\";")
+  grep -Eq -- "$regex" "$log" || problems+=("no /$regex/ in the message;")
+  [[ "$before" == "$after" ]] || problems+=("files changed: $(diff <(echo "$before") <(echo "$after") | grep '^[<>]' | head -4 | tr '\n' ' ')")
+  report "$label" "${problems[@]}"
+}
+
+accepted() {  # accepted LABEL FILE -- COMMAND...: status 0 and FILE written
+  local label=$1 file=$2; shift 3
+  local rc problems=()
+  "$@" > "$log" 2>&1; rc=$?
+  [[ $rc -eq 0 ]] || problems+=("exit status $rc, expected 0;")
+  [[ -s $file ]] || problems+=("$file not written;")
+  report "$label" "${problems[@]}"
+}
+
+S=$root/scripts
+D=$root/studies
+dens=$D/itaewon-evening-ensemble/itaewon-densities.py
+
+# --- an input is never an output (by name, another spelling, a symbolic or a hard link; not even with --force)
+refused "itaewon-densities: -o the run" "is an input" -- "$py" "$dens" run.sqlite -o run.sqlite
+refused "itaewon-densities: --csv the run by another spelling" "is an input" -- "$py" "$dens" run.sqlite -o d.md --csv ./notes/../run.sqlite
+refused "itaewon-densities: -o a symbolic link to the run, --force" "is an input" -- "$py" "$dens" run.sqlite -o link.sqlite --force
+refused "itaewon-densities: --csv a hard link to the run" "is an input" -- "$py" "$dens" run.sqlite -o d.md --csv hard.sqlite
+refused "sweep-ensembles: -o DIR/results (the sweep's results.csv), --force" "is an input" -- \
+  "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o hallway-sweep/results --metrics mean_speed_m_per_s --force
+refused "scenario-with: OUT is SCENARIO" "is an input" -- "$py" "$S/scenario-with.py" scenario.json ./scenario.json population.seed=2
+refused "night-path: -o a hard link to the run" "is an input" -- "$py" "$D/night-cheap-model/night-path.py" run.sqlite -o hard.sqlite
+refused "reaction-time-from-data: -o the run through a link" "is an input" -- \
+  "$py" "$S/reaction-time-from-data.py" run.sqlite -o link.sqlite --bootstrap 5
+refused "decision_study: OUT_DIR the sweep's results.csv" "is an input" -- \
+  "$py" "$D/open-decisions/decision_study.py" /bin/true hallway-sweep hallway-sweep/results.csv
+
+# --- two outputs, one path; a folder never replaced by a file; a foreign file or folder only with --force
+refused "itaewon-densities: -o and --csv one file" "both name" -- "$py" "$dens" run.sqlite -o d.md --csv ./d.md
+refused "itaewon-densities: -o a folder" "a folder is never replaced by a file" -- "$py" "$dens" run.sqlite -o notes --force
+refused "itaewon-densities: -o someone's notes" "--force \(which replaces it\)" -- "$py" "$dens" run.sqlite -o notes.txt
+refused "make-ansur-extract: TARGET someone's notes" "--force" -- "$py" "$S/make-ansur-extract.py" anthro notes.txt
+refused "falls-study: OUT_DIR someone's folder" "deletes nothing" -- "$py" "$D/falls-verification/falls-study.py" /bin/false notes
+
+# --- bad arguments and inputs: one line, status 2
+refused "itaewon-densities: --scale 0" "argument --scale" -- "$py" "$dens" run.sqlite -o d.md --scale 0
+refused "itaewon-densities: a JSON file as the run" "not an SQLite file" -- "$py" "$dens" scenario.json -o d.md
+refused "calibration-coverage: --truths 0" "argument --truths" -- \
+  "$py" "$D/calibration-coverage/calibration-coverage.py" coverage --truths 0
+refused "itaewon-envelope: a hallway sweep" "not of the Itaewon alley" -- \
+  "$py" "$D/itaewon-design-envelope/itaewon-envelope.py" hallway-sweep -o envelope
+refused "bottleneck-study: no ../shared/data beside the repository" "\.\./shared/data" -- \
+  "$py" norepo/main/scripts/bottleneck-study.py /bin/true study
+refused "gait-jitter-from-data: no ../shared/data beside the repository" "\.\./shared/data" -- \
+  "$py" norepo/main/scripts/gait-jitter-from-data.py
+refused "gait-jitter-from-data: a JSON file as trajectories" "PeTrack" -- "$py" "$S/gait-jitter-from-data.py" scenario.json
+refused "sweep-ensembles: a variant the sweep lacks" "has no variant" -- \
+  "$py" "$S/sweep-ensembles.py" hallway-sweep two-way three-way -o cmp
+refused "phase-table: a folder that is not a sweep" "not a crowdrecon sweep folder" -- "$py" "$S/phase-table.py" notes
+refused "sweep-compare: DIR without :VARIANT" "DIR:VARIANT" -- "$py" "$S/sweep-compare.py" hallway-sweep hallway-sweep:two-way
+refused "scenario-with: a change that is not JSON" "is not JSON" -- \
+  "$py" "$S/scenario-with.py" scenario.json copy.json population.body.mode=paper
+refused "area-stops: no run file" "required" -- "$py" "$D/local-avalanche-reading/results/area-stops.py"
+refused "releases: a sweep's results as a run" "has no run, .*tables" -- \
+  "$py" "$D/night-full-ensemble/results/releases.py" hallway-sweep/results.sqlite
+
+# --- good input still works; a rerun replaces its previous outputs
+accepted "itaewon-densities: a table" d.md -- "$py" "$dens" run.sqlite -o d.md --csv d.csv
+accepted "itaewon-densities: run again (previous outputs replaced)" d.csv -- "$py" "$dens" run.sqlite -o d.md --csv d.csv
+accepted "sweep-ensembles: two variants" cmp.md -- \
+  "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
+accepted "sweep-ensembles: run again" cmp.csv -- \
+  "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
+leftovers=$(find "$s" -name '.*partial-*')
+[[ -z $leftovers ]] || { echo "FAIL partial files left: $leftovers"; fails=$((fails + 1)); }
+
+if ((fails)); then echo "script_outputs.sh: $fails check(s) failed"; exit 1; fi
+echo "script_outputs.sh: every hostile command refused in one line, nothing changed; good ones work"
