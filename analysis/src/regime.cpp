@@ -104,6 +104,7 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
   if (n == 0) return avalanches;
   const double stationary_start_s = StationaryStart(time_s.front(), time_s.back(), options) - kTimeTolerance_s;
   bool armed = false;
+  bool flowed = !options.require_flow_before_stop;  // the series has reached the burst speed
   std::size_t below_start = kNone;   // first sample of the current run below the stop speed
   std::size_t armed_stop_start = 0;  // first sample of the stop that armed the trigger
   std::size_t last_rise = 0;         // last sample that rose above the stop speed
@@ -113,7 +114,7 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
       if (below_start == kNone) below_start = i;
       // A run below the stop speed that includes the first sample is the
       // initial rest of a crowd placed standing, not a stop of a flow.
-      if (!armed && below_start != 0 &&
+      if (!armed && flowed && below_start != 0 &&
           time_s[i] - time_s[below_start] >= options.min_stop_duration_s - kTimeTolerance_s) {
         armed = true;
         armed_stop_start = below_start;
@@ -122,7 +123,10 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
     }
     if (below_start != kNone || i == 0) last_rise = i;
     below_start = kNone;
-    if (!armed || v < options.burst_speed_m_per_s) continue;
+    if (!armed || v < options.burst_speed_m_per_s) {
+      if (v >= options.burst_speed_m_per_s) flowed = true;
+      continue;
+    }
     // The burst: the avalanche began at the last rise and lasts until V falls
     // back below the stop speed.
     Avalanche a;
@@ -151,6 +155,32 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
     i = a.end_index - 1;
   }
   return avalanches;
+}
+
+std::vector<Avalanche> FindAvalanchesBetweenGaps(const std::vector<double>& time_s,
+                                                 const std::vector<double>& speed_m_per_s,
+                                                 const RegimeOptions& options) {
+  if (time_s.size() != speed_m_per_s.size())
+    throw InputError("FindAvalanchesBetweenGaps: the time and speed series differ in length");
+  std::vector<Avalanche> all;
+  const std::size_t n = speed_m_per_s.size();
+  std::size_t from = 0;
+  while (from < n) {
+    while (from < n && std::isnan(speed_m_per_s[from])) ++from;
+    std::size_t to = from;
+    while (to < n && !std::isnan(speed_m_per_s[to])) ++to;
+    if (to > from) {
+      const auto at = [&](const std::vector<double>& v, std::size_t k) { return v.begin() + static_cast<std::ptrdiff_t>(k); };
+      const std::vector<double> t(at(time_s, from), at(time_s, to)), v(at(speed_m_per_s, from), at(speed_m_per_s, to));
+      for (Avalanche a : FindAvalanches(t, v, options)) {
+        a.start_index += from;
+        a.end_index += from;
+        all.push_back(a);
+      }
+    }
+    from = to;
+  }
+  return all;
 }
 
 RegimeResult ClassifyRegime(const std::vector<double>& time_s, const std::vector<double>& mean_speed_m_per_s,
@@ -318,6 +348,12 @@ RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::v
     r.reason += "; every direction free (" + speeds + ")";
   }
   return r;
+}
+
+RegimeOptions IncidentAvalancheOptions() {
+  RegimeOptions options;
+  options.require_flow_before_stop = true;
+  return options;
 }
 
 RegimeOptions SingleReleaseReading(RegimeOptions options) {

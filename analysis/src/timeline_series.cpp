@@ -233,35 +233,22 @@ std::vector<TimelineMark> AreaAvalanches(const TimelineSeries& s, const RegimeOp
   for (std::size_t m = 0; m < s.area_speed_m_per_s.size(); ++m) {
     const std::vector<double>& v = s.area_speed_m_per_s[m];
     const std::vector<double>& rho = s.area_density_per_m2[m];
-    // Stretches in which someone walks there: an empty area has no flow to
-    // stop, and a gap ends a stop (FindAvalanches takes no NaN).
-    std::size_t from = 0;
-    while (from < v.size()) {
-      while (from < v.size() && std::isnan(v[from])) ++from;
-      std::size_t to = from;
-      while (to < v.size() && !std::isnan(v[to])) ++to;
-      if (to > from) {
-        const std::vector<double> t(s.time_s.begin() + static_cast<std::ptrdiff_t>(from),
-                                    s.time_s.begin() + static_cast<std::ptrdiff_t>(to));
-        const std::vector<double> speed(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
-        for (const Avalanche& a : FindAvalanches(t, speed, options)) {
-          // The stop it released: from stopped_before_s before its start to its start.
-          double sum = 0.0;
-          std::size_t count = 0;
-          for (std::size_t k = from; k < from + a.start_index; ++k)
-            if (s.time_s[k] >= a.start_time_s - a.stopped_before_s - 1e-9) sum += rho[k], ++count;
-          const double stop_density = count > 0 ? sum / static_cast<double>(count) : 0.0;
-          if (stop_density < min_density_per_m2) continue;
-          TimelineMark mark{a.start_time_s,
-                            "area " + s.area_names[m] + ": released after a stop of " + FormatFixed(a.stopped_before_s, 1) +
-                                " s at " + FormatFixed(stop_density, 1) + " /m2, rise time " + FormatFixed(a.rise_time_s, 2) +
-                                " s, peak " + FormatFixed(a.peak_speed_m_per_s, 2) + " m/s",
-                            "avalanche"};
-          mark.rise_time_s = a.rise_time_s;
-          marks.push_back(mark);
-        }
-      }
-      from = to;
+    // An empty area has no flow to stop, and a gap ends a stop.
+    for (const Avalanche& a : FindAvalanchesBetweenGaps(s.time_s, v, options)) {
+      // The stop it released: from stopped_before_s before its start to its start.
+      double sum = 0.0;
+      std::size_t count = 0;
+      for (std::size_t k = 0; k < a.start_index; ++k)
+        if (s.time_s[k] >= a.start_time_s - a.stopped_before_s - 1e-9) sum += rho[k], ++count;
+      const double stop_density = count > 0 ? sum / static_cast<double>(count) : 0.0;
+      if (stop_density < min_density_per_m2) continue;
+      TimelineMark mark{a.start_time_s,
+                        "area " + s.area_names[m] + ": released after a stop of " + FormatFixed(a.stopped_before_s, 1) +
+                            " s at " + FormatFixed(stop_density, 1) + " /m2, rise time " + FormatFixed(a.rise_time_s, 2) +
+                            " s, peak " + FormatFixed(a.peak_speed_m_per_s, 2) + " m/s",
+                        "avalanche"};
+      mark.rise_time_s = a.rise_time_s;
+      marks.push_back(mark);
     }
   }
   std::stable_sort(marks.begin(), marks.end(), [](const TimelineMark& a, const TimelineMark& b) { return a.time_s < b.time_s; });
@@ -278,7 +265,7 @@ std::vector<TimelineMark> MergeAvalanches(std::vector<TimelineMark> marks, doubl
 
 std::vector<TimelineMark> AvalanchesWithAreas(const TimelineSeries& s) {
   std::vector<TimelineMark> all = s.avalanches;
-  for (TimelineMark& m : AreaAvalanches(s)) all.push_back(std::move(m));
+  for (TimelineMark& m : AreaAvalanches(s, IncidentAvalancheOptions())) all.push_back(std::move(m));
   return MergeAvalanches(std::move(all), RegimeOptions{}.min_stop_duration_s);
 }
 

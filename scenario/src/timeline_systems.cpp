@@ -472,13 +472,15 @@ class AvalancheSystem : public RunSystem {
       ++count[groups];
     }
     time_.push_back(c.sim.time_s());
+    // Nobody of a direction walking: no speed (a gap, not a stop: issue 65,
+    // the counter-flow's first arrivals were read as an avalanche).
     for (std::size_t g = 0; g <= groups; ++g)
-      series_[g].push_back(count[g] > 0 ? sum[g] / static_cast<double>(count[g]) : 0.0);
+      series_[g].push_back(count[g] > 0 ? sum[g] / static_cast<double>(count[g]) : std::nan(""));
     if (c.sim.time_s() + 1e-9 < next_check_s_) return;
     next_check_s_ = c.sim.time_s() + 1.0;
-    const analysis::RegimeOptions options;
+    const analysis::RegimeOptions options = analysis::IncidentAvalancheOptions();
     for (std::size_t g = 0; g <= groups; ++g) {
-      for (const analysis::Avalanche& a : analysis::FindAvalanches(time_, series_[g], options)) {
+      for (const analysis::Avalanche& a : analysis::FindAvalanchesBetweenGaps(time_, series_[g], options)) {
         if (a.start_time_s <= reported_[g]) continue;
         reported_[g] = a.start_time_s;
         const std::string who = g < groups ? "direction " + s_.spec.groups[g] : "crowd";

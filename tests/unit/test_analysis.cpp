@@ -142,6 +142,31 @@ TEST(Regime, InitialRestThenJamIsNotAnAvalanche) {
   EXPECT_EQ(r.regime, Regime::kLanes) << r.reason;
 }
 
+// Issue 65: an incident's avalanches are stops of a flow. A crowd placed at
+// rest that creeps, bunches up and sets off (the night demo's counter-flow
+// at 3.8 s) is starting; a group with no one walking yet (NaN) is a gap,
+// neither a stop nor a flow.
+TEST(Regime, AnIncidentsAvalancheNeedsAFlowBeforeItsStop) {
+  const std::vector<double> t = Times(20.0);
+  const auto start_up = Series(t, [](double x) { return x < 1.0 ? 0.15 : (x < 4.0 ? 0.02 : 0.8); });
+  EXPECT_EQ(FindAvalanches(t, start_up, RegimeOptions{}).size(), 1u);  // the diagrams' reading, unchanged
+  EXPECT_TRUE(FindAvalanches(t, start_up, IncidentAvalancheOptions()).empty());
+  const auto flow_stop_go = Series(t, [](double x) { return x < 5.0 ? 0.8 : (x < 9.0 ? 0.02 : 0.8); });
+  EXPECT_EQ(FindAvalanches(t, flow_stop_go, IncidentAvalancheOptions()).size(), 1u);
+  // Nobody there for 3 s, then walkers who stop and go: the gap is no stop.
+  auto gap = Series(t, [](double x) { return x < 6.0 ? 0.8 : (x < 10.0 ? 0.02 : 0.8); });
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] < 3.0) gap[k] = std::nan("");
+  const std::vector<Avalanche> found = FindAvalanchesBetweenGaps(t, gap, IncidentAvalancheOptions());
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NEAR(found[0].start_time_s, 10.0, 0.11);
+  EXPECT_NEAR(t[found[0].start_index], found[0].start_time_s, 1e-12);  // indices of the whole series
+  auto empty_then_walkers = Series(t, [](double x) { return x < 2.0 ? 0.0 : 0.8; });
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] < 2.0) empty_then_walkers[k] = std::nan("");
+  EXPECT_TRUE(FindAvalanchesBetweenGaps(t, empty_then_walkers, IncidentAvalancheOptions()).empty());
+}
+
 TEST(Regime, OneReleaseIsIntermittentAndShortRunsAreUnclassified) {
   const std::vector<double> t = Times(40.0);
   const auto v = Series(t, [](double x) { return x < 5.0 ? 0.7 : (x < 25.0 ? 0.0 : 0.8); });

@@ -70,6 +70,13 @@ struct RegimeOptions {
   // paper): a person re-accelerates to their desired speed within ~tau, so a
   // dip shorter than this is a hesitation, not a stop.
   double min_stop_duration_s = 2.0;
+  // Only a stop of a flow arms an avalanche: the series must first have
+  // reached the burst speed (people placed at rest who start, bunch up and
+  // set off again are starting, not released: issue 65, the night demo's
+  // only "avalanche" and one at 02:00 in every seed of the full night). Off
+  // for the regimes of the paper's diagrams (classifier version 2); on for
+  // an incident's timeline (its avalanche marks and the local reading).
+  bool require_flow_before_stop = false;
   // Mean speed over the final window below which the flow is frozen (m/s):
   // half the stop threshold, i.e. the crowd advances less than two body depths
   // in the 10 s window: clogged "indefinitely" (paper) as far as a run can tell.
@@ -142,6 +149,11 @@ struct Avalanche {
 // frozen window's half, 7.5 relaxation times -- a clog, not a hesitation.
 RegimeOptions SingleReleaseReading(RegimeOptions options);
 
+// The options of an incident timeline's avalanche marks (the run's avalanche
+// events and the local reading by area): the defaults, but only stops of a
+// flow arm an avalanche (require_flow_before_stop).
+RegimeOptions IncidentAvalancheOptions();
+
 // Start of the stationary stage of a run from t_first to t_last:
 // max(t_first + transient_s, t_last - stationary_window_s).
 double StationaryStart(double t_first, double t_last, const RegimeOptions& options);
@@ -149,6 +161,15 @@ double StationaryStart(double t_first, double t_last, const RegimeOptions& optio
 // Avalanches in a mean-speed series (`time_s` increasing, same length).
 std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const std::vector<double>& speed_m_per_s,
                                       const RegimeOptions& options);
+
+// The same over a series with gaps (NaN: nobody there to have a speed, a
+// direction with no one walking yet or any more): each stretch between gaps
+// on its own, so that an empty group is no stop and its first walkers no
+// release (issue 65: the counter-flow's first arrivals were the night
+// demo's only "avalanche"). Indices refer to the whole series.
+std::vector<Avalanche> FindAvalanchesBetweenGaps(const std::vector<double>& time_s,
+                                                 const std::vector<double>& speed_m_per_s,
+                                                 const RegimeOptions& options);
 
 struct DirectionRegime;
 
