@@ -115,6 +115,7 @@ std::vector<Avalanche> FindAvalanches(const std::vector<double>& time_s, const s
       // A run below the stop speed that includes the first sample is the
       // initial rest of a crowd placed standing, not a stop of a flow.
       if (!armed && flowed && below_start != 0 &&
+          time_s[below_start] - time_s.front() >= options.first_stop_after_s - kTimeTolerance_s &&
           time_s[i] - time_s[below_start] >= options.min_stop_duration_s - kTimeTolerance_s) {
         armed = true;
         armed_stop_start = below_start;
@@ -353,6 +354,7 @@ RegimeResult ClassifyByDirection(const std::vector<double>& time_s, const std::v
 RegimeOptions IncidentAvalancheOptions() {
   RegimeOptions options;
   options.require_flow_before_stop = true;
+  options.first_stop_after_s = options.transient_s;
   return options;
 }
 

@@ -151,16 +151,23 @@ TEST(Regime, AnIncidentsAvalancheNeedsAFlowBeforeItsStop) {
   const auto start_up = Series(t, [](double x) { return x < 1.0 ? 0.15 : (x < 4.0 ? 0.02 : 0.8); });
   EXPECT_EQ(FindAvalanches(t, start_up, RegimeOptions{}).size(), 1u);  // the diagrams' reading, unchanged
   EXPECT_TRUE(FindAvalanches(t, start_up, IncidentAvalancheOptions()).empty());
-  const auto flow_stop_go = Series(t, [](double x) { return x < 5.0 ? 0.8 : (x < 9.0 ? 0.02 : 0.8); });
-  EXPECT_EQ(FindAvalanches(t, flow_stop_go, IncidentAvalancheOptions()).size(), 1u);
-  // Nobody there for 3 s, then walkers who stop and go: the gap is no stop.
-  auto gap = Series(t, [](double x) { return x < 6.0 ? 0.8 : (x < 10.0 ? 0.02 : 0.8); });
-  for (std::size_t k = 0; k < t.size(); ++k)
-    if (t[k] < 3.0) gap[k] = std::nan("");
-  const std::vector<Avalanche> found = FindAvalanchesBetweenGaps(t, gap, IncidentAvalancheOptions());
+  // Groups that walk, meet, stall and pass within the start-up (the demo's
+  // counter-flow: released at 3.8 s after a stop of 2.8 s): the transient.
+  const auto meeting = Series(t, [](double x) { return x < 1.0 ? 0.5 : (x < 3.8 ? 0.02 : 0.8); });
+  EXPECT_EQ(FindAvalanches(t, meeting, RegimeOptions{}).size(), 1u);
+  EXPECT_TRUE(FindAvalanches(t, meeting, IncidentAvalancheOptions()).empty());
+  const std::vector<double> t30 = Times(30.0);
+  const auto flow_stop_go = Series(t30, [](double x) { return x < 12.0 ? 0.8 : (x < 16.0 ? 0.02 : 0.8); });
+  EXPECT_EQ(FindAvalanches(t30, flow_stop_go, IncidentAvalancheOptions()).size(), 1u);
+  // Nobody there for 3 s, then walkers who stop (after their own start-up)
+  // and go: the gap is no stop, the later stop is.
+  auto gap = Series(t30, [](double x) { return x < 16.0 ? 0.8 : (x < 20.0 ? 0.02 : 0.8); });
+  for (std::size_t k = 0; k < t30.size(); ++k)
+    if (t30[k] < 3.0) gap[k] = std::nan("");
+  const std::vector<Avalanche> found = FindAvalanchesBetweenGaps(t30, gap, IncidentAvalancheOptions());
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_NEAR(found[0].start_time_s, 10.0, 0.11);
-  EXPECT_NEAR(t[found[0].start_index], found[0].start_time_s, 1e-12);  // indices of the whole series
+  EXPECT_NEAR(found[0].start_time_s, 20.0, 0.11);
+  EXPECT_NEAR(t30[found[0].start_index], found[0].start_time_s, 1e-12);  // indices of the whole series
   auto empty_then_walkers = Series(t, [](double x) { return x < 2.0 ? 0.0 : 0.8; });
   for (std::size_t k = 0; k < t.size(); ++k)
     if (t[k] < 2.0) empty_then_walkers[k] = std::nan("");

@@ -77,6 +77,12 @@ struct RegimeOptions {
   // for the regimes of the paper's diagrams (classifier version 2); on for
   // an incident's timeline (its avalanche marks and the local reading).
   bool require_flow_before_stop = false;
+  // Only stops that begin this long after the series' first sample (or its
+  // stretch's, between gaps) arm an avalanche (s): the start-up of a crowd
+  // placed at rest, two groups placed facing each other meeting, stalling and
+  // passing, is the transient (transient_s below), not a release. 0 for the
+  // diagrams' regimes; an incident's timeline uses transient_s.
+  double first_stop_after_s = 0.0;
   // Mean speed over the final window below which the flow is frozen (m/s):
   // half the stop threshold, i.e. the crowd advances less than two body depths
   // in the 10 s window: clogged "indefinitely" (paper) as far as a run can tell.
@@ -151,7 +157,8 @@ RegimeOptions SingleReleaseReading(RegimeOptions options);
 
 // The options of an incident timeline's avalanche marks (the run's avalanche
 // events and the local reading by area): the defaults, but only stops of a
-// flow arm an avalanche (require_flow_before_stop).
+// flow (require_flow_before_stop) after the start-up (first_stop_after_s =
+// transient_s) arm an avalanche.
 RegimeOptions IncidentAvalancheOptions();
 
 // Start of the stationary stage of a run from t_first to t_last:
