@@ -98,7 +98,9 @@ def main():
     for folder in args.dirs:
         sweep, x, y, rows, wall = load(folder)
         print(f"## {sweep.get('name', folder)}\n")
-        print(f"{wall[1]} runs, {wall[0] / 3600:.2f} h of run wall time in total (sum over runs)\n")
+        # (A table whose wall times are all empty sums to NULL: none recorded.)
+        print(f"{wall[1]} runs, " + (f"{wall[0] / 3600:.2f} h of run wall time in total (sum over runs)"
+                                     if wall[0] is not None else "no run wall time recorded") + "\n")
         variants = list(dict.fromkeys(r[0] for r in rows))
         for variant in variants:
             votes = collections.defaultdict(list)

@@ -48,8 +48,13 @@ def run(crowdrecon, out_dir, name, scenario, population, falls):
         s = json.load(f)
     s["population"].update(population)
     s["timeline"]["falls"] = falls
-    # The scenario's relative paths stay valid: written beside the original.
-    tmp = os.path.join(SCENARIOS, ".study-" + name + ".json")
+    # Written into the output folder, never beside the shipped scenarios:
+    # their relative paths made absolute.
+    s["venue"] = os.path.normpath(os.path.join(SCENARIOS, s["venue"]))
+    body = s["population"].get("body", {})
+    if isinstance(body, dict) and isinstance(body.get("reference"), str):
+        body["reference"] = os.path.normpath(os.path.join(SCENARIOS, body["reference"]))
+    tmp = os.path.join(out_dir, ".study-" + name + ".json")
     with open(tmp, "w") as f:
         json.dump(s, f)
     try:
