@@ -53,6 +53,7 @@ int RunValidateCommand(const ValidateArgs& args) {
   if (!args.quiet) o.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   std::vector<NamedInput> inputs = {{"the suite", o.suite}};
   for (const auto& p : o.profiles) inputs.push_back({"the profile", p});
+  if (std::string why; !o.IsValid(&why)) throw InputError(why);
   CheckOutputs({{"-o", o.output_dir, validate::ValidationFolderOutput()}}, inputs, args.force);
   const validate::ValidateSummary s = validate::RunValidation(o);
   std::printf("%s", s.BriefReport().c_str());
@@ -76,7 +77,8 @@ void RegisterValidateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "The validation's folder DIR")->required();
   cmd->add_option("--test", args->tests, "Only this test (by id; may be repeated)")->allow_extra_args(false);
   cmd->add_flag("--quick", args->quick, "Only the tests marked quick (the subset make test runs)");
-  cmd->add_option("--seeds", args->seeds, "At most this many seeds per test (a trial; the report says how many ran)")
+  cmd->add_option("--seeds", args->seeds,
+                  "At most this many seeds per test (a trial; the report says how many ran); 0: each test's own")
       ->check(IntegerIn(0, 1000));
   cmd->add_option("--jobs", args->jobs, "Runs at a time (default: all cores); results do not depend on it")
       ->check(IntegerIn(0, 4096));

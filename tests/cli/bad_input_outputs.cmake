@@ -178,6 +178,11 @@ crowdrecon_output_test(observe.footage_o_writes_the_references_series fail
                        "make_scenario && make_run && make_observation && mv ref.json renamed.json" "renamed.json ref.csv"
                        observe footage video.mp4 --homography h.json --spec s.json -o ref.json --reference renamed.json)
 
+# --- validate: the report's folder never inside the suite (issue 65) ----------
+crowdrecon_output_test(validate.o_inside_the_suite fail "-o suite/tests: inside the suite.s folder .*suite, whose files are read as its tests"
+                       "mkdir -p suite/tests && echo {} > suite/tests/t.json" "."
+                       validate suite -o suite/tests --force --no-pdf)
+
 # --- every option checked before anything is written (issue 40) ----------------
 crowdrecon_output_test(timeline.bad_density_time_writes_nothing fail
                        "--density-times / --density-cell / --density-sigma: time -1 s, expected a time at or after the start"

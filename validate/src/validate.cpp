@@ -3,6 +3,7 @@
 // the report written.
 #include "crowdrecon/validate/validate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -211,6 +212,15 @@ bool ValidateOptions::IsValid(std::string* error) const {
   if (profiles.empty() || profiles.size() > 2) return fail("expected one or two profiles (--profile)");
   if (output_dir.empty()) return fail("-o: expected the validation's folder");
   if (seeds < 0 || seeds > 1000) return fail("--seeds: expected 0 (each test's own) .. 1000");
+  // The report's folder never inside the suite: its files would be read as
+  // tests (issue 65: -o SUITE/tests --force wrote results.json among them).
+  std::error_code ec;
+  const fs::path suite_dir = fs::weakly_canonical(fs::is_directory(suite, ec) ? suite : suite.parent_path(), ec);
+  const fs::path out = fs::weakly_canonical(output_dir, ec);
+  const auto [s_end, o_end] = std::mismatch(suite_dir.begin(), suite_dir.end(), out.begin(), out.end());
+  if (!suite_dir.empty() && s_end == suite_dir.end())
+    return fail("-o " + output_dir.string() + ": inside the suite's folder " + suite_dir.string() +
+                ", whose files are read as its tests and profiles; choose a folder outside it");
   return true;
 }
 
