@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/scoped_signals.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/sweep/sweep_runner.hpp"
 #include "evaluator.hpp"
@@ -37,23 +38,6 @@ const std::vector<double> kBandwidths{0.15, 0.25, 0.4, 0.7, std::numeric_limits<
 // (bootstrap, profiles, the posterior, the footage) poll the flag.
 std::atomic<bool> g_stop_calibration{false};
 extern "C" void OnCalibrationSignal(int) { g_stop_calibration.store(true); }
-
-class CalibrationSignals {
- public:
-  CalibrationSignals() : int_(std::signal(SIGINT, OnCalibrationSignal)), term_(std::signal(SIGTERM, OnCalibrationSignal)) {
-    g_stop_calibration.store(false);
-  }
-  ~CalibrationSignals() {
-    std::signal(SIGINT, int_);
-    std::signal(SIGTERM, term_);
-  }
-  CalibrationSignals(const CalibrationSignals&) = delete;
-  CalibrationSignals& operator=(const CalibrationSignals&) = delete;
-
- private:
-  void (*int_)(int);
-  void (*term_)(int);
-};
 
 // An evaluation was interrupted (Ctrl-C, SIGTERM): the calibration stops
 // and resumes from its cache when run again.
@@ -655,7 +639,8 @@ Summary Calibrate(const Options& options) {
   r.summary.approach = ToString(spec.approach);
   const std::vector<Statistic> statistics = ObservedStatistics(spec);
   Evaluator evaluator(spec, statistics, options.output_dir, options.jobs, options.show_progress);
-  const CalibrationSignals signals;
+  g_stop_calibration.store(false);
+  const ScopedSignals signals(OnCalibrationSignal);
   try {
     Calibration(spec, evaluator, r, options.show_stages).Run();
   } catch (const Interrupted&) {

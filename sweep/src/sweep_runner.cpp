@@ -26,6 +26,7 @@
 
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/scoped_signals.hpp"
 #include "crowdrecon/common/wall_clock.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/reports/risk.hpp"
@@ -279,23 +280,6 @@ bool AgreeOnSetUp(MpiTransport& transport, int rank, const std::exception_ptr& e
   return false;
 }
 
-// SIGINT and SIGTERM stop the sweep after the runs in progress checkpoint;
-// the previous handlers come back when the sweep ends.
-class SweepSignals {
- public:
-  SweepSignals() : int_(std::signal(SIGINT, OnSweepSignal)), term_(std::signal(SIGTERM, OnSweepSignal)) {}
-  ~SweepSignals() {
-    std::signal(SIGINT, int_);
-    std::signal(SIGTERM, term_);
-  }
-  SweepSignals(const SweepSignals&) = delete;
-  SweepSignals& operator=(const SweepSignals&) = delete;
-
- private:
-  void (*int_)(int);
-  void (*term_)(int);
-};
-
 // 3a. A worker rank: asks for a run per slot, runs what comes, sends the rows.
 void RunWorkerRank(MpiTransport& transport, int rank, int jobs, const Work& work) {
   WorkerPool pool(jobs, work);
@@ -544,7 +528,9 @@ SweepSummary RunSweep(const SweepOptions& options) {
     }
     return o;
   };
-  const SweepSignals signals;
+  // SIGINT and SIGTERM stop the sweep after the runs in progress checkpoint;
+  // the previous handlers come back when the sweep ends.
+  const ScopedSignals signals(OnSweepSignal);
   // Under MPI every rank returns only when every run's row has reached rank
   // 0, so that what the runs left behind (their after_run files) is complete
   // on every rank when RunSweep returns there (a calibration reads it next),

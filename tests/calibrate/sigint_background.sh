@@ -9,26 +9,8 @@ crowdrecon=$1
 src=$(cd "$2" && pwd)
 d=$(mktemp -d)
 trap 'kill $pid 2>/dev/null; [[ -n ${KEEP:-} ]] || rm -rf "$d"' EXIT
-python3 - "$src" "$d" <<'PY'
-import json, sys
-src, d = sys.argv[1:3]
-s = json.load(open(src + "/tests/data/scenarios/sweep-tiny.json"))
-s["venue"] = src + "/venues/madrid-arena/hallway-periodic.json"
-s["population"]["body"]["reference"] = src + "/venues/bodies/thorax-18.json"
-s["population"]["density_per_m2"] = 2.0
-s["run"]["duration_s"] = 2.0
-json.dump(s, open(d + "/scenario.json", "w"))
-s["model"] = {"back_force_gamma": 2.5}
-s["population"]["seed"] = 9
-json.dump(s, open(d + "/truth.json", "w"))
-c = {"format": "crowdrecon-calibration", "version": 1, "name": "sigint", "scenario": "scenario.json",
-     "parameters": [{"path": "model.back_force_gamma", "min": 0.5, "max": 4.5}],
-     "observations": [{"file": "truth.observation.json", "series": [
-         {"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0.4, "to_s": 2, "window_s": 0.8}]}],
-     "seeds": {"first": 1, "count": 2}, "starts": [{"model.back_force_gamma": 2}],
-     "options": {"refinements": 1, "bootstrap": 5, "profile_points": 0, "posterior_steps": 10000000}}
-json.dump(c, open(d + "/calibration.json", "w"))
-PY
+# The smoke calibration with a posterior long enough to be stopped in.
+python3 "$(dirname "$0")/smoke_calibration.py" "$src" "$d" '{"bootstrap": 5, "profile_points": 0, "posterior_steps": 10000000}'
 "$crowdrecon" simulate "$d/truth.json" -o "$d/truth.sqlite" -q > /dev/null
 "$crowdrecon" observe trajectories "$d/truth.sqlite" --spec "$src/venues/madrid-arena/observations/hallway.json" \
   -o "$d/truth.observation.json" -q > /dev/null

@@ -19,31 +19,7 @@ if [ "$mode" = mpi ]; then
   command -v mpirun > /dev/null || { echo "mpirun not found: skipped"; exit 77; }
 fi
 
-python3 - "$src" "$d" <<'PY'
-import json, sys
-src, d = sys.argv[1:3]
-s = json.load(open(src + "/tests/data/scenarios/sweep-tiny.json"))
-s["venue"] = src + "/venues/madrid-arena/hallway-periodic.json"
-s["population"]["body"]["reference"] = src + "/venues/bodies/thorax-18.json"
-s["population"]["density_per_m2"] = 2.0
-s["run"]["duration_s"] = 2.0
-# A recorded fatal clog (issue 41): compared as a time with each run's clog
-# for good (none in 2 s: the window's end).
-s["timeline"] = {"recorded": [{"time_s": 1.5, "label": "fatal clog", "kind": "fatal"}]}
-json.dump(s, open(d + "/scenario.json", "w"))
-s["model"] = {"back_force_gamma": 2.5}
-s["population"]["seed"] = 9
-json.dump(s, open(d + "/truth.json", "w"))
-c = {"format": "crowdrecon-calibration", "version": 1, "name": "smoke", "scenario": "scenario.json",
-     "parameters": [{"path": "model.back_force_gamma", "min": 0.5, "max": 4.5}],
-     "observations": [{"file": "truth.observation.json", "series": [
-         {"quantity": "speed", "where": "hallway", "direction": "forward", "from_s": 0.4, "to_s": 2, "window_s": 0.8},
-         {"quantity": "share_still", "where": "hallway", "direction": "all", "from_s": 0.4, "to_s": 2}]},
-                      {"recorded": {"kind": "fatal", "uncertainty_s": 0.5}}],
-     "seeds": {"first": 1, "count": 2}, "starts": [{"model.back_force_gamma": 4}],
-     "options": {"refinements": 1, "bootstrap": 20, "profile_points": 3}}
-json.dump(c, open(d + "/calibration.json", "w"))
-PY
+python3 "$(dirname "$0")/smoke_calibration.py" "$src" "$d"
 "$crowdrecon" simulate "$d/truth.json" -o "$d/truth.sqlite" -q > /dev/null
 "$crowdrecon" observe trajectories "$d/truth.sqlite" --spec "$src/venues/madrid-arena/observations/hallway.json" \
   -o "$d/truth.observation.json" -q > /dev/null
