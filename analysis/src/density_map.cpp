@@ -20,7 +20,9 @@ bool DensityMapOptions::IsValid(std::string* error) const {
   }
   for (double t : times_s)
     if (!std::isfinite(t) || t < 0.0) {
-      if (error) *error = "time " + FormatNumber(t) + " s, expected a time at or after the start";
+      if (error)
+        *error = "time " + FormatNumber(t) + (std::isfinite(t) ? " s" : "") +
+                 ", expected a finite time in seconds at or after the start";
       return false;
     }
   return true;

@@ -12,8 +12,12 @@ namespace crowdrecon {
 void CheckInputFile(const std::filesystem::path& file, std::string_view what) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(file, ec);
+  // "a DXF file", "an ANSUR II extract"; a description with its own article
+  // ("the test's scenario") as it is.
+  const bool has_article = what.rfind("the ", 0) == 0 || what.rfind("a ", 0) == 0 || what.rfind("an ", 0) == 0;
   const std::string expected =
-      std::string(std::string_view("AEIOUaeiou").find(what.front()) != std::string_view::npos ? "an " : "a ") +
+      (has_article ? std::string()
+                   : std::string(std::string_view("AEIOUaeiou").find(what.front()) != std::string_view::npos ? "an " : "a ")) +
       std::string(what);
   if (std::filesystem::is_directory(status)) throw InputError(file.string() + ": is a directory; expected " + expected);
   // A device (/dev/zero, a terminal) or a socket never ends or never answers;

@@ -185,13 +185,17 @@ crowdrecon_output_test(validate.o_inside_the_suite fail "-o suite/tests: inside 
 
 # --- every option checked before anything is written (issue 40) ----------------
 crowdrecon_output_test(timeline.bad_density_time_writes_nothing fail
-                       "--density-times / --density-cell / --density-sigma: time -1 s, expected a time at or after the start"
+                       "--density-times / --density-cell / --density-sigma: time -1 s, expected a finite time in seconds at or after the start"
                        "make_scenario && make_run" "."
                        timeline run.sqlite -o t.png --density-maps d.png --density-times -1)
 crowdrecon_output_test(timeline.scores_and_density_maps_of_one_run fail
                        "--density-maps draws one run.s maps: with --scores the run is scored as an ensemble \\(of one\\). draw it in a call without --scores"
                        "make_scenario && make_run" "."
                        timeline run.sqlite -o t.png --scores s.md --density-maps d.png)
+crowdrecon_output_test(timeline.density_time_not_finite fail
+                       "--density-times / --density-cell / --density-sigma: time inf, expected a finite time in seconds"
+                       "make_scenario && make_run" "."
+                       timeline run.sqlite -o t.png --density-maps d.png --density-times inf)
 crowdrecon_output_test(timeline.density_time_after_the_end_writes_nothing fail
                        "density map time 99 s lies after the run.s end \\(.* s\\). expected times within the run"
                        "make_scenario && make_run" "."

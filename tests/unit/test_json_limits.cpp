@@ -114,6 +114,8 @@ TEST(InputFile, DirectoryIsNamedAsSuch) {
   const std::string msg = ErrorOf([&] { JsonDocument::Load(dir); });
   EXPECT_TRUE(Contains(msg, dir.string() + ": is a directory; expected a JSON file")) << msg;
   EXPECT_TRUE(Contains(ErrorOf([&] { ReadInputFile(dir, "WKT file"); }), "is a directory; expected a WKT file"));
+  // A description with its own article keeps it (issue 65: "expected a the test's scenario").
+  EXPECT_TRUE(Contains(ErrorOf([&] { ReadInputFile(dir, "the test's scenario"); }), "is a directory; expected the test's scenario"));
 }
 
 TEST(InputFile, MissingFileNamesTheReason) {
