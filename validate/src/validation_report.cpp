@@ -31,7 +31,6 @@ namespace svg = reports::svg;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kProfileColor[] = {"#1f4e79", "#c0392b"};
 const char* const kDataColor = "#7f7f7f";
 
