@@ -4,9 +4,9 @@
 #include <boost/math/special_functions/erf.hpp>
 #include <boost/math/special_functions/gamma.hpp>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
+#include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 
 namespace crowdrecon {
@@ -14,12 +14,6 @@ namespace crowdrecon {
 namespace {
 
 constexpr double kMaxTime_s = 1e6;
-
-std::string Num(double v) {
-  char s[32];
-  std::snprintf(s, sizeof s, "%.6g", v);
-  return s;
-}
 
 }  // namespace
 
@@ -35,14 +29,9 @@ double Distribution::Quantile(double u) const {
 }
 
 double Distribution::Cdf(double t) const {
-  if (kind == Kind::kUniform) {
-    if (t < a) return 0.0;
-    if (t >= b) return 1.0;
-    return (t - a) / (b - a);
-  }
-  if (!(t > 0.0)) return 0.0;
+  if (kind != Kind::kUniform && !(t > 0.0)) return 0.0;  // (a time: none below 0)
   switch (kind) {
-    case Kind::kUniform: break;
+    case Kind::kUniform: return t < a ? 0.0 : t >= b ? 1.0 : (t - a) / (b - a);
     case Kind::kGamma: return boost::math::gamma_p(a, t / b);
     case Kind::kLognormal: return 0.5 * boost::math::erfc(-(std::log(t) - a) / (b * std::sqrt(2.0)));
     case Kind::kWeibull: return -std::expm1(-std::pow(t / b, a));
@@ -52,10 +41,10 @@ double Distribution::Cdf(double t) const {
 
 std::string Distribution::Describe() const {
   switch (kind) {
-    case Kind::kUniform: return "uniform over [" + Num(a) + ", " + Num(b) + "] s";
-    case Kind::kGamma: return "gamma (shape " + Num(a) + ", scale " + Num(b) + " s)";
-    case Kind::kLognormal: return "log-normal (mu " + Num(a) + ", sigma " + Num(b) + " of ln t/s)";
-    case Kind::kWeibull: return "Weibull (shape " + Num(a) + ", scale " + Num(b) + " s)";
+    case Kind::kUniform: return "uniform over [" + FormatNumber(a) + ", " + FormatNumber(b) + "] s";
+    case Kind::kGamma: return "gamma (shape " + FormatNumber(a) + ", scale " + FormatNumber(b) + " s)";
+    case Kind::kLognormal: return "log-normal (mu " + FormatNumber(a) + ", sigma " + FormatNumber(b) + " of ln t/s)";
+    case Kind::kWeibull: return "Weibull (shape " + FormatNumber(a) + ", scale " + FormatNumber(b) + " s)";
   }
   return "?";
 }

@@ -186,7 +186,7 @@ TestResult Judge(const ValidationTest& test, const std::string& profile, std::ve
     cv.criterion = c;
     std::vector<std::size_t> which;
     for (std::size_t i = 0; i < test.cases.size(); ++i)
-      if (c.cases.empty() || std::count(c.cases.begin(), c.cases.end(), test.cases[i].name)) which.push_back(i);
+      if (c.AppliesTo(test.cases[i].name)) which.push_back(i);
     if (c.kind == CriterionKind::kIncreasing || c.kind == CriterionKind::kRatio) {
       // Over cases: each case's aggregate, then the rise or the ratio.
       std::vector<double> agg;

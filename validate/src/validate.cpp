@@ -129,12 +129,13 @@ struct TestRun {
 TestRun RunTest(const ValidationTest& test, const Profile& profile, const ValidateOptions& options) {
   const json sweep_json = SweepOf(test, profile, options.seeds);
   const std::string sweep_text = sweep_json.dump(1);
-  // The folder is named by the sweep's text, the test's measure, the
-  // content of the files the runs read and the build's sources (a sweep's runs are one source fingerprint's:
-  // sweep/results.hpp): a changed test, measure or profile, or other
-  // sources, is a new sweep, never one refused as "a different sweep" or
-  // mixed with other sources' runs; a commit of documents or results reuses
-  // the runs (and so does another machine building the same sources).
+  // The folder is named by the sweep's text, the test's measure, the content
+  // of the files the runs read and the build's sources (a sweep's runs are
+  // one source fingerprint's: sweep/results.hpp): a changed test, measure,
+  // profile or input file, or other sources, is a new sweep, never one
+  // refused as "a different sweep" or mixed with other sources' runs; a
+  // commit of documents or results reuses the runs (and so does another
+  // machine building the same sources).
   const std::string key = Sha256Hex(sweep_text + "\nmeasure " + test.measure_json + "\ninputs " +
                                     InputsDigest(sweep_json, test.scenario) + "\nsources " + sweep::SourceFingerprint())
                               .substr(0, 12);

@@ -246,7 +246,7 @@ std::string FollowsFigures(const ValidationTest& t, const std::vector<const Test
     svg::Chart c;
     std::string cases;
     for (const Case& k : t.cases)
-      if (crit.cases.empty() || std::count(crit.cases.begin(), crit.cases.end(), k.name))
+      if (crit.AppliesTo(k.name))
         cases += (cases.empty() ? "" : ", ") + k.label;
     c.title = cases;  // (a case's label names its distribution; the criterion table gives it in full)
     c.x_label = crit.statistic;
@@ -262,7 +262,7 @@ std::string FollowsFigures(const ValidationTest& t, const std::vector<const Test
     for (std::size_t p = 0; p < per_profile.size(); ++p) {
       std::vector<Statistics> all;
       for (std::size_t i = 0; i < t.cases.size(); ++i)
-        if (crit.cases.empty() || std::count(crit.cases.begin(), crit.cases.end(), t.cases[i].name))
+        if (crit.AppliesTo(t.cases[i].name))
           all.insert(all.end(), per_profile[p]->runs[i].begin(), per_profile[p]->runs[i].end());
       const std::vector<double> v = Pooled(all, crit.statistic);
       if (v.empty()) continue;

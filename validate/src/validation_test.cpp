@@ -356,7 +356,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
   for (const Criterion& c : t.criteria)
     if (c.kind == CriterionKind::kNearReference)
       for (const Case& k : t.cases)
-        if ((c.cases.empty() || std::count(c.cases.begin(), c.cases.end(), k.name)) && k.reference.empty())
+        if (c.AppliesTo(k.name) && k.reference.empty())
           r.At("criteria").Fail("near_reference needs published values (\"reference\") in case \"" + k.name + "\"");
   if (const auto fig = r.Find("figure")) {
     const std::string kind = fig->Choice("kind", "distribution", {"distribution", "cumulative"});

@@ -26,6 +26,7 @@
 // value and what was expected.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -83,6 +84,10 @@ struct Criterion {
   std::string why;                  // the tolerance and its reason
   // One line: "travel_time_s (every) in [26, 34]".
   std::string Describe() const;
+  // Whether the criterion judges the case of this name (`cases`, or every case).
+  bool AppliesTo(const std::string& case_name) const {
+    return cases.empty() || std::find(cases.begin(), cases.end(), case_name) != cases.end();
+  }
 };
 
 // One case of a test: a named set of overrides (a width, a density, a share
