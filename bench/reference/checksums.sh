@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Reference checksums: proof that a change of structure changed no result.
-# Runs each reference scenario (this folder, plus the closed room and the
-# dense hallway of the tests) with 1 and with 2 threads and prints, per run,
+# Runs each reference scenario (this folder, plus the closed room, the
+# dense hallway and the open hallway's timeline of the tests) with 1 and 2 threads and prints, per run,
 # the SHA-256 of its per-frame tables (trajectory_data, person_state, contact,
 # frame_time; tests/cli/run_tables.sh). Run it before and after a refactoring
 # and compare the two lists; they must be identical, line for line.
@@ -10,6 +10,9 @@
 #   ...change...
 #   bench/reference/checksums.sh [CROWDRECON] > after.txt && diff before.txt after.txt
 #   bench/reference/checksums.sh --check [CROWDRECON]   # against checksums.txt (a ctest)
+# The two hallway-extensions-* scenes switch on every behaviour extension of
+# the drive (each one changes their results: switched off one at a time, each
+# gives other tables), the timeline a group's own back force and arrivals.
 # checksums.txt holds the values of the current model: a change of physics
 # changes them on purpose (then regenerate it and say so in the commit); a
 # change of structure must not.
@@ -32,7 +35,8 @@ exe=${1:-build/release/cli/crowdrecon}
 source tests/cli/run_tables.sh
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-scenarios=(bench/reference/*.json tests/data/scenarios/closed-room-polygon.json tests/data/scenarios/dense-7pm2.json)
+scenarios=(bench/reference/*.json tests/data/scenarios/closed-room-polygon.json tests/data/scenarios/dense-7pm2.json
+           tests/data/scenarios/timeline-hallway.json)
 for scenario in "${scenarios[@]}"; do
   for threads in 1 2; do
     "$exe" simulate "$scenario" -o "$tmp/run.sqlite" --threads "$threads" --fixed-threads -q --force >/dev/null
