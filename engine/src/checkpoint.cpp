@@ -31,7 +31,11 @@ namespace {
 // such rather than misread. Version 4: the time step's mode and the adaptive
 // step's parameters, and with the adaptive step its ticks and level (the
 // fixed step's time is written where the step was); version 3 is refused.
-constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '5'};
+// Version 6: the behaviour terms' per-person states as sections, each with
+// the term's name and the version of its state (behaviour.hpp); version 5,
+// which wrote the same states bare in a fixed order, is still read.
+constexpr char kStateMagic[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '6'};
+constexpr char kStateMagicV5[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '5'};
 constexpr char kStateMagicV4[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '4'};
 constexpr char kStateMagicV3[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '3'};
 constexpr char kStateMagicV2[8] = {'C', 'R', 'S', 'T', 'A', 'T', 'E', '2'};
@@ -45,9 +49,57 @@ class StateWriter : public detail::BinaryWriter {
 
 class StateReader : public detail::BinaryReader {
  public:
-  StateReader(const std::string& data, bool v1)
-      : BinaryReader(data, v1 ? kStateMagicV1 : kStateMagic, "checkpoint", "state") {}
+  StateReader(const std::string& data, const char (&magic)[8]) : BinaryReader(data, magic, "checkpoint", "state") {}
 };
+
+// The terms' sections (version 6): the names of the terms with state, in
+// the list's order, then per term the version of its state and what it saves.
+void PutTermStates(StateWriter& w, const ActiveTerms& terms) {
+  w.Put(static_cast<std::uint64_t>(terms.stateful.size()));
+  for (const std::string name : terms.stateful_names) w.PutVector(std::vector<char>(name.begin(), name.end()));
+  for (const BehaviourTerm* term : terms.stateful) {
+    w.Put(term->state_version());
+    term->Save(w);
+  }
+}
+
+std::string Names(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return names.empty() ? "none" : text;
+}
+
+void GetTermStates(StateReader& r, const ActiveTerms& terms, std::size_t people) {
+  const std::size_t count = r.GetCount(8);
+  std::vector<std::string> theirs, ours(terms.stateful_names.begin(), terms.stateful_names.end());
+  for (std::size_t t = 0; t < count; ++t) {
+    std::vector<char> name;
+    r.GetVector(name);
+    theirs.emplace_back(name.begin(), name.end());
+  }
+  if (theirs != ours)
+    throw InputError("checkpoint: holds the state of the behaviour terms " + Names(theirs) +
+                     " where this run's parameters have " + Names(ours) + " (different model parameters?)");
+  for (std::size_t t = 0; t < terms.stateful.size(); ++t) {
+    BehaviourTerm* term = terms.stateful[t];
+    const auto version = r.Get<std::uint32_t>();
+    if (version != term->state_version())
+      throw InputError("checkpoint: holds the state of the behaviour term " + ours[t] + " in version " +
+                       std::to_string(version) + " where this build reads version " +
+                       std::to_string(term->state_version()) +
+                       "; resume the run with the version that wrote it, or start it again");
+    term->Load(r, people);
+  }
+}
+
+// Version 5: the states of the averaged back-force trigger, the reaction time
+// and giving way, bare and in that order, where the run has them (each
+// term's version-1 state).
+void GetTermStatesV5(StateReader& r, const ActiveTerms& terms, std::size_t people) {
+  for (const char* legacy : {"back_force", "reaction_time", "giving_way"})
+    for (std::size_t t = 0; t < terms.stateful.size(); ++t)
+      if (std::string(terms.stateful_names[t]) == legacy) terms.stateful[t]->Load(r, people);
+}
 
 // The model parameters, every entry of the parameter table in its order.
 void PutParameters(StateWriter& w, const ModelParameters& p) {
@@ -156,18 +208,9 @@ std::string Simulation::SaveState() const {
   w.Put(in_->gear_initialised);
   w.PutVector(in_->gear_xy);
   w.PutVector(in_->gear_theta);
-  // Only with BackForceTrigger::kAveragedVelocity (the definition, which the
-  // checkpoint is restored into, says which).
-  if (!in_->averaged_along.empty()) w.PutVector(in_->averaged_along);
-  // Only with DriveReaction::kLagged (the same).
-  if (!in_->perceived_velocity.empty()) w.PutVector(in_->perceived_velocity);
-  // Only with GiveWay::kWhereRoom (the same).
-  if (!in_->give_way_along.empty()) {
-    w.PutVector(in_->give_way_along);
-    w.PutVector(in_->give_way_blocked_s);
-    w.PutVector(in_->give_way_left_s);
-    w.PutVector(in_->give_way_direction);
-  }
+  // The behaviour terms' states (the definition, which the checkpoint is
+  // restored into, says which terms the run has).
+  PutTermStates(w, in_->terms);
   w.PutVector(bodies_.id);
   w.PutVector(bodies_.shape);
   w.PutVector(bodies_.mass_kg);
@@ -195,8 +238,8 @@ void Simulation::LoadState(const std::string& data) {
       throw InputError(std::string("checkpoint: written by an older crowdrecon (state format ") + format +
                        ", before the model parameters of November 2026); resume the run with the version that "
                        "wrote it, or start it again");
-  const bool v1 = HasMagic(data, kStateMagicV1);
-  StateReader r(data, v1);
+  const bool v1 = HasMagic(data, kStateMagicV1), v5 = HasMagic(data, kStateMagicV5);
+  StateReader r(data, v1 ? kStateMagicV1 : v5 ? kStateMagicV5 : kStateMagic);
   const auto n = r.Get<std::uint64_t>();
   if (n != bodies_.size())
     throw InputError("checkpoint: holds " + std::to_string(n) + " people where this run has " +
@@ -230,14 +273,10 @@ void Simulation::LoadState(const std::string& data) {
   in_->gear_initialised = r.Get<bool>();
   r.GetVector(in_->gear_xy);
   r.GetVector(in_->gear_theta);
-  if (!in_->averaged_along.empty()) r.GetVector(in_->averaged_along, n);
-  if (!in_->perceived_velocity.empty()) r.GetVector(in_->perceived_velocity, n);
-  if (!in_->give_way_along.empty()) {
-    r.GetVector(in_->give_way_along, n);
-    r.GetVector(in_->give_way_blocked_s, n);
-    r.GetVector(in_->give_way_left_s, n);
-    r.GetVector(in_->give_way_direction, n);
-  }
+  if (v1 || v5)
+    GetTermStatesV5(r, in_->terms, n);
+  else
+    GetTermStates(r, in_->terms, n);
   if (!v1) {
     r.GetVector(bodies_.id, n);
     r.GetVector(bodies_.shape, n);
@@ -295,11 +334,6 @@ void Simulation::LoadState(const std::string& data) {
   RequireFinite(bodies_.desired_speed_m_per_s, "desired speed");
   RequireFinite(bodies_.mass_kg, "mass");
   RequireFinite(bodies_.inertia_kg_m2, "moment of inertia");
-  RequireFinite(in_->averaged_along, "averaged velocity");
-  RequireFinite(in_->perceived_velocity, "perceived velocity");
-  RequireFinite(in_->give_way_along, "give-way velocity");
-  RequireFinite(in_->give_way_blocked_s, "give-way blocked time");
-  RequireFinite(in_->give_way_left_s, "give-way time left");
   for (std::size_t i = 0; i < n; ++i) {
     if (static_cast<std::uint8_t>(bodies_.state[i]) > static_cast<std::uint8_t>(PersonState::kRemoved))
       throw InputError("checkpoint: damaged state: slot " + std::to_string(i) + " has no valid state");

@@ -74,6 +74,9 @@ void ValidateWorld(WorldDef& def) {
 Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_unique<Internals>()) {
   ValidateWorld(def_);
   LoadBodies();
+  // The behaviour terms of the drive, with the state of the people as placed.
+  in_->terms = ActiveTerms::For(def_.parameters, def_, nullptr);
+  for (ActiveTerms::Active& t : in_->terms.terms) t.term->Start(bodies_);
   BuildShapeFamilies();
   BuildWalls();
   // The contact law's constants, the time step, the device, the forces at t = 0.
@@ -138,16 +141,6 @@ void Simulation::LoadBodies() {
   in_->bound_m.resize(n);
   for (std::size_t i = 0; i < n; ++i) LoadPerson(i, def_.people[i], static_cast<std::uint32_t>(i));
   in_->cos_angle.assign(n, 1.0);
-  // People are placed at rest: u_i = 0, no back force until pushed back.
-  if (def_.parameters.back_force_trigger == BackForceTrigger::kAveragedVelocity) in_->averaged_along.assign(n, 0.0);
-  // A reaction time: people perceive the velocity they are placed with.
-  if (def_.parameters.drive_reaction == DriveReaction::kLagged) in_->perceived_velocity = bodies_.velocity_m_per_s;
-  if (def_.parameters.give_way == GiveWay::kWhereRoom) {
-    in_->give_way_along.assign(n, 0.0);
-    in_->give_way_blocked_s.assign(n, 0.0);
-    in_->give_way_left_s.assign(n, 0.0);
-    in_->give_way_direction.assign(n, {});
-  }
   in_->sin_angle.assign(n, 0.0);
   in_->travel_m.assign(n, 0.0);
   in_->field_cache.assign(n, {});
@@ -262,6 +255,7 @@ Vec2 Simulation::Separation(Vec2 a, Vec2 b) const { return detail::Separation(de
 void Simulation::ComputeForces() {
   UpdatePairs();
   PlaceShapes();
+  Neighbours();
   Collide();
   Gather();
   Drive();
@@ -288,9 +282,7 @@ void Simulation::Step() {
   ++profile_.steps_at_level[static_cast<std::size_t>(level_)];
   last_step_ticks_ = step_ticks;
   in_->drive_time_s = time_s_;
-  AverageBackForceTrigger();  // (these three with the step just taken)
-  UpdatePerceivedVelocity();
-  UpdateGiveWay();
+  UpdateBehaviourTerms();  // (with the step just taken)
   level_ = next_level_;
   dt_s_ = next_dt_s_;
   Check();
@@ -303,7 +295,7 @@ void Simulation::AdvanceTo(double end_time_s) {
 void Simulation::Quench() {
   std::fill(bodies_.velocity_m_per_s.begin(), bodies_.velocity_m_per_s.end(), Vec2{});
   std::fill(bodies_.angular_velocity_rad_per_s.begin(), bodies_.angular_velocity_rad_per_s.end(), 0.0);
-  std::fill(in_->perceived_velocity.begin(), in_->perceived_velocity.end(), Vec2{});
+  for (BehaviourTerm* t : in_->terms.stateful) t->Quench();
   in_->gear_initialised = false;
 }
 
@@ -320,7 +312,7 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
   if (state != PersonState::kWalking) {
     bodies_.velocity_m_per_s[person] = {};
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
-    if (!in_->perceived_velocity.empty()) in_->perceived_velocity[person] = {};
+    for (BehaviourTerm* t : in_->terms.stateful) t->Stop(person);
   }
   if (state == PersonState::kRemoved) {
     // No forces on an empty slot (the stages skip it), and their contacts go
@@ -400,14 +392,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
   if (slot < in.trailing_torque.size()) in.trailing_torque[slot] = 0.0;
   if (slot < in.gear_xy.size()) in.gear_xy[slot] = {};
   if (slot < in.gear_theta.size()) in.gear_theta[slot] = {};
-  if (!in.averaged_along.empty()) in.averaged_along[slot] = 0.0;
-  if (!in.perceived_velocity.empty()) in.perceived_velocity[slot] = bodies_.velocity_m_per_s[slot];
-  if (!in.give_way_along.empty()) {
-    in.give_way_along[slot] = 0.0;
-    in.give_way_blocked_s[slot] = 0.0;
-    in.give_way_left_s[slot] = 0.0;
-    in.give_way_direction[slot] = {};
-  }
+  for (BehaviourTerm* t : in.terms.stateful) t->Place(slot, bodies_);
   in.pairs_valid = false;
   in.cuda_has_history = false;
   Drive();  // the newcomer's own forces enter the current evaluation (the others' are unchanged)
@@ -472,6 +457,8 @@ void Simulation::SetParameters(const ModelParameters& parameters) {
     throw InputError("model parameters: the run's time step " + FormatNumber(LargestStep()) +
                      " s is above the stability limit " + FormatNumber(estimate.stability_limit_s) +
                      " s of the new parameters (limited by " + estimate.limited_by + ")");
+  ActiveTerms terms = ActiveTerms::For(p, def_, &in_->terms);  // (refuses a term with state switched on or off)
+  in_->terms = std::move(terms);
   def_.parameters = p;
   in_->restitution_factor = RestitutionDampingFactor(p.restitution);
   in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);

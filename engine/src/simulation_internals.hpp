@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "behaviour.hpp"
 #include "contact_law.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/fast_math.hpp"
@@ -276,36 +277,20 @@ struct Simulation::Internals {
   std::vector<std::array<double, 4>> gear_theta;
   bool gear_initialised = false;
 
-  // BackForceTrigger::kAveragedVelocity: per body, the velocity along the
-  // desired direction averaged over back_force_reaction_time_s (updated once
-  // per step, after the integrator; empty otherwise).
-  std::vector<double> averaged_along;
-
-  // DriveReaction::kLagged: per body, the velocity w_i that eq. (3) relaxes
-  // from, a first-order lag of the velocity (updated once per step, after the
-  // integrator; in the checkpoint; empty otherwise).
-  std::vector<Vec2> perceived_velocity;
-
-  // Yielding::kWhenBlocked: per body, its desired direction and the sum of
-  // the backward parts of its contact forces from people (<= 0), summed in
-  // Drive from the contact list in its order (one pass, no threads: the
-  // same on any thread count, and from the restored contacts after a resume).
-  std::vector<Vec2> yield_direction;
+  // The run's behaviour terms (behaviour.hpp), each with its own per-person
+  // state; made at construction, made again when the parameters change.
+  detail::ActiveTerms terms;
+  // For terms that need people ahead (ActiveTerms::people_ahead), derived in
+  // Drive from the contacts (not in the checkpoint): per body, its desired
+  // direction and the sum of the backward parts of its contact forces from
+  // people ahead (<= 0).
+  std::vector<Vec2> desired_direction;
   std::vector<double> held_back_n;
-
-  // GiveWay::kWhereRoom (empty otherwise), per body: the velocity along the
-  // desired direction averaged over 1 s, how long it has been below the
-  // threshold, how long the person still gives way, and the direction they
-  // walk meanwhile. Updated once per step after the integrator
-  // (UpdateGiveWay); in the checkpoint.
-  std::vector<double> give_way_along;
-  std::vector<double> give_way_blocked_s;
-  std::vector<double> give_way_left_s;
-  std::vector<Vec2> give_way_direction;
-  // UpdateGiveWay's scratch (derived each step, not in the checkpoint):
-  // per body, the people touched and the sum of their desired directions.
-  std::vector<int> give_way_touching;
-  std::vector<Vec2> give_way_their_way;
+  // The neighbour stage's list (empty unless a term asks for neighbours),
+  // with the positions at its build and the skin its candidates carry.
+  detail::NeighbourList neighbours;
+  std::vector<Vec2> neighbours_position_at_build;
+  double requested_neighbour_radius_m = 0.0;  // Simulation::RequestNeighbours
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.
   // Only the gait jitter (a function of time) reads it.

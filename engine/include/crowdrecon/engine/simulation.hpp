@@ -187,6 +187,17 @@ class Simulation {
   // Results do not depend on when it is rebuilt. For benchmarks and tests.
   void RebuildNeighbourList();
   std::size_t neighbour_pair_count() const;  // person-person pairs in the list
+  // The names of the run's behaviour terms, the parts of the drive stage
+  // its parameters switch on, in the order the drive asks them
+  // (engine/src/behaviour.hpp; "desired_velocity", "back_force", ...).
+  std::vector<std::string> BehaviourTermNames() const;
+  // The neighbour stage (stages.hpp), for tests and benchmarks: asks it for
+  // everyone's neighbours within `radius_m` (0..1000 m) from now on, as a
+  // behaviour term would (0: only what the run's terms ask for), and the
+  // people within `radius_m` (at most the radius asked for) of `person` at
+  // the last evaluation, every slot whatever its state, in increasing index.
+  void RequestNeighbours(double radius_m);
+  std::vector<std::uint32_t> NeighboursWithin(std::uint32_t person, double radius_m) const;
   // With false, the narrow phase forgets what it knows of pairs and vertices
   // still apart (temporal coherence) and measures every pair of the list at
   // every evaluation. The results are the same, bit for bit; for tests.
@@ -220,9 +231,8 @@ class Simulation {
   friend class detail::PairCollider;
   void Gather();
   void Drive();
-  void AverageBackForceTrigger();  // after each step (stage_drive.cpp)
-  void UpdatePerceivedVelocity();  // after each step (stage_drive.cpp)
-  void UpdateGiveWay();            // after each step (stage_drive.cpp)
+  void UpdateBehaviourTerms();  // after each step (stage_drive.cpp)
+  void Neighbours();
   void ComputeForces();
   void VerletKickDrift();
   void VerletKick();

@@ -6,15 +6,16 @@
 //   stage          file                              what it does
 //   update_pairs   engine/src/stage_update_pairs.cpp  Verlet neighbour lists (cells + skin), when people moved
 //   place_shapes   engine/src/stage_place_shapes.cpp  body-frame vertices -> world frame (sin, cos of each angle)
+//   neighbours     engine/src/stage_neighbours.cpp    people within the radius a behaviour term asks for (none: no cost)
 //   collide        engine/src/stage_collide.cpp       narrow phase + contact forces per pair (eqs. 7-14, 19)
 //   gather         engine/src/stage_gather.cpp        contact forces and torques onto bodies, fixed order (eq. 18)
-//   drive          engine/src/stage_drive.cpp         self-driven force (3), back force (15), torques (16-17), slope
+//   drive          engine/src/stage_drive.cpp         the behaviour terms (engine/src/behaviour.hpp): eqs. 3, 15-17, slope, ...
 //   integrate      engine/src/stage_integrate.cpp     velocity Verlet or Gear 5th-order predictor-corrector
 //   check          engine/src/stage_check.cpp         non-finite state, cores interpenetrating -> SimulationError
 //   choose_step    engine/src/stage_choose_step.cpp   the next step (TimeStepMode::kAdaptive only)
 //
 // With the velocity Verlet integrator a step is: integrate (kick + drift),
-// [choose_step,] then the force stages 1-5, then integrate (kick), then check. With Gear:
+// [choose_step,] then the force stages 1-6, then integrate (kick), then check. With Gear:
 // integrate (predict), force stages, integrate (correct), check.
 #pragma once
 
@@ -25,8 +26,18 @@
 
 namespace crowdrecon::engine {
 
-enum class Stage : std::uint8_t { kUpdatePairs, kPlaceShapes, kCollide, kGather, kDrive, kIntegrate, kCheck, kChooseStep };
-inline constexpr std::size_t kStageCount = 8;
+enum class Stage : std::uint8_t {
+  kUpdatePairs,
+  kPlaceShapes,
+  kNeighbours,
+  kCollide,
+  kGather,
+  kDrive,
+  kIntegrate,
+  kCheck,
+  kChooseStep
+};
+inline constexpr std::size_t kStageCount = 9;
 
 struct StageInfo {
   Stage stage;
@@ -37,9 +48,10 @@ struct StageInfo {
 inline constexpr std::array<StageInfo, kStageCount> kStages{{
     {Stage::kUpdatePairs, "update_pairs", "Verlet neighbour lists (cells + skin), rebuilt when people moved"},
     {Stage::kPlaceShapes, "place_shapes", "body-frame vertices to the world frame"},
+    {Stage::kNeighbours, "neighbours", "people within the radius a behaviour term asks for (none asks: no cost)"},
     {Stage::kCollide, "collide", "narrow phase and contact forces per pair (eqs. 7-14, 19)"},
     {Stage::kGather, "gather", "contact forces and torques onto bodies in a fixed order (eq. 18)"},
-    {Stage::kDrive, "drive", "self-driven force (3), back force (15), torques (16-17), slope"},
+    {Stage::kDrive, "drive", "the behaviour terms: self-driven force (3), back force (15), torques (16-17), slope, ..."},
     {Stage::kIntegrate, "integrate", "velocity Verlet or Gear 5th-order predictor-corrector"},
     {Stage::kCheck, "check", "non-finite state or interpenetrating cores: SimulationError"},
     {Stage::kChooseStep, "choose_step", "the next step from the approach speeds of pairs that may touch (adaptive)"},

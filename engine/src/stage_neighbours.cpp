@@ -1,0 +1,169 @@
+// Stage neighbours: the people within the radius a behaviour term asks for
+// (BehaviourTerm::neighbour_radius_m; the largest any active term asks for),
+// for interactions at a distance, which the contact stage's Verlet lists do
+// not reach (they hold pairs within their bounding radii plus a skin, about
+// 0.6 m apart; keeping a distance looks 2-3 m ahead). When no term asks, the
+// stage returns at once: no cost, no list.
+// (one of the stages of Simulation::Step; engine/include/crowdrecon/engine/stages.hpp)
+//
+// The list is a Verlet list of its own: candidates within radius + skin of
+// each person, found with a grid of cells of that size (minimum image in a
+// periodic box), and kept until someone has moved half the skin since it
+// was built; a term measures the distance itself. Every slot is listed,
+// whatever its state (a term reads the state), and a newcomer's slot moves
+// far, which rebuilds the list. Candidates are a superset of the people
+// within the radius whenever the list is used, so when it is rebuilt changes
+// no result; the list is built in one serial pass in a fixed order (the
+// same on any thread count) and is not in the checkpoint.
+#include "simulation_internals.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace crowdrecon::engine {
+
+using namespace detail;  // the stages' shared helpers (simulation_internals.hpp)
+
+namespace {
+
+// The skin: a person walking at 2 m/s crosses half of it in 0.1 s, some
+// hundred steps.
+constexpr double kNeighbourSkin_m = 0.4;
+
+// One axis of the grid: `count` cells of `size` from `origin`; along a
+// periodic axis they tile the period (and fewer than three cells are all
+// searched, so no candidate is missed or listed twice).
+struct GridAxis {
+  double origin = 0.0, size = 1.0;
+  std::int64_t count = 1;
+  bool periodic = false;
+  std::int64_t Cell(double x) const {
+    const auto c = static_cast<std::int64_t>(std::floor((x - origin) / size));
+    return periodic ? ((c % count) + count) % count : std::clamp<std::int64_t>(c, 0, count - 1);
+  }
+  // The cells next to c (c - 1, c, c + 1), each once.
+  int Around(std::int64_t c, std::int64_t out[3]) const {
+    if (periodic && count < 3) {
+      for (std::int64_t k = 0; k < count; ++k) out[k] = k;
+      return static_cast<int>(count);
+    }
+    int m = 0;
+    for (std::int64_t d = -1; d <= 1; ++d) {
+      std::int64_t k = c + d;
+      if (periodic) k = (k + count) % count;
+      if (k >= 0 && k < count) out[m++] = k;
+    }
+    return m;
+  }
+};
+
+GridAxis Axis(bool periodic, double box_min, double box_max, double low, double high, double cell) {
+  GridAxis a;
+  a.periodic = periodic;
+  if (periodic) {
+    a.origin = box_min;
+    a.count = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor((box_max - box_min) / cell)));
+    a.size = (box_max - box_min) / static_cast<double>(a.count);
+  } else {
+    a.origin = low;
+    a.size = cell;
+    a.count = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor((high - low) / cell)) + 1);
+    a.count = std::min<std::int64_t>(a.count, 1 << 20);  // (a world far larger than the radius: cells grow instead)
+    a.size = std::max(cell, (high - low) / static_cast<double>(a.count) * (1.0 + 1e-12));
+  }
+  return a;
+}
+
+}  // namespace
+
+void Simulation::Neighbours() {
+  Internals& in = *in_;
+  const double radius = std::max(in.terms.neighbour_radius_m, in.requested_neighbour_radius_m);
+  if (!(radius > 0.0)) {
+    if (!in.neighbours.empty()) in.neighbours = NeighbourList{};
+    return;
+  }
+  ScopedTimer timer(profile_.stage_s[Index(Stage::kNeighbours)]);
+  const std::size_t n = bodies_.size();
+  // Still valid: built for this radius, and nobody has moved half the skin since.
+  if (!in.neighbours.empty() && in.neighbours.radius_m == radius && in.neighbours_position_at_build.size() == n) {
+    const double half_skin = kNeighbourSkin_m / 2.0;
+    bool valid = true;
+    for (std::size_t i = 0; i < n && valid; ++i)
+      valid = Length(detail::Separation(def_.periodic, bodies_.position_m[i], in.neighbours_position_at_build[i])) <= half_skin;
+    if (valid) return;
+  }
+  const double reach = radius + kNeighbourSkin_m;
+  Vec2 low{0.0, 0.0}, high{0.0, 0.0};
+  if (n > 0) low = high = bodies_.position_m[0];
+  for (const Vec2& x : bodies_.position_m) {
+    low = {std::min(low.x, x.x), std::min(low.y, x.y)};
+    high = {std::max(high.x, x.x), std::max(high.y, x.y)};
+  }
+  const PeriodicBox& box = def_.periodic;
+  const GridAxis ax = Axis(box.x, box.min_m.x, box.max_m.x, low.x, high.x, reach);
+  const GridAxis ay = Axis(box.y, box.min_m.y, box.max_m.y, low.y, high.y, reach);
+  // People by cell (counting sort: within a cell in increasing index).
+  std::vector<std::uint32_t> cell_start(static_cast<std::size_t>(ax.count * ay.count) + 1, 0), cell_items(n);
+  std::vector<std::uint32_t> cell_of(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 x = bodies_.position_m[i];
+    cell_of[i] = static_cast<std::uint32_t>(ay.Cell(x.y) * ax.count + ax.Cell(x.x));
+    ++cell_start[cell_of[i] + 1];
+  }
+  for (std::size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
+  {
+    std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) cell_items[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  NeighbourList& list = in.neighbours;
+  list.radius_m = radius;
+  list.start.assign(n + 1, 0);
+  list.items.clear();
+  const double reach2 = reach * reach;
+  std::vector<std::uint32_t> mine;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 x = bodies_.position_m[i];
+    std::int64_t cx[3], cy[3];
+    const int mx = ax.Around(ax.Cell(x.x), cx), my = ay.Around(ay.Cell(x.y), cy);
+    mine.clear();
+    for (int a = 0; a < my; ++a)
+      for (int b = 0; b < mx; ++b) {
+        const auto c = static_cast<std::size_t>(cy[a] * ax.count + cx[b]);
+        for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
+          const std::uint32_t j = cell_items[k];
+          if (j == i) continue;
+          const Vec2 d = detail::Separation(box, x, bodies_.position_m[j]);
+          if (Dot(d, d) <= reach2) mine.push_back(j);
+        }
+      }
+    std::sort(mine.begin(), mine.end());
+    list.items.insert(list.items.end(), mine.begin(), mine.end());
+    list.start[i + 1] = static_cast<std::uint32_t>(list.items.size());
+  }
+  in.neighbours_position_at_build = bodies_.position_m;
+}
+
+void Simulation::RequestNeighbours(double radius_m) {
+  if (!(radius_m >= 0.0 && radius_m <= 1e3))
+    throw InputError("neighbour radius " + FormatNumber(radius_m) + " m, expected 0..1000 m");
+  in_->requested_neighbour_radius_m = radius_m;
+  in_->neighbours = NeighbourList{};
+  Neighbours();
+}
+
+std::vector<std::uint32_t> Simulation::NeighboursWithin(std::uint32_t person, double radius_m) const {
+  const NeighbourList& list = in_->neighbours;
+  if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
+  if (list.empty() || radius_m > list.radius_m)
+    throw InputError("the neighbour stage holds no list of radius " + FormatNumber(radius_m) + " m");
+  std::vector<std::uint32_t> within;
+  for (std::uint32_t k = list.start[person]; k < list.start[person + 1]; ++k) {
+    const std::uint32_t j = list.items[k];
+    if (Length(Separation(bodies_.position_m[person], bodies_.position_m[j])) <= radius_m) within.push_back(j);
+  }
+  return within;
+}
+
+}  // namespace crowdrecon::engine
