@@ -22,18 +22,21 @@ class BackForce final : public BehaviourTerm {
   unsigned phases() const override { return averaged_ ? kForce | kAfterStep : kForce; }
 
   void Force(const DriveInputs& in, DriveBlock& b) const override {
-    const ModelParameters& mp = in.def.parameters;
-    const double back_factor = mp.back_force_gamma * in.inverse_tau;  // Gamma / tau
+    const double inverse_tau = in.inverse_tau;
+    const double back_factor = in.def.parameters.back_force_gamma * inverse_tau;  // Gamma / tau
+    const Vec2* velocity = in.bodies.velocity_m_per_s.data() + b.first;
+    const double* averaged = averaged_ ? averaged_along_.data() + b.first : nullptr;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
-      const std::size_t i = b.first + k;
       const Vec2 e = b.direction[k];
-      const double along = averaged_ ? averaged_along_[i] : Dot(e, in.bodies.velocity_m_per_s[i]);
+      const double along = averaged != nullptr ? averaged[k] : Dot(e, velocity[k]);
+      if (!(-along > 0.0)) continue;  // pushed backwards only
+      const std::size_t i = b.first + k;
       double back = back_factor;
       if (const std::uint32_t g = in.bodies.group[i]; g < in.group_gamma.size() && !std::isnan(in.group_gamma[g]))
-        back = in.group_gamma[g] * in.inverse_tau;
+        back = in.group_gamma[g] * inverse_tau;
       // Along e plus e x k, which points to the person's right.
-      if (-along > 0.0) b.force[k] += (e + Vec2{e.y, -e.x}) * (back * in.bodies.mass_kg[i] * in.bodies.desired_speed_m_per_s[i]);
+      b.force[k] += (e + Vec2{e.y, -e.x}) * (back * in.bodies.mass_kg[i] * in.bodies.desired_speed_m_per_s[i]);
     }
   }
 

@@ -11,11 +11,10 @@ class DesiredVelocity final : public BehaviourTerm {
  public:
   unsigned phases() const override { return kForce; }
   void Force(const DriveInputs& in, DriveBlock& b) const override {
-    for (std::size_t k = 0; k < b.count; ++k) {
-      if (!b.driven[k]) continue;
-      const double m = in.bodies.mass_kg[b.first + k];
-      b.force[k] += (b.direction[k] * b.pace[k] - b.from[k]) * (m * in.inverse_tau);  // eq. (3)
-    }
+    const double inverse_tau = in.inverse_tau;
+    const double* mass = in.bodies.mass_kg.data() + b.first;
+    for (std::size_t k = 0; k < b.count; ++k)
+      if (b.driven[k]) b.force[k] += (b.direction[k] * b.pace[k] - b.from[k]) * (mass[k] * inverse_tau);  // eq. (3)
   }
 };
 

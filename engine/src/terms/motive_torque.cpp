@@ -21,28 +21,31 @@ class MotiveTorque final : public BehaviourTerm {
 
   void Facing(const DriveInputs& in, DriveBlock& b) const override {
     const bool face_velocity = in.def.parameters.facing_target == FacingTarget::kVelocity;
+    const Vec2* velocity = in.bodies.velocity_m_per_s.data() + b.first;
+    const double* desired_speed = in.bodies.desired_speed_m_per_s.data() + b.first;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
-      const std::size_t i = b.first + k;
-      const Vec2 v = in.bodies.velocity_m_per_s[i];
+      const Vec2 v = velocity[k];
       // Only the direction of the facing matters to the angle (atan2 of two
       // products with it), so the velocity needs no normalising.
       b.facing[k] = face_velocity ? v : b.direction[k];
-      const double v0 = in.bodies.desired_speed_m_per_s[i];
+      const double v0 = desired_speed[k];
       b.gain[k] = v0 > 0.0 ? 1.0 - std::exp(-Length(v) / v0) : 1.0;
     }
   }
 
   void Force(const DriveInputs& in, DriveBlock& b) const override {
-    const ModelParameters& mp = in.def.parameters;
-    const double torsion_factor = mp.torsion_stiffness_lambda * in.inverse_tau * in.inverse_tau;  // lambda / tau^2
+    const double inverse_tau = in.inverse_tau;
+    const double torsion_factor = in.def.parameters.torsion_stiffness_lambda * inverse_tau * inverse_tau;  // lambda / tau^2
+    const double* inertia = in.bodies.inertia_kg_m2.data() + b.first;
+    const bool groups = !in.group_lambda.empty();
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k] || !b.turning[k]) continue;
-      const std::size_t i = b.first + k;
       double torsion = torsion_factor;
-      if (const std::uint32_t g = in.bodies.group[i]; g < in.group_lambda.size() && !std::isnan(in.group_lambda[g]))
-        torsion = in.group_lambda[g] * in.inverse_tau * in.inverse_tau;
-      b.torque[k] += torsion * in.bodies.inertia_kg_m2[i] * b.gain[k] * b.angle[k];
+      if (groups)
+        if (const std::uint32_t g = in.bodies.group[b.first + k]; g < in.group_lambda.size() && !std::isnan(in.group_lambda[g]))
+          torsion = in.group_lambda[g] * inverse_tau * inverse_tau;
+      b.torque[k] += torsion * inertia[k] * b.gain[k] * b.angle[k];
     }
   }
 };

@@ -10,11 +10,10 @@ class RotationalDamping final : public BehaviourTerm {
   unsigned phases() const override { return kForce; }
   void Force(const DriveInputs& in, DriveBlock& b) const override {
     const double rotation_damping = 1.0 / in.def.parameters.rotation_relaxation_time_s;
-    for (std::size_t k = 0; k < b.count; ++k) {
-      if (!b.driven[k]) continue;
-      const std::size_t i = b.first + k;
-      b.torque[k] -= in.bodies.inertia_kg_m2[i] * rotation_damping * in.bodies.angular_velocity_rad_per_s[i];
-    }
+    const double* inertia = in.bodies.inertia_kg_m2.data() + b.first;
+    const double* omega = in.bodies.angular_velocity_rad_per_s.data() + b.first;
+    for (std::size_t k = 0; k < b.count; ++k)
+      if (b.driven[k]) b.torque[k] -= inertia[k] * rotation_damping * omega[k];
   }
 };
 
