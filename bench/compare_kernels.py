@@ -32,7 +32,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import bench_common as bc  # noqa: E402
 
 
-def run_kernels(exe, pattern, min_time):
+def run_kernels(exe, pattern, min_time, stage=None):
     command = [str(exe), f"--benchmark_filter={pattern}", f"--benchmark_min_time={min_time}", "--benchmark_format=json"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
@@ -49,6 +49,8 @@ def run_kernels(exe, pattern, min_time):
             continue
         results[b["name"]] = {"real_time": b["real_time"], "time_unit": b.get("time_unit", "ns"),
                               "contacts": b.get("contacts")}
+        if stage:
+            results[b["name"]]["stage_ms"] = b.get(f"{stage}_ms")
     if not results:
         bc.fail(f"{exe}: no benchmark matches the filter {pattern!r}")
     return results
@@ -59,6 +61,8 @@ def main():
     bc.add_comparison_arguments(p, "crowdrecon_bench_kernels")
     p.add_argument("--filter", required=True, help="Google Benchmark filter (regular expression)")
     p.add_argument("--min-time", type=float, default=1.0, help="--benchmark_min_time, seconds (default: %(default)s)")
+    p.add_argument("--stage", help="also compare one engine stage's time per step (a Step benchmark's counter "
+                   "STAGE_ms, e.g. drive), with its own paired ratio")
     args = p.parse_args()
 
     builds = bc.parse_builds(args)
@@ -68,7 +72,7 @@ def main():
     runs = []  # dicts: rep, build, results
     for rep in range(args.repeat):
         for name, exe in builds:
-            results = run_kernels(exe, args.filter, args.min_time)
+            results = run_kernels(exe, args.filter, args.min_time, args.stage)
             runs.append({"rep": rep, "build": name, "results": results})
             for bench, r in results.items():
                 print(f"  {rep + 1}/{args.repeat} {name:>10} {bench}: {r['real_time']:.4g} {r['time_unit']}", file=sys.stderr)
@@ -94,8 +98,19 @@ def main():
             else:
                 paired = [a / b for a, b in zip(ref, times)]
                 row.append(f"{bc.median(ref) / bc.median(times):.2f}× (paired {bc.median(paired):.2f}×)")
+            if args.stage:
+                stage = [x for x in pick(name, "stage_ms") if x is not None]
+                ref_stage = [x for x in pick(reference, "stage_ms") if x is not None]
+                row.append(f"{bc.median(stage) * 1e3:.4g} µs" if stage else "")
+                if stage and ref_stage and name != reference:
+                    paired = [a / b for a, b in zip(ref_stage, stage)]
+                    row.append(f"{bc.median(ref_stage) / bc.median(stage):.2f}× (paired {bc.median(paired):.2f}×)")
+                else:
+                    row.append("")
             rows.append(row)
     header = ["benchmark", "build", "time (median)", "range", "contacts", f"speed-up over {reference}"]
+    if args.stage:
+        header += [f"{args.stage} per step (median)", f"{args.stage} speed-up over {reference}"]
     table = bc.markdown_table(header, rows)
     print(table)
     notes = [f"- builds: " + ", ".join(f"{name} = `{exe}`" for name, exe in builds),
