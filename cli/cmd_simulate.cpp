@@ -56,6 +56,7 @@ int RunSimulate(const SimulateArgs& args) {
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.log_progress_every_s = LogProgressEvery(args.log_every_s, args.quiet);
   options.stop_after_s = args.stop_after_s;
+  for (const std::string& line : sc.settings_without_effect) std::printf("note: %s\n", line.c_str());
   scenario::InstallInterruptHandlers();
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
   std::printf("scenario: %s\n", sc.name.c_str());

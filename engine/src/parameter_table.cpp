@@ -53,6 +53,13 @@ ParameterInfo Flag(const char* name, bool P::*field, const char* source, const c
   return info;
 }
 
+// `info`, acting only when `when` ("give_way = where_room") holds.
+ParameterInfo When(ParameterInfo info, const char* when, bool (*applies)(const P&)) {
+  info.applies_when = when;
+  info.applies = applies;
+  return info;
+}
+
 // An enumeration whose values are 0..N-1, named `choices`.
 template <auto Field, std::size_t N>
 ParameterInfo Choice(const char* name, const char* const (&choices)[N], const char* source, const char* meaning) {
@@ -83,8 +90,9 @@ auto MakeTable() {
              "epsilon of person-wall contacts (a scenario without it uses restitution)", "restitution"),
       Choice<&P::tangential_damping>("tangential_damping", kTangentialDampingChoices, "ERRATA 2",
              "how gamma_t is set: from the restitution with k_t, equal to gamma_n, or fixed"),
-      Number("tangential_damping_rate_per_s", &P::tangential_damping_rate_per_s, "1/s", 0.0, 1e6, "ERRATA 2",
+      When(Number("tangential_damping_rate_per_s", &P::tangential_damping_rate_per_s, "1/s", 0.0, 1e6, "ERRATA 2",
              "gamma_t when tangential_damping is fixed"),
+           "tangential_damping = fixed", [](const P& p) { return p.tangential_damping == TangentialDamping::kFixed; }),
       Choice<&P::tangential_spring>("tangential_spring", kTangentialSpringChoices, "eqs. 9-10; issue 19",
              "history: the tangential spring accumulates while a contact lasts (static friction); none: only "
              "the tangential dashpot of eq. 12; creeping: as history, relaxing over "
@@ -101,8 +109,9 @@ auto MakeTable() {
       Choice<&P::back_force_trigger>("back_force_trigger", kBackForceTriggerChoices, "eq. 15; issue 19",
              "what Theta of eq. 15 reads: the instantaneous velocity along e (the paper), or that velocity "
              "averaged over back_force_reaction_time_s"),
-      Number("back_force_reaction_time_s", &P::back_force_reaction_time_s, "s", 0.01, 10.0, "issue 19",
+      When(Number("back_force_reaction_time_s", &P::back_force_reaction_time_s, "s", 0.01, 10.0, "issue 19",
              "time constant of the averaged velocity of back_force_trigger = averaged_velocity (about one step)"),
+           "back_force_trigger = averaged_velocity", [](const P& p) { return p.back_force_trigger == BackForceTrigger::kAveragedVelocity; }),
       // --- Torques (eqs. 16-17) ---
       Number("torsion_stiffness_lambda", &P::torsion_stiffness_lambda, "", 0.0, 1e4, "Table 1 (fitted to footage)",
              "lambda, torsion stiffness of the motive torque (eq. 16; ERRATA 4)"),
@@ -124,74 +133,103 @@ auto MakeTable() {
              "velocity Verlet (default) or Gear's fifth-order predictor-corrector (the paper's code)"),
       Number("time_step_s", &P::time_step_s, "s", 0.0, 0.1, "ERRATA 12",
              "time step; 0: chosen by the engine from every stiffness and the lightest body"),
-      Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
+      When(Number("time_step_safety", &P::time_step_safety, "", 1e-4, 1.0, "ERRATA 12",
              "the engine's step as a fraction of the integrator's stability limit"),
+           "time_step_s = 0", [](const P& p) { return p.time_step_s == 0.0; }),
       Choice<&P::time_step_mode>("time_step_mode", kTimeStepModeChoices, "issue 42",
              "fixed: one step for the whole run; adaptive: the step doubled (up to adaptive_max_safety of the "
              "stability limit) while no pair approaches fast enough for its restitution to suffer (velocity "
              "Verlet only)"),
-      Number("adaptive_max_safety", &P::adaptive_max_safety, "", 1e-4, 0.5, "issue 42 (docs/decisions.md)",
+      When(Number("adaptive_max_safety", &P::adaptive_max_safety, "", 1e-4, 0.5, "issue 42 (docs/decisions.md)",
              "the largest adaptive step as a fraction of the stability limit (a jam's contact network is up "
              "to ~2.5 times stiffer than one pair)"),
-      Number("adaptive_reference_speed_m_per_s", &P::adaptive_reference_speed_m_per_s, "m/s", 0.0, 20.0,
+           "time_step_mode = adaptive", [](const P& p) { return p.time_step_mode == TimeStepMode::kAdaptive; }),
+      When(Number("adaptive_reference_speed_m_per_s", &P::adaptive_reference_speed_m_per_s, "m/s", 0.0, 20.0,
              "issue 42 (docs/decisions.md)",
              "collisions up to this speed keep the fixed step's restitution accuracy, slower ones its absolute "
              "velocity error; 0: the fastest desired speed of the people"),
+           "time_step_mode = adaptive", [](const P& p) { return p.time_step_mode == TimeStepMode::kAdaptive; }),
       // --- Extensions beyond the paper (issue 39; off by default) ---
       Choice<&P::gait_jitter>("gait_jitter", kGaitJitterChoices, "issue 39; Wuppertal trajectories",
              "none: eq. 3 as printed; isotropic: eq. 3's desired velocity plus a band-limited random velocity "
              "on both axes (people shifting and stepping in place)"),
-      Number("gait_jitter_velocity_m_per_s", &P::gait_jitter_velocity_m_per_s, "m/s", 0.0, 5.0,
-             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)",
+      When(Number("gait_jitter_velocity_m_per_s", &P::gait_jitter_velocity_m_per_s, "m/s", 0.0, 5.0,
+             "Wuppertal 2018 bottleneck (studies/wuppertal-bottleneck/gait-jitter-from-data.py)",
              "sigma_u, standard deviation per axis of the jitter's velocity"),
-      Number("gait_jitter_band_low_hz", &P::gait_jitter_band_low_hz, "Hz", 0.01, 20.0,
-             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)", "lowest frequency of the jitter"),
-      Number("gait_jitter_band_high_hz", &P::gait_jitter_band_high_hz, "Hz", 0.01, 20.0,
-             "Wuppertal 2018 bottleneck (scripts/gait-jitter-from-data.py)",
+           "gait_jitter = isotropic", [](const P& p) { return p.gait_jitter == GaitJitter::kIsotropic; }),
+      When(Number("gait_jitter_band_low_hz", &P::gait_jitter_band_low_hz, "Hz", 0.01, 20.0,
+             "Wuppertal 2018 bottleneck (studies/wuppertal-bottleneck/gait-jitter-from-data.py)", "lowest frequency of the jitter"),
+           "gait_jitter = isotropic", [](const P& p) { return p.gait_jitter == GaitJitter::kIsotropic; }),
+      When(Number("gait_jitter_band_high_hz", &P::gait_jitter_band_high_hz, "Hz", 0.01, 20.0,
+             "Wuppertal 2018 bottleneck (studies/wuppertal-bottleneck/gait-jitter-from-data.py)",
              "highest frequency of the jitter (at least the lowest)"),
-      Number("gait_jitter_seed", &P::gait_jitter_seed, "", 0.0, 4503599627370496.0, "crowdrecon",
+           "gait_jitter = isotropic", [](const P& p) { return p.gait_jitter == GaitJitter::kIsotropic; }),
+      When(Number("gait_jitter_seed", &P::gait_jitter_seed, "", 0.0, 4503599627370496.0, "crowdrecon",
              "whole number: the seed of each person's jitter (a scenario without it uses population.seed "
              "modulo 2^52)"),
+           "gait_jitter = isotropic", [](const P& p) { return p.gait_jitter == GaitJitter::kIsotropic; }),
       Choice<&P::yielding>("yielding", kWhenBlockedChoices, "issue 39; Wuppertal trajectories",
              "none: eq. 3 as printed; when_blocked: a person pushed back against the desired direction by a "
              "contact with a person drives toward yielding_push_share times the desired speed (walls do not count)"),
-      Number("yielding_push_share", &P::yielding_push_share, "", 0.0, 1.0,
-             "Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
+      When(Number("yielding_push_share", &P::yielding_push_share, "", 0.0, 1.0,
+             "Wuppertal 2018 bottleneck (studies/wuppertal-bottleneck/bottleneck-study.py)",
              "share of the desired speed a blocked person still drives toward (1: the paper's push)"),
-      Number("tangential_spring_relaxation_time_s", &P::tangential_spring_relaxation_time_s, "s", 1e-3, 1e4,
-             "issue 39; Wuppertal 2018 bottleneck (scripts/bottleneck-study.py)",
+           "yielding = when_blocked", [](const P& p) { return p.yielding == Yielding::kWhenBlocked; }),
+      When(Number("tangential_spring_relaxation_time_s", &P::tangential_spring_relaxation_time_s, "s", 1e-3, 1e4,
+             "issue 39; Wuppertal 2018 bottleneck (studies/wuppertal-bottleneck/bottleneck-study.py)",
              "T of tangential_spring = creeping: a contact held at rest loses its tangential elastic force as exp(-t/T)"),
+           "tangential_spring = creeping", [](const P& p) { return p.tangential_spring == TangentialSpring::kCreeping; }),
       Choice<&P::shoulder_turn>("shoulder_turn", kWhenBlockedChoices,
              "issue 39; Yamamoto et al. 2019 (passing in narrow corridors)",
              "none: eq. 16 as printed; when_blocked: a person pushed back against the desired direction by a "
              "person ahead is turned (eq. 16's torque at full gain) toward the desired direction rotated by "
              "shoulder_turn_angle_deg, to the nearer side"),
-      Number("shoulder_turn_angle_deg", &P::shoulder_turn_angle_deg, "deg", 0.0, 90.0,
+      When(Number("shoulder_turn_angle_deg", &P::shoulder_turn_angle_deg, "deg", 0.0, 90.0,
              "issue 39; Yamamoto et al. 2019",
              "how far a blocked person turns from the desired direction (90: sideways, a shoulder first)"),
+           "shoulder_turn = when_blocked", [](const P& p) { return p.shoulder_turn == ShoulderTurn::kWhenBlocked; }),
       Choice<&P::give_way>("give_way", kGiveWayChoices, "issue 39 (candidate b); issue 19's give-up",
              "none: the paper's model; where_room: a person blocked for give_way_blocked_s who touches at most "
              "give_way_max_contacts people, most heading against them, walks their way for give_way_duration_s"),
-      Number("give_way_blocked_s", &P::give_way_blocked_s, "s", 0.1, 600.0, "issue 19's give-up",
+      When(Number("give_way_blocked_s", &P::give_way_blocked_s, "s", 0.1, 600.0, "issue 19's give-up",
              "how long a person is blocked (velocity along the desired direction, averaged over 1 s, below "
              "give_way_speed_m_per_s) before giving way"),
-      Number("give_way_speed_m_per_s", &P::give_way_speed_m_per_s, "m/s", 0.0, 2.0, "issue 19's give-up",
+           "give_way = where_room", [](const P& p) { return p.give_way == GiveWay::kWhereRoom; }),
+      When(Number("give_way_speed_m_per_s", &P::give_way_speed_m_per_s, "m/s", 0.0, 2.0, "issue 19's give-up",
              "below this averaged velocity along the desired direction a person is blocked"),
-      Number("give_way_duration_s", &P::give_way_duration_s, "s", 0.1, 600.0, "issue 19's give-up",
+           "give_way = where_room", [](const P& p) { return p.give_way == GiveWay::kWhereRoom; }),
+      When(Number("give_way_duration_s", &P::give_way_duration_s, "s", 0.1, 600.0, "issue 19's give-up",
              "how long a person who gives way walks with the people against them"),
-      Number("give_way_max_contacts", &P::give_way_max_contacts, "", 0.0, 20.0, "issue 39 (candidate b)",
+           "give_way = where_room", [](const P& p) { return p.give_way == GiveWay::kWhereRoom; }),
+      When(Number("give_way_max_contacts", &P::give_way_max_contacts, "", 0.0, 20.0, "issue 39 (candidate b)",
              "whole number: a person touching more people than this has no room to turn and does not give way"),
+           "give_way = where_room", [](const P& p) { return p.give_way == GiveWay::kWhereRoom; }),
       Choice<&P::drive_reaction>("drive_reaction", kDriveReactionChoices,
-             "issue 39; Juelich corridors (scripts/reaction-time-from-data.py)",
+             "issue 39; Juelich corridors (studies/reaction-time/reaction-time-from-data.py)",
              "instant: eq. 3 as printed, from this step's velocity; lagged: eq. 3 from the velocity perceived "
              "with a first-order lag of drive_reaction_time_s (a reaction time)"),
-      Number("drive_reaction_time_s", &P::drive_reaction_time_s, "s", 0.01, 10.0,
-             "Juelich corridors (scripts/reaction-time-from-data.py)",
+      When(Number("drive_reaction_time_s", &P::drive_reaction_time_s, "s", 0.01, 10.0,
+             "Juelich corridors (studies/reaction-time/reaction-time-from-data.py)",
              "T of drive_reaction = lagged: the time constant (and mean delay) of the perceived velocity"),
+           "drive_reaction = lagged", [](const P& p) { return p.drive_reaction == DriveReaction::kLagged; }),
   };
 }
 
 }  // namespace
+
+std::vector<std::string> SettingsWithoutEffect(const ModelParameters& p, const std::vector<std::string>& given) {
+  std::vector<std::string> lines;
+  for (const std::string& key : given) {
+    const ParameterInfo* info = FindModelParameter(key);
+    if (info == nullptr || info->applies == nullptr || info->applies(p)) continue;
+    const std::string when = info->applies_when;
+    const std::string switch_name = when.substr(0, when.find(" = "));
+    std::string here;
+    if (const ParameterInfo* sw = FindModelParameter(switch_name)) here = " (here " + switch_name + " is " + sw->ValueText(p) + ")";
+    lines.push_back("model." + key + " changes nothing: it acts only when " + when + here);
+  }
+  return lines;
+}
 
 std::span<const ParameterInfo> ModelParameterTable() {
   static const auto table = MakeTable();

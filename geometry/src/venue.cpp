@@ -339,9 +339,14 @@ class VenueReader {
 
   static Vec2 ReadDirection(const JsonReader& direction) {
     const Vec2 d = direction.AsPoint();
-    if (Length(d) < 1e-12)
+    const double largest = std::max(std::abs(d.x), std::abs(d.y));
+    if (!(largest > 0.0))
       direction.Fail("the direction " + direction.ValueText() + " has zero length; expected a non-zero vector [x, y]");
-    return Normalized(d);
+    // A length that overflows or underflows (components of 1e308, or 1e-200)
+    // is taken of the vector scaled by its largest component: the same
+    // direction (issue 65: [1e308, 1e308] became (0, 0), a slope that pulled nowhere).
+    const double length = Length(d);
+    return std::isfinite(length) && length >= 1e-12 ? Normalized(d) : Normalized(Vec2{d.x / largest, d.y / largest});
   }
 
   JsonReader root_;

@@ -164,6 +164,22 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     std::string error;
     if (!s.model.IsValid(&error)) root.At("model").Fail(error);
   }
+  // Settings that change nothing here (issue 65): an extension's numbers
+  // while it is off, and a floor slope's settings while the floor is level.
+  if (auto model = root.Find("model")) {
+    s.settings_without_effect = engine::SettingsWithoutEffect(s.model, model->Keys());
+    const bool sloping = s.venue.slope && s.venue.slope->enabled && s.venue.slope->gradient > 0.0;
+    const std::string level =
+        !s.venue.slope ? "the venue has no slope" : !s.venue.slope->enabled ? "the slope is off (slope.enabled false)"
+                                                                          : "the slope's gradient is 0";
+    for (const char* key : {"slope_response", "gravity_m_per_s2"})
+      if (!sloping && model->Has(key))
+        s.settings_without_effect.push_back(std::string("model.") + key + " changes nothing: the floor is level here: " +
+                                            level);
+  }
+  if (auto slope = root.Find("slope"); slope && slope->Has("gradient") && s.venue.slope && !s.venue.slope->enabled)
+    s.settings_without_effect.push_back("slope.gradient changes nothing: the slope is off (slope.enabled false; "
+                                        "\"enabled\": true switches it on)");
 
   if (auto run = root.Find("run")) {
     s.run.duration_s = run->Number("duration_s", s.run.duration_s, 0.0, 1e6);

@@ -450,8 +450,20 @@ scenario::Scenario RunScenarioOf(const SweepSpec& spec, const RunPlan& run) {
   }
 }
 
-void ValidateRuns(const SweepSpec& spec, const std::vector<RunPlan>& runs) {
-  for (const RunPlan& r : runs) (void)RunScenarioOf(spec, r);
+std::vector<std::string> ValidateRuns(const SweepSpec& spec, const std::vector<RunPlan>& runs) {
+  std::vector<std::pair<std::string, std::size_t>> seen;  // in the order first met
+  for (const RunPlan& r : runs)
+    for (const std::string& line : RunScenarioOf(spec, r).settings_without_effect) {
+      auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& x) { return x.first == line; });
+      if (it == seen.end())
+        seen.emplace_back(line, 1);
+      else
+        ++it->second;
+    }
+  std::vector<std::string> notes;
+  for (const auto& [line, count] : seen)
+    notes.push_back(line + " (in " + std::to_string(count) + " of " + std::to_string(runs.size()) + " runs)");
+  return notes;
 }
 
 }  // namespace crowdrecon::sweep

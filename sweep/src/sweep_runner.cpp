@@ -251,7 +251,9 @@ SweepSetup SetUpSweep(const SweepOptions& options, int rank) {
   try {
     setup.spec = LoadSweep(options.sweep_file);
     setup.runs = ExpandRuns(setup.spec);
-    ValidateRuns(setup.spec, setup.runs);
+    const std::vector<std::string> notes = ValidateRuns(setup.spec, setup.runs);
+    if (rank == 0)
+      for (const std::string& note : notes) std::fprintf(stderr, "crowdrecon: note: %s\n", note.c_str());
     CreateOutputFolder(setup.runs_dir);
     if (rank == 0)
       setup.store = std::make_unique<ResultsStore>(options.output_dir, setup.spec, setup.runs, analysis::OptionsToJson({}));

@@ -31,7 +31,7 @@ done
 echo "my own notes" > notes/notes.txt
 echo "my own notes" > notes.txt
 # A copy of the scripts without the data folder ../shared/data beside it.
-mkdir -p norepo/main && cp -r "$root/scripts" norepo/main/
+mkdir -p norepo/main/studies && cp -r "$root/scripts" norepo/main/ && cp -r "$root/studies/wuppertal-bottleneck" norepo/main/studies/
 
 snapshot() {  # every entry (type, name, link target) and every file's sha256
   (cd "$s" && find . -mindepth 1 -printf '%y %p %l\n' | LC_ALL=C sort &&
@@ -86,7 +86,7 @@ refused "sweep-ensembles: -o DIR/results (the sweep's results.csv), --force" "is
 refused "scenario-with: OUT is SCENARIO" "is an input" -- "$py" "$S/scenario-with.py" scenario.json ./scenario.json population.seed=2
 refused "night-path: -o a hard link to the run" "is an input" -- "$py" "$D/night-cheap-model/night-path.py" run.sqlite -o hard.sqlite
 refused "reaction-time-from-data: -o the run through a link" "is an input" -- \
-  "$py" "$S/reaction-time-from-data.py" run.sqlite -o link.sqlite --bootstrap 5
+  "$py" "$D/reaction-time/reaction-time-from-data.py" run.sqlite -o link.sqlite --bootstrap 5
 refused "decision_study: OUT_DIR the sweep's results.csv" "is an input" -- \
   "$py" "$D/open-decisions/decision_study.py" /bin/true hallway-sweep hallway-sweep/results.csv
 
@@ -105,10 +105,10 @@ refused "calibration-coverage: --truths 0" "argument --truths" -- \
 refused "itaewon-envelope: a hallway sweep" "not of the Itaewon alley" -- \
   "$py" "$D/itaewon-design-envelope/itaewon-envelope.py" hallway-sweep -o envelope
 refused "bottleneck-study: no ../shared/data beside the repository" "\.\./shared/data" -- \
-  "$py" norepo/main/scripts/bottleneck-study.py /bin/true study
+  "$py" norepo/main/studies/wuppertal-bottleneck/bottleneck-study.py /bin/true study
 refused "gait-jitter-from-data: no ../shared/data beside the repository" "\.\./shared/data" -- \
-  "$py" norepo/main/scripts/gait-jitter-from-data.py
-refused "gait-jitter-from-data: a JSON file as trajectories" "PeTrack" -- "$py" "$S/gait-jitter-from-data.py" scenario.json
+  "$py" norepo/main/studies/wuppertal-bottleneck/gait-jitter-from-data.py
+refused "gait-jitter-from-data: a JSON file as trajectories" "PeTrack" -- "$py" "$D/wuppertal-bottleneck/gait-jitter-from-data.py" scenario.json
 refused "sweep-ensembles: a variant the sweep lacks" "has no variant" -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way three-way -o cmp
 refused "phase-table: a folder that is not a sweep" "not a crowdrecon sweep folder" -- "$py" "$S/phase-table.py" notes

@@ -178,6 +178,16 @@ TEST(Venue, TheItaewonAlleySlopesInsideItsRegion) {
   EXPECT_NE(ParseError(std::string(kRoom) + R"(, "slope": {"direction": [1, 0], "gradient": 0.1, "region": [[0, 0], [1, 0]]})")
                 .find("/slope/region"),
             std::string::npos);
+  // A direction whose length overflows or underflows is still its direction
+  // (issue 65: [1e308, 1e308] was read as (0, 0), a slope that pulled nowhere).
+  for (const auto& [text, expected] : {std::pair{"[1e308, 1e308]", Vec2{std::sqrt(0.5), std::sqrt(0.5)}},
+                                       std::pair{"[1e200, -1e200]", Vec2{std::sqrt(0.5), -std::sqrt(0.5)}},
+                                       std::pair{"[0, 1e-300]", Vec2{0.0, 1.0}}}) {
+    const Venue t = ParseVenue("{" + std::string(kRoom) + R"(, "slope": {"direction": )" + text + R"(, "gradient": 0.1}})",
+                               "tilted.json");
+    EXPECT_NEAR(t.slope->direction.x, expected.x, 1e-15) << text;
+    EXPECT_NEAR(t.slope->direction.y, expected.y, 1e-15) << text;
+  }
 }
 
 // The Itaewon alley's building fronts are walls with a thickness drawn outside

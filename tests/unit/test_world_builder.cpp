@@ -59,5 +59,26 @@ TEST(WorldBuilder, TheScenarioSetsTheSlopesGradient) {
   EXPECT_NE(error.find("has no slope"), std::string::npos) << error;
 }
 
+// Settings that change nothing are said (issue 65, the adversarial pass's
+// A24, B05, L03): an extension's numbers while it is off, a slope's gradient
+// while the slope is off, how people meet a slope on a level floor; none when
+// they act.
+TEST(WorldBuilder, SettingsThatChangeNothingAreSaid) {
+  const std::string dir = std::string(CROWDRECON_SOURCE_DIR) + "/venues/itaewon/scenarios";
+  const std::string body = R"({"format": "crowdrecon-scenario", "version": 1, "venue": "../alley.json",
+    "population": {"count": 20, "target": "to_station", "body": {"mode": "circle"}}, "run": {"duration_s": 1}, )";
+  const Scenario off = ParseScenario(body + R"("model": {"give_way_blocked_s": 3, "yielding": "when_blocked",
+    "yielding_push_share": 0.5, "slope_response": "held"}, "slope": {"gradient": 0.1, "enabled": false}})", "off.json", dir);
+  ASSERT_EQ(off.settings_without_effect.size(), 3u);
+  EXPECT_EQ(off.settings_without_effect[0],
+            "model.give_way_blocked_s changes nothing: it acts only when give_way = where_room (here give_way is none)");
+  EXPECT_EQ(off.settings_without_effect[1],
+            "model.slope_response changes nothing: the floor is level here: the slope is off (slope.enabled false)");
+  EXPECT_NE(off.settings_without_effect[2].find("slope.gradient changes nothing: the slope is off"), std::string::npos);
+  const Scenario on = ParseScenario(body + R"("model": {"give_way": "where_room", "give_way_blocked_s": 3,
+    "slope_response": "held"}, "slope": {"gradient": 0.1}})", "on.json", dir);
+  EXPECT_TRUE(on.settings_without_effect.empty()) << on.settings_without_effect[0];
+}
+
 }  // namespace
 }  // namespace crowdrecon::scenario

@@ -3,7 +3,7 @@
 // person's own stationary random velocity of standard deviation
 // gait_jitter_velocity_m_per_s per axis, flat in the band gait_jitter_band_*
 // (the sway of the gait, measured from the Juelich trajectories:
-// scripts/gait-jitter-from-data.py), so the force m u_i(t) / tau.
+// studies/wuppertal-bottleneck/gait-jitter-from-data.py), so the force m u_i(t) / tau.
 //
 // u_i(t) per axis is sigma sqrt(2/K) sum_k cos(2 pi (f_k t + phi_k)), f_k
 // uniform in the band and phi_k uniform in [0, 1), drawn from the seed and

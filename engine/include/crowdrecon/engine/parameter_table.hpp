@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "crowdrecon/engine/parameters.hpp"
 
@@ -32,6 +33,11 @@ struct ParameterInfo {
   // this one (read before it), rather than its own default.
   const char* default_from = nullptr;
 
+  // The setting under which it acts at all ("give_way = where_room": a
+  // number of an extension, of an option), and the test of it; null: always.
+  const char* applies_when = nullptr;
+  bool (*applies)(const ModelParameters&) = nullptr;
+
   // kFlag.
   bool ModelParameters::*flag = nullptr;
 
@@ -51,6 +57,12 @@ struct ParameterInfo {
 std::span<const ParameterInfo> ModelParameterTable();
 // The entry named `name`, or nullptr.
 const ParameterInfo* FindModelParameter(const std::string& name);
+
+// Of the parameters named in `given` (the keys a scenario's "model" sets),
+// those that change nothing under `p`, each as one line: "model.give_way_blocked_s
+// changes nothing: it acts only when give_way = where_room (here give_way is
+// none)". Empty when every given setting acts.
+std::vector<std::string> SettingsWithoutEffect(const ModelParameters& p, const std::vector<std::string>& given);
 
 // The table as the Markdown of docs/model.md ("| name | unit | default |
 // range | source | meaning |"), one row per parameter.

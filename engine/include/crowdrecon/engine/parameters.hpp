@@ -45,7 +45,7 @@ enum class TangentialSpring {
 // (issue 39; docs/decisions.md, "Issue 39: gait jitter"): people in a dense
 // crowd shift their weight and step in place, so their desired velocity is
 // not exactly v0 e_i. Measured in the Wuppertal bottleneck's waiting crowd
-// (scripts/gait-jitter-from-data.py).
+// (studies/wuppertal-bottleneck/gait-jitter-from-data.py).
 enum class GaitJitter {
   kNone,        // the paper's eq. (3): the desired velocity is v0 e_i (default)
   kIsotropic,   // eq. (3) with v0 e_i + u_i(t), u_i band-limited noise on both axes
@@ -87,7 +87,7 @@ enum class GiveWay {
 // eq. (3) relaxes toward v0 e_i from the velocity of this very step, so a
 // person whose way clears pushes off at once and one who is stopped stops
 // pushing at once. People react to the person ahead with a delay (measured in
-// the Juelich corridors: scripts/reaction-time-from-data.py), which
+// the Juelich corridors: studies/reaction-time/reaction-time-from-data.py), which
 // follow-the-leader models turn into stop-and-go waves.
 enum class DriveReaction {
   kInstant,  // the paper's eq. (3): m/tau (v0 e_i - v_i) (default)

@@ -72,6 +72,11 @@ struct RunSpec {
 struct Scenario {
   std::string name;
   std::vector<std::string> notes;  // "notes": assumptions and their sources (free text)
+  // Settings the file gives that change nothing here, each as one line that
+  // says why ("model.give_way_blocked_s changes nothing: it acts only when
+  // give_way = where_room (here give_way is none)"; a slope's gradient while
+  // the slope is off): the commands print them as notes.
+  std::vector<std::string> settings_without_effect;
   std::filesystem::path file;  // where it was read from ("" if from text)
   std::string json_text;       // as given (kept in the run file)
   std::filesystem::path venue_file;

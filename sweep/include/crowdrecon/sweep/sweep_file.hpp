@@ -121,8 +121,10 @@ std::string RunScenarioJson(const SweepSpec& spec, const RunPlan& run);
 scenario::Scenario RunScenarioOf(const SweepSpec& spec, const RunPlan& run);
 
 // Reads every run's scenario once, so that a bad override fails before any
-// run starts. Throws the first run's InputError.
-void ValidateRuns(const SweepSpec& spec, const std::vector<RunPlan>& runs);
+// run starts. Throws the first run's InputError. Returns the settings that
+// change nothing (Scenario::settings_without_effect), each once, with the
+// number of runs it concerns ("... (in 6 of 6 runs)").
+std::vector<std::string> ValidateRuns(const SweepSpec& spec, const std::vector<RunPlan>& runs);
 
 // Value `index` of `axis` as shown in tables and pictures: numbers in their
 // shortest exact form, strings as they are, anything else as compact JSON.

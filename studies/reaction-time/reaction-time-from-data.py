@@ -102,7 +102,7 @@ bootstrap resamples people across seeds).  What differs from the PeTrack path, a
     grid, the bootstrap, the sensitivity table.  A summary table of all sections (data and runs) comes
     first when there are simulated runs; without them the report is as before.
 
-usage: scripts/reaction-time-from-data.py [TRAJECTORIES.txt ...] [RUN.sqlite ...] [--pool]
+usage: studies/reaction-time/reaction-time-from-data.py [TRAJECTORIES.txt ...] [RUN.sqlite ...] [--pool]
          [--sweep DIR [--variants A,B]] [--from-s 30] [--periodic-area cut|whole]
          [-o REPORT.md] [--bootstrap 2000]
   (default: ../shared/data/juelich-uni/traj_UNI_CORR_500_01.txt and ../shared/data/juelich-bfr/bi_corr_400_b_03.txt;
@@ -124,11 +124,13 @@ import re
 import sqlite3
 import sys
 
-from petrack import read_petrack  # (this folder: the scripts are run as files, so it is on the path)
-import script_guard as guard
-
 HERE = os.path.dirname(os.path.abspath(__file__))
-DATA = os.path.join(HERE, '..', '..', 'shared', 'data')
+ROOT = os.path.dirname(os.path.dirname(HERE))  # studies/NAME/ is two levels down
+sys.path.insert(0, os.path.join(ROOT, 'scripts'))
+from petrack import read_petrack  # noqa: E402  (scripts/: the PeTrack reader the studies share)
+import script_guard as guard  # noqa: E402
+
+DATA = os.path.join(ROOT, '..', 'shared', 'data')
 DEFAULT_FILES = [os.path.join(DATA, 'juelich-uni', 'traj_UNI_CORR_500_01.txt'),
                  os.path.join(DATA, 'juelich-bfr', 'bi_corr_400_b_03.txt')]
 
@@ -909,14 +911,14 @@ def main():
     rep = Report()
     rep.heading('Reaction time from the Jülich corridor trajectories' if not groups else
                 'Reaction time: Jülich corridor trajectories and simulated runs', 1)
-    rep.para('Made by `scripts/reaction-time-from-data.py` (method, biases: its header). Follower: a person; '
+    rep.para('Made by `studies/reaction-time/reaction-time-from-data.py` (method, biases: its header). Follower: a person; '
              f'leader: the nearest person ahead walking the same way, |dy| < {BAND_M} m, ahead < {AHEAD_M} m, '
              f'both in the measurement area ({END_CUT_M} m off each end of the corridor), for ≥ {MIN_PAIR_S:g} s. '
              f'r(L): correlation of the follower\'s speed with the leader\'s L earlier (each minus its segment '
              f'mean), averaged over segments weighted by length. T_r: time constant of the exponential filter '
              f'of the leader\'s speed that correlates best with the follower\'s. Intervals: bootstrap over '
              f'followers, {args.bootstrap} resamples.')
-    rep.para('Regenerate: `python3 scripts/reaction-time-from-data.py '
+    rep.para('Regenerate: `python3 studies/reaction-time/reaction-time-from-data.py '
              + ' '.join(os.path.relpath(f, root) for f in (petrack + sims if args.files else petrack))
              + (' --pool' if args.pool else '')
              + (f' --sweep {os.path.relpath(args.sweep, root)}' if args.sweep else '')

@@ -18,7 +18,7 @@ high by its share; a person among neighbours moves less than a free one
 under the same u, so sigma_u is too low by the crowd's resistance.  Both are
 stated with the result, neither is corrected.
 
-usage: scripts/gait-jitter-from-data.py [TRAJECTORIES.txt]  (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)
+usage: studies/wuppertal-bottleneck/gait-jitter-from-data.py [TRAJECTORIES.txt]  (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)
 The default needs the data folder ../shared/data beside the repository (its
 README says where the files come from); without it, or with a file that is not
 a PeTrack trajectory file or has no standing windows, the script says so in
@@ -29,7 +29,8 @@ import math
 import os
 import sys
 
-import script_guard as guard  # (this folder: the scripts are run as files, so it is on the path)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), 'scripts'))
+import script_guard as guard  # noqa: E402  (scripts/)
 
 TAU_S = 2.0 / 3.0          # relaxation time of eq. 3 (paper)
 FPS = 25.0
@@ -69,7 +70,7 @@ def periodogram(values):
 
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
-    default = os.path.join(here, '..', '..', 'shared', 'data', 'juelich-bottleneck', '040_c_56_h-.txt')
+    default = os.path.join(here, '..', '..', '..', 'shared', 'data', 'juelich-bottleneck', '040_c_56_h-.txt')
     p = guard.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument('trajectories', nargs='?', type=guard.existing_file,
                    help='a PeTrack trajectory file (default: ../shared/data/juelich-bottleneck/040_c_56_h-.txt)')
