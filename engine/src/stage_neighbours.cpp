@@ -58,20 +58,18 @@ struct GridAxis {
   }
 };
 
-GridAxis Axis(bool periodic, double box_min, double box_max, double low, double high, double cell) {
+// Cells of at least `cell` (the reach), at most `most` of them along the
+// axis (so that people spread over a wide world need no more cells than
+// there are people: a cell then holds more than the reach).
+GridAxis Axis(bool periodic, double box_min, double box_max, double low, double high, double cell, std::int64_t most) {
   GridAxis a;
   a.periodic = periodic;
-  if (periodic) {
-    a.origin = box_min;
-    a.count = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor((box_max - box_min) / cell)));
-    a.size = (box_max - box_min) / static_cast<double>(a.count);
-  } else {
-    a.origin = low;
-    a.size = cell;
-    a.count = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor((high - low) / cell)) + 1);
-    a.count = std::min<std::int64_t>(a.count, 1 << 20);  // (a world far larger than the radius: cells grow instead)
-    a.size = std::max(cell, (high - low) / static_cast<double>(a.count) * (1.0 + 1e-12));
-  }
+  const double extent = periodic ? box_max - box_min : high - low;
+  const double fit = std::floor(extent / cell);
+  a.count = std::clamp<std::int64_t>(fit < static_cast<double>(most) ? static_cast<std::int64_t>(fit) : most, 1, most);
+  a.origin = periodic ? box_min : low;
+  if (!periodic) ++a.count;  // (the last person's cell, at `high`)
+  a.size = periodic ? extent / static_cast<double>(a.count) : std::max(cell, extent / static_cast<double>(a.count - 1));
   return a;
 }
 
@@ -102,8 +100,9 @@ void Simulation::Neighbours() {
     high = {std::max(high.x, x.x), std::max(high.y, x.y)};
   }
   const PeriodicBox& box = def_.periodic;
-  const GridAxis ax = Axis(box.x, box.min_m.x, box.max_m.x, low.x, high.x, reach);
-  const GridAxis ay = Axis(box.y, box.min_m.y, box.max_m.y, low.y, high.y, reach);
+  const auto most = static_cast<std::int64_t>(std::sqrt(4.0 * static_cast<double>(n))) + 1;
+  const GridAxis ax = Axis(box.x, box.min_m.x, box.max_m.x, low.x, high.x, reach, most);
+  const GridAxis ay = Axis(box.y, box.min_m.y, box.max_m.y, low.y, high.y, reach, most);
   // People by cell (counting sort: within a cell in increasing index).
   std::vector<std::uint32_t> cell_start(static_cast<std::size_t>(ax.count * ay.count) + 1, 0), cell_items(n);
   std::vector<std::uint32_t> cell_of(n);

@@ -154,6 +154,20 @@ TEST(NeighbourStage, FindsExactlyThePeopleWithinTheRadiusInAnOpenWorldAndAPeriod
   ExpectNeighboursAsBruteForce(true);
 }
 
+TEST(NeighbourStage, PeopleFarApartNeedNoMoreCellsThanPeople) {
+  WorldDef def = Walkers(ModelParameters{}, 2);
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[1].position_m = {1.0, 0.5};
+  def.people[2].position_m = {1e7, -1e7};  // a grid of 2 m cells would have 5e6 x 5e6 of them
+  def.people[3].position_m = {1e7 + 1.5, -1e7};
+  Simulation sim(def);
+  sim.RequestNeighbours(2.0);
+  EXPECT_EQ(sim.NeighboursWithin(0, 2.0), (std::vector<std::uint32_t>{1}));
+  EXPECT_EQ(sim.NeighboursWithin(3, 2.0), (std::vector<std::uint32_t>{2}));
+  EXPECT_TRUE(sim.NeighboursWithin(2, 1.0).empty());
+}
+
 TEST(NeighbourStage, CostsNothingAndListsNothingWhenNoTermAsks) {
   Simulation sim(Walkers(ModelParameters{}));
   sim.AdvanceTo(0.05);
