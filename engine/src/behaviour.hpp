@@ -12,8 +12,10 @@
 // block:
 //
 //   phase      what a term may change            terms (list order)
-//   direction  e_i, where the person heads         giving_way
-//   desire     the desired speed (pace) and the   yielding, reaction_time, floor_slope (held)
+//   direction  e_i, where the person wants to go   giving_way
+//   steer      the heading eq. 3 drives along      headway
+//              (e_i unless a term steers)
+//   desire     the desired speed (pace) and the   yielding, reaction_time, floor_slope (held), headway (its cap)
 //              velocity eq. 3 relaxes from
 //   facing     where the body turns, eq. 16's gain motive_torque, shoulder_turn
 //   (the drive: theta_D - theta of every facing)
@@ -81,6 +83,8 @@ struct DriveBlock {
   std::size_t first = 0, count = 0;
   bool driven[kDriveBlock];      // walking, with the ground reaction on: the terms act on these only
   Vec2 direction[kDriveBlock];   // e_i (the target's direction; the direction phase may change it)
+  Vec2 heading[kDriveBlock];     // the direction eq. (3) drives along: e_i, unless the steer phase turns it
+                                 // (e_i stays where the person wants to go: the back force and the facing read it)
   double pace[kDriveBlock];      // the desired speed of eq. (3) (v0_i; the desire phase may change it)
   Vec2 from[kDriveBlock];        // the velocity eq. (3) relaxes from (v_i; the desire phase may change it)
   Vec2 facing[kDriveBlock];      // where the body turns (only its direction matters; zero: nowhere)
@@ -102,7 +106,7 @@ struct StepInputs {
 
 class BehaviourTerm {
  public:
-  enum Phase : unsigned { kDirection = 1u, kDesire = 2u, kFacing = 4u, kForce = 8u, kAfterStep = 16u };
+  enum Phase : unsigned { kDirection = 1u, kDesire = 2u, kFacing = 4u, kForce = 8u, kAfterStep = 16u, kSteer = 32u };
   virtual ~BehaviourTerm() = default;
   // The phases it takes part in (a sum of Phase).
   virtual unsigned phases() const = 0;
@@ -112,6 +116,7 @@ class BehaviourTerm {
   virtual double neighbour_radius_m() const { return 0.0; }
 
   virtual void Direction(const DriveInputs&, DriveBlock&) const {}
+  virtual void Steer(const DriveInputs&, DriveBlock&) const {}
   virtual void Desire(const DriveInputs&, DriveBlock&) const {}
   virtual void Facing(const DriveInputs&, DriveBlock&) const {}
   virtual void Force(const DriveInputs&, DriveBlock&) const {}
@@ -151,7 +156,7 @@ struct ActiveTerms {
     std::unique_ptr<BehaviourTerm> term;
   };
   std::vector<Active> terms;
-  std::vector<const BehaviourTerm*> direction, desire, facing, force;
+  std::vector<const BehaviourTerm*> direction, steer, desire, facing, force;
   std::vector<BehaviourTerm*> after_step, stateful;
   std::vector<const char*> stateful_names;
   bool people_ahead = false;

@@ -101,8 +101,15 @@ void GetTermStatesV5(StateReader& r, const ActiveTerms& terms, std::size_t peopl
       if (std::string(terms.stateful_names[t]) == legacy) terms.stateful[t]->Load(r, people);
 }
 
-// The model parameters, every entry of the parameter table in its order.
+// The model parameters, every entry of the parameter table in its order
+// after their count (version 6; version 5 wrote the first
+// kParametersOfVersion5 entries without it). A checkpoint with fewer entries
+// than this build's table (new parameters are appended to the table) leaves
+// the others at the run's values.
+constexpr std::size_t kParametersOfVersion5 = 42;
+
 void PutParameters(StateWriter& w, const ModelParameters& p) {
+  w.Put(static_cast<std::uint64_t>(ModelParameterTable().size()));
   for (const ParameterInfo& info : ModelParameterTable()) {
     switch (info.kind) {
       case ParameterInfo::Kind::kNumber: w.Put(p.*info.number); break;
@@ -112,8 +119,12 @@ void PutParameters(StateWriter& w, const ModelParameters& p) {
   }
 }
 
-ModelParameters GetParameters(StateReader& r, ModelParameters p) {
-  for (const ParameterInfo& info : ModelParameterTable()) {
+ModelParameters GetParameters(StateReader& r, ModelParameters p, bool v5) {
+  const std::size_t count = v5 ? kParametersOfVersion5 : r.Get<std::uint64_t>();
+  if (count > ModelParameterTable().size())
+    throw InputError("checkpoint: holds " + std::to_string(count) + " model parameters, this build knows " +
+                     std::to_string(ModelParameterTable().size()) + " (written by a newer crowdrecon?)");
+  for (const ParameterInfo& info : ModelParameterTable().first(count)) {
     switch (info.kind) {
       case ParameterInfo::Kind::kNumber: p.*info.number = r.Get<double>(); break;
       case ParameterInfo::Kind::kFlag: p.*info.flag = r.Get<std::uint8_t>() != 0; break;
@@ -287,7 +298,7 @@ void Simulation::LoadState(const std::string& data) {
     r.GetVector(in_->group_lambda);
     if (in_->group_gamma.size() != in_->group_lambda.size() || in_->group_gamma.size() > 1024)
       throw InputError("checkpoint: damaged per-group drive");
-    const ModelParameters p = GetParameters(r, def_.parameters);
+    const ModelParameters p = GetParameters(r, def_.parameters, v5);
     std::string error;
     if (!p.IsValid(&error)) throw InputError("checkpoint: damaged model parameters: " + error);
     def_.parameters = p;

@@ -27,6 +27,7 @@ constexpr const char* kWhenBlockedChoices[] = {"none", "when_blocked"};
 constexpr const char* kGiveWayChoices[] = {"none", "where_room"};
 constexpr const char* kSlopeResponseChoices[] = {"body_force", "held"};
 constexpr const char* kDriveReactionChoices[] = {"instant", "lagged"};
+constexpr const char* kHeadwayChoices[] = {"none", "time_gap"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -212,6 +213,23 @@ auto MakeTable() {
              "Juelich corridors (studies/reaction-time/reaction-time-from-data.py)",
              "T of drive_reaction = lagged: the time constant (and mean delay) of the perceived velocity"),
            "drive_reaction = lagged", [](const P& p) { return p.drive_reaction == DriveReaction::kLagged; }),
+      // --- Keeping a distance (issue 64; off by default; appended: checkpoints read the table's first entries) ---
+      Choice<&P::headway>("headway", kHeadwayChoices,
+             "issue 64; Tordeux, Chraibi and Seyfried 2016 (the collision-free speed model)",
+             "none: eq. 3 as printed; time_gap: the desired direction turned away from near people and the desired "
+             "speed capped by the headway to the person ahead, max(0, (s - headway_length_m) / headway_time_gap_s)"),
+      When(Number("headway_time_gap_s", &P::headway_time_gap_s, "s", 0.01, 10.0,
+                  "Tordeux et al. 2016; JuPedSim's default", "T, the time gap kept to the person ahead"),
+           "headway = time_gap", [](const P& p) { return p.headway == Headway::kTimeGap; }),
+      When(Number("headway_length_m", &P::headway_length_m, "m", 0.0, 2.0, "Tordeux et al. 2016; JuPedSim's default",
+                  "l, the centre distance at which the capped speed is zero, and the width of the lane ahead"),
+           "headway = time_gap", [](const P& p) { return p.headway == Headway::kTimeGap; }),
+      When(Number("headway_repulsion_strength", &P::headway_repulsion_strength, "", 0.0, 1e3,
+                  "Tordeux et al. 2016; JuPedSim's default", "a, how strongly near people turn the desired direction"),
+           "headway = time_gap", [](const P& p) { return p.headway == Headway::kTimeGap; }),
+      When(Number("headway_repulsion_range_m", &P::headway_repulsion_range_m, "m", 0.001, 2.0,
+                  "Tordeux et al. 2016; JuPedSim's default", "D, the range of that turning"),
+           "headway = time_gap", [](const P& p) { return p.headway == Headway::kTimeGap; }),
   };
 }
 

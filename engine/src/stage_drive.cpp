@@ -94,6 +94,8 @@ void Simulation::Drive() {
       b.from[k] = bodies_.velocity_m_per_s[i];
     }
     for (const BehaviourTerm* t : terms.direction) t->Direction(inputs, b);
+    for (std::size_t k = 0; k < b.count; ++k) b.heading[k] = b.direction[k];
+    for (const BehaviourTerm* t : terms.steer) t->Steer(inputs, b);
     for (const BehaviourTerm* t : terms.desire) t->Desire(inputs, b);
     for (const BehaviourTerm* t : terms.facing) t->Facing(inputs, b);
     // theta_D - theta wrapped to (-pi, pi], from the body's orientation (cos,

@@ -51,7 +51,7 @@ TEST(FuzzSeeds, TheWorldAndCheckpointSeedsAreInTheCurrentFormats) {
 TEST(FuzzSeeds, AStateOfTheFormerFormatIsRefusedAsSuch) {
   const WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
   std::string state = Read(kStateSeed);
-  ASSERT_EQ(state.substr(0, 8), "CRSTATE5");
+  ASSERT_EQ(state.substr(0, 8), "CRSTATE6");
   state[7] = '2';
   Simulation sim(world);
   try {
@@ -60,6 +60,26 @@ TEST(FuzzSeeds, AStateOfTheFormerFormatIsRefusedAsSuch) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("written by an older crowdrecon (state format 2"), std::string::npos) << e.what();
   }
+}
+
+// A checkpoint of format 5 (before the behaviour terms' sections and the
+// parameters' count; tests/data/checkpoints/, the seed as the build of
+// 7df3dee wrote it) is still read, and holds the same state as the seed of
+// format 6 written from the same world by this build: a run checkpointed
+// before the change resumes after it.
+TEST(FuzzSeeds, ACheckpointOfFormat5IsStillRead) {
+  const WorldDef world = LoadWorld(WithChecksum(Read(kWorldSeed)), kWorldSeed);
+  const std::string v5 = Read(std::string(CROWDRECON_SOURCE_DIR) +
+                              "/tests/data/checkpoints/gas-2x2-colliding-after-40-steps.v5.state-nochecksum");
+  ASSERT_EQ(v5.substr(0, 8), "CRSTATE5");
+  Simulation old_format(world), new_format(world);
+  old_format.LoadState(WithChecksum(v5));
+  new_format.LoadState(WithChecksum(Read(kStateSeed)));
+  for (int step = 0; step < 3; ++step) {
+    old_format.Step();
+    new_format.Step();
+  }
+  EXPECT_EQ(old_format.SaveState(), new_format.SaveState());
 }
 
 // The checkpoint seed: the world seed's people drawn together (positions 0.7

@@ -1,7 +1,8 @@
 // Term desired_velocity: the self-driven force of eq. (3),
 // m_i (v0_i e_i - v_i) / tau, from the block's pace (v0_i, or what the desire
-// phase made of it) and the velocity it relaxes from (v_i, or the perceived
-// velocity of reaction_time). The paper's; always on.
+// phase made of it), its heading (e_i, or where the steer phase turned it)
+// and the velocity it relaxes from (v_i, or the perceived velocity of
+// reaction_time). The paper's; always on.
 #include "../behaviour.hpp"
 
 namespace crowdrecon::engine::detail {
@@ -14,7 +15,7 @@ class DesiredVelocity final : public BehaviourTerm {
     const double inverse_tau = in.inverse_tau;
     const double* mass = in.bodies.mass_kg.data() + b.first;
     for (std::size_t k = 0; k < b.count; ++k)
-      if (b.driven[k]) b.force[k] += (b.direction[k] * b.pace[k] - b.from[k]) * (mass[k] * inverse_tau);  // eq. (3)
+      if (b.driven[k]) b.force[k] += (b.heading[k] * b.pace[k] - b.from[k]) * (mass[k] * inverse_tau);  // eq. (3)
   }
 };
 

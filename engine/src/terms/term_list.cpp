@@ -19,7 +19,8 @@
   X("motive_torque", MakeMotiveTorque, "the motive torque lambda I / tau^2 g (theta_D - theta), eq. (16)")        \
   X("shoulder_turn", MakeShoulderTurn, "a person held up by people ahead turns a shoulder into the way (issue 39)") \
   X("rotational_damping", MakeRotationalDamping, "the rotational damping -I omega / tau_r, eq. (17)")             \
-  X("floor_slope", MakeFloorSlope, "a sloping floor pulls people, or their legs hold it and their pace follows the grade (issue 43)")
+  X("floor_slope", MakeFloorSlope, "a sloping floor pulls people, or their legs hold it and their pace follows the grade (issue 43)") \
+  X("headway", MakeHeadway, "keeping a distance: e turned away from near people, v0 capped by the headway (issue 64)")
 
 namespace crowdrecon::engine::detail {
 
@@ -64,6 +65,7 @@ ActiveTerms ActiveTerms::For(const ModelParameters& parameters, const WorldDef& 
     BehaviourTerm* term = t.term.get();
     const unsigned phases = term->phases();
     if (phases & BehaviourTerm::kDirection) a.direction.push_back(term);
+    if (phases & BehaviourTerm::kSteer) a.steer.push_back(term);
     if (phases & BehaviourTerm::kDesire) a.desire.push_back(term);
     if (phases & BehaviourTerm::kFacing) a.facing.push_back(term);
     if (phases & BehaviourTerm::kForce) a.force.push_back(term);

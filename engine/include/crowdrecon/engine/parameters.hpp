@@ -94,6 +94,18 @@ enum class DriveReaction {
   kLagged,   // m/tau (v0 e_i - w_i), w_i the velocity perceived with a first-order lag of drive_reaction_time_s
 };
 
+// Keeping a distance from the people ahead (issue 64; off by default): the
+// paper's people interact only by touching, so at walking densities they run
+// into each other in files (a headway of 0.19 m where the Juelich corridor's
+// people keep 0.97 m). The collision-free speed model's two rules (Tordeux,
+// Chraibi and Seyfried 2016; JuPedSim's default model), as a behaviour term
+// beside the contact forces: the desired direction turned away from near
+// people, and the desired speed capped by the headway to the person ahead.
+enum class Headway {
+  kNone,     // the paper's eq. (3) (default)
+  kTimeGap,  // e_i + sum_j a exp((l - d_ij)/D) n_ji normalised; v0_i capped at max(0, (s_i - l)/T)
+};
+
 // How a sloping floor acts on walking people (issue 43; docs/itaewon.md).
 enum class SlopeResponse {
   kBodyForce,  // issue 19: m g sin(theta) downhill on every walking person (default; eq. 3 alone holds it)
@@ -192,6 +204,19 @@ struct ModelParameters {
   // this filter is T.
   DriveReaction drive_reaction = DriveReaction::kInstant;
   double drive_reaction_time_s = 0.5;
+
+  // --- Keeping a distance (issue 64; off by default) ------------------------
+  // Headway::kTimeGap: s_i the distance to the nearest person ahead along e_i
+  // whose centre lies within headway_length_m of e_i's line; the desired
+  // speed capped at max(0, (s_i - l) / T), l = headway_length_m, T =
+  // headway_time_gap_s; e_i turned by a exp((l - d_ij) / D) away from each
+  // person j at d_ij (a = headway_repulsion_strength, D = headway_repulsion_range_m).
+  // Defaults: JuPedSim's collision-free speed model (T 1 s, l 0.4 m, a 8, D 0.1 m).
+  Headway headway = Headway::kNone;
+  double headway_time_gap_s = 1.0;
+  double headway_length_m = 0.4;
+  double headway_repulsion_strength = 8.0;
+  double headway_repulsion_range_m = 0.1;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)

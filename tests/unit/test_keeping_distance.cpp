@@ -1,0 +1,161 @@
+// Keeping a distance (issue 64): the behaviour term headway (the
+// collision-free speed model's two rules, Tordeux, Chraibi and Seyfried 2016)
+// against what its equations give: a file of walkers in a ring walks at the
+// model's fundamental diagram, min(v0, (1/rho - l) / T); the desired
+// heading is turned away from a person beside by exactly a exp((l - d)/D);
+// a walker meeting a standing person never touches them; off, the paper's
+// model bit for bit; the same on any thread count and after a resume.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "crowdrecon/engine/simulation.hpp"
+#include "engine_scenes.hpp"
+
+namespace crowdrecon::engine {
+namespace {
+
+using testing::SetMassFromShape;
+using testing::ThoraxLikeShape;
+
+ModelParameters KeepingDistance() {
+  ModelParameters p;
+  p.headway = Headway::kTimeGap;
+  return p;  // JuPedSim's values: T 1 s, l 0.4 m, a 8, D 0.1 m
+}
+
+// `count` walkers in a file along x at `spacing_m`, in a ring (periodic in x),
+// heading +x at `v0`, facing it, at rest.
+WorldDef File(int count, double spacing_m, double v0, const ModelParameters& parameters) {
+  WorldDef def;
+  def.parameters = parameters;
+  def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
+  def.shapes.push_back(ThoraxLikeShape());
+  for (int i = 0; i < count; ++i) {
+    PersonDef p;
+    SetMassFromShape(def.shapes[0], 1000.0, p);
+    p.position_m = {(i + 0.5) * spacing_m, 0.0};
+    p.desired_speed_m_per_s = v0;
+    def.people.push_back(p);
+  }
+  def.periodic.x = true;
+  def.periodic.min_m = {0.0, -5.0};
+  def.periodic.max_m = {count * spacing_m, 5.0};
+  return def;
+}
+
+TEST(Headway, AFileInARingWalksAtTheModelsFundamentalDiagram) {
+  const ModelParameters p = KeepingDistance();
+  for (const double spacing : {0.6, 1.0, 1.3, 2.0}) {
+    const double v0 = 1.2;
+    const double expected = std::min(v0, (spacing - p.headway_length_m) / p.headway_time_gap_s);
+    Simulation sim(File(12, spacing, v0, p));
+    sim.AdvanceTo(20.0);  // many relaxation times
+    for (std::size_t i = 0; i < sim.bodies().size(); ++i) {
+      EXPECT_NEAR(sim.bodies().velocity_m_per_s[i].x, expected, 1e-6) << "spacing " << spacing << ", person " << i;
+      EXPECT_NEAR(sim.bodies().velocity_m_per_s[i].y, 0.0, 1e-9);
+    }
+    EXPECT_TRUE(sim.contacts().empty()) << "spacing " << spacing;
+  }
+}
+
+TEST(Headway, TheHeadingTurnsAwayFromAPersonBesideAsTheModelSays) {
+  // A walker at rest at the origin heading +x, a standing person 0.5 m to its
+  // left: at rest eq. (3)'s force is m/tau v0 e', e' = (1, 0) - a e^((l-d)/D) (0, 1) normalised.
+  WorldDef def = File(1, 10.0, 1.0, KeepingDistance());
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  PersonDef beside = def.people[0];
+  beside.position_m = {0.0, 0.5};
+  beside.desired_speed_m_per_s = 0.0;
+  beside.state = PersonState::kFallen;  // (an obstacle: it does not move itself)
+  def.people.push_back(beside);
+  const Simulation sim(def);
+  const ModelParameters& p = def.parameters;
+  const double push = p.headway_repulsion_strength * std::exp((p.headway_length_m - 0.5) / p.headway_repulsion_range_m);
+  const Vec2 expected = Normalized(Vec2{1.0, -push});
+  const Vec2 f = sim.bodies().force_n[0];
+  EXPECT_NEAR(f.x / Length(f), expected.x, 1e-12);
+  EXPECT_NEAR(f.y / Length(f), expected.y, 1e-12);
+  // Its size: m/tau v0 (no cap: the person beside is not ahead).
+  EXPECT_NEAR(Length(f), def.people[0].mass_kg / p.relaxation_time_s * 1.0, 1e-9);
+}
+
+// A walker meeting a standing person on its line: the paper's walker runs
+// into them; keeping a distance, it slows to a stop short of them (the cap),
+// is turned back by them within l + D ln a (0.61 m), and the back force of
+// eq. (15), which that first step back triggers, takes it round them to its
+// right (e x k): it never touches them, and walks on.
+TEST(Headway, AWalkerMeetingAStandingPersonNeverTouchesThem) {
+  for (const bool keep : {false, true}) {
+    WorldDef def = File(1, 10.0, 1.2, keep ? KeepingDistance() : ModelParameters{});
+    def.periodic = PeriodicBox{};
+    def.people[0].position_m = {0.0, 0.0};
+    PersonDef ahead = def.people[0];
+    ahead.position_m = {3.0, 0.0};
+    ahead.desired_speed_m_per_s = 0.0;
+    def.people.push_back(ahead);
+    Simulation sim(def);
+    bool touched = false;
+    double closest = 3.0, slowest_before_passing = 1.2;
+    while (sim.time_s() < 10.0) {
+      sim.Step();
+      touched = touched || !sim.contacts().empty();
+      const Vec2 d = sim.bodies().position_m[1] - sim.bodies().position_m[0];
+      closest = std::min(closest, Length(d));
+      if (d.x > 0.0) slowest_before_passing = std::min(slowest_before_passing, Length(sim.bodies().velocity_m_per_s[0]));
+    }
+    if (keep) {
+      EXPECT_FALSE(touched);
+      EXPECT_GT(closest, KeepingDistance().headway_length_m);  // the cap stops it before l
+      EXPECT_LT(slowest_before_passing, 0.05);                 // it stopped first
+      EXPECT_LT(sim.bodies().position_m[0].y, -0.4);           // then went round to its right
+      EXPECT_GT(sim.bodies().position_m[0].x, 5.0);            // and walked on
+    } else {
+      EXPECT_TRUE(touched);  // the paper's walker runs into the person ahead
+    }
+  }
+}
+
+TEST(Headway, OffIsThePapersModelBitForBit) {
+  ModelParameters off;  // headway none, its numbers changed: nothing changes
+  off.headway_time_gap_s = 2.0;
+  off.headway_length_m = 0.9;
+  WorldDef a = testing::RandomGas(6, 0.45, 5, true), b = a;
+  a.parameters.ground_reaction = b.parameters.ground_reaction = true;
+  b.parameters.headway_time_gap_s = off.headway_time_gap_s;
+  b.parameters.headway_length_m = off.headway_length_m;
+  Simulation sa(a), sb(b);
+  sa.AdvanceTo(0.4);
+  sb.AdvanceTo(0.4);
+  const std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(sa.bodies().position_m.data(), sb.bodies().position_m.data(), bytes), 0);
+  EXPECT_EQ(sb.profile().seconds(Stage::kNeighbours), 0.0);  // and the neighbour stage costs nothing
+}
+
+TEST(Headway, SameOnAnyThreadCountAndAfterAResume) {
+  WorldDef def = testing::RandomGas(24, 0.5, 3, true);  // 576 people: the drive runs on threads
+  def.parameters = KeepingDistance();
+  for (PersonDef& p : def.people) p.desired_speed_m_per_s = 1.2;
+  def.threads = 1;
+  Simulation one(def);
+  one.AdvanceTo(0.1);
+  const std::string state = one.SaveState();
+  one.AdvanceTo(0.2);
+  def.threads = 2;
+  Simulation two(def);
+  two.AdvanceTo(0.2);
+  Simulation resumed(def);
+  resumed.LoadState(state);
+  resumed.AdvanceTo(0.2);
+  const std::size_t bytes = one.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+}
+
+}  // namespace
+}  // namespace crowdrecon::engine
