@@ -13,6 +13,7 @@
 #include "option_checks.hpp"
 #include "crowdrecon/calibrate/calibrate.hpp"
 #include "crowdrecon/common/output_path.hpp"
+#include "crowdrecon/common/scoped_signals.hpp"
 
 namespace crowdrecon::cli {
 
@@ -39,7 +40,7 @@ int RunCalibrateCommand(const CalibrateArgs& args) {
   // MPI ranks other than 0 say nothing, but exit as rank 0 does (every rank
   // learns from it whether the calibration was interrupted).
   if (s.coordinator) std::printf("%s", s.BriefReport().c_str());
-  return s.interrupted ? 130 : 0;
+  return s.interrupted ? StoppedExitStatus() : 0;  // 143 after SIGTERM, 130 after Ctrl-C
 }
 
 }  // namespace

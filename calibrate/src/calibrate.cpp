@@ -37,7 +37,10 @@ const std::vector<double> kBandwidths{0.15, 0.25, 0.4, 0.7, std::numeric_limits<
 // handlers while they run and hand these back; the stages between them
 // (bootstrap, profiles, the posterior, the footage) poll the flag.
 std::atomic<bool> g_stop_calibration{false};
-extern "C" void OnCalibrationSignal(int) { g_stop_calibration.store(true); }
+extern "C" void OnCalibrationSignal(int signal) {
+  RecordStopSignal(signal);
+  g_stop_calibration.store(true);
+}
 
 // An evaluation was interrupted (Ctrl-C, SIGTERM): the calibration stops
 // and resumes from its cache when run again.

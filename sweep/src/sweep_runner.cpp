@@ -55,7 +55,8 @@ static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs 
 // losing the request (a calibration would go on to its next batch).
 std::atomic<bool> g_signalled{false};
 
-extern "C" void OnSweepSignal(int) {
+extern "C" void OnSweepSignal(int signal) {
+  RecordStopSignal(signal);
   g_signalled.store(true);
   g_stop.store(true);
 }

@@ -31,7 +31,8 @@ for signal in INT TERM; do
   if kill -0 $pid 2>/dev/null; then echo "sigint_background.sh: SIG$signal not answered within 5 s"; kill -9 $pid; exit 1; fi
   wait $pid; rc=$?
   echo "SIG$signal in the posterior: exit $rc"
-  [[ $rc -eq 130 ]] || { cat "$d/err.txt" "$d/out.txt"; echo "sigint_background.sh: exit $rc, expected 130"; exit 1; }
+  expected=$([[ $signal == TERM ]] && echo 143 || echo 130)
+  [[ $rc -eq $expected ]] || { cat "$d/err.txt" "$d/out.txt"; echo "sigint_background.sh: exit $rc, expected $expected"; exit 1; }
   grep -q "interrupted: run the same command again to continue" "$d/out.txt" || { cat "$d/out.txt"; echo "sigint_background.sh: no hint"; exit 1; }
 done
 echo "calibrate answers SIGINT and SIGTERM as a background job: OK"

@@ -31,6 +31,8 @@
 // handlers and hands each run its flag (RunOptions::stop_flag).
 #pragma once
 
+#include "crowdrecon/common/scoped_signals.hpp"
+
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -84,8 +86,9 @@ struct SweepSummary {
 
   std::string BriefReport() const;
   // The command's exit status, the same on every MPI rank: exit_code when
-  // the sweep could not start or failed, 130 when interrupted, else 0.
-  int ExitStatus() const { return exit_code != 0 ? exit_code : (interrupted ? 130 : 0); }
+  // the sweep could not start or failed, when interrupted 143 after SIGTERM
+  // and 130 otherwise (StoppedExitStatus), else 0.
+  int ExitStatus() const { return exit_code != 0 ? exit_code : (interrupted ? StoppedExitStatus() : 0); }
 };
 
 // Runs (or continues) the sweep. Throws InputError for a bad sweep file, a
