@@ -28,6 +28,7 @@ constexpr const char* kGiveWayChoices[] = {"none", "where_room"};
 constexpr const char* kSlopeResponseChoices[] = {"body_force", "held"};
 constexpr const char* kDriveReactionChoices[] = {"instant", "lagged"};
 constexpr const char* kHeadwayChoices[] = {"none", "time_gap"};
+constexpr const char* kSocialForceChoices[] = {"none", "circular"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -230,6 +231,20 @@ auto MakeTable() {
       When(Number("headway_repulsion_range_m", &P::headway_repulsion_range_m, "m", 0.001, 2.0,
                   "Tordeux et al. 2016; JuPedSim's default", "D, the range of that turning"),
            "headway = time_gap", [](const P& p) { return p.headway == Headway::kTimeGap; }),
+      Choice<&P::social_force>("social_force", kSocialForceChoices,
+             "issue 64; Helbing, Farkas and Vicsek 2000; Johansson, Helbing and Shukla 2007",
+             "none: the paper's model; circular: every person within reach pushes a walking person away with "
+             "social_force_strength_n exp((r_ij - d_ij) / social_force_range_m), weighted by social_force_anisotropy "
+             "behind, A once their bounding circles overlap"),
+      When(Number("social_force_strength_n", &P::social_force_strength_n, "N", 0.0, 1e5,
+                  "Helbing, Farkas and Vicsek 2000", "A, the repulsion at touching bounding circles"),
+           "social_force = circular", [](const P& p) { return p.social_force == SocialForce::kCircular; }),
+      When(Number("social_force_range_m", &P::social_force_range_m, "m", 0.001, 2.0, "Helbing, Farkas and Vicsek 2000",
+                  "B, the range of the repulsion"),
+           "social_force = circular", [](const P& p) { return p.social_force == SocialForce::kCircular; }),
+      When(Number("social_force_anisotropy", &P::social_force_anisotropy, "", 0.0, 1.0,
+                  "Johansson, Helbing and Shukla 2007", "lambda, the weight of people behind (1: isotropic)"),
+           "social_force = circular", [](const P& p) { return p.social_force == SocialForce::kCircular; }),
   };
 }
 

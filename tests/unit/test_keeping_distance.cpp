@@ -157,5 +157,64 @@ TEST(Headway, SameOnAnyThreadCountAndAfterAResume) {
   EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
 }
 
+// The social force (issue 64): a walker at rest with one person on its line,
+// ahead or behind, at a distance or overlapping: eq. (3)'s m/tau v0 plus
+// exactly A exp((r - d)/B) (ahead) or lambda times it (behind), A once the
+// bounding circles overlap.
+TEST(SocialForce, ThePushOfOnePersonIsTheModelsExactly) {
+  ModelParameters p;
+  p.social_force = SocialForce::kCircular;
+  p.social_force_anisotropy = 0.3;
+  for (const double at : {0.7, -0.7, 0.2}) {
+    WorldDef def = File(1, 10.0, 1.0, p);
+    def.periodic = PeriodicBox{};
+    def.people[0].position_m = {0.0, 0.0};
+    PersonDef other = def.people[0];
+    other.position_m = {at, 0.0};
+    other.state = PersonState::kFallen;  // (an obstacle: no push of its own)
+    def.people.push_back(other);
+    const Simulation sim(def);
+    const BodyShape& shape = sim.definition().shapes[0];  // (its core radius filled by the engine)
+    const double bound = shape.core_radius_m + shape.radius_m;
+    const double distance = std::abs(at);
+    const double weight = at > 0.0 ? 1.0 : p.social_force_anisotropy;
+    const double push = p.social_force_strength_n * std::exp(std::min(0.0, 2.0 * bound - distance) / p.social_force_range_m) * weight;
+    const double drive = def.people[0].mass_kg / p.relaxation_time_s * 1.0;
+    const Vec2 f = sim.bodies().force_n[0] - sim.bodies().contact_force_n[0];
+    EXPECT_NEAR(f.x, drive + (at > 0.0 ? -push : push), 1e-9 * (drive + push)) << "other at " << at;
+    EXPECT_NEAR(f.y, 0.0, 1e-9);
+    if (distance < 2.0 * bound) {
+      EXPECT_NEAR(push, p.social_force_strength_n * weight, 1e-9);
+    }
+  }
+}
+
+TEST(SocialForce, OffIsThePapersModelAndOnIsTheSameOnAnyThreadCountAndAfterAResume) {
+  WorldDef paper = testing::RandomGas(6, 0.45, 5, true), numbers = paper;
+  paper.parameters.ground_reaction = numbers.parameters.ground_reaction = true;
+  numbers.parameters.social_force_strength_n = 50.0;  // off: its numbers change nothing
+  Simulation sa(paper), sb(numbers);
+  sa.AdvanceTo(0.3);
+  sb.AdvanceTo(0.3);
+  std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(sa.bodies().position_m.data(), sb.bodies().position_m.data(), bytes), 0);
+  WorldDef def = testing::RandomGas(24, 0.5, 3, true);
+  def.parameters.social_force = SocialForce::kCircular;
+  for (PersonDef& person : def.people) person.desired_speed_m_per_s = 1.2;
+  def.threads = 1;
+  Simulation one(def);
+  one.AdvanceTo(0.05);
+  const std::string state = one.SaveState();
+  one.AdvanceTo(0.1);
+  def.threads = 2;
+  Simulation two(def), resumed(def);
+  two.AdvanceTo(0.1);
+  resumed.LoadState(state);
+  resumed.AdvanceTo(0.1);
+  bytes = one.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+}
+
 }  // namespace
 }  // namespace crowdrecon::engine

@@ -106,6 +106,16 @@ enum class Headway {
   kTimeGap,  // e_i + sum_j a exp((l - d_ij)/D) n_ji normalised; v0_i capped at max(0, (s_i - l)/T)
 };
 
+// The social force's repulsion between people (issue 64; off by default):
+// the second of the field's forms of keeping a distance, a force beside the
+// contact forces (Helbing and Molnar 1995; Helbing, Farkas and Vicsek 2000;
+// the circular specification with anisotropy of Johansson, Helbing and
+// Shukla 2007).
+enum class SocialForce {
+  kNone,      // the paper's model (default)
+  kCircular,  // A exp((r_ij - d_ij)/B) n_ij (lambda + (1 - lambda)(1 + cos phi_ij)/2) from each person j
+};
+
 // How a sloping floor acts on walking people (issue 43; docs/itaewon.md).
 enum class SlopeResponse {
   kBodyForce,  // issue 19: m g sin(theta) downhill on every walking person (default; eq. 3 alone holds it)
@@ -217,6 +227,18 @@ struct ModelParameters {
   double headway_length_m = 0.4;
   double headway_repulsion_strength = 8.0;
   double headway_repulsion_range_m = 0.1;
+  // SocialForce::kCircular: on a walking person i from every other person j
+  // (walking or fallen) at centre distance d_ij, A exp((r_ij - d_ij)/B) n_ij
+  // w(phi_ij), r_ij the sum of the two bodies' bounding radii, n_ij the unit
+  // vector from j to i, w = lambda + (1 - lambda)(1 + cos phi_ij)/2 with
+  // phi_ij the angle between e_i and the direction to j (people behind count
+  // lambda, people ahead 1). Once the bodies' bounding circles overlap the
+  // force stays A: the contact forces carry the bodies. Defaults: Helbing,
+  // Farkas and Vicsek 2000 (A 2000 N, B 0.08 m), isotropic (lambda 1).
+  SocialForce social_force = SocialForce::kNone;
+  double social_force_strength_n = 2000.0;
+  double social_force_range_m = 0.08;
+  double social_force_anisotropy = 1.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
