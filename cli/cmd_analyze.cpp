@@ -143,22 +143,27 @@ void RegisterAnalyzeCommand(CLI::App& app) {
       "analyze", "Metrics of a run (flow, speed, lanes, stops, avalanches, loads) and its regime: lanes, avalanches "
                  "or clogging (docs/analysis.md)");
   cmd->add_option("RUN", args->run_file, "run file (.sqlite) written by `crowdrecon simulate`")->required();
-  cmd->add_option("--json", args->json, "also write everything (summary, avalanches, series) as JSON to this file");
-  cmd->add_flag("--write", args->write,
+  CLI::Option* json = cmd->add_option("--json", args->json, "also write everything (summary, avalanches, series) as JSON to this file");
+  CLI::Option* write = cmd->add_flag("--write", args->write,
                 "store the results in the run file (tables metric_series, metric_summary, metric_avalanche, "
                 "metric_load_histogram; run values regime, regime_reason)");
   AddForceFlag(cmd, &args->force);
-  cmd->add_flag("--full", args->full, "print the full report (set-up, every avalanche, load histogram)");
-  cmd->add_flag("--digest", args->digest,
+  CLI::Option* full = cmd->add_flag("--full", args->full, "print the full report (set-up, every avalanche, load histogram)");
+  CLI::Option* digest = cmd->add_flag("--digest", args->digest,
                 "print only the SHA-256 of the run's per-frame tables: equal for a run and the same run resumed "
-                "from a checkpoint, or run on another number of threads (the file's own bytes may differ)");
-  cmd->add_flag("--settle-check", args->settle_check,
+                "from a checkpoint, or run on another number of threads (the file's own bytes may differ); "
+                "nothing else (it excludes the analysis's options)");
+  CLI::Option* settle = cmd->add_flag("--settle-check", args->settle_check,
                 "replay the run through the check of run.stop_when_settled: when it would have stopped, and "
                 "whether the verdict then is the whole run's (docs/analysis.md)");
-  cmd->add_option("--transient", args->transient_s, "start-up time left out of stationary averages, s (default 10)")
-      ->check(NumberIn(0.0, 1e6, "s"));
-  cmd->add_option("--line", args->line,
-                  "measurement line X1,Y1,X2,Y2 in metres (default: the venue's first measurement line)");
+  CLI::Option* transient =
+      cmd->add_option("--transient", args->transient_s, "start-up time left out of stationary averages, s (default 10)")
+          ->check(NumberIn(0.0, 1e6, "s"));
+  CLI::Option* line = cmd->add_option("--line", args->line,
+                                      "measurement line X1,Y1,X2,Y2 in metres (default: the venue's first measurement line)");
+  // --digest prints the digest alone: an analysis option beside it would be
+  // dropped without a word (issue 65, the adversarial pass's P06, P11, P12).
+  for (CLI::Option* option : {json, write, full, settle, transient, line}) digest->excludes(option);
   cmd->callback([args] { RunAnalyze(*args); });
 }
 

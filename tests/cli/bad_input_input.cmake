@@ -73,6 +73,8 @@ foreach(case
     "simulate_stop_after_nan~--stop-after: value nan is not finite~simulate;${S}/hallway-short.json;-o;@OUT@/x.sqlite;--stop-after;nan"
     "simulate_threads~--threads: \"two\" is not a whole number. expected a whole number in \\[0, 1024\\]~simulate;${S}/hallway-short.json;-o;@OUT@/x.sqlite;--threads;two"
     "analyze_transient~--transient: value -1 is out of range. expected a number in \\[0, 1000000\\] s~analyze;@TMP@/none.sqlite;--transient;-1"
+    "analyze_digest_write~--write excludes --digest~analyze;@TMP@/none.sqlite;--digest;--write"
+    "analyze_digest_json~--json excludes --digest~analyze;@TMP@/none.sqlite;--digest;--json;@OUT@/a.json"
     "render_fps_nan~--fps: value nan is not finite. expected a number in \\[0.01, 1000\\]~render;@TMP@/none.sqlite;-o;@OUT@/f;--fps;nan"
     "render_width~--width: value 10 is out of range. expected a whole number in \\[320, 8000\\]~render;@TMP@/none.sqlite;-o;@OUT@/f;--width;10"
     "render_force_scale~--force-scale: value -3 is out of range~render;@TMP@/none.sqlite;-o;@OUT@/f;--force-scale;-3"

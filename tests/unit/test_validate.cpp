@@ -442,6 +442,8 @@ TEST(ValidationFiles, BadTestsAreRefusedWithTheirJsonPath) {
   EXPECT_NE(ErrorOf(bad_measure).find("/measure/kind"), std::string::npos);
   EXPECT_NE(ErrorOf(TestText(R"(, "set": {"venue": "no-such-venue.json"})", ok)).find("no-such-venue.json"),
             std::string::npos);
+  EXPECT_NE(ErrorOf(TestText("", "")).find("/criteria: expected at least one criterion"), std::string::npos)
+      << ErrorOf(TestText("", ""));  // (K17: an empty list ran its seeds for nothing)
 }
 
 TEST(ValidationFiles, EveryShippedTestAndProfileReads) {

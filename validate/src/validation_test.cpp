@@ -353,6 +353,11 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
   if (const auto criteria = r.Find("criteria"))
     for (std::size_t i = 0; i < criteria->Size(); ++i)
       t.criteria.push_back(ReadCriterion(criteria->Element(i), case_names, t.data.has_value()));
+  // A test with nothing to judge or show would run its seeds for nothing
+  // (issue 65, the adversarial pass's K17).
+  if (t.criteria.empty())
+    (r.Has("criteria") ? r.At("criteria") : r)
+        .Fail("expected at least one criterion (a test judges or documents a statistic: \"criteria\": [{...}])");
   for (const Criterion& c : t.criteria)
     if (c.kind == CriterionKind::kNearReference)
       for (const Case& k : t.cases)
