@@ -137,6 +137,9 @@ void DrawObservationFigure(const observe::Observation& obs, const observe::Obser
                            const std::filesystem::path& file);
 
 void RunTrajectories(const TrajectoryArgs& args) {
+  // The figure's format before any output (issue 65, Q09: a .txt figure failed
+  // after the observation's JSON and CSV were written).
+  if (!args.figure.empty()) CheckPictureName("--figure", args.figure);
   CheckObservationOutputs(args.output, {{"the trajectories", args.file}, {"the spec", args.spec}}, args.force);
   CheckOutputs({{"--figure", args.figure, PictureOutputKind()}}, {{"the trajectories", args.file}}, args.force);
   const observe::ObservationSpec spec = observe::ReadObservationSpec(args.spec);
@@ -302,6 +305,7 @@ struct FootageArgs {
 };
 
 void RunFootage(const FootageArgs& args) {
+  if (!args.figure.empty()) CheckPictureName("--figure", args.figure);
   std::vector<PlannedOutput> outputs = {{"--figure", args.figure, PictureOutputKind()}};
   std::vector<NamedInput> inputs = {{"the video", args.video}, {"the homography", args.homography}, {"the spec", args.spec}};
   AddObservationInputs("the reference", args.reference, &inputs);

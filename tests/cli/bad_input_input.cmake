@@ -131,6 +131,12 @@ foreach(case
   set_tests_properties(cli.bad_input.run_file.${name} PROPERTIES FIXTURES_REQUIRED render_data)
 endforeach()
 
+# A figure of an unknown format is refused before the observation is written (issue 65, Q09).
+crowdrecon_refused_test(observe_figure_format_first 2 "--figure .*f.txt: .*picture format"
+  -- ${EXE} observe trajectories ${RUN} --spec venues/madrid-arena/observations/hallway.json -o @OUT@/o.json
+  --figure @OUT@/f.txt)
+set_tests_properties(cli.bad_input.observe_figure_format_first PROPERTIES FIXTURES_REQUIRED render_data)
+
 # --- run.stop_when_settled (issue 19) ---------------------------------------------
 crowdrecon_refused_test(json.settle_not_an_object 2
   "bad-settle-not-object.json: /run/stop_when_settled: expected an object \\{\"frozen_window_s\": \\.\\.\\., \"lanes_window_s\": \\.\\.\\.\\} \\(may be empty: the defaults\\), found true"
