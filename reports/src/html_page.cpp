@@ -1,6 +1,8 @@
 // The pieces every HTML report shares (html_page.hpp).
 #include "crowdrecon/reports/html_page.hpp"
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <sstream>
 
@@ -114,6 +116,24 @@ std::string SelfCheckScript(std::size_t figures) {
 std::string ChromiumOrError(const std::string& given) {
   const std::string chromium = FindChromium(given);
   if (chromium.empty()) PrintPdf(chromium, {}, {});
+  // A browser given by the user is checked too, before any work (issue 65,
+  // M15, K41: a path that did not exist failed after the whole report or
+  // suite was computed): a program found as given, or by name on PATH.
+  if (!given.empty()) {
+    const auto runnable = [](const fs::path& p) {
+      std::error_code ec;
+      return fs::is_regular_file(p, ec) && access(p.c_str(), X_OK) == 0;
+    };
+    bool found = given.find('/') != std::string::npos && runnable(given);
+    if (given.find('/') == std::string::npos) {
+      const char* path = std::getenv("PATH");
+      std::stringstream dirs(path ? path : "/usr/bin");
+      for (std::string dir; !found && std::getline(dirs, dir, ':');) found = runnable(fs::path(dir) / given);
+    }
+    if (!found)
+      throw InputError("--chromium " + given + ": no such program (or not executable); give a Chromium that can print "
+                       "the PDF, or --no-pdf for the HTML report alone");
+  }
   return chromium;
 }
 

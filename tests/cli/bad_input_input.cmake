@@ -137,6 +137,13 @@ crowdrecon_refused_test(observe_figure_format_first 2 "--figure .*f.txt: .*pictu
   --figure @OUT@/f.txt)
 set_tests_properties(cli.bad_input.observe_figure_format_first PROPERTIES FIXTURES_REQUIRED render_data)
 
+# A browser given that is not there is refused before any work (issue 65, M15, K41).
+crowdrecon_refused_test(report_chromium_missing 2 "--chromium /nonexistent/chrome: no such program"
+  -- ${EXE} report ${RUN} --chromium /nonexistent/chrome -o @OUT@/r)
+set_tests_properties(cli.bad_input.report_chromium_missing PROPERTIES FIXTURES_REQUIRED render_data)
+crowdrecon_refused_test(validate_chromium_missing 2 "--chromium /nonexistent/chrome: no such program"
+  -- ${EXE} validate venues/validation/tests/rimea-01-corridor.json --chromium /nonexistent/chrome -o @OUT@/v)
+
 # --- run.stop_when_settled (issue 19) ---------------------------------------------
 crowdrecon_refused_test(json.settle_not_an_object 2
   "bad-settle-not-object.json: /run/stop_when_settled: expected an object \\{\"frozen_window_s\": \\.\\.\\., \"lanes_window_s\": \\.\\.\\.\\} \\(may be empty: the defaults\\), found true"
