@@ -122,15 +122,21 @@ std::string RunFileReader::RunValue(const std::string& key) const {
 std::string RunFileReader::UnfinishedNote() const {
   const std::string status = RunValue("status");
   if (status == "complete") return "";
+  const bool failed = status.rfind("failed", 0) == 0;
   const std::string why = status == "running"       ? "still being written, or killed"
                           : status == "interrupted" ? "stopped before its end"
                           : status.empty()          ? "no status recorded"
+                          : failed                  ? "it went numerically wrong and stopped"
                                                     : "it did not finish";
   Statement last(*impl_->db, "SELECT MAX(time_s) FROM frame_time");
   const bool has = last.Next() && last.Type(0) != SQLITE_NULL;
+  // A failed run cannot be resumed (simulate --resume refuses it: issue 65,
+  // V03, the advice could not be followed); its frames up to the failure are
+  // what it has.
   return impl_->file + " is unfinished (status \"" + status + "\": " + why + "): what follows covers " +
          (has ? "its frames up to t = " + FormatNumber(last.Double(0)) + " s only" : "no frame") +
-         "; resume it with crowdrecon simulate --resume to finish it";
+         (failed ? "; it cannot be resumed: change what made it fail (its message above) and run it again"
+                 : "; resume it with crowdrecon simulate --resume to finish it");
 }
 
 double RunFileReader::RunNumber(const std::string& key, double fallback, double min, double max) const {

@@ -411,6 +411,14 @@ TimelineSpec ReadTimeline(const JsonReader& reader, const geometry::Venue& venue
     f.trip_over_fallen = falls->Bool("trip_over_fallen", f.trip_over_fallen);
     if (f.trip_over_fallen && f.criterion != FallSpec::Criterion::kAcceleration)
       falls->At("trip_over_fallen").Fail("applies to the criterion \"acceleration\" only (the criterion is \"" + c + "\")");
+    // A setting of a criterion the falls do not use (issue 65, D07: a threshold
+    // with the criterion "none" was accepted without a word).
+    for (const auto& [key, criterion] : {std::pair{"threshold_m_per_s2", "acceleration"}, std::pair{"window_s", "acceleration"},
+                                         std::pair{"load_n", "load"}, std::pair{"load_duration_s", "load"}})
+      if (falls->Has(key) && c != criterion)
+        falls->At(key).Fail(std::string("applies to the criterion \"") + criterion + "\" only (the criterion is \"" + c + "\")");
+    if (falls->Has("sample_s") && c == "none")
+      falls->At("sample_s").Fail("applies to the criteria \"acceleration\" and \"load\" (the criterion is \"none\")");
     falls->Finish();
   }
   t.max_present = static_cast<std::size_t>(reader.Integer("max_present", 0, 0, 200000));

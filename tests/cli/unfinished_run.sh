@@ -15,6 +15,13 @@ for command in "export $d/run.sqlite -o $d/e.sqlite" "render $d/run.sqlite -o $d
   "$crowdrecon" $command > "$d/out.txt"
   grep -q "$note" "$d/out.txt" || { echo "$command: no note"; cat "$d/out.txt"; exit 1; }
 done
+# A failed run is said to be one, and not offered a resume that simulate
+# refuses (issue 65, V03): its status as the engine's failure writes it.
+cp "$d/run.sqlite" "$d/failed.sqlite"
+sqlite3 "$d/failed.sqlite" "UPDATE run SET value = 'failed: person 14 went through wall 0 at t = 1 s' WHERE key = 'status'"
+"$crowdrecon" export "$d/failed.sqlite" -o "$d/f.sqlite" > "$d/out.txt"
+grep -q 'went numerically wrong and stopped).*it cannot be resumed' "$d/out.txt" || { echo "failed run: no such note"; cat "$d/out.txt"; exit 1; }
+if grep -q -- "--resume" "$d/out.txt"; then echo "a failed run was offered --resume"; cat "$d/out.txt"; exit 1; fi
 "$crowdrecon" simulate "$scenario" -o "$d/whole.sqlite" -q > /dev/null
 "$crowdrecon" export "$d/whole.sqlite" -o "$d/w.sqlite" > "$d/out.txt"
 if grep -q unfinished "$d/out.txt"; then echo "a finished run was called unfinished"; exit 1; fi

@@ -475,6 +475,10 @@ TEST(Timeline, BadTimelinesAreRefusedWithThePath) {
     }
   };
   refuse(R"({"inflows": [{"entry": "nowhere", "rate_per_s": 1}]})", "/timeline/inflows/0/entry: the venue has no entry zone \"nowhere\"");
+  // A setting of a fall criterion not chosen (issue 65, D07).
+  refuse(R"({"falls": {"criterion": "none", "threshold_m_per_s2": 3}})",
+         "/timeline/falls/threshold_m_per_s2: applies to the criterion \"acceleration\" only (the criterion is \"none\")");
+  refuse(R"({"falls": {"criterion": "acceleration", "load_n": 900}})", "/timeline/falls/load_n: applies to the criterion \"load\"");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": [[5, 1], [2, 1]]}]})", "/timeline/inflows/0/rate_per_s: times must increase");
   refuse(R"({"inflows": [{"entry": "from_court", "rate_per_s": -1}]})", "/timeline/inflows/0/rate_per_s");
   refuse(R"({"inflows": [{"entry": "from_court", "group": "staff", "rate_per_s": 1}]})", "group \"staff\" needs a \"target\"");
