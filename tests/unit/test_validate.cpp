@@ -446,6 +446,28 @@ TEST(ValidationFiles, BadTestsAreRefusedWithTheirJsonPath) {
       << ErrorOf(TestText("", ""));  // (K17: an empty list ran its seeds for nothing)
 }
 
+// A profile's bad model key or value is blamed on the profile, by its JSON
+// path (issue 65, K03, K10: it was blamed on every test's scenario).
+TEST(ValidationFiles, AProfilesBadModelIsRefusedInTheProfile) {
+  const auto error = [](const std::string& model) {
+    try {
+      ParseProfile(R"({"format": "crowdrecon-profile", "version": 1, "name": "p", "model": )" + model + "}", "p.json",
+                   fs::path(CROWDRECON_SOURCE_DIR));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error(R"({"gait_jitter": "isotropic", "gait_jitter_velocity_m_per_s": 0.3})"), "");
+  EXPECT_NE(error(R"({"gait_jiter": 0.3})").find("p.json: /model/gait_jiter: unknown model parameter"), std::string::npos)
+      << error(R"({"gait_jiter": 0.3})");
+  EXPECT_NE(error(R"({"gait_jitter_velocity_m_per_s": 7})").find("p.json: /model/gait_jitter_velocity_m_per_s"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"headway": "far"})").find("p.json: /model/headway: \"far\"; expected one of none, time_gap"),
+            std::string::npos)
+      << error(R"({"headway": "far"})");
+}
+
 TEST(ValidationFiles, EveryShippedTestAndProfileReads) {
   const fs::path suite = fs::path(CROWDRECON_SOURCE_DIR) / "venues/validation";
   const std::vector<ValidationTest> tests = LoadSuite(suite);

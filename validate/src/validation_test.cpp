@@ -10,6 +10,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
+#include "crowdrecon/engine/parameter_table.hpp"
 
 namespace crowdrecon::validate {
 
@@ -398,7 +399,25 @@ Profile ParseProfile(const std::string& text, const std::string& origin, const f
   p.description = r.String("description", "");
   if (const auto model = r.Find("model")) {
     if (!model->IsObject()) model->Fail("expected the scenario's model block {\"key\": value, ...}");
-    for (const std::string& key : model->Keys()) p.set.push_back({"model." + key, RawAt(doc, model->At(key)).dump()});
+    for (const std::string& key : model->Keys()) {
+      // Checked here, against the parameter table, so that a bad key or value
+      // is blamed on the profile (issue 65, K03, K10: it was blamed on every
+      // test's scenario, which does not have it).
+      const JsonReader value = model->At(key);
+      const engine::ParameterInfo* info = engine::FindModelParameter(key);
+      if (info == nullptr) value.Fail("unknown model parameter; expected one of the parameter table's (docs/model.md)");
+      switch (info->kind) {
+        case engine::ParameterInfo::Kind::kNumber: value.AsNumber(info->min, info->max); break;
+        case engine::ParameterInfo::Kind::kFlag: (void)model->Bool(key, false); break;
+        case engine::ParameterInfo::Kind::kChoice: {
+          const std::vector<std::string> allowed(info->choices, info->choices + info->choice_count);
+          if (std::find(allowed.begin(), allowed.end(), value.AsString()) == allowed.end())
+            value.Fail("\"" + value.AsString() + "\"; expected " + info->Expected());
+          break;
+        }
+      }
+      p.set.push_back({"model." + key, RawAt(doc, value).dump()});
+    }
   }
   if (const auto body = r.Find("body")) {
     if (!body->IsObject()) body->Fail("expected the scenario's body block {\"mode\": ..., ...}");
