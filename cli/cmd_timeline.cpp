@@ -155,6 +155,11 @@ void RunTimeline(const TimelineArgs& args) {
     throw InputError("--density-times / --density-cell / --density-sigma: " + why);
   if (!runfile::IsRunFile(args.run)) throw InputError(args.run + ": " + DescribeExisting(args.run) + ", not a crowdrecon run file");
   analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
+  // The local reading needs the venue's measurement areas (issue 65, H09: on a
+  // venue without any it changed nothing, without a word).
+  if (args.area_avalanches && s.area_names.empty())
+    throw InputError("--area-avalanches: the run's venue has no measurement areas (\"measurement_areas\" in its venue "
+                     "file) to read avalanches in; leave the option out for the crowd's and the directions' reading");
   if (args.area_avalanches) s.avalanches = analysis::AvalanchesWithAreas(s);
   // What may still refuse the run (the maps' times, the sweep's folder) is
   // read or drawn before the run's own figures.
