@@ -74,6 +74,13 @@ TEST(Distribution, BadDistributionsAreRefusedWithTheirPath) {
   EXPECT_NE(ErrorOf(R"({"lognormal": {"mu": 4, "sigma": 0}})").find("/lognormal/sigma"), std::string::npos);
   EXPECT_NE(ErrorOf(R"({"weibull": {"shape": 1, "scale_s": 1, "k": 2}})").find("k"), std::string::npos);
   EXPECT_NE(ErrorOf(R"({"weibull": 3})").find("expected an object"), std::string::npos);
+  // Draws the times cannot hold (issue 65, G08, K39): at 0 s or beyond any run.
+  EXPECT_NE(ErrorOf(R"({"weibull": {"shape": 0.001, "scale_s": 1000000}})")
+                .find("/weibull: its 1 % and 99 % quantiles are 0 and"),
+            std::string::npos)
+      << ErrorOf(R"({"weibull": {"shape": 0.001, "scale_s": 1000000}})");
+  EXPECT_NE(ErrorOf(R"({"lognormal": {"mu": 19, "sigma": 5}})").find("expected both within [1e-9, 1e6] s"), std::string::npos);
+  EXPECT_EQ(ErrorOf(R"({"weibull": {"shape": 1.5, "scale_s": 60}})"), "");  // NIST's kind of values
 }
 
 }  // namespace
