@@ -147,6 +147,7 @@ void RunTrajectories(const TrajectoryArgs& args) {
   const observe::Observation obs = observe::ObserveTrajectories(t, spec);
   WriteObservationSayingLeftovers(obs, args.output);
   if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
+  SayIfUnfinished(args.file);  // (a run file's; issue 65, Q08)
   if (!args.quiet) {
     std::printf("%zu people, frames %lld-%lld at %s fps\n", t.people, static_cast<long long>(t.first_frame),
                 static_cast<long long>(t.last_frame), FormatNumber(t.fps).c_str());

@@ -105,6 +105,21 @@ ReportSummary WriteReport(const ReportOptions& options) {
   // (issues 40, 65). Another scenario's runs go with --compare.
   CheckSeedsOfOneScenario(main_files, "the ensemble", "give another scenario's runs with --compare");
   CheckSeedsOfOneScenario(other_files, "the --compare ensemble");
+  // An unfinished run (interrupted, killed, failed) is refused in an ensemble,
+  // as the timeline's ensembles refuse it, and said of a run reported alone:
+  // in the summary and on the report's page (issue 65, M10, M11, V02).
+  std::string unfinished;
+  for (const std::vector<fs::path>* files : {&main_files, &other_files})
+    for (const fs::path& f : *files) {
+      const std::string status = runfile::RunFileReader(f).RunValue("status");
+      if (status == "complete") continue;
+      if (files->size() > 1)
+        throw InputError(f.string() + ": the run's status is \"" + status + "\"; an ensemble pools finished runs (" +
+                         (status.rfind("failed", 0) == 0 ? "leave the failed run out" : "resume it with crowdrecon simulate --resume, or leave it out") + ")");
+      const std::string note = runfile::RunFileReader(f).UnfinishedNote();
+      input_notes.push_back(note);
+      unfinished += (unfinished.empty() ? "" : " ") + note;
+    }
   const std::string chromium = ChromiumFor(options);
   const auto say = [&](const std::string& text) {
     if (options.progress) options.progress(text);
@@ -208,6 +223,9 @@ ReportSummary WriteReport(const ReportOptions& options) {
   {
     const analysis::PlausibilityOptions& po = validity_options;
     h += "<h3>Are these states a human crowd can reach?</h3>\n";
+    if (!unfinished.empty())
+      h += "<p><b>An unfinished run.</b> " + Escape(unfinished) + ". Every figure of this report covers only what it "
+           "recorded.</p>\n";
     const auto validity = [&](const std::string& label, const std::vector<RunRisk>& runs) {
       if (runs.empty()) return;
       std::vector<double> peak, equivalent, overlap;

@@ -10,7 +10,8 @@ trap 'rm -rf "$d"' EXIT
 "$crowdrecon" simulate "$scenario" -o "$d/run.sqlite" -q --stop-after 1 > /dev/null 2>&1 || true
 note='note: .*run.sqlite is unfinished (status "interrupted": stopped before its end): what follows covers its frames up to t = 1 s only'
 for command in "export $d/run.sqlite -o $d/e.sqlite" "render $d/run.sqlite -o $d/frames --frames last" \
-               "timeline $d/run.sqlite -o $d/t.png"; do
+               "timeline $d/run.sqlite -o $d/t.png" \
+               "observe trajectories $d/run.sqlite --spec $(dirname "$0")/../../venues/madrid-arena/observations/hallway.json -o $d/o.json"; do
   # shellcheck disable=SC2086
   "$crowdrecon" $command > "$d/out.txt"
   grep -q "$note" "$d/out.txt" || { echo "$command: no note"; cat "$d/out.txt"; exit 1; }
