@@ -44,7 +44,7 @@ void RunExport(const ExportArgs& args) {
   if (!std::filesystem::exists(args.run_file, ec))
     throw InputError(args.run_file + ": no such file; expected a run file (.sqlite) written by `crowdrecon simulate`");
   if (!runfile::IsRunFile(args.run_file))
-    throw InputError(args.run_file + ": is " + DescribeExisting(args.run_file) +
+    throw InputError(args.run_file + ": is " + runfile::DescribeNonRunFile(args.run_file) +
                      ", not a crowdrecon run file; expected a run file (.sqlite) written by `crowdrecon simulate`");
   const runfile::RunFileReader run(args.run_file);
   const runfile::ExportSummary s = runfile::ExportTrajectories(run, args.output);

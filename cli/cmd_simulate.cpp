@@ -34,6 +34,11 @@ struct SimulateArgs {
 
 int RunSimulate(const SimulateArgs& args) {
   const scenario::Scenario sc = scenario::LoadScenario(args.scenario);
+  // A resume of what is no run (a run file cut short, another program's
+  // file) is said as such, not offered --force (issue 65, R07).
+  if (std::error_code ec; args.resume && std::filesystem::exists(args.output, ec) && !runfile::IsRunFile(args.output))
+    throw InputError(args.output + ": nothing to resume: it is " + runfile::DescribeNonRunFile(args.output) +
+                     ", not a crowdrecon run file; run the scenario again without --resume (--force replaces the file)");
   CheckOutputs({{"-o", args.output, runfile::RunFileOutput()}},
                {{"the scenario", sc.file},
                 {"the venue", sc.venue_file},

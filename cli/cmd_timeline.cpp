@@ -153,7 +153,8 @@ void RunTimeline(const TimelineArgs& args) {
   density.sigma_m = args.density_sigma_m;
   if (std::string why; !args.density_maps.empty() && !density.IsValid(&why))
     throw InputError("--density-times / --density-cell / --density-sigma: " + why);
-  if (!runfile::IsRunFile(args.run)) throw InputError(args.run + ": " + DescribeExisting(args.run) + ", not a crowdrecon run file");
+  if (!runfile::IsRunFile(args.run))
+    throw InputError(args.run + ": " + runfile::DescribeNonRunFile(args.run) + ", not a crowdrecon run file");
   analysis::TimelineSeries s = analysis::ComputeTimeline(args.run, args.smooth_s);
   // The local reading needs the venue's measurement areas (issue 65, H09: on a
   // venue without any it changed nothing, without a word).

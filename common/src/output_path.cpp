@@ -107,7 +107,7 @@ void CheckOne(const PlannedOutput& out, const std::vector<NamedInput>& inputs, b
   std::error_code ec;
   const fs::file_status link = fs::symlink_status(out.path, ec);
   if (!fs::exists(link)) return;  // nothing there: nothing to lose
-  const std::string there = DescribeExisting(out.path);
+  const std::string there = out.kind.describe ? out.kind.describe(out.path) : DescribeExisting(out.path);
   const bool folder = fs::is_directory(out.path, ec);
   const bool empty_folder = folder && fs::is_empty(out.path, ec);
   if (!out.kind.folder && folder)

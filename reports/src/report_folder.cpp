@@ -90,7 +90,8 @@ std::vector<fs::path> RunFilesOf(const std::vector<fs::path>& inputs, std::vecto
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::is_regular_file(in, ec)) {
       if (!runfile::IsRunFile(in))
-        throw InputError(in.string() + ": not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
+        throw InputError(in.string() + ": " + runfile::DescribeNonRunFile(in) +
+                         ", not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
       files.push_back(in);
     } else {
       throw InputError(in.string() + ": no such file or folder; expected a run file or a folder of run files");

@@ -131,7 +131,8 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   std::string why;
   if (!options.IsValid(&why)) throw InputError("risk options: " + why);
   if (!runfile::IsRunFile(run_file))
-    throw InputError(run_file.string() + ": not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
+    throw InputError(run_file.string() + ": " + runfile::DescribeNonRunFile(run_file) +
+                     ", not a crowdrecon run file; expected the SQLite file of crowdrecon simulate");
   const runfile::RunFileReader reader(run_file);
   RunRisk risk;
   risk.file = run_file;

@@ -100,7 +100,33 @@ bool IsRunFile(const std::filesystem::path& file) {
   }
 }
 
-OutputKind RunFileOutput() { return {"a crowdrecon run file", false, IsRunFile}; }
+std::string DescribeNonRunFile(const std::filesystem::path& file) {
+  const std::string what = DescribeExisting(file);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec) || !FileStartsWith(file, std::string("SQLite format 3\0", 16)))
+    return what;
+  try {
+    (void)RunFileReader(file).RunValue("format");
+  } catch (const std::exception& e) {
+    const std::string why = e.what();
+    const std::size_t at = why.find("SQLite error: ");
+    if (at != std::string::npos) {
+      std::string sqlite = why.substr(at + 14);
+      if (const std::size_t end = sqlite.find(" (in: "); end != std::string::npos) sqlite.resize(end);
+      for (const char* damaged : {"malformed", "disk I/O error", "not a database"})
+        if (sqlite.find(damaged) != std::string::npos)
+          return "a damaged SQLite file (SQLite: " + sqlite +
+                 "; a run file cut short or damaged, which cannot be read or resumed)";
+    }
+  }
+  return what;
+}
+
+OutputKind RunFileOutput() {
+  OutputKind kind{"a crowdrecon run file", false, IsRunFile};
+  kind.describe = DescribeNonRunFile;
+  return kind;
+}
 
 void CopyRunFile(const std::filesystem::path& from, const std::filesystem::path& to) {
   std::error_code ec;

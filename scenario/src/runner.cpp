@@ -168,7 +168,7 @@ std::string NothingToResume(const std::filesystem::path& run_file, const Scenari
   if (!std::filesystem::exists(run_file, ec))
     return file + ": nothing to resume: the run file does not exist; start the run without --resume";
   if (!runfile::IsRunFile(run_file))
-    return file + ": nothing to resume: it is " + DescribeExisting(run_file) + ", not a crowdrecon run file";
+    return file + ": nothing to resume: it is " + runfile::DescribeNonRunFile(run_file) + ", not a crowdrecon run file";
   const runfile::RunFileReader reader(run_file);
   if (reader.RunValue("scenario") != scenario.json_text)
     return file + ": nothing to resume: the run file was written for a different scenario (" +

@@ -40,7 +40,7 @@ crowdrecon_output_test(simulate.o_foreign_json fail "-o other.json: exists and i
                        "make_scenario && cp venue.json other.json" . simulate scenario.json -o other.json -q)
 crowdrecon_output_test(simulate.o_foreign_text fail "-o run.sqlite: exists and is a text file of [0-9]+ bytes, not a crowdrecon run file"
                        "make_scenario && foreign run.sqlite" . simulate scenario.json -o run.sqlite -q)
-crowdrecon_output_test(simulate.resume_foreign_file fail "-o run.sqlite: exists and is a text file of [0-9]+ bytes, not a crowdrecon run file"
+crowdrecon_output_test(simulate.resume_foreign_file fail "run.sqlite: nothing to resume: it is a text file of [0-9]+ bytes, not a crowdrecon run file"
                        "make_scenario && foreign run.sqlite" . simulate scenario.json -o run.sqlite -q --resume)
 crowdrecon_output_test(simulate.o_previous_run_replaced ok "run file: run.sqlite \\(3 frames\\), status complete"
                        "make_scenario && make_run" ${INPUTS} simulate scenario.json -o run.sqlite -q)

@@ -36,6 +36,9 @@ struct OutputKind {
   // Called on an existing path (a regular file, or for folder kinds a
   // non-empty folder): true if it is a previous output of this kind.
   std::function<bool(const std::filesystem::path&)> is_previous;
+  // Optional: what an existing path that is no previous output is, where the
+  // kind can say more than DescribeExisting ("a damaged SQLite file (...)").
+  std::function<std::string(const std::filesystem::path&)> describe = {};
 };
 
 struct PlannedOutput {

@@ -417,6 +417,12 @@ class RunFileReader {
 OutputKind RunFileOutput();
 // True if `file` is a crowdrecon run file (false for anything else, no error).
 bool IsRunFile(const std::filesystem::path& file);
+// What `file`, which is not a run file, is: DescribeExisting's words, or for
+// an SQLite file that SQLite cannot read "a damaged SQLite file (SQLite:
+// database disk image is malformed; a run file cut short or damaged, which
+// cannot be read or resumed)" (issue 65: such a file was called "not a
+// crowdrecon run file", and replacing it was offered for a resume).
+std::string DescribeNonRunFile(const std::filesystem::path& file);
 // Copies the run file `from` to `to` (which must not exist): a consistent
 // snapshot, also of a run being written (SQLite's VACUUM INTO). For a run
 // branched at a checkpoint (scenario::BranchRun).
