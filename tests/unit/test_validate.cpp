@@ -43,6 +43,12 @@ observe::Line LineAt(double x, double y0, double y1) {
   return l;
 }
 
+// Every statistic a measure gives is one StatisticNames declares (the list a
+// test's criteria are checked against when read).
+void ExpectDeclared(const Statistics& s, MeasureKind kind) {
+  for (const auto& [name, values] : s) EXPECT_EQ(UnknownStatistic(kind, name), "") << name;
+}
+
 TEST(ValidationMeasures, TravelTimeIsTheTimeBetweenTheTwoLines) {
   observe::Trajectories t = Empty(10.0);
   Walk(&t, 1, {-1.0, 1.0}, {1.25, 0.0}, 0, 400);  // 1.25 m/s: 40 m in 32 s
@@ -52,6 +58,7 @@ TEST(ValidationMeasures, TravelTimeIsTheTimeBetweenTheTwoLines) {
   m.from_line = LineAt(0, 0, 2);
   m.to_line = LineAt(40, 0, 2);
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   ASSERT_EQ(s.at("travel_time_s").size(), 1u);
   EXPECT_NEAR(s.at("travel_time_s")[0], 32.0, 1e-9);
   EXPECT_NEAR(s.at("speed_m_per_s")[0], 1.25, 1e-9);
@@ -71,6 +78,7 @@ TEST(ValidationMeasures, PassagesGiveFlowLapsesAndTheOpenLapseOfAClog) {
   m.line = LineAt(0, 0, 1);
   m.direction = {1, 0};
   Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_DOUBLE_EQ(s.at("passed")[0], 5.0);
   EXPECT_NEAR(s.at("passed_share")[0], 5.0 / 6.0, 1e-12);
   EXPECT_NEAR(s.at("flow_per_s")[0], 4.0 / 9.0, 1e-9);
@@ -95,6 +103,7 @@ TEST(ValidationMeasures, PassageTimesCountFromTheFilesFirstFrame) {
   m.line = LineAt(0, 0, 1);
   m.direction = {1, 0};
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_NEAR(s.at("time_to_all_s")[0], 2.0, 1e-9);
   EXPECT_NEAR(s.at("open_lapse_s")[0], 0.0, 1e-12);
 }
@@ -107,6 +116,7 @@ TEST(ValidationMeasures, ClearanceCountsTracksThatEndBeforeTheFile) {
   MeasureSpec m;
   m.kind = MeasureKind::kClearance;
   Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_NEAR(s.at("left_share")[0], 2.0 / 3.0, 1e-12);
   EXPECT_TRUE(std::isnan(s.at("time_to_all_s")[0]));
   t.points.erase(std::remove_if(t.points.begin(), t.points.end(), [](const auto& p) { return p.id == 3; }), t.points.end());
@@ -127,6 +137,7 @@ TEST(ValidationMeasures, HeadwayIsTheDistanceToThePersonAheadInTheSameFile) {
   m.has_area = true;
   m.area.polygon_m = {{-10, 0}, {30, 0}, {30, 3}, {-10, 3}};
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   const auto& h = s.at("headway_m");
   ASSERT_FALSE(h.empty());
   for (double v : h) EXPECT_NEAR(v, 1.0, 1e-9);
@@ -144,11 +155,13 @@ TEST(ValidationMeasures, WalkingSpeedIsPathOverTimeInTheAreaByGroup) {
   m.has_area = true;
   m.area.polygon_m = {{5, 0}, {15, 0}, {15, 50}, {5, 50}};
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_NEAR(s.at("speed_m_per_s@group0")[0], 1.2, 1e-9);
   EXPECT_NEAR(s.at("speed_m_per_s@group1")[0], 1.0, 1e-9);
   // The group filter keeps one group's people.
   m.group = "group1";
   const Statistics g = MeasureTrajectories(t, m);
+  ExpectDeclared(g, m.kind);
   EXPECT_EQ(g.at("speed_m_per_s").size(), 1u);
 }
 
@@ -163,6 +176,7 @@ TEST(ValidationMeasures, FundamentalDiagramGivesTheAreasDensityAndSpeed) {
   m.area.polygon_m = {{0, 0}, {4, 0}, {4, 2}, {0, 2}};
   m.frame_step = 1;
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_NEAR(s.at("density_per_m2")[0], 1.0, 1e-9);
   EXPECT_NEAR(s.at("speed_m_per_s")[0], 1.1, 1e-9);
   EXPECT_NEAR(s.at("specific_flow_per_m_s")[0], 1.1, 1e-9);
@@ -196,6 +210,7 @@ TEST(ValidationMeasures, LanesThatMixAreCountedAsBroken) {
   m.direction = {1, 0};
   m.frame_step = 1;
   const Statistics s = MeasureTrajectories(t, m);
+  ExpectDeclared(s, m.kind);
   EXPECT_DOUBLE_EQ(s.at("lane_breaks")[0], 1.0);
   EXPECT_DOUBLE_EQ(s.at("lane_reformations")[0], 1.0);
   EXPECT_DOUBLE_EQ(s.at("organized_at_end")[0], 1.0);
@@ -224,12 +239,14 @@ TEST(ValidationMeasures, ARunsClearanceAndStartsCountEveryone) {
   MeasureSpec clearance;
   clearance.kind = MeasureKind::kClearance;
   const Statistics c = MeasureRun(options.output, clearance);
+  ExpectDeclared(c, clearance.kind);
   EXPECT_EQ(c.at("left_share")[0], 1.0);
   EXPECT_TRUE(std::isfinite(c.at("time_to_all_s")[0]));
   EXPECT_LT(c.at("time_to_all_s")[0], 60.0);
   MeasureSpec starts;
   starts.kind = MeasureKind::kStartTimes;
   const Statistics st = MeasureRun(options.output, starts);
+  ExpectDeclared(st, starts.kind);
   EXPECT_EQ(st.at("premovement_s").size(), 4u);
   EXPECT_EQ(st.at("started_people")[0], 4.0);
   for (double t : st.at("premovement_s")) {
@@ -419,14 +436,20 @@ TEST(ValidationFiles, BadTestsAreRefusedWithTheirJsonPath) {
   EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "within": [1, 2]})")).find("why"), std::string::npos);
   EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "near_data": 0.2, "why": "w"})")).find("no \"data\""),
             std::string::npos);
-  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "near_reference": 0.2, "why": "w"})")).find("reference"),
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "travel_time_s", "near_reference": 0.2, "why": "w"})")).find("reference"),
             std::string::npos);
   EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "ratio": {"of": "a", "to": "base", "within": [1, 2]}, "why": "w"})"))
                 .find("\"a\" is not a case"),
             std::string::npos);
   EXPECT_NE(ErrorOf(TestText(R"(, "cases": [{"name": "a b"}])", ok)).find("/cases/0/name"), std::string::npos);
-  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "s", "follows": {"gamma": {"shape": 1.3, "scale_s": 104}}, "alpha": 0.05, "why": "w"})")), "");
-  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "s", "within": [1, null], "why": "w"})")), "");
+  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "travel_time_s", "follows": {"gamma": {"shape": 1.3, "scale_s": 104}}, "alpha": 0.05, "why": "w"})")), "");
+  EXPECT_EQ(ErrorOf(TestText("", R"({"statistic": "travel_time_s", "within": [1, null], "why": "w"})")), "");
+  // A statistic the measure does not give (issue 65, K19).
+  EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "travel_tme_s", "within": [1, 2], "why": "w"})"))
+                .find("/criteria/0/statistic: \"travel_tme_s\" is not a statistic of the measure travel; expected one of "
+                      "travel_time_s, speed_m_per_s, arrived_share, completed"),
+            std::string::npos)
+      << ErrorOf(TestText("", R"({"statistic": "travel_tme_s", "within": [1, 2], "why": "w"})"));
   EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "within_data": [null, 0.5], "why": "w"})")).find("quantiles"),
             std::string::npos);
   EXPECT_NE(ErrorOf(TestText("", R"({"statistic": "s", "follows": {"gamma": {"shape": -1, "scale_s": 104}}, "why": "w"})"))

@@ -431,6 +431,39 @@ bool FromString(const std::string& name, MeasureKind* kind) {
   return false;
 }
 
+const std::vector<std::string>& StatisticNames(MeasureKind kind) {
+  static const std::map<MeasureKind, std::vector<std::string>> names{
+      {MeasureKind::kTravel, {"travel_time_s", "speed_m_per_s", "arrived_share"}},
+      {MeasureKind::kWalls, {"outside_walls", "wall_crossings", "people"}},
+      {MeasureKind::kWalkingSpeed, {"speed_m_per_s"}},
+      {MeasureKind::kPassages,
+       {"passed", "passed_share", "open_lapse_s", "time_to_all_s", "time_to_95_s", "span_s", "flow_per_s",
+        "sustained_flow_per_s", "lapse_s", "median_lapse_s", "max_lapse_s", "tail_exponent", "front_density_per_m2"}},
+      {MeasureKind::kClearance, {"left_share", "time_to_all_s", "time_to_95_s"}},
+      {MeasureKind::kFundamentalDiagram,
+       {"density_per_m2", "speed_m_per_s", "specific_flow_per_m_s", "fd_density_per_m2", "fd_speed_m_per_s"}},
+      {MeasureKind::kHeadway, {"headway_m", "density_per_m2"}},
+      {MeasureKind::kLanes,
+       {"lane_order", "organized_share", "lane_breaks", "lane_reformations", "longest_organized_s", "organized_at_end"}},
+      {MeasureKind::kStartTimes,
+       {"premovement_s", "start_delay_s", "moved_early", "never_started", "started_people", "gone_before_start"}},
+      {MeasureKind::kRunState,
+       {"peak_local_density_per_m2", "peak_local_density_real_per_m2", "time_beyond_measured_s", "largest_overlap_m",
+        "duration_s"}},
+  };
+  return names.at(kind);
+}
+
+std::string UnknownStatistic(MeasureKind kind, const std::string& statistic) {
+  const std::vector<std::string>& names = StatisticNames(kind);
+  if (statistic == "completed" || std::find(names.begin(), names.end(), statistic) != names.end()) return "";
+  if (kind == MeasureKind::kWalkingSpeed && statistic.rfind("speed_m_per_s@", 0) == 0 && statistic.size() > 14) return "";
+  std::string list;
+  for (const std::string& n : names) list += n + ", ";
+  return "\"" + statistic + "\" is not a statistic of the measure " + ToString(kind) + "; expected one of " + list +
+         "completed" + (kind == MeasureKind::kWalkingSpeed ? " (or speed_m_per_s@GROUP)" : "");
+}
+
 std::string MeasureKindNames() {
   std::string s;
   for (const auto& [k, name] : KindNames()) s += (s.empty() ? "" : ", ") + std::string(name);

@@ -354,6 +354,12 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
   if (const auto criteria = r.Find("criteria"))
     for (std::size_t i = 0; i < criteria->Size(); ++i)
       t.criteria.push_back(ReadCriterion(criteria->Element(i), case_names, t.data.has_value()));
+  // Every statistic a criterion or the figure names is one the measure gives
+  // (issue 65, K19: a misspelt one was found after the runs, as a failure).
+  if (const auto criteria = r.Find("criteria"))
+    for (std::size_t i = 0; i < t.criteria.size(); ++i)
+      if (const std::string why = UnknownStatistic(t.measure.kind, t.criteria[i].statistic); !why.empty())
+        criteria->Element(i).At("statistic").Fail(why);
   // A test with nothing to judge or show would run its seeds for nothing
   // (issue 65, the adversarial pass's K17).
   if (t.criteria.empty())
@@ -368,6 +374,8 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
     const std::string kind = fig->Choice("kind", "distribution", {"distribution", "cumulative"});
     t.figure.kind = kind == "cumulative" ? FigureSpec::Kind::kCumulative : FigureSpec::Kind::kDistribution;
     t.figure.statistic = fig->String("statistic", "");
+    if (const std::string why = UnknownStatistic(t.measure.kind, t.figure.statistic); !t.figure.statistic.empty() && !why.empty())
+      fig->At("statistic").Fail(why);
     t.figure.log = fig->Bool("log", false);
     if (t.figure.kind == FigureSpec::Kind::kCumulative && t.measure.kind != MeasureKind::kPassages)
       fig->At("kind").Fail("a cumulative figure counts passages; the test's measure is " + ToString(t.measure.kind));

@@ -70,6 +70,14 @@ std::string ToString(MeasureKind kind);
 bool FromString(const std::string& name, MeasureKind* kind);
 // "travel, walls, ..." for messages.
 std::string MeasureKindNames();
+// The statistics a measure of `kind` gives (a run's measures also
+// "completed"; walking_speed also "speed_m_per_s@GROUP" per group): a test's
+// criterion that names another is refused when the test is read (issue 65,
+// K19: a misspelt statistic was found after the runs, as a model failure).
+// The measures' tests check every statistic they give is listed here.
+const std::vector<std::string>& StatisticNames(MeasureKind kind);
+// "" if `statistic` is one a measure of `kind` gives, else why not.
+std::string UnknownStatistic(MeasureKind kind, const std::string& statistic);
 
 struct MeasureSpec {
   MeasureKind kind = MeasureKind::kRunState;
