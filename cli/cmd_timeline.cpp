@@ -191,8 +191,7 @@ void RunTimeline(const TimelineArgs& args) {
     }
     for (const analysis::DensityMap& m : maps)
       std::printf("density at %s: %zu people, densest %.2f persons/m2\n",
-                  s.clock.start.empty() ? ("t = " + FormatNumber(m.time_s) + " s").c_str()
-                                        : s.clock.Text(m.time_s).c_str(),
+                  s.clock.MomentText(m.time_s).c_str(),
                   m.people, m.max_per_m2);
   }
 }

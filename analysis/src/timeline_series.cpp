@@ -90,9 +90,17 @@ std::string RunClock::TickText(double t_s, double tick_s) const {
 }
 
 std::string RunClock::AxisLabel() const {
-  if (start.empty()) return "time of the run";
+  if (start.empty() && scale == 1.0) return "time of the run";
+  if (start.empty())
+    return "time of the incident since the run's start (a second of the run stands for " + FormatNumber(scale) + " s)";
   if (scale == 1.0) return "time of night (run time 0 = " + start + ")";
   return "time of night (run time 0 = " + start + "; a second of the run stands for " + FormatNumber(scale) + " s)";
+}
+
+std::string RunClock::MomentText(double t_s) const {
+  if (!start.empty()) return Text(t_s);
+  const std::string run = "t = " + FormatNumber(std::round(t_s * 10.0) / 10.0) + " s";
+  return scale == 1.0 ? run : run + " (" + Text(t_s) + " of the incident)";
 }
 
 TimelineSeries ComputeTimeline(const std::filesystem::path& run_file, double smooth_s) {

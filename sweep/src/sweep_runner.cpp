@@ -538,13 +538,16 @@ SweepSummary RunSweep(const SweepOptions& options) {
   // 0, so that what the runs left behind (their after_run files) is complete
   // on every rank when RunSweep returns there (a calibration reads it next),
   // and knows what rank 0 knows: failed, done, or interrupted (a worker rank
-  // that went on as if its sweep were complete would look for runs never made).
-  enum RootStatus { kFailed = 0, kDone = 1, kInterrupted = 2 };
+  // that went on as if its sweep were complete would look for runs never made),
+  // and by which signal, so that every rank exits with rank 0's status (143
+  // after SIGTERM, 130 otherwise).
+  enum RootStatus { kFailed = 0, kDone = 1, kInterrupted = 2, kTerminated = 3 };
   if (rank != 0) {
     RunWorkerRank(*transport, rank, jobs, work);
     const int status = transport->RootStatus(kDone);
     if (status == kFailed) s.exit_code = 2;
-    s.interrupted = status == kInterrupted;
+    s.interrupted = status == kInterrupted || status == kTerminated;
+    if (status == kTerminated) RecordStopSignal(SIGTERM);
     s.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
     return s;
   }
@@ -554,7 +557,8 @@ SweepSummary RunSweep(const SweepOptions& options) {
     if (mpi) transport->RootStatus(kFailed);
     throw;
   }
-  if (mpi) transport->RootStatus(s.interrupted ? kInterrupted : kDone);
+  if (mpi)
+    transport->RootStatus(!s.interrupted ? kDone : StopSignal().load() == SIGTERM ? kTerminated : kInterrupted);
   return s;
 }
 

@@ -171,7 +171,8 @@ if [ "$mode" = mpi ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader OMPI_MCA_rmaps_base_oversubscribe=1
   # Interrupted under MPI (SIGTERM to rank 0 once the first batch runs):
   # every rank stops (a worker rank that went on to the next stage waited
-  # for rank 0 forever), exit status 130; then continued, below.
+  # for rank 0 forever), each with rank 0's exit status, 143 after SIGTERM
+  # (issue 65; 130 before); then continued, below.
   # (a hung one is ended after two minutes: exit status 124)
   # Each rank's exit status is kept (a worker rank exited 0 until 2026-11-27).
   rm -f "$d"/mpi.rc.*
@@ -188,10 +189,10 @@ if [ "$mode" = mpi ]; then
   rc=$?
   set -e
   cat "$d/mpi-interrupted.txt"
-  [ "$rc" = 130 ] || { echo "FAIL: the interrupted MPI calibration exited $rc, expected 130"; exit 1; }
+  [ "$rc" = 143 ] || { echo "FAIL: the interrupted MPI calibration exited $rc, expected 143"; exit 1; }
   for r in 0 1; do
-    [ "$(cat "$d/mpi.rc.$r" 2> /dev/null)" = 130 ] ||
-      { echo "FAIL: rank $r of the interrupted calibration exited $(cat "$d/mpi.rc.$r" 2> /dev/null), expected 130"; exit 1; }
+    [ "$(cat "$d/mpi.rc.$r" 2> /dev/null)" = 143 ] ||
+      { echo "FAIL: rank $r of the interrupted calibration exited $(cat "$d/mpi.rc.$r" 2> /dev/null), expected 143"; exit 1; }
   done
   grep -q "interrupted: run the same command again" "$d/mpi-interrupted.txt"
   ! grep -q "cannot open" "$d/mpi-interrupted.txt" || { echo "FAIL: a rank looked for runs never made"; exit 1; }

@@ -22,6 +22,7 @@
 #include "crowdrecon/viz/render_run.hpp"
 #include "crowdrecon/viz/timeline_figure.hpp"
 #include "render_scene.hpp"
+#include "ticks.hpp"
 
 namespace crowdrecon::viz {
 namespace {
@@ -64,6 +65,19 @@ std::filesystem::path WriteRun(const std::filesystem::path& dir, int frames, boo
 // a 6-px gap), at most the rows given (then the row that ends first). The
 // Itaewon marks at 156, 180 and 204 s of 270 overlapped with two rows taken
 // in turn.
+// The timeline's time axis has ticks at every length of run (issue 65, T08:
+// a 6 s run had one tick, "0 s"): about five below a minute, whole tens of
+// seconds or minutes above.
+TEST(TimeAxis, EveryRunGetsSeveralTicks) {
+  for (const double span : {2.0, 6.0, 25.0, 59.0, 60.0, 300.0, 599.0, 3600.0, 6 * 3600.0}) {
+    const double tick = viz::detail::TimeAxisTick(span);
+    EXPECT_GE(span / tick, 3.0) << "span " << span << " s, tick " << tick << " s";
+    EXPECT_LE(span / tick, 13.0) << "span " << span << " s, tick " << tick << " s";
+  }
+  EXPECT_EQ(viz::detail::TimeAxisTick(6.0), 1.0);
+  EXPECT_EQ(viz::detail::TimeAxisTick(2.0), 0.5);
+}
+
 TEST(LabelRows, ALabelGoesWhereItDoesNotOverlap) {
   const std::vector<std::string> labels{"22:11 last police call before the crush (/10)", "22:15 swept down (/10)",
                                         "22:19 first rescue team (/10)", "22:43 (/10)"};

@@ -142,7 +142,12 @@ TEST(RunClock, ACompressedRunsClockGivesTheIncidentsTime) {
   const analysis::RunClock none{"", 20.0};
   EXPECT_EQ(none.Text(285.0), "95 min");
   EXPECT_EQ(none.Text(1.0), "0 min 20 s");
-  EXPECT_EQ(none.AxisLabel(), "time of the run");
+  // A scale without a start (issue 65, F11): the axis is the incident's time, and so are the maps' titles.
+  EXPECT_EQ(none.AxisLabel(), "time of the incident since the run's start (a second of the run stands for 20 s)");
+  EXPECT_EQ(none.MomentText(15.0), "t = 15 s (5 min of the incident)");
+  EXPECT_EQ((analysis::RunClock{"", 1.0}.AxisLabel()), "time of the run");
+  EXPECT_EQ((analysis::RunClock{"", 1.0}.MomentText(15.04)), "t = 15 s");
+  EXPECT_EQ(plain.MomentText(50.0), "02:00:50");
 }
 
 // The scale travels through the run file (run value timeline_clock_scale,

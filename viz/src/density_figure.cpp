@@ -71,8 +71,7 @@ void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geomet
       c.Line(s.a + shift, s.b + shift, Color::Hex(0x222222), std::max(1.5, 2.0 * s.radius_m * ppm));
     for (const geometry::Exit& e : venue.exits) c.Line(e.a + shift, e.b + shift, Color::Hex(0x1a9850), 4.0);
     char label[160];
-    const std::string when = clock.start.empty() ? "t = " + FormatNumber(std::round(m.time_s * 10.0) / 10.0) + " s"
-                                                 : clock.Text(m.time_s);
+    const std::string when = clock.MomentText(m.time_s);
     std::snprintf(label, sizeof label, "%s: %zu people, densest %.1f /m2", when.c_str(), m.people, m.max_per_m2);
     c.Text({ox, oy + h + 0.25 * title_m}, label, 15);
   }

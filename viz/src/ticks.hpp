@@ -14,4 +14,20 @@ inline double NiceStep(double range, double ticks) {
   return 10.0 * p;
 }
 
+// The step of a timeline's time axis over `span_s` seconds of the run: whole
+// minutes and their multiples for long runs (at most 12 ticks), 10 s or 60 s
+// below ten minutes, and below a minute a nice step of about six ticks
+// (issue 65, T08: a 6 s run had one tick, "0 s").
+inline double TimeAxisTick(double span_s) {
+  double tick = 60.0;
+  for (double c : {60.0, 300.0, 600.0, 900.0, 1800.0, 3600.0})
+    if (span_s / c <= 12.0) {
+      tick = c;
+      break;
+    }
+  if (span_s < 600.0) tick = span_s / 6.0 > 30.0 ? 60.0 : 10.0;
+  if (span_s < 60.0 && span_s > 0.0) tick = NiceStep(span_s, 6.0);
+  return tick;
+}
+
 }  // namespace crowdrecon::viz::detail

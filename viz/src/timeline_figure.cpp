@@ -164,10 +164,7 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   }
   // Time axis under the last panel, and labels of the marks over the first.
   const double span = t1 - t0;
-  double tick = 60.0;
-  for (double c : {60.0, 300.0, 600.0, 900.0, 1800.0, 3600.0})
-    if (span / c <= 12.0) { tick = c; break; }
-  if (span < 600.0) tick = span / 6.0 > 30.0 ? 60.0 : 10.0;
+  const double tick = detail::TimeAxisTick(span);
   for (double t = std::ceil(t0 / tick) * tick; t <= t1 + 1e-9; t += tick) {
     for (const Panel& q : p) s.canvas.Line(s.P(q.X(t), q.bottom), s.P(q.X(t), q.bottom + 4), kInk, 1.0);
     const std::string text = ts.clock.TickText(t, tick);

@@ -49,9 +49,16 @@ struct RunClock {
   // (Text) where a tick spans a minute of the incident or more, the run's
   // seconds otherwise ("30 s").
   std::string TickText(double t_s, double tick_s) const;
-  // The words under such an axis: "time of the run" without a start, else
-  // "time of night (run time 0 = 21:45)", with the scale where it is not 1.
+  // The words under such an axis: "time of the run" without a start or a
+  // scale, "time of the incident since the run's start (a second of the run
+  // stands for 10 s)" with a scale alone, else "time of night (run time 0 =
+  // 21:45)", with the scale where it is not 1.
   std::string AxisLabel() const;
+  // A moment's title (a density map's): "t = 15 s" of the run; with a scale
+  // alone "t = 15 s (2 min 30 s of the incident)"; with a start the clock
+  // ("21:47:30"), as the axis reads (issue 65, F11: maps and figure were on
+  // two clocks).
+  std::string MomentText(double t_s) const;
   bool operator==(const RunClock&) const = default;
 };
 
