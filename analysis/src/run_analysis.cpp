@@ -259,6 +259,15 @@ void ChooseMeasurementLine(const AnalysisOptions& options, const VenueLookup& ve
   if (options.line) {
     out->line = *options.line;
     out->line_source = "given";
+    // A line wholly beside the walkable area counts no one (issue 65, P10).
+    Vec2 lo, hi;
+    const Vec2 a = options.line->a_m, b = options.line->b_m;
+    if (WktBounds(run.walkable_wkt(), &lo, &hi) &&
+        (std::max(a.x, b.x) < lo.x || std::min(a.x, b.x) > hi.x || std::max(a.y, b.y) < lo.y || std::min(a.y, b.y) > hi.y))
+      throw InputError("--line " + FormatNumber(a.x) + "," + FormatNumber(a.y) + "," + FormatNumber(b.x) + "," +
+                       FormatNumber(b.y) + ": lies wholly beside the venue's walkable area, (" + FormatNumber(lo.x) +
+                       ", " + FormatNumber(lo.y) + ") to (" + FormatNumber(hi.x) + ", " + FormatNumber(hi.y) +
+                       ") m; expected a line across it");
   } else if (venue.venue && !venue.venue->measurement_lines.empty()) {
     const geometry::MeasurementLine& l = venue.venue->measurement_lines.front();
     out->line = {l.a, l.b};

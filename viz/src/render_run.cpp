@@ -526,6 +526,14 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
     }
   }
   if (options.has_window) {  // a crop: exactly the window
+    // A window beside everything drawn would be a blank picture (issue 65, O05).
+    if (lo.x <= hi.x && (options.window_max_m.x < lo.x || options.window_min_m.x > hi.x ||
+                         options.window_max_m.y < lo.y || options.window_min_m.y > hi.y))
+      throw InputError("--window " + FormatNumber(options.window_min_m.x) + "," + FormatNumber(options.window_min_m.y) +
+                       "," + FormatNumber(options.window_max_m.x) + "," + FormatNumber(options.window_max_m.y) +
+                       ": holds nothing of the run; its venue and people lie within (" + FormatNumber(std::round(lo.x * 100) / 100) +
+                       ", " + FormatNumber(std::round(lo.y * 100) / 100) + ") to (" + FormatNumber(std::round(hi.x * 100) / 100) +
+                       ", " + FormatNumber(std::round(hi.y * 100) / 100) + ") m");
     lo = options.window_min_m;
     hi = options.window_max_m;
   } else {
