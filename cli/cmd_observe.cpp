@@ -148,6 +148,20 @@ void RunTrajectories(const TrajectoryArgs& args) {
   WriteObservationSayingLeftovers(obs, args.output);
   if (!args.figure.empty()) DrawObservationFigure(obs, nullptr, args.figure);
   SayIfUnfinished(args.file);  // (a run file's; issue 65, Q08)
+  // A region nobody ever enters gives empty series (issue 65, Q06: a region
+  // beside the venue gave "speed nan, density 0" without a word).
+  for (const observe::Region& region : spec.regions) {
+    bool entered = false;
+    for (const observe::TrajectoryPoint& p : t.points)
+      if (region.Contains(p.position_m)) {
+        entered = true;
+        break;
+      }
+    if (!entered && !t.points.empty())
+      std::printf("note: nobody is ever inside the region \"%s\" (check its coordinates against the trajectories'); "
+                  "its series are empty\n",
+                  region.name.c_str());
+  }
   if (!args.quiet) {
     std::printf("%zu people, frames %lld-%lld at %s fps\n", t.people, static_cast<long long>(t.first_frame),
                 static_cast<long long>(t.last_frame), FormatNumber(t.fps).c_str());
