@@ -98,6 +98,7 @@ img.network, svg.network { max-width: 100%; height: auto; display: block; border
 figure { margin: 10px 0 18px; page-break-inside: avoid; } figcaption { color: #444; font-size: 13px; }
 pre { background: #f6f6f3; padding: 8px; overflow-x: auto; font-size: 11px; white-space: pre-wrap; word-break: break-all; }
 code { font-size: 12px; } .note { color: #555; font-size: 13px; }
+.caveat { border-left: 4px solid #b35806; background: #fff4e6; padding: 6px 10px; margin: 8px 0; }
 @page { size: A4; margin: 14mm; }
 @media print { body { max-width: none; margin: 0; font-size: 11px; } h2 { page-break-after: avoid; } details { display: block; } details > summary { display: none; } }
 )CSS";

@@ -184,8 +184,38 @@ ReportSummary WriteReport(const ReportOptions& options) {
     k += "<div>beyond the tolerance dose<b>" + SpreadText(e.beyond_tolerance) + "</b></div>";
     return k + "</div>\n";
   };
-  h += "<h3>" + Escape(options.label) + "</h3>" + key_boxes(summary.main);
-  if (!other_runs.empty()) h += "<h3>" + Escape(options.compare_label) + "</h3>" + key_boxes(summary.other);
+  // The validity beside the headline numbers it qualifies (issue 65: the
+  // demo's 3,951 people in danger stood on page 1 without the caveat the
+  // next section gave).
+  const auto caveat = [](const std::vector<RunRisk>& runs) -> std::string {
+    std::size_t beyond_measured = 0, beyond_static = 0;
+    double peak = 0.0, longest = 0.0;
+    for (const RunRisk& r : runs) {
+      if (!r.validity) continue;
+      const analysis::Plausibility& p = *r.validity;
+      if (p.verdict == analysis::PlausibilityVerdict::kBeyondMeasured) ++beyond_measured;
+      if (p.verdict == analysis::PlausibilityVerdict::kBeyondStatic) ++beyond_static;
+      peak = std::max(peak, p.peak_equivalent_density_per_m2);
+      longest = std::max(longest, p.time_beyond_measured_s);
+    }
+    const std::string of = " of " + std::to_string(runs.size()) + (runs.size() == 1 ? " run" : " runs");
+    if (beyond_measured > 0)
+      return "<p class=\"caveat\"><b>Read these numbers with their validity.</b> In " + std::to_string(beyond_measured) +
+             of + " the crowd reached states beyond what any human crowd has been measured to reach (up to " +
+             Short(peak) + " persons/m² as real-size people" +
+             (longest > 0.0 ? ", beyond 10 /m² for up to " + Short(longest) + " s" : std::string()) +
+             "): the counts and loads below are the model's in that state, not injuries to expect (\"Are these states a "
+             "human crowd can reach?\", below).</p>\n";
+    if (beyond_static > 0)
+      return "<p class=\"caveat\"><b>Read these numbers with their validity.</b> In " + std::to_string(beyond_static) + of +
+             " the crowd went beyond Fruin's critical density of a static crowd (7.1 /m², up to " + Short(peak) +
+             " persons/m² as real-size people), within what crushes have reached (\"Are these states a human crowd can "
+             "reach?\", below).</p>\n";
+    return "";
+  };
+  h += "<h3>" + Escape(options.label) + "</h3>" + key_boxes(summary.main) + caveat(main_runs);
+  if (!other_runs.empty())
+    h += "<h3>" + Escape(options.compare_label) + "</h3>" + key_boxes(summary.other) + caveat(other_runs);
   {
     std::vector<std::vector<std::string>> rows;
     const auto row = [&](const std::string& what, auto get) {

@@ -92,6 +92,30 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
   s.canvas.TextPxAligned(kLeft, 54,
                          "lines: centred " + Number(ts.smooth_s) + "-s moving means of the run's frames; " + ts.run_file,
                          12, 0.0, 0.5, Color::Hex(0x555555), 0.0, false, kWidth - kLeft - 20);
+  // The run's validity on the figure itself (issue 65): whether its states
+  // are ones a human crowd can reach, in one line.
+  if (ts.validity.frames > 0) {
+    const analysis::Plausibility& v = ts.validity;
+    const std::string peak = Number(std::round(v.peak_equivalent_density_per_m2 * 10.0) / 10.0) + " real-size persons/m2";
+    std::string line;
+    Color colour = Color::Hex(0x555555);
+    switch (v.verdict) {
+      case analysis::PlausibilityVerdict::kWithin: line = "validity: within the range of human crowds (peak " + peak + ")"; break;
+      case analysis::PlausibilityVerdict::kBeyondStatic:
+        line = "validity: beyond Fruin's critical density of a static crowd (7.1 /m2) for " +
+               Number(std::round(v.time_beyond_static_s * 10.0) / 10.0) + " s, peak " + peak + ": within what crushes have reached";
+        colour = Color::Hex(0xb35806);
+        break;
+      case analysis::PlausibilityVerdict::kBeyondMeasured:
+        line = "validity: BEYOND what any human crowd has been measured to reach for " +
+               Number(std::round(v.time_beyond_measured_s * 10.0) / 10.0) + " s (peak " + peak +
+               "): read its loads and counts as the model's in that state";
+        colour = Color::Hex(0xb2182b);
+        break;
+    }
+    s.canvas.TextPxAligned(kLeft, 72, line, 12, 0.0, 0.5, colour, 0.0, v.verdict != analysis::PlausibilityVerdict::kWithin,
+                           kWidth - kLeft - 20);
+  }
   const double t0 = ts.time_s.empty() ? 0.0 : ts.time_s.front();
   const double t1 = ts.time_s.empty() ? 1.0 : std::max(ts.time_s.back(), t0 + 1.0);
   const auto smooth = [&](const std::vector<double>& v) { return analysis::MovingMean(ts.time_s, v, ts.smooth_s); };
