@@ -99,6 +99,8 @@ figure { margin: 10px 0 18px; page-break-inside: avoid; } figcaption { color: #4
 pre { background: #f6f6f3; padding: 8px; overflow-x: auto; font-size: 11px; white-space: pre-wrap; word-break: break-all; }
 code { font-size: 12px; } .note { color: #555; font-size: 13px; }
 .caveat { border-left: 4px solid #b35806; background: #fff4e6; padding: 6px 10px; margin: 8px 0; }
+.inset-pair { display: flex; gap: 12px; align-items: flex-start; } .inset-pair .main { flex: 3; margin: 0; }
+.inset-pair .inset { flex: 1.2; margin: 0; } .inset-pair img, .inset-pair svg { max-width: 100%; height: auto; }
 @page { size: A4; margin: 14mm; }
 @media print { body { max-width: none; margin: 0; font-size: 11px; } h2 { page-break-after: avoid; } details { display: block; } details > summary { display: none; } }
 )CSS";

@@ -305,30 +305,37 @@ ReportSummary WriteReport(const ReportOptions& options) {
     for (const FrameRisk& fr : r.frames)
       if (fr.frame == r.worst_frame) people = fr.present;
     viz::RenderSummary whole;
-    std::string f = "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix, std::nullopt, &whole) +
-                    "<figcaption>" + Escape(label) + ": frame " + std::to_string(r.worst_frame) + " (t = " +
-                    Short(r.worst_time_s, 4) + " s) of " + Escape(r.file.filename().string()) +
-                    ", the moment with the most people above F0. A line from each body's centre to each contact point, "
-                    "its thickness the contact force (the paper's Figure 6 a–b).</figcaption></figure>\n";
-    ++figures;
-    // A close-up where the whole view is too large to read the network: a
-    // square around the most loaded person, moved inside the whole view.
+    const std::string whole_figure = ForceNetworkFigure(r.file, r.worst_frame, people, prefix, std::nullopt, &whole);
+    const std::string moment = Escape(label) + ": frame " + std::to_string(r.worst_frame) + " (t = " +
+                               Short(r.worst_time_s, 4) + " s) of " + Escape(r.file.filename().string()) +
+                               ", the moment with the most people above F0";
+    const std::string how = "A line from each body's centre to each contact point, its thickness the contact force (the "
+                            "paper's Figure 6 a–b).";
+    // Where the whole view is too large to read the network (bodies as
+    // specks: issue 65), the worst region is the figure, at a readable scale
+    // (a square around the most loaded person, moved inside the whole view),
+    // and the whole venue an inset beside it with that square marked.
     const double side = options.close_up_m;
     const Vec2 extent = whole.world_max_m - whole.world_min_m;
-    if (side > 0.0 && r.worst_person > 0 && std::max(extent.x, extent.y) > 3.0 * side) {
-      Vec2 lo = r.worst_place_m - Vec2{side / 2.0, side / 2.0};
-      lo.x = std::clamp(lo.x, whole.world_min_m.x, std::max(whole.world_min_m.x, whole.world_max_m.x - side));
-      lo.y = std::clamp(lo.y, whole.world_min_m.y, std::max(whole.world_min_m.y, whole.world_max_m.y - side));
-      const Vec2 hi = {std::min(lo.x + side, whole.world_max_m.x), std::min(lo.y + side, whole.world_max_m.y)};
-      say("drawing its close-up around person " + std::to_string(r.worst_person));
-      f += "<figure>" + ForceNetworkFigure(r.file, r.worst_frame, people, prefix + "c-", std::pair{lo, hi}) +
-           "<figcaption>" + Escape(label) + ", the same moment, close up: x " + Short(lo.x, 4) + " to " +
-           Short(hi.x, 4) + " m, y " + Short(lo.y, 4) + " to " + Short(hi.y, 4) + " m, around person " +
-           std::to_string(r.worst_person) +
-           ", the most loaded then; its force scale is that of the contacts inside it.</figcaption></figure>\n";
+    if (!(side > 0.0 && r.worst_person > 0 && std::max(extent.x, extent.y) > 3.0 * side)) {
       ++figures;
+      return "<figure>" + whole_figure + "<figcaption>" + moment + ". " + how + "</figcaption></figure>\n";
     }
-    return f;
+    Vec2 lo = r.worst_place_m - Vec2{side / 2.0, side / 2.0};
+    lo.x = std::clamp(lo.x, whole.world_min_m.x, std::max(whole.world_min_m.x, whole.world_max_m.x - side));
+    lo.y = std::clamp(lo.y, whole.world_min_m.y, std::max(whole.world_min_m.y, whole.world_max_m.y - side));
+    const Vec2 hi = {std::min(lo.x + side, whole.world_max_m.x), std::min(lo.y + side, whole.world_max_m.y)};
+    say("drawing its worst region around person " + std::to_string(r.worst_person) + ", and the venue with it marked");
+    const std::string close = ForceNetworkFigure(r.file, r.worst_frame, people, prefix + "c-", std::pair{lo, hi});
+    const std::string inset = ForceNetworkFigure(r.file, r.worst_frame, people, prefix + "i-", std::nullopt, nullptr,
+                                                 std::pair{lo, hi}, 900);
+    figures += 2;
+    return "<div class=\"inset-pair\"><figure class=\"main\">" + close + "<figcaption>" + moment +
+           ": the worst region, x " + Short(lo.x, 4) + " to " + Short(hi.x, 4) + " m, y " + Short(lo.y, 4) + " to " +
+           Short(hi.y, 4) + " m, around person " + std::to_string(r.worst_person) +
+           ", the most loaded then; its force scale is that of the contacts inside it. " + how +
+           "</figcaption></figure><figure class=\"inset\">" + inset +
+           "<figcaption>The whole venue at the same moment, the region in red.</figcaption></figure></div>\n";
   };
   h += network(first, options.label, "n1-");
   if (!other_runs.empty()) h += network(other_runs.front(), options.compare_label, "n2-");

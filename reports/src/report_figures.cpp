@@ -97,7 +97,8 @@ constexpr std::uint32_t kNetworkSvgPeople = 2000;
 // a-b): the whole view, or with `window` (its lower-left and upper-right
 // corners) that part of it; `summary` (may be null) receives the layout.
 std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uint32_t people, const std::string& id_prefix,
-                               const std::optional<std::pair<Vec2, Vec2>>& window, viz::RenderSummary* summary) {
+                               const std::optional<std::pair<Vec2, Vec2>>& window, viz::RenderSummary* summary,
+                               const std::optional<std::pair<Vec2, Vec2>>& mark, int width_px) {
   std::mt19937_64 rng(std::random_device{}());
   const fs::path dir = fs::temp_directory_path() / ("crowdrecon-report-" + std::to_string(rng()));
   viz::RenderOptions o;
@@ -105,7 +106,12 @@ std::string ForceNetworkFigure(const fs::path& run, std::int64_t frame, std::uin
   o.frames = viz::ParseFrameSelection(std::to_string(frame));
   const bool as_svg = people <= kNetworkSvgPeople;
   o.svg = as_svg;
-  o.width_px = as_svg ? 1100 : 2000;
+  o.width_px = width_px > 0 ? width_px : as_svg ? 1100 : 2000;
+  if (mark) {
+    o.has_mark = true;
+    o.mark_min_m = mark->first;
+    o.mark_max_m = mark->second;
+  }
   if (window) {
     o.has_window = true;
     o.window_min_m = window->first;

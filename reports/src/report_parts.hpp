@@ -40,9 +40,9 @@ std::string SpreadText(const Spread& s, int digits = 3);
 // a-b): the whole view, or with `window` (its lower-left and upper-right
 // corners) that part of it; `summary` (may be null) receives the layout.
 std::string ForceNetworkFigure(const std::filesystem::path& run, std::int64_t frame, std::uint32_t people,
-                               const std::string& id_prefix,
-                               const std::optional<std::pair<Vec2, Vec2>>& window = std::nullopt,
-                               viz::RenderSummary* summary = nullptr);
+                               const std::string& id_prefix, const std::optional<std::pair<Vec2, Vec2>>& window,
+                               viz::RenderSummary* summary = nullptr,
+                               const std::optional<std::pair<Vec2, Vec2>>& mark = std::nullopt, int width_px = 0);
 // 1 - CDF of each set of forces (N, sorted) against F / F0, with the zones.
 std::string CdfChart(const std::string& title, const std::string& x_label,
                      const std::vector<std::pair<std::string, std::vector<double>>>& sets, const RiskOptions& o,

@@ -3,7 +3,8 @@
 # network is unreadable in the whole view): with --close-up S on a run whose
 # whole view is more than 3 S across, the report draws a second network, an
 # S x S window around the most loaded person at the worst moment, inside the
-# whole view; with --close-up 0, none; a window out of range is refused.
+# whole view (now the figure, the whole venue an inset beside it with the
+# region marked: issue 65); with --close-up 0, none; a window out of range is refused.
 #   report_close_up.sh CROWDRECON RUN_FILE
 set -uo pipefail
 exe=$1; run=$2
@@ -11,8 +12,8 @@ d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
 fail() { echo "report_close_up.sh: $*"; exit 1; }
 "$exe" report "$run" -o "$d/none" --no-pdf -q --close-up 0 > /dev/null 2>&1 || fail "report --close-up 0 failed"
 "$exe" report "$run" -o "$d/close" --no-pdf -q --close-up 2 > "$d/out.txt" 2>&1 || { cat "$d/out.txt"; fail "report --close-up 2 failed"; }
-grep -q "close up" "$d/none/report.html" && fail "a close-up with --close-up 0"
-caption=$(grep -o "the same moment, close up: x [-0-9.]* to [-0-9.]* m, y [-0-9.]* to [-0-9.]* m, around person [0-9]*" "$d/close/report.html")
+grep -q "the worst region" "$d/none/report.html" && fail "a close-up with --close-up 0"
+caption=$(grep -o "the worst region, x [-0-9.]* to [-0-9.]* m, y [-0-9.]* to [-0-9.]* m, around person [0-9]*" "$d/close/report.html")
 [[ -n $caption ]] || fail "no close-up caption with --close-up 2"
 echo "$caption"
 python3 - "$caption" <<'PY' || fail "the close-up is not a 2 m x 2 m window"

@@ -31,7 +31,7 @@ def main():
     if a.close_up:
         html = open(a.close_up).read()
         worst = re.search(r"runs: frame ([0-9]+) \(t = ", html)
-        around = re.search(r"close up: x .*? m, around person ([0-9]+)", html)
+        around = re.search(r"the worst region, x .*? m, around person ([0-9]+)", html)
         if not worst or not around:
             print(f"{a.close_up}: no worst frame or no close-up caption")
             return 1

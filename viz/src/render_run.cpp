@@ -159,6 +159,8 @@ struct Layout {
   double ppm = 1.0;   // pixels per metre
   int width_px = 0, height_px = 0;
   bool cropped = false;  // RenderOptions::has_window: drawing is clipped to the window
+  bool marked = false;   // RenderOptions::has_mark: the rectangle drawn over the picture
+  Vec2 mark_lo, mark_hi;
 
   // World point at a device position (pixels from the top-left corner).
   Vec2 World(double x_px, double y_px) const {
@@ -549,6 +551,9 @@ Layout ChooseLayout(const runfile::RunFileReader& run, const std::vector<std::in
   layout.lo = lo;
   layout.hi = hi;
   layout.cropped = options.has_window;
+  layout.marked = options.has_mark;
+  layout.mark_lo = options.mark_min_m;
+  layout.mark_hi = options.mark_max_m;
   // A hair below the exact scale, so that Canvas's ceil() lands on width_px.
   layout.ppm = (options.width_px - 2.0 * kMargin_px) / (hi.x - lo.x) * (1.0 - 1e-9);
   layout.width_px = static_cast<int>(std::ceil((hi.x - lo.x) * layout.ppm + 2.0 * kMargin_px));
@@ -658,6 +663,10 @@ std::pair<double, double> DrawFrame(const std::filesystem::path& path, const run
   *stats = FrameStats{};
   DrawForceNetwork(canvas, layout, scene, frame, slot_of_person, summary.force_n_per_px, stats);
   for (Vec2 p : frame.position_m) canvas.Dot(p, std::clamp(0.02 * layout.ppm, 1.0, 2.5), kForce);
+  if (layout.marked) {
+    const Vec2 a = layout.mark_lo, b = layout.mark_hi;
+    canvas.StrokePolyline({a, {b.x, a.y}, b, {a.x, b.y}, a}, Color::Hex(0xd62728), 3.0, /*dashed=*/false);
+  }
   canvas.ResetClip();
   DrawLegend(canvas, layout, legend, *stats, summary.force_n_per_px, summary.max_contact_force_n);
   canvas.Finish();

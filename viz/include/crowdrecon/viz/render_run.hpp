@@ -97,6 +97,11 @@ struct RenderOptions {
   // clipped. The force scale is then chosen from the contacts inside it.
   bool has_window = false;
   Vec2 window_min_m, window_max_m;
+  // A rectangle drawn over the picture (its lower-left and upper-right
+  // corners, m): where a close-up lies, on the whole view beside it (the
+  // injury-risk report's force network).
+  bool has_mark = false;
+  Vec2 mark_min_m, mark_max_m;
   // Called after each frame (may be empty).
   std::function<void(const RenderProgress&)> progress;
 
