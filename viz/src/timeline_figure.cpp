@@ -15,7 +15,7 @@ namespace crowdrecon::viz {
 
 namespace {
 
-constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 92, kPanel = 150, kGap = 26;
+constexpr double kWidth = 1400, kLeft = 110, kRight = 1180, kTop = 112, kPanel = 150, kGap = 26;
 const Color kInk = Color::Hex(0x222222), kGrid = Color::Hex(0xe3e3e3);
 const Color kFatal = RecordedMarkStyleOf("fatal").color, kDetected = Color::Hex(0x6a3d9a);
 const Color kSeries[] = {Color::Hex(0x2166ac), Color::Hex(0xd6604d), Color::Hex(0x1b7837), Color::Hex(0x762a83)};
@@ -113,7 +113,7 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
         colour = Color::Hex(0xb2182b);
         break;
     }
-    s.canvas.TextPxAligned(kLeft, 72, line, 12, 0.0, 0.5, colour, 0.0, v.verdict != analysis::PlausibilityVerdict::kWithin,
+    s.canvas.TextPxAligned(kLeft, 73, line, 12, 0.0, 0.5, colour, 0.0, v.verdict != analysis::PlausibilityVerdict::kWithin,
                            kWidth - kLeft - 20);
   }
   const double t0 = ts.time_s.empty() ? 0.0 : ts.time_s.front();
