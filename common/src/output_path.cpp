@@ -105,6 +105,17 @@ void CheckOne(const PlannedOutput& out, const std::vector<NamedInput>& inputs, b
     throw InputError(where + ": names a folder, not " + out.kind.name + "; give a file name (such as " +
                      Shortened((out.path / "out").string(), 200) + " with its extension)");
   std::error_code ec;
+  // A file goes into a folder that exists (issue 65: `timeline --scores
+  // missing/s.csv` failed only after its figure was written).
+  if (!out.kind.folder) {
+    const fs::path parent = out.path.parent_path().empty() ? fs::path(".") : out.path.parent_path();
+    if (!fs::exists(parent, ec))
+      throw InputError(where + ": its folder " + Shortened(parent.string(), 200) +
+                       " does not exist; expected an existing folder (no folder is made for a file)");
+    if (!fs::is_directory(parent, ec))
+      throw InputError(where + ": " + Shortened(parent.string(), 200) + " is " + DescribeExisting(parent) +
+                       ", not a folder; expected an existing folder");
+  }
   const fs::file_status link = fs::symlink_status(out.path, ec);
   if (!fs::exists(link)) return;  // nothing there: nothing to lose
   const std::string there = out.kind.describe ? out.kind.describe(out.path) : DescribeExisting(out.path);

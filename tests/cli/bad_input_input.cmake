@@ -137,6 +137,12 @@ crowdrecon_refused_test(observe_figure_format_first 2 "--figure .*f.txt: .*pictu
   --figure @OUT@/f.txt)
 set_tests_properties(cli.bad_input.observe_figure_format_first PROPERTIES FIXTURES_REQUIRED render_data)
 
+# A file output into a folder that does not exist is refused before any work
+# (issue 65: timeline --scores failed after writing its figure).
+crowdrecon_refused_test(output_folder_missing 2 "--json .*missing/a.json: its folder .*missing does not exist"
+  -- ${EXE} analyze ${RUN} --json @OUT@/missing/a.json)
+set_tests_properties(cli.bad_input.output_folder_missing PROPERTIES FIXTURES_REQUIRED render_data)
+
 # A browser given that is not there is refused before any work (issue 65, M15, K41).
 crowdrecon_refused_test(report_chromium_missing 2 "--chromium /nonexistent/chrome: no such program"
   -- ${EXE} report ${RUN} --chromium /nonexistent/chrome -o @OUT@/r)
