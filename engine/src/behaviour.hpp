@@ -42,10 +42,20 @@
 #include "crowdrecon/engine/contact.hpp"
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/world.hpp"
+#include "minimum_image.hpp"
 
 namespace crowdrecon::engine::detail {
 
 inline constexpr std::size_t kDriveBlock = 64;
+
+// The minimum-image difference a - b under the periodic box (the stages and
+// the terms that look at their neighbours).
+inline Vec2 Separation(const PeriodicBox& box, Vec2 a, Vec2 b) {
+  Vec2 d = a - b;
+  if (box.x) d.x = MinimumImage(d.x, box.max_m.x - box.min_m.x);
+  if (box.y) d.y = MinimumImage(d.y, box.max_m.y - box.min_m.y);
+  return d;
+}
 
 // The people within a radius of each walking or fallen person (the neighbour
 // stage, stage_neighbours.cpp), for terms that act at a distance: person i's

@@ -127,12 +127,7 @@ inline void Wrap(const PeriodicBox& box, Vec2& p) {
   }
 }
 
-inline Vec2 Separation(const PeriodicBox& box, Vec2 a, Vec2 b) {
-  Vec2 d = a - b;
-  if (box.x) d.x = MinimumImage(d.x, box.max_m.x - box.min_m.x);
-  if (box.y) d.y = MinimumImage(d.y, box.max_m.y - box.min_m.y);
-  return d;
-}
+// (Separation(box, a, b), the minimum-image difference a - b: behaviour.hpp, shared with the behaviour terms.)
 
 // The previous evaluation's contact with a given (pair key, feature), for its
 // tangential spring. The lookups of one work chunk come in increasing order

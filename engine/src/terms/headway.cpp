@@ -27,20 +27,11 @@
 #include <cmath>
 
 #include "../behaviour.hpp"
-#include "../minimum_image.hpp"
 
 namespace crowdrecon::engine::detail {
 namespace {
 
 constexpr double kHeadwayRadiusSpeed_m_per_s = 2.5;
-
-// x_j - x_i under the periodic box.
-Vec2 Apart(const PeriodicBox& box, Vec2 xi, Vec2 xj) {
-  Vec2 d = xj - xi;
-  if (box.x) d.x = MinimumImage(d.x, box.max_m.x - box.min_m.x);
-  if (box.y) d.y = MinimumImage(d.y, box.max_m.y - box.min_m.y);
-  return d;
-}
 
 class HeadwayTerm final : public BehaviourTerm {
  public:
@@ -62,7 +53,7 @@ class HeadwayTerm final : public BehaviourTerm {
       for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
         const std::uint32_t j = list.items[m];
         if (in.bodies.state[j] == PersonState::kRemoved) continue;
-        const Vec2 d = Apart(in.def.periodic, xi, in.bodies.position_m[j]);
+        const Vec2 d = Separation(in.def.periodic, in.bodies.position_m[j], xi);  // x_j - x_i
         const double dij = Length(d);
         if (!(dij > 0.0) || dij > radius_m_) continue;
         turned -= d * (a * std::exp((l - dij) / range) / dij);
@@ -84,7 +75,7 @@ class HeadwayTerm final : public BehaviourTerm {
       for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
         const std::uint32_t j = list.items[m];
         if (in.bodies.state[j] == PersonState::kRemoved) continue;
-        const Vec2 d = Apart(in.def.periodic, xi, in.bodies.position_m[j]);
+        const Vec2 d = Separation(in.def.periodic, in.bodies.position_m[j], xi);  // x_j - x_i
         const double along = Dot(d, e);
         if (!(along > 0.0) || std::abs(Cross(e, d)) >= l) continue;
         headway = std::min(headway, Length(d));

@@ -21,7 +21,6 @@
 #include <cmath>
 
 #include "../behaviour.hpp"
-#include "../minimum_image.hpp"
 
 namespace crowdrecon::engine::detail {
 namespace {
@@ -55,9 +54,7 @@ class SocialForceTerm final : public BehaviourTerm {
       for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
         const std::uint32_t j = list.items[m];
         if (in.bodies.state[j] == PersonState::kRemoved) continue;
-        Vec2 d = xi - in.bodies.position_m[j];  // from j to i
-        if (box.x) d.x = MinimumImage(d.x, box.max_m.x - box.min_m.x);
-        if (box.y) d.y = MinimumImage(d.y, box.max_m.y - box.min_m.y);
+        const Vec2 d = Separation(box, xi, in.bodies.position_m[j]);  // from j to i
         const double dij = Length(d);
         if (!(dij > 0.0) || dij > radius_m_) continue;
         const Vec2 n = d * (1.0 / dij);
