@@ -20,7 +20,8 @@
 //   facing     where the body turns, eq. 16's gain motive_torque, shoulder_turn
 //   (the drive: theta_D - theta of every facing)
 //   force      the force and torque on the person  desired_velocity, gait_jitter, back_force,
-//                                                  motive_torque, rotational_damping, floor_slope
+//                                                  motive_torque, rotational_damping, floor_slope,
+//                                                  social_force, centrifugal, anticipation
 //
 // so each sum is added in the same order as the single loop it replaced
 // (forces: contacts, eq. 3, jitter, back force, slope; torques: contacts,

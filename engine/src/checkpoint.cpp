@@ -279,6 +279,7 @@ void Simulation::LoadState(const std::string& data) {
   r.GetVector(bodies_.target, n);
   r.GetVector(bodies_.desired_speed_m_per_s, n);
   r.GetVector(contacts_);
+  for (Contact& c : contacts_) std::fill(std::begin(c.padding_), std::end(c.padding_), std::uint8_t{0});  // (older files: whatever was there)
   r.GetVector(in_->leading_force);
   r.GetVector(in_->leading_torque);
   in_->gear_initialised = r.Get<bool>();

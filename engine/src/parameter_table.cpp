@@ -29,6 +29,8 @@ constexpr const char* kSlopeResponseChoices[] = {"body_force", "held"};
 constexpr const char* kDriveReactionChoices[] = {"instant", "lagged"};
 constexpr const char* kHeadwayChoices[] = {"none", "time_gap"};
 constexpr const char* kSocialForceChoices[] = {"none", "circular"};
+constexpr const char* kCentrifugalChoices[] = {"none", "generalized"};
+constexpr const char* kAnticipationChoices[] = {"none", "time_to_collision"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -245,6 +247,52 @@ auto MakeTable() {
       When(Number("social_force_anisotropy", &P::social_force_anisotropy, "", 0.0, 1.0,
                   "Johansson, Helbing and Shukla 2007", "lambda, the weight of people behind (1: isotropic)"),
            "social_force = circular", [](const P& p) { return p.social_force == SocialForce::kCircular; }),
+      Choice<&P::centrifugal>("centrifugal", kCentrifugalChoices,
+             "issue 64; Chraibi, Seyfried and Schadschneider 2010 (the generalized centrifugal force model)",
+             "none: the paper's model; generalized: a walking person is pushed back from each person ahead by "
+             "m K (centrifugal_strength v0 + closing speed)^2 / the gap between their speed-dependent ellipses"),
+      When(Number("centrifugal_strength", &P::centrifugal_strength, "", 0.0, 10.0, "Chraibi et al. 2010",
+                  "eta, the share of the desired speed in the repulsion's numerator"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_cutoff_m", &P::centrifugal_cutoff_m, "m", 0.05, 10.0, "JuPedSim's default",
+                  "r_c, the gap beyond which the repulsion is zero"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_interpolation_m", &P::centrifugal_interpolation_m, "m", 0.001, 1.0,
+                  "JuPedSim's default", "r_eps, the width of the two interpolations (near contact and near r_c)"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_max_factor", &P::centrifugal_max_factor, "", 1.0, 100.0, "JuPedSim's default",
+                  "f_m, the repulsion at touching ellipses in units of its value at the gap r_eps"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_a_min_m", &P::centrifugal_a_min_m, "m", 0.01, 2.0, "Chraibi et al. 2010",
+                  "a_min, the ellipse's semi-axis along the velocity at rest"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_a_time_s", &P::centrifugal_a_time_s, "s", 0.0, 5.0, "Chraibi et al. 2010",
+                  "tau_a, how the semi-axis along the velocity grows with the speed"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_b_min_m", &P::centrifugal_b_min_m, "m", 0.01, 2.0, "Chraibi et al. 2010",
+                  "b_min, the semi-axis across the velocity at the desired speed"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      When(Number("centrifugal_b_max_m", &P::centrifugal_b_max_m, "m", 0.01, 2.0, "Chraibi et al. 2010",
+                  "b_max, the semi-axis across the velocity at rest"),
+           "centrifugal = generalized", [](const P& p) { return p.centrifugal == Centrifugal::kGeneralized; }),
+      Choice<&P::anticipation>("anticipation", kAnticipationChoices,
+             "issue 64; Karamouzas, Skinner and Guy 2014 (the time-to-collision power law)",
+             "none: the paper's model; time_to_collision: a walking person is pushed off each collision course by "
+             "the gradient of the energy anticipation_strength_m2 tau^-2 exp(-tau / anticipation_horizon_s)"),
+      When(Number("anticipation_strength_m2", &P::anticipation_strength_m2, "m^2", 0.0, 100.0,
+                  "Karamouzas, Skinner and Guy 2014", "k, the energy's scale"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Number("anticipation_horizon_s", &P::anticipation_horizon_s, "s", 0.1, 60.0,
+                  "Karamouzas, Skinner and Guy 2014", "tau0, the horizon beyond which collisions are ignored"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Number("anticipation_max_acceleration_m_per_s2", &P::anticipation_max_acceleration_m_per_s2, "m/s^2", 0.01,
+                  100.0, "issue 64 (ours: twice eq. 3's largest push at the venues' speeds)",
+                  "the ceiling of the anticipation force per unit mass, from each person"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Number("anticipation_radius_m", &P::anticipation_radius_m, "m", 0.1, 20.0,
+                  "issue 64 (ours: Karamouzas et al. looked 10 m; half of it for the cost)",
+                  "the centre distance within which people anticipate each other"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
   };
 }
 

@@ -216,5 +216,179 @@ TEST(SocialForce, OffIsThePapersModelAndOnIsTheSameOnAnyThreadCountAndAfterAResu
   EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
 }
 
+
+// A walker at the origin moving +x at `speed` (desired speed v0) with one
+// fallen person (at rest, facing +x) at (at, 0): the force of the terms on
+// the walker, less eq. (3)'s m/tau (v0 - speed) along +x.
+Vec2 TermForceOnAWalker(const ModelParameters& p, double speed, double v0, double at, double* mass = nullptr) {
+  WorldDef def = File(1, 10.0, v0, p);
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[0].velocity_m_per_s = {speed, 0.0};
+  PersonDef other = def.people[0];
+  other.position_m = {at, 0.0};
+  other.velocity_m_per_s = {0.0, 0.0};
+  other.state = PersonState::kFallen;
+  def.people.push_back(other);
+  const Simulation sim(def);
+  if (mass != nullptr) *mass = def.people[0].mass_kg;
+  const double drive = def.people[0].mass_kg / p.relaxation_time_s * (v0 - speed);
+  return sim.bodies().force_n[0] - sim.bodies().contact_force_n[0] - Vec2{drive, 0.0};
+}
+
+// The generalized centrifugal force (issue 64): a walker at 1 m/s (its
+// desired speed) heads for a person at rest. Its ellipse reaches a_min +
+// tau_a (0.71 m) ahead, theirs a_min (0.18 m) back, so the gap is at - 0.89 m;
+// K = 1, the closing speed 1 m/s: f(gap) = m (eta + 1)^2 / gap exactly
+// between the interpolations, f_m f(r_eps) at touching ellipses and beyond,
+// the far interpolation's midpoint and zero past r_c; nothing from a person
+// behind, nothing on a walker at rest.
+TEST(Centrifugal, TheRepulsionOfOnePersonIsTheModelsExactly) {
+  ModelParameters p;
+  p.centrifugal = Centrifugal::kGeneralized;
+  const double reach = p.centrifugal_a_min_m + p.centrifugal_a_time_s * 1.0 + p.centrifugal_a_min_m;
+  double m = 0.0;
+  TermForceOnAWalker(p, 1.0, 1.0, 5.0, &m);
+  const double scale = m * (p.centrifugal_strength + 1.0) * (p.centrifugal_strength + 1.0);
+  const double eps = p.centrifugal_interpolation_m, rc = p.centrifugal_cutoff_m;
+  struct Case {
+    double gap, expected;
+  };
+  const double x0 = rc - eps;
+  const double far_mid = (scale / x0) / 2.0 + eps * (-scale / (x0 * x0)) / 8.0;  // a cubic Hermite at t = 1/2
+  for (const Case c : {Case{1.11, scale / 1.11}, Case{0.5, scale / 0.5}, Case{eps, scale / eps},
+                       Case{x0, scale / x0}, Case{x0 + eps / 2.0, far_mid}, Case{rc + 0.01, 0.0},
+                       Case{0.0, p.centrifugal_max_factor * scale / eps},
+                       Case{-0.05, p.centrifugal_max_factor * scale / eps}}) {
+    const Vec2 f = TermForceOnAWalker(p, 1.0, 1.0, reach + c.gap);
+    EXPECT_NEAR(f.x, -c.expected, 1e-9 * (1.0 + c.expected)) << "gap " << c.gap;
+    EXPECT_NEAR(f.y, 0.0, 1e-9) << "gap " << c.gap;
+  }
+  // Continuous across the interpolations' ends.
+  for (const double joint : {eps, x0}) {
+    const double below = -TermForceOnAWalker(p, 1.0, 1.0, reach + joint - 1e-7).x;
+    const double above = -TermForceOnAWalker(p, 1.0, 1.0, reach + joint + 1e-7).x;
+    EXPECT_NEAR(below, above, 1e-4 * above) << "at gap " << joint;
+  }
+  // It rises toward touching ellipses, monotonically.
+  double previous = 0.0;
+  for (double gap = 0.3; gap >= 0.0; gap -= 0.01) {
+    const double f = -TermForceOnAWalker(p, 1.0, 1.0, reach + gap).x;
+    EXPECT_GT(f, previous) << "gap " << gap;
+    previous = f;
+  }
+  EXPECT_EQ(Length(TermForceOnAWalker(p, 1.0, 1.0, -1.0)), 0.0);  // behind
+  EXPECT_EQ(Length(TermForceOnAWalker(p, 0.0, 1.0, 0.8)), 0.0);   // a walker at rest
+}
+
+// Anticipation by time to collision (issue 64): a walker at speed u heads
+// for a person at rest at distance d on its line: tau = (d - R) / u, R the
+// two bounding radii, and the force is m k e^(-tau/tau0) tau^-2 (2/tau +
+// 1/tau0) / u backwards, exactly, up to its ceiling m a_max; nothing from a
+// person it passes by (offset beyond R) or moves away from.
+TEST(Anticipation, TheForceOfOneCollisionCourseIsTheModelsExactly) {
+  ModelParameters p;
+  p.anticipation = Anticipation::kTimeToCollision;
+  WorldDef probe = File(1, 10.0, 1.0, p);
+  const Simulation shape_probe(probe);
+  const BodyShape& shape = shape_probe.definition().shapes[0];
+  const double reach = 2.0 * (shape.core_radius_m + shape.radius_m);
+  for (const double u : {0.6, 1.3}) {
+    for (const double d : {1.5, 2.5, 4.0, 4.9}) {
+      double m = 0.0;
+      const Vec2 f = TermForceOnAWalker(p, u, 1.0, d, &m);
+      const double tau = (d - reach) / u;
+      const double k = p.anticipation_strength_m2, t0 = p.anticipation_horizon_s;
+      const double a = std::min(k * std::exp(-tau / t0) / (tau * tau) * (2.0 / tau + 1.0 / t0) / u,
+                                p.anticipation_max_acceleration_m_per_s2);
+      EXPECT_NEAR(f.x, -m * a, 1e-9 * m * a) << "u " << u << ", d " << d;
+      EXPECT_NEAR(f.y, 0.0, 1e-9);
+    }
+  }
+  double m = 0.0;
+  const double at_the_ceiling = -TermForceOnAWalker(p, 1.0, 1.0, reach + 0.05, &m).x;
+  EXPECT_NEAR(at_the_ceiling, m * p.anticipation_max_acceleration_m_per_s2, 1e-9 * m);  // the ceiling
+  EXPECT_EQ(Length(TermForceOnAWalker(p, 1.0, 1.0, -2.0)), 0.0);             // moving away
+  EXPECT_EQ(Length(TermForceOnAWalker(p, 1.0, 1.0, p.anticipation_radius_m + 0.1)), 0.0);  // beyond the radius
+  // Passing by: the other person 2 m ahead and R + 1 cm to the side.
+  WorldDef def = File(1, 10.0, 1.0, p);
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[0].velocity_m_per_s = {1.0, 0.0};
+  PersonDef other = def.people[0];
+  other.position_m = {2.0, reach + 0.01};
+  other.velocity_m_per_s = {0.0, 0.0};
+  other.state = PersonState::kFallen;
+  def.people.push_back(other);
+  const Simulation sim(def);
+  EXPECT_NEAR(sim.bodies().force_n[0].y, 0.0, 1e-12);
+}
+
+// Two walkers meeting head on, their lines 0.1 m apart: with the paper's
+// model they collide; with either term they pass each other.
+TEST(KeepingDistance, TwoWalkersMeetingHeadOnPassWithTheCentrifugalForceOrAnticipation) {
+  ModelParameters centrifugal, anticipation;
+  centrifugal.centrifugal = Centrifugal::kGeneralized;
+  anticipation.anticipation = Anticipation::kTimeToCollision;
+  const std::vector<const ModelParameters*> cases{nullptr, &centrifugal, &anticipation};
+  for (const ModelParameters* p : cases) {
+    WorldDef def = File(1, 10.0, 1.2, p != nullptr ? *p : ModelParameters{});
+    def.periodic = PeriodicBox{};
+    def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+    def.people[0].position_m = {0.0, 0.0};
+    def.people[0].velocity_m_per_s = {1.2, 0.0};
+    PersonDef other = def.people[0];
+    other.position_m = {8.0, 0.1};
+    other.velocity_m_per_s = {-1.2, 0.0};
+    other.angle_rad = 3.14159265358979;
+    other.target = 1;
+    def.people.push_back(other);
+    Simulation sim(def);
+    bool touched = false;
+    while (sim.time_s() < 12.0) {
+      sim.Step();
+      touched = touched || !sim.contacts().empty();
+    }
+    const bool passed = sim.bodies().position_m[0].x > 8.0 && sim.bodies().position_m[1].x < 0.0;
+    if (p == nullptr) {
+      EXPECT_TRUE(touched) << "the paper's model";
+    } else {
+      EXPECT_FALSE(touched) << (p == &centrifugal ? "centrifugal" : "anticipation");
+      EXPECT_TRUE(passed) << (p == &centrifugal ? "centrifugal" : "anticipation");
+    }
+  }
+}
+
+TEST(KeepingDistance, TheCentrifugalForceAndAnticipationOffAreThePapersModelAndOnTheSameOnAnyThreadCountAndAfterAResume) {
+  WorldDef paper = testing::RandomGas(6, 0.45, 5, true), numbers = paper;
+  paper.parameters.ground_reaction = numbers.parameters.ground_reaction = true;
+  numbers.parameters.centrifugal_strength = 2.0;  // off: their numbers change nothing
+  numbers.parameters.anticipation_strength_m2 = 9.0;
+  Simulation sa(paper), sb(numbers);
+  sa.AdvanceTo(0.3);
+  sb.AdvanceTo(0.3);
+  std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
+  EXPECT_EQ(std::memcmp(sa.bodies().position_m.data(), sb.bodies().position_m.data(), bytes), 0);
+  for (const int which : {0, 1}) {
+    WorldDef def = testing::RandomGas(24, 0.5, 3, true);
+    if (which == 0) def.parameters.centrifugal = Centrifugal::kGeneralized;
+    if (which == 1) def.parameters.anticipation = Anticipation::kTimeToCollision;
+    for (PersonDef& person : def.people) person.desired_speed_m_per_s = 1.2;
+    def.threads = 1;
+    Simulation one(def);
+    one.AdvanceTo(0.05);
+    const std::string state = one.SaveState();
+    one.AdvanceTo(0.1);
+    def.threads = 2;
+    Simulation two(def), resumed(def);
+    two.AdvanceTo(0.1);
+    resumed.LoadState(state);
+    resumed.AdvanceTo(0.1);
+    bytes = one.bodies().size() * sizeof(Vec2);
+    EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0) << which;
+    EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0) << which;
+  }
+}
+
 }  // namespace
 }  // namespace crowdrecon::engine

@@ -21,7 +21,9 @@
   X("rotational_damping", MakeRotationalDamping, "the rotational damping -I omega / tau_r, eq. (17)")             \
   X("floor_slope", MakeFloorSlope, "a sloping floor pulls people, or their legs hold it and their pace follows the grade (issue 43)") \
   X("headway", MakeHeadway, "keeping a distance: e turned away from near people, v0 capped by the headway (issue 64)") \
-  X("social_force", MakeSocialForce, "keeping a distance: the social force's repulsion from people near (issue 64)")
+  X("social_force", MakeSocialForce, "keeping a distance: the social force's repulsion from people near (issue 64)") \
+  X("centrifugal", MakeCentrifugal, "keeping a distance: the generalized centrifugal force from people ahead (issue 64)") \
+  X("anticipation", MakeAnticipation, "anticipating: the time-to-collision force off collision courses (issue 64)")
 
 namespace crowdrecon::engine::detail {
 

@@ -17,6 +17,10 @@ struct Contact {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
   bool wall = false;
+  // The bytes between `wall` and `feature`, named so that they are zero: a
+  // checkpoint writes contacts as they lie in memory, and unnamed padding
+  // held whatever was there (the same state gave different bytes).
+  std::uint8_t padding_[3] = {};
   std::uint32_t feature = 0;      // owning vertex within (a, b), see narrow_phase.hpp
   Vec2 point_m;                   // application point (in a's periodic image)
   Vec2 normal;                    // unit, from b to a

@@ -116,6 +116,24 @@ enum class SocialForce {
   kCircular,  // A exp((r_ij - d_ij)/B) n_ij (lambda + (1 - lambda)(1 + cos phi_ij)/2) from each person j
 };
 
+// The generalized centrifugal force (issue 64; off by default): the third
+// form, a repulsion that grows with the speed at which a person closes in on
+// another's speed-dependent ellipse (Chraibi, Seyfried and Schadschneider,
+// Phys. Rev. E 82:046111, 2010).
+enum class Centrifugal {
+  kNone,         // the paper's model (default)
+  kGeneralized,  // -m K_ij (eta v0_i + v_ij)^2 / dist_ij e_ij from each person j ahead, interpolated near 0 and r_c
+};
+
+// Anticipation by time to collision (issue 64; off by default): the fourth
+// form, the force of the energy E = k tau^-2 exp(-tau/tau0) of the time tau
+// to the collision of two bodies moving on (Karamouzas, Skinner and Guy,
+// Phys. Rev. Lett. 113:238701, 2014).
+enum class Anticipation {
+  kNone,             // the paper's model (default)
+  kTimeToCollision,  // -m grad_x E(tau) from each person j on a collision course
+};
+
 // How a sloping floor acts on walking people (issue 43; docs/itaewon.md).
 enum class SlopeResponse {
   kBodyForce,  // issue 19: m g sin(theta) downhill on every walking person (default; eq. 3 alone holds it)
@@ -239,6 +257,39 @@ struct ModelParameters {
   double social_force_strength_n = 2000.0;
   double social_force_range_m = 0.08;
   double social_force_anisotropy = 1.0;
+  // Centrifugal::kGeneralized: on a walking person i moving at v_i from each
+  // person j with K_ij = max(0, v_i . e_ij) / |v_i| > 0 (e_ij from i to j;
+  // nobody at rest is pushed), -m_i K_ij (eta v0_i + v_ij)^2 / dist_ij e_ij,
+  // v_ij = max(0, (v_i - v_j) . e_ij), dist_ij the gap between the two
+  // people's ellipses along the line of centres (semi-axes a = a_min + tau_a
+  // |v| along the velocity, b = b_max - (b_max - b_min) min(1, |v| / v0)
+  // across it). Between r_c - r_eps and r_c it falls to 0, below r_eps it
+  // rises to f_m times its value at r_eps (Hermite interpolations; f_m times
+  // that value where the ellipses overlap). Defaults: Chraibi et al. 2010
+  // (eta 0.28; a_min 0.18 m, tau_a 0.53 s, b_min 0.2 m, b_max 0.25 m) and
+  // JuPedSim's (r_c 2 m, r_eps 0.1 m, f_m 3).
+  Centrifugal centrifugal = Centrifugal::kNone;
+  double centrifugal_strength = 0.28;
+  double centrifugal_cutoff_m = 2.0;
+  double centrifugal_interpolation_m = 0.1;
+  double centrifugal_max_factor = 3.0;
+  double centrifugal_a_min_m = 0.18;
+  double centrifugal_a_time_s = 0.53;
+  double centrifugal_b_min_m = 0.2;
+  double centrifugal_b_max_m = 0.25;
+  // Anticipation::kTimeToCollision: tau the time until the bounding circles
+  // of i and j touch if both keep their velocities (none when they move
+  // apart, miss, or already overlap); on i, m_i k e^(-tau/tau0) tau^-2 (2/tau
+  // + 1/tau0) (x_ij + v_ij tau) / sqrt(D) (x_ij = x_i - x_j, v_ij = v_i -
+  // v_j, D the discriminant of |x_ij + v_ij t| = r_i + r_j), its size at most
+  // m_i times anticipation_max_acceleration_m_per_s2, from each person within
+  // anticipation_radius_m. Defaults: Karamouzas, Skinner and Guy 2014 (k 1.5
+  // m^2, tau0 3 s); the ceiling and the radius are ours.
+  Anticipation anticipation = Anticipation::kNone;
+  double anticipation_strength_m2 = 1.5;
+  double anticipation_horizon_s = 3.0;
+  double anticipation_max_acceleration_m_per_s2 = 5.0;
+  double anticipation_radius_m = 5.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
