@@ -65,6 +65,7 @@ int RunSimulate(const SimulateArgs& args) {
   scenario::InstallInterruptHandlers();
   const scenario::RunSummary s = scenario::RunScenario(sc, options);
   std::printf("scenario: %s\n", sc.name.c_str());
+  std::printf("profile: %s\n", sc.profile.c_str());
   if (s.slots > 0)
     std::printf("timeline: %zu people at the start, room in the engine for %zu at once\n", s.people, s.slots);
   // A max_present the engine could not keep is said (issue 40: it was raised without a word).

@@ -168,7 +168,11 @@ ReportSummary WriteReport(const ReportOptions& options) {
                   "</style></head><body>\n";
   const RunRisk& first = main_runs.front();
   h += "<h1>Injury-risk report</h1>\n<p class=\"sub\">" + Escape(first.scenario_name) + " — venue: " +
-       Escape(first.venue_name) + "<br>" + std::to_string(main_runs.size()) +
+       Escape(first.venue_name) + " — model profile: <b>" + Escape(first.profile) + "</b>" +
+       (other_runs.empty() || other_runs.front().profile == first.profile
+            ? std::string()
+            : " (compared with profile <b>" + Escape(other_runs.front().profile) + "</b>)") +
+       "<br>" + std::to_string(main_runs.size()) +
        (main_runs.size() == 1 ? " run" : " runs (seeds)") +
        (other_runs.empty() ? "" : ", compared with " + Escape(other_runs.front().scenario_name) + " (" +
                                       std::to_string(other_runs.size()) + (other_runs.size() == 1 ? " run)" : " runs)")) +
@@ -618,7 +622,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
       for (const RunRisk& r : runs) {
         say("checksum of " + r.file.string());
         const runfile::RunFileReader reader(r.file);
-        rows.push_back({Escape(set), Escape(r.file.string()), Escape(r.seed), Short(r.duration_s, 5) + " s",
+        rows.push_back({Escape(set), Escape(r.file.string()), Escape(r.profile), Escape(r.seed), Short(r.duration_s, 5) + " s",
                         std::to_string(r.people.size()), "<code>" + Sha256OfFile(r.file) + "</code>",
                         "<code>" + Sha256Hex(reader.RunValue("scenario")) + "</code>",
                         "<code>" + Sha256Hex(reader.venue_json()) + "</code>"});
@@ -626,7 +630,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
     };
     list(main_runs, options.label);
     list(other_runs, options.compare_label);
-    h += Table({"set", "run file", "seed", "simulated", "people", "SHA-256 of the run file", "of its scenario", "of its venue"}, rows);
+    h += Table({"set", "run file", "profile", "seed", "simulated", "people", "SHA-256 of the run file", "of its scenario", "of its venue"}, rows);
     h += "<p class=\"note\">The scenario and venue as given are stored in each run file (table run, keys scenario and "
          "venue); their checksums are of that text. Check a run file with <code>sha256sum</code>; regenerate it with "
          "<code>crowdrecon simulate</code> on the scenario (same input and seed give the same file content, whatever "

@@ -138,6 +138,8 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   risk.file = run_file;
   risk.fps = reader.fps();
   risk.scenario_name = JsonName(reader.RunValue("scenario"));
+  risk.profile = reader.RunValue("profile");
+  if (risk.profile.empty()) risk.profile = "paper (run file from before model profiles)";
   risk.venue_name = JsonName(reader.venue_json());
   risk.seed = reader.RunValue("seed");
   const std::vector<runfile::Person> setup = reader.People();

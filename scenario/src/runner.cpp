@@ -480,6 +480,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   runfile::RunFileWriter& writer = opened.writer;
   std::int64_t last_frame = opened.last_frame;
   writer.SetRunValue("people", std::to_string(timeline ? built.timeline.initial_people : sim.bodies().size()));
+  writer.SetRunValue("profile", scenario.profile);  // the model profile (scenario/profile.hpp)
   if (timeline) {
     std::string groups;
     for (const std::string& g : scenario.timeline.groups) groups += (groups.empty() ? "" : ",") + g;

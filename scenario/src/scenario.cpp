@@ -5,11 +5,14 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
 #include "crowdrecon/geometry/population_table.hpp"
+#include "crowdrecon/scenario/profile.hpp"
 #include "timeline_systems.hpp"
 
 namespace crowdrecon::scenario {
@@ -50,6 +53,42 @@ void ReadModel(const JsonReader& model, engine::ModelParameters& m) {
   model.Finish();
 }
 
+// A profile's values where the scenario gives none of its own (its model
+// block's keys one by one, the population's body block and free speeds as
+// wholes); body files by paths relative to the scenario's folder, as a
+// scenario names them. Whether anything was added.
+bool ApplyProfile(const ModelProfile& profile, const std::filesystem::path& base_dir, nlohmann::json& scenario) {
+  bool changed = false;
+  if (!profile.model.empty()) {
+    nlohmann::json& model = scenario["model"];
+    if (model.is_null()) model = nlohmann::json::object();
+    if (model.is_object())
+      for (const auto& [key, value] : profile.model)
+        if (!model.contains(key)) {
+          model[key] = nlohmann::json::parse(value);
+          changed = true;
+        }
+  }
+  const auto population = scenario.find("population");
+  if (population == scenario.end() || !population->is_object()) return changed;  // (the reader says what is wrong)
+  if (!profile.body_json.empty() && !population->contains("body")) {
+    nlohmann::json body = nlohmann::json::parse(profile.body_json);
+    if (!base_dir.empty())
+      for (const char* key : {"reference", "anthropometry"})
+        if (body.contains(key) && body[key].is_string())
+          body[key] = std::filesystem::path(body[key].get<std::string>())
+                          .lexically_relative(std::filesystem::absolute(base_dir).lexically_normal())
+                          .string();
+    (*population)["body"] = body;
+    changed = true;
+  }
+  if (profile.desired_speed_m_per_s && !population->contains("desired_speed_m_per_s")) {
+    (*population)["desired_speed_m_per_s"] = {profile.desired_speed_m_per_s->first, profile.desired_speed_m_per_s->second};
+    changed = true;
+  }
+  return changed;
+}
+
 }  // namespace
 
 Scenario ParseScenario(const std::string& json_text, const std::string& origin,
@@ -57,9 +96,30 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
   const JsonDocument doc = JsonDocument::Parse(json_text, origin);
   const JsonReader root = doc.Root();
   if (!root.IsObject()) root.Fail("expected a scenario object {...}");
+  // The model profile (profile.hpp): its values are written into the
+  // scenario where it gives none of its own, and the scenario is read from
+  // that text, which the run file keeps (a later change of the profile's file
+  // is then a change of the scenario: a resume refuses it).
+  std::string profile_name = kDefaultProfile;
+  if (auto named = root.Find("profile")) {
+    const std::string given = named->AsString();
+    ModelProfile profile;
+    try {
+      profile = LoadModelProfile(ProfilePath(given, base_dir));
+    } catch (const InputError& e) {
+      std::string names;
+      for (const std::string& n : NamedProfiles()) names += (names.empty() ? "" : ", ") + n;
+      named->Fail(std::string("cannot use the profile: ") + e.what() + "; expected one of the named profiles (" + names +
+                  ") or a profile file");
+    }
+    nlohmann::json merged = doc.Json();
+    if (ApplyProfile(profile, base_dir, merged)) return ParseScenario(merged.dump(2) + "\n", origin, base_dir);
+    profile_name = profile.name;
+  }
   Scenario s;
   s.json_text = json_text;
   s.file = origin;
+  s.profile = profile_name;
   const std::string format = root.String("format", "crowdrecon-scenario");
   if (format != "crowdrecon-scenario")
     root.At("format").Fail("\"" + format + "\" is not a scenario; expected \"crowdrecon-scenario\"");

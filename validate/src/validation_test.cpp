@@ -11,6 +11,7 @@
 #include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/engine/parameter_table.hpp"
+#include "crowdrecon/scenario/profile.hpp"
 
 namespace crowdrecon::validate {
 
@@ -396,57 +397,19 @@ ValidationTest LoadValidationTest(const fs::path& file) {
 }
 
 Profile ParseProfile(const std::string& text, const std::string& origin, const fs::path& base_dir) {
-  const JsonDocument doc = JsonDocument::Parse(text, origin);
-  const JsonReader r = doc.Root();
-  if (!r.IsObject()) r.Fail("expected a profile object");
-  if (r.String("format") != "crowdrecon-profile") r.At("format").Fail("expected \"crowdrecon-profile\"");
-  r.Integer("version", 1, 1);
+  // The format is the scenarios' (scenario/profile.hpp): one reader.
+  const scenario::ModelProfile m = scenario::ParseModelProfile(text, origin, base_dir);
   Profile p;
-  p.name = r.String("name");
-  if (!IsCaseName(p.name)) r.At("name").Fail("expected letters, digits, '.', '_' or '-' (at most 64)");
-  p.description = r.String("description", "");
-  if (const auto model = r.Find("model")) {
-    if (!model->IsObject()) model->Fail("expected the scenario's model block {\"key\": value, ...}");
-    for (const std::string& key : model->Keys()) {
-      // Checked here, against the parameter table, so that a bad key or value
-      // is blamed on the profile (issue 65, K03, K10: it was blamed on every
-      // test's scenario, which does not have it).
-      const JsonReader value = model->At(key);
-      const engine::ParameterInfo* info = engine::FindModelParameter(key);
-      if (info == nullptr) value.Fail("unknown model parameter; expected one of the parameter table's (docs/model.md)");
-      switch (info->kind) {
-        case engine::ParameterInfo::Kind::kNumber: value.AsNumber(info->min, info->max); break;
-        case engine::ParameterInfo::Kind::kFlag: (void)model->Bool(key, false); break;
-        case engine::ParameterInfo::Kind::kChoice: {
-          const std::vector<std::string> allowed(info->choices, info->choices + info->choice_count);
-          if (std::find(allowed.begin(), allowed.end(), value.AsString()) == allowed.end())
-            value.Fail("\"" + value.AsString() + "\"; expected " + info->Expected());
-          break;
-        }
-      }
-      p.set.push_back({"model." + key, RawAt(doc, value).dump()});
-    }
-  }
-  if (const auto body = r.Find("body")) {
-    if (!body->IsObject()) body->Fail("expected the scenario's body block {\"mode\": ..., ...}");
-    json b = RawAt(doc, *body);
-    // File paths resolve against the profile's folder.
-    for (const char* key : {"reference", "anthropometry"})
-      if (b.contains(key) && b[key].is_string())
-        b[key] = fs::absolute(base_dir / b[key].get<std::string>()).lexically_normal().string();
-    for (const std::string& key : body->Keys()) body->At(key);  // (checked by the scenario reader)
-    p.set.push_back({"population.body", b.dump()});
-  }
-  if (const auto v0 = r.Find("desired_speed_m_per_s")) {
-    // The crowd's free speeds where a test does not prescribe them (a test
-    // case that sets them comes after the profile).
-    const std::vector<Vec2> one = {v0->AsPoint()};
-    if (!(one[0].x >= 0.0 && one[0].x <= one[0].y && one[0].y <= 10.0))
-      v0->Fail("expected [low, high] m/s with 0 <= low <= high <= 10");
-    p.set.push_back({"population.desired_speed_m_per_s", RawAt(doc, *v0).dump()});
-  }
-  r.Finish();
-  p.canonical_json = doc.Json().dump();
+  p.name = m.name;
+  p.description = m.description;
+  for (const auto& [key, value] : m.model) p.set.push_back({"model." + key, value});
+  if (!m.body_json.empty()) p.set.push_back({"population.body", m.body_json});
+  // The crowd's free speeds where a test does not prescribe them (a test
+  // case that sets them comes after the profile).
+  if (m.desired_speed_m_per_s)
+    p.set.push_back({"population.desired_speed_m_per_s",
+                     json::array({m.desired_speed_m_per_s->first, m.desired_speed_m_per_s->second}).dump()});
+  p.canonical_json = m.canonical_json;
   return p;
 }
 

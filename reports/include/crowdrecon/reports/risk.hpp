@@ -119,6 +119,9 @@ struct ForceHistogram {
 struct RunRisk {
   std::filesystem::path file;
   std::string scenario_name;
+  // The model profile that made it (run value "profile"; run files from
+  // before profiles ran the paper's: said so).
+  std::string profile;
   std::string venue_name;
   std::string seed;
   double fps = 0.0;

@@ -13,7 +13,8 @@
 //       "placement": {"region": "walkable", "max_overlap_m": 0.003},
 //       "seed": 2012
 //     },
-//     "model": { "restitution": 0.4, "back_force_gamma": 1.2, ... },   (engine::ModelParameters)
+//     "profile": "paper",              (a named model profile or a profile file: profile.hpp)
+//     "model": { "restitution": 0.4, "back_force_gamma": 1.2, ... },   (engine::ModelParameters; wins over the profile)
 //     "run": {"duration_s": 60, "output_fps": 10, "checkpoint_interval_s": 10, "contacts": true},
 //     "timeline": { "inflows": [...], "events": [...], "falls": {...} }   (optional: timeline.hpp)
 //   }
@@ -78,7 +79,12 @@ struct Scenario {
   // the slope is off): the commands print them as notes.
   std::vector<std::string> settings_without_effect;
   std::filesystem::path file;  // where it was read from ("" if from text)
-  std::string json_text;       // as given (kept in the run file)
+  // As given, with its profile's values written in where it gives none of
+  // its own (kept in the run file).
+  std::string json_text;
+  // The model profile it runs ("profile", scenario/profile.hpp; "paper"
+  // without one: the engine's defaults are the paper's model).
+  std::string profile;
   std::filesystem::path venue_file;
   geometry::Venue venue;
   PopulationSpec population;
