@@ -97,7 +97,7 @@ svg.chart, svg.plan { max-width: 100%; height: auto; display: block; margin: 6px
 img.network, svg.network { max-width: 100%; height: auto; display: block; border: 1px solid #ddd; }
 figure { margin: 10px 0 18px; page-break-inside: avoid; } figcaption { color: #444; font-size: 13px; }
 pre { background: #f6f6f3; padding: 8px; overflow-x: auto; font-size: 11px; white-space: pre-wrap; word-break: break-all; }
-code { font-size: 12px; } .note { color: #555; font-size: 13px; }
+code { font-size: 12px; } td code { word-break: break-all; } .note { color: #555; font-size: 13px; }
 .caveat { border-left: 4px solid #b35806; background: #fff4e6; padding: 6px 10px; margin: 8px 0; }
 .inset-pair { display: flex; gap: 12px; align-items: flex-start; } .inset-pair .main { flex: 3; margin: 0; }
 .inset-pair .inset { flex: 1.2; margin: 0; } .inset-pair img, .inset-pair svg { max-width: 100%; height: auto; }

@@ -631,8 +631,9 @@ ReportSummary WriteReport(const ReportOptions& options) {
     list(main_runs, options.label);
     list(other_runs, options.compare_label);
     h += Table({"set", "run file", "profile", "seed", "simulated", "people", "SHA-256 of the run file", "of its scenario", "of its venue"}, rows);
-    h += "<p class=\"note\">The scenario and venue as given are stored in each run file (table run, keys scenario and "
-         "venue); their checksums are of that text. Check a run file with <code>sha256sum</code>; regenerate it with "
+    h += "<p class=\"note\">The scenario (as given, with its model profile's values written in where it gives none of its "
+         "own) and the venue are stored in each run file (table run, keys scenario and venue); their checksums are of that "
+         "text; the profile's name is run value profile. Check a run file with <code>sha256sum</code>; regenerate it with "
          "<code>crowdrecon simulate</code> on the scenario (same input and seed give the same file content, whatever "
          "the number of threads).</p>\n";
     const runfile::RunFileReader reader(first.file);
