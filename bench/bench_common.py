@@ -160,6 +160,15 @@ def percent(value):
     return "–" if value is None else f"{100 * value:.0f} %"
 
 
+def fresh_run_file(folder):
+    """FOLDER/run.sqlite with no run file (or its SQLite journals) left there
+    by the previous run of a script."""
+    out = pathlib.Path(folder) / "run.sqlite"
+    for leftover in (out, pathlib.Path(str(out) + "-wal"), pathlib.Path(str(out) + "-shm")):
+        leftover.unlink(missing_ok=True)
+    return out
+
+
 def markdown_table(header, rows):
     lines = ["| " + " | ".join(header) + " |", "|" + "|".join(" --- " for _ in header) + "|"]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]

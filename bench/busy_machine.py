@@ -58,9 +58,7 @@ def scenario_copy(path, duration_s):
 
 
 def run_once(exe, scenario, threads, extra, env, busy, folder):
-    out = pathlib.Path(folder) / "run.sqlite"
-    for leftover in (out, pathlib.Path(str(out) + "-wal"), pathlib.Path(str(out) + "-shm")):
-        leftover.unlink(missing_ok=True)
+    out = bc.fresh_run_file(folder)
     hog = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if busy else None
     if hog:
         time.sleep(0.3)  # the other program is busy before the run starts

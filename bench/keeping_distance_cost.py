@@ -53,9 +53,7 @@ def scenario_copy(path, duration_s, population, profile, folder):
 
 
 def run_once(exe, scenario, folder):
-    out = pathlib.Path(folder) / "run.sqlite"
-    for leftover in (out, pathlib.Path(str(out) + "-wal"), pathlib.Path(str(out) + "-shm")):
-        leftover.unlink(missing_ok=True)
+    out = bc.fresh_run_file(folder)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     result = subprocess.run([str(exe), "simulate", str(scenario), "-o", str(out), "-q", "--threads", "1",
                              "--fixed-threads"], capture_output=True, text=True)

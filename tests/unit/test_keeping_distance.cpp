@@ -137,24 +137,29 @@ TEST(Headway, OffIsThePapersModelBitForBit) {
   EXPECT_EQ(sb.profile().seconds(Stage::kNeighbours), 0.0);  // and the neighbour stage costs nothing
 }
 
-TEST(Headway, SameOnAnyThreadCountAndAfterAResume) {
-  WorldDef def = testing::RandomGas(24, 0.5, 3, true);  // 576 people: the drive runs on threads
-  def.parameters = KeepingDistance();
+// 576 walkers at 1.2 m/s with `parameters` (the drive runs on threads): the
+// same positions on one thread and two, and after a resume at half of `end_s`.
+void ExpectTheSameOnAnyThreadCountAndAfterAResume(const ModelParameters& parameters, double end_s, const char* what) {
+  WorldDef def = testing::RandomGas(24, 0.5, 3, true);
+  def.parameters = parameters;
   for (PersonDef& p : def.people) p.desired_speed_m_per_s = 1.2;
   def.threads = 1;
   Simulation one(def);
-  one.AdvanceTo(0.1);
+  one.AdvanceTo(end_s / 2.0);
   const std::string state = one.SaveState();
-  one.AdvanceTo(0.2);
+  one.AdvanceTo(end_s);
   def.threads = 2;
-  Simulation two(def);
-  two.AdvanceTo(0.2);
-  Simulation resumed(def);
+  Simulation two(def), resumed(def);
+  two.AdvanceTo(end_s);
   resumed.LoadState(state);
-  resumed.AdvanceTo(0.2);
+  resumed.AdvanceTo(end_s);
   const std::size_t bytes = one.bodies().size() * sizeof(Vec2);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0) << what;
+  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0) << what;
+}
+
+TEST(Headway, SameOnAnyThreadCountAndAfterAResume) {
+  ExpectTheSameOnAnyThreadCountAndAfterAResume(KeepingDistance(), 0.2, "headway");
 }
 
 // The social force (issue 64): a walker at rest with one person on its line,
@@ -196,24 +201,11 @@ TEST(SocialForce, OffIsThePapersModelAndOnIsTheSameOnAnyThreadCountAndAfterAResu
   Simulation sa(paper), sb(numbers);
   sa.AdvanceTo(0.3);
   sb.AdvanceTo(0.3);
-  std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
+  const std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
   EXPECT_EQ(std::memcmp(sa.bodies().position_m.data(), sb.bodies().position_m.data(), bytes), 0);
-  WorldDef def = testing::RandomGas(24, 0.5, 3, true);
-  def.parameters.social_force = SocialForce::kCircular;
-  for (PersonDef& person : def.people) person.desired_speed_m_per_s = 1.2;
-  def.threads = 1;
-  Simulation one(def);
-  one.AdvanceTo(0.05);
-  const std::string state = one.SaveState();
-  one.AdvanceTo(0.1);
-  def.threads = 2;
-  Simulation two(def), resumed(def);
-  two.AdvanceTo(0.1);
-  resumed.LoadState(state);
-  resumed.AdvanceTo(0.1);
-  bytes = one.bodies().size() * sizeof(Vec2);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0);
-  EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0);
+  ModelParameters on;
+  on.social_force = SocialForce::kCircular;
+  ExpectTheSameOnAnyThreadCountAndAfterAResume(on, 0.1, "social force");
 }
 
 
@@ -367,27 +359,13 @@ TEST(KeepingDistance, TheCentrifugalForceAndAnticipationOffAreThePapersModelAndO
   Simulation sa(paper), sb(numbers);
   sa.AdvanceTo(0.3);
   sb.AdvanceTo(0.3);
-  std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
+  const std::size_t bytes = sa.bodies().size() * sizeof(Vec2);
   EXPECT_EQ(std::memcmp(sa.bodies().position_m.data(), sb.bodies().position_m.data(), bytes), 0);
-  for (const int which : {0, 1}) {
-    WorldDef def = testing::RandomGas(24, 0.5, 3, true);
-    if (which == 0) def.parameters.centrifugal = Centrifugal::kGeneralized;
-    if (which == 1) def.parameters.anticipation = Anticipation::kTimeToCollision;
-    for (PersonDef& person : def.people) person.desired_speed_m_per_s = 1.2;
-    def.threads = 1;
-    Simulation one(def);
-    one.AdvanceTo(0.05);
-    const std::string state = one.SaveState();
-    one.AdvanceTo(0.1);
-    def.threads = 2;
-    Simulation two(def), resumed(def);
-    two.AdvanceTo(0.1);
-    resumed.LoadState(state);
-    resumed.AdvanceTo(0.1);
-    bytes = one.bodies().size() * sizeof(Vec2);
-    EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), two.bodies().position_m.data(), bytes), 0) << which;
-    EXPECT_EQ(std::memcmp(one.bodies().position_m.data(), resumed.bodies().position_m.data(), bytes), 0) << which;
-  }
+  ModelParameters centrifugal, anticipation;
+  centrifugal.centrifugal = Centrifugal::kGeneralized;
+  anticipation.anticipation = Anticipation::kTimeToCollision;
+  ExpectTheSameOnAnyThreadCountAndAfterAResume(centrifugal, 0.1, "centrifugal");
+  ExpectTheSameOnAnyThreadCountAndAfterAResume(anticipation, 0.1, "anticipation");
 }
 
 }  // namespace
