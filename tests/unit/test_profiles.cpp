@@ -127,5 +127,22 @@ TEST(ModelProfiles, TheRunFileSaysWhichProfileMadeIt) {
   EXPECT_NE(run.RunValue("scenario").find("\"yielding\": \"when_blocked\""), std::string::npos);
 }
 
+// Every shipped named profile is read and applies to a scenario that names
+// it; "validated" is issue 64's crowd (its evidence: docs/decisions.md).
+TEST(ModelProfiles, EveryNamedProfileIsReadAndApplies) {
+  const std::vector<std::string> names = NamedProfiles();
+  ASSERT_GE(names.size(), 2u);
+  for (const std::string& name : names) {
+    const Scenario s = ParseScenario(kHead + R"(, "profile": ")" + name + "\"}", "s.json", kDir);
+    EXPECT_EQ(s.profile, name);
+  }
+  const Scenario v = ParseScenario(kHead + R"(, "profile": "validated"})", "s.json", kDir);
+  EXPECT_EQ(v.model.anticipation, engine::Anticipation::kTimeToCollision);
+  EXPECT_EQ(v.model.tangential_spring, engine::TangentialSpring::kNone);
+  EXPECT_EQ(v.model.headway, engine::Headway::kNone);
+  EXPECT_EQ(v.population.desired_speed_min_m_per_s, 1.0);
+  EXPECT_EQ(v.population.body_mode, geometry::PopulationMode::kPaper);
+}
+
 }  // namespace
 }  // namespace crowdrecon::scenario
