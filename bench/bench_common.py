@@ -160,6 +160,18 @@ def percent(value):
     return "–" if value is None else f"{100 * value:.0f} %"
 
 
+def checked_exe_and_repeat(args):
+    """The program of --exe (relative to the repository) and --repeat, checked;
+    exits with a message if the program is missing or the count below 1."""
+    exe = pathlib.Path(args.exe)
+    exe = exe if exe.is_absolute() else ROOT / exe
+    if not exe.exists():
+        fail(f"{exe} not found")
+    if args.repeat < 1:
+        fail("--repeat must be at least 1")
+    return exe
+
+
 def fresh_run_file(folder):
     """FOLDER/run.sqlite with no run file (or its SQLite journals) left there
     by the previous run of a script."""

@@ -84,12 +84,7 @@ def main():
     parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
     parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = parser.parse_args()
-    exe = pathlib.Path(args.exe)
-    exe = exe if exe.is_absolute() else bc.ROOT / exe
-    if not exe.exists():
-        bc.fail(f"{exe} not found")
-    if args.repeat < 1:
-        bc.fail("--repeat must be at least 1")
+    exe = bc.checked_exe_and_repeat(args)
     started = bc.now()
     load_before = bc.warn_if_busy()
     names = args.scenario or sorted(SCENARIOS)

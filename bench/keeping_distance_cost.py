@@ -4,7 +4,7 @@ Wuppertal bottleneck and of the Juelich uni corridor at 2 persons/m2 with
 each profile of the keeping-distance study, one thread, interleaved rounds.
 
     bench/keeping_distance_cost.py [--exe build/release/cli/crowdrecon] [--repeat 3] [--label L]
-        [--profile FILE ...]   (default: studies/keeping-distance/pilot2/*.profile.json but the scans)
+        [--profile FILE ...]   (default: pilot 2's five, studies/keeping-distance/pilot2/)
 
 Each run is `crowdrecon simulate` of the scenario with the profile's values
 (the scenario's own body and speeds removed so that the profile's apply),
@@ -28,6 +28,10 @@ import tempfile
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import bench_common as bc  # noqa: E402
+
+# The door mechanisms alone and with each form of keeping a distance at its
+# authors' values (pilot 2).
+DEFAULT_PROFILES = ["doors", "doors-anticipation", "doors-centrifugal", "doors-headway", "doors-social-force"]
 
 SCENARIOS = {
     "wuppertal": ("venues/juelich/scenarios/wuppertal-bottleneck.json", 40.0, {}),
@@ -77,15 +81,10 @@ def main():
     parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
     parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = parser.parse_args()
-    exe = pathlib.Path(args.exe)
-    exe = exe if exe.is_absolute() else bc.ROOT / exe
-    if not exe.exists():
-        bc.fail(f"{exe} not found")
-    if args.repeat < 1:
-        bc.fail("--repeat must be at least 1")
+    exe = bc.checked_exe_and_repeat(args)
     folder_of_study = bc.ROOT / "studies/keeping-distance/pilot2"
-    profiles = [pathlib.Path(p) for p in args.profile] if args.profile else sorted(
-        p for p in folder_of_study.glob("*.profile.json") if not re.search(r"-(T|eta|A)[0-9.]+\.profile", p.name))
+    profiles = [pathlib.Path(p) for p in args.profile] if args.profile else [
+        folder_of_study / f"{name}.profile.json" for name in DEFAULT_PROFILES]
     for p in profiles:
         if not p.exists():
             bc.fail(f"{p}: no such profile")
