@@ -59,9 +59,16 @@ std::string SetupFigure(const ValidationTest& t, const TestResult& r) {
     }
   plan.min_m = lo - Vec2{0.5, 0.5};
   plan.max_m = hi + Vec2{0.5, 0.5};
-  // At most about 460 px tall: a tall venue is drawn narrower.
+  // At most about 460 px tall: a tall venue is drawn narrower, centred in a
+  // figure at least 600 px wide, so that its title and legend are not cut
+  // (they were for RiMEA 12a, 12b and 15).
   const Vec2 span = plan.max_m - plan.min_m;
-  plan.width = std::clamp(460.0 * span.x / std::max(span.y, 1e-6), 300.0, 760.0);
+  plan.width = std::clamp(460.0 * span.x / std::max(span.y, 1e-6), 600.0, 760.0);
+  const double drawn_x = span.y * (plan.width - 32.0) / 460.0;  // the x span that keeps the plan ~460 px tall
+  if (drawn_x > span.x) {
+    plan.min_m.x -= (drawn_x - span.x) / 2.0;
+    plan.max_m.x += (drawn_x - span.x) / 2.0;
+  }
   plan.walls = r.walls;
   for (const Vec2& p : r.start_positions) plan.dots.push_back({p, kProfileColor[0], 0.2, ""});
   const MeasureSpec& m = t.measure;
