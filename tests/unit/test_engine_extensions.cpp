@@ -21,8 +21,8 @@ using testing::RandomGas;
 using testing::SetMassFromShape;
 using testing::ThoraxLikeShape;
 
-// People far apart (no contacts), standing (v0 = 0), with the gait jitter on.
-WorldDef StandingApart(int count, double sigma_m_per_s) {
+// People far apart (no contacts), walking +x at 1 m/s, with the gait jitter on.
+WorldDef WalkingApart(int count, double sigma_m_per_s) {
   WorldDef def;
   def.targets.push_back(geometry::NavigationField::Constant({1.0, 0.0}));
   def.shapes.push_back(ThoraxLikeShape());
@@ -35,7 +35,7 @@ WorldDef StandingApart(int count, double sigma_m_per_s) {
     p.mass_kg *= 0.8 + 0.4 * (i % 7) / 6.0;  // the jitter is an acceleration: mass must not matter
     p.inertia_kg_m2 *= 0.8 + 0.4 * (i % 7) / 6.0;
     p.position_m = {5.0 * (i % 10), 5.0 * (i / 10)};
-    p.desired_speed_m_per_s = 0.0;
+    p.desired_speed_m_per_s = 1.0;  // all along +x at the same speed: they keep apart
     def.people.push_back(p);
   }
   return def;
@@ -91,7 +91,7 @@ using ParameterChange = std::function<void(ModelParameters&)>;
 //   = sigma^2/(f2 - f1) * [atan(2 pi f tau)/(2 pi tau)]_f1^f2.
 TEST(GaitJitter, FreePeopleMoveWithTheAnalyticVarianceOfEquation3) {
   const double sigma = 0.3;
-  WorldDef def = StandingApart(100, sigma);
+  WorldDef def = WalkingApart(100, sigma);
   const ModelParameters& mp = def.parameters;
   const double tau = mp.relaxation_time_s, f1 = mp.gait_jitter_band_low_hz, f2 = mp.gait_jitter_band_high_hz;
   const double w = 2.0 * std::numbers::pi * tau;
@@ -102,17 +102,32 @@ TEST(GaitJitter, FreePeopleMoveWithTheAnalyticVarianceOfEquation3) {
   long samples = 0;
   for (int k = 1; k <= 1500; ++k) {  // 60 s sampled every 0.04 s
     sim.AdvanceTo(5.0 * tau + 0.04 * k);
-    for (const Vec2& v : sim.bodies().velocity_m_per_s) {
-      sum += v.x + v.y;
-      sum_sq += v.x * v.x + v.y * v.y;
+    for (const Vec2& v : sim.bodies().velocity_m_per_s) {  // (about the desired velocity (1, 0) m/s)
+      sum += (v.x - 1.0) + v.y;
+      sum_sq += (v.x - 1.0) * (v.x - 1.0) + v.y * v.y;
       samples += 2;
     }
   }
   const double mean = sum / double(samples), variance = sum_sq / double(samples) - mean * mean;
   EXPECT_NEAR(mean, 0.0, 0.02 * std::sqrt(expected));
   EXPECT_NEAR(variance, expected, 0.05 * expected) << "expected " << expected << " (m/s)^2 per axis";
-  // Nobody met anybody: the people stood 5 m apart and moved centimetres.
+  // Nobody met anybody: the people walked 5 m apart and swayed centimetres.
   EXPECT_TRUE(sim.contacts().empty());
+}
+
+// The jitter is the gait's: a person who stands by choice (desired speed 0:
+// waiting for a pre-movement time) does not sway; one who wants to walk does.
+TEST(GaitJitter, PeopleWhoStandByChoiceDoNotSway) {
+  WorldDef def = WalkingApart(4, 0.3);
+  def.people[0].desired_speed_m_per_s = 0.0;
+  def.people[1].desired_speed_m_per_s = 0.0;
+  Simulation sim(def);
+  sim.AdvanceTo(5.0);
+  for (int i : {0, 1}) {
+    EXPECT_EQ(sim.bodies().position_m[i].x, def.people[i].position_m.x) << "person " << i;
+    EXPECT_EQ(sim.bodies().position_m[i].y, def.people[i].position_m.y) << "person " << i;
+  }
+  EXPECT_NE(sim.bodies().position_m[2].y, def.people[2].position_m.y);  // walking, it sways across
 }
 
 // Off, the strength and band change nothing: the paper's model bit for bit.
