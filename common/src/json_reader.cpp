@@ -1,6 +1,7 @@
 #include "crowdrecon/common/json_reader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -112,6 +113,18 @@ long long JsonReader::Integer(std::string_view key, long long fallback, long lon
 std::string JsonReader::AsString() const {
   if (!value_->is_string()) Fail("expected a string, found " + ValueText());
   return value_->get<std::string>();
+}
+
+bool IsPlainName(std::string_view name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' || ch == '-';
+  });
+}
+
+std::string JsonReader::AsName() const {
+  std::string name = AsString();
+  if (!IsPlainName(name)) Fail("expected letters, digits, '.', '_' or '-' (at most 64)");
+  return name;
 }
 
 std::string JsonReader::String(std::string_view key) const { return At(key).AsString(); }

@@ -70,6 +70,17 @@ struct NeighbourList {
   bool empty() const { return start.empty(); }
 };
 
+// Calls visit(j) for each of person i's candidates that is in the venue
+// (walking or fallen: the list holds every slot, removed ones too), in the
+// list's order (so that sums are the same on any thread count).
+template <class BodyStateT, class Visit>
+void ForEachNeighbour(const NeighbourList& list, const BodyStateT& bodies, std::size_t i, Visit&& visit) {
+  for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
+    const std::uint32_t j = list.items[m];
+    if (bodies.state[j] != PersonState::kRemoved) visit(j);
+  }
+}
+
 // What every term may read during one evaluation of the drive.
 struct DriveInputs {
   const BodyState& bodies;

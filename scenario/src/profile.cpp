@@ -18,24 +18,16 @@ using nlohmann::json;
 
 namespace {
 
-bool IsProfileName(const std::string& name) {
-  if (name.empty() || name.size() > 64) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' || ch == '-'; });
-}
-
 bool EndsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
-
-const json& RawAt(const JsonDocument& doc, const JsonReader& r) { return doc.Json().at(json::json_pointer(r.path())); }
 
 fs::path ProfilesFolder() { return DataDirectory() / "venues" / "profiles"; }
 
 }  // namespace
 
 fs::path ProfilePath(const std::string& name_or_file, const fs::path& base_dir) {
-  if (IsProfileName(name_or_file) && !EndsWith(name_or_file, ".json")) return ProfilesFolder() / (name_or_file + ".json");
+  if (IsPlainName(name_or_file) && !EndsWith(name_or_file, ".json")) return ProfilesFolder() / (name_or_file + ".json");
   const fs::path p(name_or_file);
   return p.is_absolute() ? p : (base_dir / p).lexically_normal();
 }
@@ -47,8 +39,7 @@ ModelProfile ParseModelProfile(const std::string& text, const std::string& origi
   if (r.String("format") != "crowdrecon-profile") r.At("format").Fail("expected \"crowdrecon-profile\"");
   r.Integer("version", 1, 1);
   ModelProfile p;
-  p.name = r.String("name");
-  if (!IsProfileName(p.name)) r.At("name").Fail("expected letters, digits, '.', '_' or '-' (at most 64)");
+  p.name = r.At("name").AsName();
   p.description = r.String("description", "");
   if (const auto model = r.Find("model")) {
     if (!model->IsObject()) model->Fail("expected the scenario's model block {\"key\": value, ...}");
@@ -69,12 +60,12 @@ ModelProfile ParseModelProfile(const std::string& text, const std::string& origi
           break;
         }
       }
-      p.model.emplace_back(key, RawAt(doc, value).dump());
+      p.model.emplace_back(key, value.Raw().dump());
     }
   }
   if (const auto body = r.Find("body")) {
     if (!body->IsObject()) body->Fail("expected the scenario's body block {\"mode\": ..., ...}");
-    json b = RawAt(doc, *body);
+    json b = body->Raw();
     // File paths resolve against the profile's folder.
     for (const char* key : {"reference", "anthropometry"})
       if (b.contains(key) && b[key].is_string())

@@ -68,10 +68,6 @@ Enum ValueOf(const std::vector<Named<Enum>>& table, const std::string& name) {
   return table.front().value;  // (names are checked by Choice before)
 }
 
-const json& RawAt(const JsonDocument& doc, const JsonReader& r) {
-  return doc.Json().at(json::json_pointer(r.path()));
-}
-
 // Whether an override's value is a file path (resolved against the test's
 // folder, where it was written, not the sweep's that the runner writes).
 bool IsPathKey(const std::string& key) {
@@ -81,14 +77,14 @@ bool IsPathKey(const std::string& key) {
   return key == "venue" || ends(".reference") || ends(".anthropometry") || ends(".rate_csv");
 }
 
-std::vector<sweep::Override> ReadOverrides(const JsonDocument& doc, const JsonReader& r, const fs::path& base_dir) {
+std::vector<sweep::Override> ReadOverrides(const JsonReader& r, const fs::path& base_dir) {
   if (!r.IsObject()) r.Fail("expected an object of overrides {\"dotted.path\": value, ...}");
   std::vector<sweep::Override> out;
   for (const std::string& key : r.Keys()) {
     const JsonReader v = r.At(key);
     if (key.empty() || key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos)
       v.Fail("expected a dotted scenario path such as \"population.count\"");
-    json value = RawAt(doc, v);
+    json value = v.Raw();
     if (IsPathKey(key) && value.is_string()) {
       const fs::path file = fs::absolute(base_dir / value.get<std::string>()).lexically_normal();
       CheckInputFile(file, "the file of override " + key + " (" + v.Where() + ")");
@@ -232,12 +228,6 @@ Criterion ReadCriterion(const JsonReader& r, const std::set<std::string>& case_n
   return c;
 }
 
-bool IsCaseName(const std::string& name) {
-  if (name.empty() || name.size() > 64) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' || ch == '-'; });
-}
-
 std::vector<std::uint64_t> ReadSeeds(const JsonReader& r) {
   std::vector<std::uint64_t> seeds;
   if (r.IsArray()) {
@@ -299,8 +289,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
     r.At("format").Fail("expected \"crowdrecon-validation-test\"");
   r.Integer("version", 1, 1);
   ValidationTest t;
-  t.id = r.String("id");
-  if (!IsCaseName(t.id)) r.At("id").Fail("expected letters, digits, '.', '_' or '-' (at most 64)");
+  t.id = r.At("id").AsName();
   t.title = r.String("title");
   t.standard = r.String("standard");
   t.source = r.String("source");
@@ -311,7 +300,7 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
   const JsonReader sc = r.At("scenario");
   t.scenario = fs::absolute(base_dir / sc.AsString()).lexically_normal();
   CheckInputFile(t.scenario, "the test's scenario (" + sc.Where() + ")");
-  if (const auto set = r.Find("set")) t.set = ReadOverrides(doc, *set, base_dir);
+  if (const auto set = r.Find("set")) t.set = ReadOverrides(*set, base_dir);
   t.seeds = r.Has("seeds") ? ReadSeeds(r.At("seeds")) : std::vector<std::uint64_t>{1};
   t.x_label = r.String("x_label", "");
   std::set<std::string> case_names;
@@ -320,12 +309,11 @@ ValidationTest ParseValidationTest(const std::string& text, const std::string& o
     for (std::size_t i = 0; i < cases->Size(); ++i) {
       const JsonReader c = cases->Element(i);
       Case k;
-      k.name = c.String("name");
-      if (!IsCaseName(k.name)) c.At("name").Fail("expected letters, digits, '.', '_' or '-' (at most 64)");
+      k.name = c.At("name").AsName();
       if (!case_names.insert(k.name).second) c.At("name").Fail("a second case of this name");
       k.label = c.String("label", k.name);
       k.x = c.Number("x", std::numeric_limits<double>::quiet_NaN(), -kHuge, kHuge);
-      if (const auto set = c.Find("set")) k.set = ReadOverrides(doc, *set, base_dir);
+      if (const auto set = c.Find("set")) k.set = ReadOverrides(*set, base_dir);
       if (const auto ref = c.Find("reference")) {
         for (std::size_t j = 0; j < ref->Size(); ++j) k.reference.push_back(ref->Element(j).AsNumber(-kHuge, kHuge));
         if (k.reference.empty()) ref->Fail("expected at least one published value");

@@ -43,32 +43,29 @@ class AnticipationTerm final : public BehaviourTerm {
     const ModelParameters& mp = in.def.parameters;
     const double k = mp.anticipation_strength_m2, inverse_horizon = 1.0 / mp.anticipation_horizon_s;
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
-    const NeighbourList& list = in.neighbours;
     for (std::size_t n = 0; n < b.count; ++n) {
       if (!b.driven[n]) continue;
       const std::size_t i = b.first + n;
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push{};
-      for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
-        const std::uint32_t j = list.items[m];
-        if (in.bodies.state[j] == PersonState::kRemoved) continue;
+      ForEachNeighbour(in.neighbours, in.bodies, i, [&](std::uint32_t j) {
         const Vec2 x = Separation(in.def.periodic, xi, in.bodies.position_m[j]);  // x_i - x_j
         const double xx = Dot(x, x);
-        if (xx > radius_m_ * radius_m_) continue;
+        if (xx > radius_m_ * radius_m_) return;
         const Vec2 v = vi - in.bodies.velocity_m_per_s[j];
         const double reach = ri + bound_m_[in.bodies.shape[j]];
         const double a = Dot(v, v), bb = Dot(x, v), c = xx - reach * reach;
-        if (!(c > 0.0) || !(bb < 0.0)) continue;
+        if (!(c > 0.0) || !(bb < 0.0)) return;
         const double discriminant = bb * bb - a * c;
-        if (!(discriminant > 0.0)) continue;
+        if (!(discriminant > 0.0)) return;
         const double root = std::sqrt(discriminant);
         const double tau = c / (root - bb);
         const double size = k * std::exp(-tau * inverse_horizon) / (tau * tau) * (2.0 / tau + inverse_horizon) / root;
         const Vec2 at_contact = x + v * tau;  // |at_contact| = reach
         const double acceleration = std::min(size * reach, ceiling);
         push += at_contact * (acceleration / reach);
-      }
+      });
       b.force[n] += push * in.bodies.mass_kg[i];
     }
   }

@@ -65,7 +65,6 @@ class CentrifugalTerm final : public BehaviourTerm {
     const ModelParameters& mp = in.def.parameters;
     const double eta = mp.centrifugal_strength, cutoff = mp.centrifugal_cutoff_m;
     const double width = mp.centrifugal_interpolation_m, factor = mp.centrifugal_max_factor;
-    const NeighbourList& list = in.neighbours;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
       const std::size_t i = b.first + k;
@@ -78,22 +77,20 @@ class CentrifugalTerm final : public BehaviourTerm {
       const double numerator_speed = eta * in.bodies.desired_speed_m_per_s[i];
       const Vec2 xi = in.bodies.position_m[i];
       Vec2 push{};
-      for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
-        const std::uint32_t j = list.items[m];
-        if (in.bodies.state[j] == PersonState::kRemoved) continue;
+      ForEachNeighbour(in.neighbours, in.bodies, i, [&](std::uint32_t j) {
         const Vec2 d = Separation(in.def.periodic, in.bodies.position_m[j], xi);  // x_j - x_i
         const double dij = Length(d);
-        if (!(dij > 0.0) || dij > radius_m_) continue;
+        if (!(dij > 0.0) || dij > radius_m_) return;
         const Vec2 e = d * (1.0 / dij);
         const double kij = Dot(vi, e) / speed;
-        if (!(kij > 0.0)) continue;
+        if (!(kij > 0.0)) return;
         const Vec2 vj = in.bodies.velocity_m_per_s[j];
         const double vj_speed = Length(vj);
         const Vec2 uj = vj_speed > kAtRest_m_per_s ? vj * (1.0 / vj_speed) : Vec2{in.cos_angle[j], in.sin_angle[j]};
         const double aj = mp.centrifugal_a_min_m + mp.centrifugal_a_time_s * vj_speed;
         const double bj = SemiAxisAcross(mp, vj_speed, in.bodies.desired_speed_m_per_s[j]);
         const double gap = dij - PolarRadius(ai, bi, ui, e) - PolarRadius(aj, bj, uj, e * -1.0);
-        if (gap >= cutoff) continue;
+        if (gap >= cutoff) return;
         const double closing = std::max(0.0, Dot(vi - vj, e));
         const double scale = in.bodies.mass_kg[i] * kij * (numerator_speed + closing) * (numerator_speed + closing);
         double f;
@@ -108,7 +105,7 @@ class CentrifugalTerm final : public BehaviourTerm {
           f = factor * scale / width;
         }
         push -= e * f;
-      }
+      });
       b.force[k] += push;
     }
   }

@@ -44,20 +44,17 @@ class HeadwayTerm final : public BehaviourTerm {
   void Steer(const DriveInputs& in, DriveBlock& b) const override {
     const ModelParameters& mp = in.def.parameters;
     const double a = mp.headway_repulsion_strength, range = mp.headway_repulsion_range_m, l = mp.headway_length_m;
-    const NeighbourList& list = in.neighbours;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
       const std::size_t i = b.first + k;
       const Vec2 xi = in.bodies.position_m[i];
       Vec2 turned = b.heading[k];
-      for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
-        const std::uint32_t j = list.items[m];
-        if (in.bodies.state[j] == PersonState::kRemoved) continue;
+      ForEachNeighbour(in.neighbours, in.bodies, i, [&](std::uint32_t j) {
         const Vec2 d = Separation(in.def.periodic, in.bodies.position_m[j], xi);  // x_j - x_i
         const double dij = Length(d);
-        if (!(dij > 0.0) || dij > radius_m_) continue;
+        if (!(dij > 0.0) || dij > radius_m_) return;
         turned -= d * (a * std::exp((l - dij) / range) / dij);
-      }
+      });
       const double norm = Length(turned);
       if (norm > 0.0) b.heading[k] = turned * (1.0 / norm);
     }
@@ -66,20 +63,17 @@ class HeadwayTerm final : public BehaviourTerm {
   void Desire(const DriveInputs& in, DriveBlock& b) const override {
     const ModelParameters& mp = in.def.parameters;
     const double l = mp.headway_length_m, inverse_gap = 1.0 / mp.headway_time_gap_s;
-    const NeighbourList& list = in.neighbours;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
       const std::size_t i = b.first + k;
       const Vec2 xi = in.bodies.position_m[i], e = b.heading[k];
       double headway = radius_m_ + 1.0;  // (no one ahead: no cap)
-      for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
-        const std::uint32_t j = list.items[m];
-        if (in.bodies.state[j] == PersonState::kRemoved) continue;
+      ForEachNeighbour(in.neighbours, in.bodies, i, [&](std::uint32_t j) {
         const Vec2 d = Separation(in.def.periodic, in.bodies.position_m[j], xi);  // x_j - x_i
         const double along = Dot(d, e);
-        if (!(along > 0.0) || std::abs(Cross(e, d)) >= l) continue;
+        if (!(along > 0.0) || std::abs(Cross(e, d)) >= l) return;
         headway = std::min(headway, Length(d));
-      }
+      });
       if (headway <= radius_m_) b.pace[k] = std::min(b.pace[k], std::max(0.0, (headway - l) * inverse_gap));
     }
   }

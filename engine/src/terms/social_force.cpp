@@ -44,25 +44,22 @@ class SocialForceTerm final : public BehaviourTerm {
     const double a = mp.social_force_strength_n, inverse_range = 1.0 / mp.social_force_range_m;
     const double lambda = mp.social_force_anisotropy;
     const PeriodicBox& box = in.def.periodic;
-    const NeighbourList& list = in.neighbours;
     for (std::size_t k = 0; k < b.count; ++k) {
       if (!b.driven[k]) continue;
       const std::size_t i = b.first + k;
       const Vec2 xi = in.bodies.position_m[i], e = b.direction[k];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push{};
-      for (std::uint32_t m = list.start[i]; m < list.start[i + 1]; ++m) {
-        const std::uint32_t j = list.items[m];
-        if (in.bodies.state[j] == PersonState::kRemoved) continue;
+      ForEachNeighbour(in.neighbours, in.bodies, i, [&](std::uint32_t j) {
         const Vec2 d = Separation(box, xi, in.bodies.position_m[j]);  // from j to i
         const double dij = Length(d);
-        if (!(dij > 0.0) || dij > radius_m_) continue;
+        if (!(dij > 0.0) || dij > radius_m_) return;
         const Vec2 n = d * (1.0 / dij);
         const double cos_phi = -Dot(n, e);
         const double weight = lambda + (1.0 - lambda) * (1.0 + cos_phi) / 2.0;
         const double reach = std::min(0.0, ri + bound_m_[in.bodies.shape[j]] - dij);
         push += n * (a * std::exp(reach * inverse_range) * weight);
-      }
+      });
       b.force[k] += push;
     }
   }

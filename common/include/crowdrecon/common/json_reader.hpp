@@ -25,6 +25,9 @@ namespace crowdrecon {
 
 class JsonReader;
 
+// A name safe in file and folder names: 1 to 64 letters, digits, '.', '_' or '-'.
+bool IsPlainName(std::string_view name);
+
 // A parsed JSON file (or string) that owns its data.
 class JsonDocument {
  public:
@@ -95,6 +98,10 @@ class JsonReader {
   // --- this value ------------------------------------------------------
   double AsNumber(double min, double max) const;
   std::string AsString() const;
+  // A string that IsPlainName (a profile's, a validation test's, a case's name).
+  std::string AsName() const;
+  // The value as parsed, for code that copies raw JSON on (overrides, profiles).
+  const nlohmann::json& Raw() const { return *value_; }
   // [x, y]
   Vec2 AsPoint() const;
   // [[x, y], ...] with at least `min_count` points.
