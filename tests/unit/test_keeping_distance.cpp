@@ -316,6 +316,35 @@ TEST(Anticipation, TheForceOfOneCollisionCourseIsTheModelsExactly) {
   EXPECT_NEAR(sim.bodies().force_n[0].y, 0.0, 1e-12);
 }
 
+// Anticipation is a walker's: a person who stands by choice (desired speed
+// 0, waiting for a pre-movement time) does not dodge a walker heading at
+// them; the walker dodges them all the same, and a person who wants to walk
+// (standing still for the moment) dodges too.
+TEST(Anticipation, PeopleWhoStandByChoiceDoNotDodge) {
+  ModelParameters p;
+  p.anticipation = Anticipation::kTimeToCollision;
+  for (const double desired : {0.0, 0.5}) {
+    WorldDef def = File(1, 10.0, 1.0, p);
+    def.periodic = PeriodicBox{};
+    def.people[0].position_m = {0.0, 0.0};
+    def.people[0].velocity_m_per_s = {1.0, 0.0};
+    PersonDef other = def.people[0];
+    other.position_m = {2.0, 0.05};
+    other.velocity_m_per_s = {0.0, 0.0};
+    other.desired_speed_m_per_s = desired;
+    def.people.push_back(other);
+    const Simulation sim(def);
+    const Vec2 on_walker = sim.bodies().force_n[0] - sim.bodies().contact_force_n[0];
+    EXPECT_LT(on_walker.x, -1.0) << "desired " << desired;  // the walker brakes and turns
+    const double drive = def.people[1].mass_kg / p.relaxation_time_s * desired;  // toward +x from rest
+    const Vec2 on_standing = sim.bodies().force_n[1] - sim.bodies().contact_force_n[1] - Vec2{drive, 0.0};
+    if (desired == 0.0)
+      EXPECT_EQ(Length(on_standing), 0.0);
+    else
+      EXPECT_GT(Length(on_standing), 1.0);
+  }
+}
+
 // Two walkers meeting head on, their lines 0.1 m apart: with the paper's
 // model they collide; with either term they pass each other.
 TEST(KeepingDistance, TwoWalkersMeetingHeadOnPassWithTheCentrifugalForceOrAnticipation) {

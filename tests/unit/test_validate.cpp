@@ -145,11 +145,16 @@ TEST(ValidationMeasures, HeadwayIsTheDistanceToThePersonAheadInTheSameFile) {
   EXPECT_EQ(h.size(), 21u);
 }
 
-TEST(ValidationMeasures, WalkingSpeedIsPathOverTimeInTheAreaByGroup) {
+TEST(ValidationMeasures, WalkingSpeedIsDistanceOverTimeInTheAreaByGroup) {
   observe::Trajectories t = Empty(10.0);
   Walk(&t, 1, {0.0, 1.0}, {1.2, 0.0}, 0, 300);
   Walk(&t, 2, {0.0, 2.0}, {0.6, 0.8}, 0, 300);  // 1.0 m/s diagonally
-  t.groups = {{1, 0}, {2, 1}};
+  // A walker at 0.9 m/s who sways 4 cm across the way every frame: the
+  // sway is not distance (its path is 0.1 m per frame, 1.0 m/s).
+  Walk(&t, 3, {0.0, 4.0}, {0.9, 0.0}, 0, 300);
+  for (auto& p : t.points)
+    if (p.id == 3 && p.frame % 2 == 1) p.position_m.y += 0.04;
+  t.groups = {{1, 0}, {2, 1}, {3, 0}};
   MeasureSpec m;
   m.kind = MeasureKind::kWalkingSpeed;
   m.has_area = true;
@@ -157,6 +162,8 @@ TEST(ValidationMeasures, WalkingSpeedIsPathOverTimeInTheAreaByGroup) {
   const Statistics s = MeasureTrajectories(t, m);
   ExpectDeclared(s, m.kind);
   EXPECT_NEAR(s.at("speed_m_per_s@group0")[0], 1.2, 1e-9);
+  ASSERT_EQ(s.at("speed_m_per_s@group0").size(), 2u);
+  EXPECT_NEAR(s.at("speed_m_per_s@group0")[1], 0.9, 1e-3);  // (the last frame inside may be a swayed one)
   EXPECT_NEAR(s.at("speed_m_per_s@group1")[0], 1.0, 1e-9);
   // The group filter keeps one group's people.
   m.group = "group1";

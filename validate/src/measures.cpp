@@ -128,12 +128,24 @@ void MeasureWalkingSpeed(const observe::Trajectories& t, const std::vector<obser
   std::vector<double> speeds;
   std::map<std::string, std::vector<double>> by_group;
   for (const observe::Track& track : tracks) {
+    // A walking speed is the distance covered over the time taken (RiMEA's
+    // tests time a walk over a distance; PedPy's passing speed likewise):
+    // per stretch of consecutive frames inside the area, the length of the
+    // displacement from its first frame to its last (the steps summed as
+    // vectors: a periodic seam is crossed by minimum images), so that a
+    // gait's sway across the way is not counted as distance.
     double path = 0, time = 0;
-    for (std::size_t k = 1; k < track.position_m.size(); ++k) {
-      if (track.frame[k] != track.frame[k - 1] + 1) continue;
-      if (!spec.area.Contains(track.position_m[k]) || !spec.area.Contains(track.position_m[k - 1])) continue;
-      path += Length(t.box.MinimumImage(track.position_m[k] - track.position_m[k - 1]));
-      time += 1.0 / t.fps;
+    Vec2 stretch{};
+    for (std::size_t k = 1; k <= track.position_m.size(); ++k) {
+      const bool step = k < track.position_m.size() && track.frame[k] == track.frame[k - 1] + 1 &&
+                        spec.area.Contains(track.position_m[k]) && spec.area.Contains(track.position_m[k - 1]);
+      if (step) {
+        stretch += t.box.MinimumImage(track.position_m[k] - track.position_m[k - 1]);
+        time += 1.0 / t.fps;
+      } else {
+        path += Length(stretch);
+        stretch = Vec2{};
+      }
     }
     if (time <= 0.0) continue;
     const double v = path / time;

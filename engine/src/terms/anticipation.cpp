@@ -20,6 +20,12 @@
 // largest push at the venues' speeds, 1.2 m/s / 0.5 s). The neighbour radius: anticipation_radius_m (Karamouzas et al.
 // looked 10 m; people closing at 2.6 m/s from 5 m meet in under 2 s, so
 // half of it keeps the collisions that matter at a quarter of the cost).
+// It acts on people who want to walk (desired speed > 0): the force is the
+// change of a walker's chosen velocity (Karamouzas et al.'s agents choose a
+// velocity toward a goal), and a person who stands by choice (desired speed
+// 0: waiting for a pre-movement time, told to stand) chooses none; walkers
+// avoid them all the same (their own force, with the standing person as j),
+// and the contact forces act as ever (as the gait jitter, gait_jitter.cpp).
 // Summed in the neighbour list's order: the same on any thread count.
 // No state.
 #include <algorithm>
@@ -44,8 +50,8 @@ class AnticipationTerm final : public BehaviourTerm {
     const double k = mp.anticipation_strength_m2, inverse_horizon = 1.0 / mp.anticipation_horizon_s;
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
     for (std::size_t n = 0; n < b.count; ++n) {
-      if (!b.driven[n]) continue;
       const std::size_t i = b.first + n;
+      if (!b.driven[n] || !(in.bodies.desired_speed_m_per_s[i] > 0.0)) continue;
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push{};
