@@ -1,4 +1,4 @@
-// crowdrecon simulate SCENARIO -o RUN.sqlite [--threads N] [--device cpu|cuda] [--resume | --branch-from RUN]
+// crowdrecon simulate SCENARIO -o RUN.sqlite [--profile NAME] [--threads N] [--device cpu|cuda] [--resume | --branch-from RUN]
 #include <unistd.h>
 
 #include <cstdio>
@@ -21,6 +21,7 @@ namespace {
 struct SimulateArgs {
   std::string scenario;
   std::string output;
+  std::string profile;  // --profile: another model profile than the scenario's
   int threads = 0;
   std::string device = "cpu";
   bool resume = false;
@@ -33,7 +34,7 @@ struct SimulateArgs {
 };
 
 int RunSimulate(const SimulateArgs& args) {
-  const scenario::Scenario sc = scenario::LoadScenario(args.scenario);
+  const scenario::Scenario sc = scenario::LoadScenario(args.scenario, args.profile);
   // A resume of what is no run (a run file cut short, another program's
   // file) is said as such, not offered --force (issue 65, R07).
   if (std::error_code ec; args.resume && std::filesystem::exists(args.output, ec) && !runfile::IsRunFile(args.output))
@@ -104,8 +105,9 @@ int RunSimulate(const SimulateArgs& args) {
   if (const std::string steps = engine::StepLevelHistogram(p, s.time_step_s); !steps.empty())
     std::printf("adaptive step: %s\n", steps.c_str());
   if (s.status != "complete") {
-    std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s -o %s --resume\n",
-                 s.simulated_s, args.scenario.c_str(), args.output.c_str());
+    std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s%s -o %s --resume\n",
+                 s.simulated_s, args.scenario.c_str(), args.profile.empty() ? "" : (" --profile " + args.profile).c_str(),
+                 args.output.c_str());
     return scenario::InterruptedExitStatus();
   }
   return 0;
@@ -118,6 +120,10 @@ void RegisterSimulateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("simulate", "Run a scenario and write its run file (SQLite, JuPedSim format)");
   cmd->add_option("scenario", args->scenario, "Scenario file (JSON)")->required();
   cmd->add_option("-o,--output", args->output, "Run file to write (.sqlite)")->required();
+  cmd->add_option("--profile", args->profile,
+                  "Run under this model profile instead of the scenario's own \"profile\": a name (venues/profiles/: "
+                  "paper, validated) or a profile file; the scenario's own single values still win. A resume takes "
+                  "the same --profile");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); results do not depend on it")
       ->check(IntegerIn(0, 1024));
   cmd->add_option("--device", args->device,

@@ -26,8 +26,12 @@ fs::path ProfilesFolder() { return DataDirectory() / "venues" / "profiles"; }
 
 }  // namespace
 
+bool IsProfileName(const std::string& name_or_file) {
+  return IsPlainName(name_or_file) && !EndsWith(name_or_file, ".json");
+}
+
 fs::path ProfilePath(const std::string& name_or_file, const fs::path& base_dir) {
-  if (IsPlainName(name_or_file) && !EndsWith(name_or_file, ".json")) return ProfilesFolder() / (name_or_file + ".json");
+  if (IsProfileName(name_or_file)) return ProfilesFolder() / (name_or_file + ".json");
   const fs::path p(name_or_file);
   return p.is_absolute() ? p : (base_dir / p).lexically_normal();
 }

@@ -299,4 +299,17 @@ Scenario LoadScenario(const std::filesystem::path& file) {
   return s;
 }
 
+Scenario LoadScenario(const std::filesystem::path& file, const std::string& profile) {
+  if (profile.empty()) return LoadScenario(file);
+  const std::string text = ReadInputFile(file, "scenario file");
+  nlohmann::json j = JsonDocument::Parse(text, file.string()).Json();
+  if (!j.is_object()) return LoadScenario(file);  // (its own message)
+  // A file named on the command line is the working folder's, not the
+  // scenario's: made absolute before the scenario resolves it.
+  j["profile"] = IsProfileName(profile) ? profile : ProfilePath(profile, std::filesystem::current_path()).string();
+  Scenario s = ParseScenario(j.dump(2) + "\n", file.string() + " (with --profile " + profile + ")", file.parent_path());
+  s.file = file;
+  return s;
+}
+
 }  // namespace crowdrecon::scenario

@@ -13,7 +13,7 @@ exe=$1; src=$2; prefix_s=${3:-300}
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 shipped="$src/results/timelines/madrid-night/census.csv"
 set +e
-"$exe" simulate "$src/venues/madrid-arena/scenarios/madrid-night.json" -o "$tmp/night.sqlite" \
+"$exe" simulate "$src/venues/madrid-arena/scenarios/madrid-night.json" --profile paper -o "$tmp/night.sqlite" \
   --stop-after "$prefix_s" -q >/dev/null 2>"$tmp/err.txt"
 rc=$?
 set -e

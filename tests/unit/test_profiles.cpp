@@ -144,5 +144,36 @@ TEST(ModelProfiles, EveryNamedProfileIsReadAndApplies) {
   EXPECT_EQ(v.population.body_mode, geometry::PopulationMode::kPaper);
 }
 
+
+// `simulate --profile`: a scenario run under another profile than its own
+// key without editing it (the paper's model one option away from a
+// reconstruction's validated crowd); its own single values still win; a
+// file is the working folder's; an unknown name is the same clear error.
+TEST(ModelProfiles, AScenarioRunsUnderAnotherProfileWithoutEditingIt) {
+  const fs::path night = fs::path(CROWDRECON_SOURCE_DIR) / "venues/madrid-arena/scenarios/madrid-night.json";
+  const Scenario own = LoadScenario(night);
+  EXPECT_EQ(own.profile, "validated");
+  const Scenario paper = LoadScenario(night, "paper");
+  EXPECT_EQ(paper.profile, "paper");
+  EXPECT_EQ(paper.model.anticipation, engine::Anticipation::kNone);
+  EXPECT_EQ(paper.model.back_force_gamma, own.model.back_force_gamma);  // the night's own Gamma
+  EXPECT_EQ(LoadScenario(night, "").json_text, own.json_text);
+  const fs::path file = WriteProfile("polite.profile.json", R"({"format": "crowdrecon-profile", "version": 1,
+    "name": "polite", "model": {"yielding": "when_blocked"}})");
+  const fs::path cwd = fs::current_path();
+  fs::current_path(file.parent_path());
+  const Scenario polite = LoadScenario(night, file.filename().string());
+  fs::current_path(cwd);
+  EXPECT_EQ(polite.profile, "polite");
+  EXPECT_EQ(polite.model.yielding, engine::Yielding::kWhenBlocked);
+  try {
+    LoadScenario(night, "polit");
+    ADD_FAILURE() << "an unknown profile was accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("madrid-night.json (with --profile polit): /profile: cannot use the profile"), std::string::npos) << m;
+  }
+}
+
 }  // namespace
 }  // namespace crowdrecon::scenario

@@ -38,6 +38,8 @@ struct ModelProfile {
 // '.', '_', '-', without ".json") is venues/profiles/NAME.json of
 // DataDirectory(); anything else is a file, relative to `base_dir`.
 std::filesystem::path ProfilePath(const std::string& name_or_file, const std::filesystem::path& base_dir);
+// Whether `name_or_file` is a name (of venues/profiles/), not a file.
+bool IsProfileName(const std::string& name_or_file);
 ModelProfile LoadModelProfile(const std::filesystem::path& file);
 ModelProfile ParseModelProfile(const std::string& text, const std::string& origin, const std::filesystem::path& base_dir);
 // The names of venues/profiles/*.json, sorted.

@@ -94,6 +94,12 @@ struct Scenario {
 };
 
 Scenario LoadScenario(const std::filesystem::path& file);
+// The scenario under another model profile than its own "profile" (a name
+// of venues/profiles/ or a profile file, relative to the working folder):
+// the file read as if its "profile" said `profile` (its own single values
+// still win). For comparing profiles without editing the scenario
+// (`crowdrecon simulate --profile`); empty: LoadScenario(file).
+Scenario LoadScenario(const std::filesystem::path& file, const std::string& profile);
 // `base_dir` resolves relative paths; `origin` names the text in messages.
 Scenario ParseScenario(const std::string& json_text, const std::string& origin,
                        const std::filesystem::path& base_dir);
