@@ -56,11 +56,13 @@ def scenario_copy(path, duration_s, population, profile, folder):
     return copy
 
 
-def run_once(exe, scenario, folder):
+def run_once(exe, scenario, folder, extra=()):
+    """One `crowdrecon simulate` on one thread (extra: more options, e.g.
+    --profile): its processor and wall time, steps and the engine's shares."""
     out = bc.fresh_run_file(folder)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     result = subprocess.run([str(exe), "simulate", str(scenario), "-o", str(out), "-q", "--threads", "1",
-                             "--fixed-threads"], capture_output=True, text=True)
+                             "--fixed-threads", *extra], capture_output=True, text=True)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if result.returncode != 0:  # (a run that goes numerically wrong is a result too: counted, not timed)
         return {"failed": result.stderr.strip().splitlines()[-1] if result.stderr.strip() else f"exit {result.returncode}"}
