@@ -21,7 +21,9 @@
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/reports/ensemble.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/scenario/profile.hpp"
 #include "crowdrecon/sweep/phase_diagram.hpp"
+#include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/viz/density_figure.hpp"
 #include "crowdrecon/viz/timeline_figure.hpp"
 #include "option_checks.hpp"
@@ -168,6 +170,16 @@ void RunTimeline(const TimelineArgs& args) {
       args.density_maps.empty() ? std::vector<analysis::DensityMap>{} : analysis::ComputeDensityMaps(args.run, density);
   if (!args.phase.empty()) {
     phase.path = PathOf(s, args.path_step_s);
+    // A path over another model's regimes is said, on the figure and here.
+    std::string run_profile = runfile::RunFileReader(args.run).RunValue("profile");
+    if (run_profile.empty()) run_profile = scenario::kDefaultProfile;  // (a run from before profiles)
+    const std::string diagram_profile = sweep::SweepProfile(sweep::ReadResults(args.phase));
+    if (!diagram_profile.empty() && diagram_profile != run_profile) {
+      const std::string note = "the run's model (profile " + run_profile + ") is not the diagrams' (profile " +
+                               diagram_profile + "): the path crosses another model's regimes";
+      phase.path.note = "Note: " + note;
+      std::printf("note: %s\n", note.c_str());
+    }
     const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
     std::printf("%s", summary.BriefReport().c_str());
   }

@@ -348,8 +348,11 @@ void DrawPath(Page& page, const Layout& L, const PathOverlay& path) {
     page.canvas.Dot(page.P(spot.first, spot.second), 4.5, ink);
     page.canvas.TextPxAligned(spot.first + 7, spot.second - 7, text, 12, 0.0, 1.0, ink, 0.0, true);
   }
+  const double room = L.width - L.left - 12.0;  // (long captions shrink to fit the page)
   if (!path.caption.empty())
-    page.canvas.TextPxAligned(L.left, L.height - 32, path.caption, 12, 0.0, 0.0, ink);
+    page.canvas.TextPxAligned(L.left, L.height - 32, path.caption, 12, 0.0, 0.0, ink, 0.0, false, room);
+  if (!path.note.empty())
+    page.canvas.TextPxAligned(L.left, 78, path.note, 13, 0.0, 0.5, Color::Hex(0xb2182b), 0.0, true, room);
 }
 
 void DrawPhase(const Panel& panel, const Layout& L, const std::string& sweep_name, const fs::path& file,

@@ -1,5 +1,6 @@
 #include "crowdrecon/sweep/results.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "crowdrecon/scenario/profile.hpp"
 
 #include "crowdrecon/sweep/version.hpp"  // generated at build time: CROWDRECON_GIT_VERSION
 
@@ -310,6 +312,28 @@ std::optional<std::size_t> ResultsTable::FindColumn(const std::string& name) con
 std::size_t ResultsTable::Column(const std::string& name) const {
   if (const auto i = FindColumn(name)) return *i;
   throw InputError(file.string() + ": the runs table has no column \"" + name + "\"");
+}
+
+std::string SweepProfile(const ResultsTable& table) {
+  const auto sweep_text = table.sweep.find("sweep"), scenario_text = table.sweep.find("scenario");
+  if (sweep_text == table.sweep.end() || scenario_text == table.sweep.end()) return "";
+  const nlohmann::json sweep = nlohmann::json::parse(sweep_text->second, nullptr, false);
+  const nlohmann::json scenario = nlohmann::json::parse(scenario_text->second, nullptr, false);
+  auto named = [](const nlohmann::json& object, const char* key) -> std::string {
+    return object.is_object() && object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : "";
+  };
+  std::string base = sweep.is_object() && sweep.contains("set") ? named(sweep["set"], "profile") : "";
+  if (base.empty()) base = named(scenario, "profile");
+  if (base.empty()) base = scenario::kDefaultProfile;
+  std::vector<std::string> profiles{base};
+  if (sweep.is_object() && sweep.contains("variants") && sweep["variants"].is_array())
+    for (const nlohmann::json& v : sweep["variants"]) {
+      const std::string own = v.is_object() && v.contains("set") ? named(v["set"], "profile") : "";
+      if (!own.empty() && std::find(profiles.begin(), profiles.end(), own) == profiles.end()) profiles.push_back(own);
+    }
+  std::string out;
+  for (const std::string& p : profiles) out += (out.empty() ? "" : ", ") + p;
+  return out;
 }
 
 ResultsTable ReadResults(const fs::path& dir_or_file) {

@@ -537,6 +537,22 @@ TEST(SweepFile, ExactNumbers) {
   EXPECT_EQ(std::stod(ExactNumber(1.0 / 3.0)), 1.0 / 3.0);
 }
 
+// The profile a sweep's runs ran (issue 64; timeline --phase says when a
+// run's path crosses another model's diagram): the sweep's set, else the
+// scenario's key, else "paper"; variants' own named too; "" for old tables.
+TEST(SweepResults, TheProfileOfASweepsRuns) {
+  ResultsTable t;
+  EXPECT_EQ(SweepProfile(t), "");
+  t.sweep["scenario"] = R"({"format": "crowdrecon-scenario", "name": "s"})";
+  t.sweep["sweep"] = R"({"set": {"run.duration_s": 60}})";
+  EXPECT_EQ(SweepProfile(t), "paper");
+  t.sweep["scenario"] = R"({"format": "crowdrecon-scenario", "profile": "validated"})";
+  EXPECT_EQ(SweepProfile(t), "validated");
+  t.sweep["sweep"] = R"({"set": {"profile": "paper"}, "variants": [{"name": "a", "set": {}},
+                         {"name": "b", "set": {"profile": "validated"}}]})";
+  EXPECT_EQ(SweepProfile(t), "paper, validated");
+}
+
 TEST(SweepResults, ColumnsAndRowRoundTrip) {
   const std::vector<std::string>& c = MetricColumns();
   EXPECT_EQ(c.front(), "duration_s");

@@ -34,6 +34,7 @@ struct PathOverlay {
   std::vector<std::pair<double, double>> points;  // (x, y) in the diagram's units, in time order
   std::vector<std::pair<std::size_t, std::string>> labels;  // index into points, text ("02:30")
   std::string caption;  // one line under the diagram ("path of madrid-night.sqlite, 5-s means")
+  std::string note;     // a warning over the diagram (the run's model is not the diagram's), or ""
 };
 
 struct PhaseOptions {
