@@ -1,8 +1,8 @@
 # The two commands of crowdrecon (see README.md):
 #   make demo   install what is missing, build, run the Madrid Arena case into out/
 #   make test   install what is missing, build, run the whole suite with ctest
-#   make validate  the validation suite on the paper's model (thorax and circle
-#               bodies) into out/validation (docs/validation.md)
+#   make validate  the validation suite on the validated crowd and the paper's
+#               model side by side into out/validation (docs/validation.md)
 #   make fuzz   build the libFuzzer harnesses (clang) and run each for
 #               FUZZ_SECONDS (default 60) s; FUZZ_HARNESSES picks some (docs/fuzzing.md)
 PRESET ?= release
@@ -35,7 +35,7 @@ demo: build
 
 # The whole validation suite (docs/validation.md): every test on each profile,
 # side by side; run again to continue or to reuse the runs done.
-VALIDATION_PROFILES ?= venues/validation/profiles/paper.json venues/validation/profiles/paper-circle.json
+VALIDATION_PROFILES ?= venues/profiles/validated.json venues/validation/profiles/paper.json
 validate: build
 	@$(CROWDRECON) validate $(foreach p,$(VALIDATION_PROFILES),--profile $(p)) -o out/validation --jobs $(JOBS)
 

@@ -21,7 +21,7 @@ namespace {
 // The suite and the profile of the project's reconstructions, found from
 // the program's own tree when run from a checkout (the defaults).
 constexpr const char* kDefaultSuite = "venues/validation";
-constexpr const char* kDefaultProfile = "venues/validation/profiles/paper.json";
+constexpr const char* kDefaultProfile = "venues/profiles/validated.json";
 
 struct ValidateArgs {
   std::string suite = kDefaultSuite;
@@ -71,7 +71,7 @@ void RegisterValidateCommand(CLI::App& app) {
       "again on the same DIR reuse the runs done; exit 1 when a judged criterion fails (docs/validation.md)");
   cmd->add_option("SUITE", args->suite, "The suite folder (default venues/validation) or one test file");
   cmd->add_option("--profile", args->profiles,
-                  "A profile file (model and body blocks; default venues/validation/profiles/paper.json); give two "
+                  "A profile file (model and body blocks; default venues/profiles/validated.json, the reconstructions' crowd); give two "
                   "to see them side by side")
       ->allow_extra_args(false);
   cmd->add_option("-o,--output", args->output, "The validation's folder DIR")->required();
