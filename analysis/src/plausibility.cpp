@@ -184,7 +184,9 @@ Plausibility PlausibilityPass::Finish(const runfile::RunFileReader& reader) {
       largest_overlap_frame_ = largest->frame;
       largest_overlap_wall_ = largest->wall;
     }
-  if (contacts_given_) {
+  // A run with its contacts' briefs (issue 66) knows its overlaps even
+  // where no two bodies ever touched.
+  if (contacts_given_ || reader.HasContactSummary()) {
     result.contacts_available = true;
     if (largest_overlap_m_ > 0.0) {
       result.max_overlap_m = largest_overlap_m_;
@@ -231,7 +233,9 @@ std::string Plausibility::Statement(const PlausibilityOptions& o) const {
          num(o.crush_highest_per_m2, 0) + " /m2).";
   else
     s += " This is within Fruin's critical density of a static crowd (" + num(o.static_critical_per_m2, 1) + " /m2).";
-  if (contacts_available) {
+  if (contacts_available && !(max_overlap_m > 0.0)) {
+    s += " No two bodies overlapped.";
+  } else if (contacts_available) {
     const double share = max_overlap_m / o.reference_chest_depth_m;
     s += " Largest overlap of two bodies" + std::string(max_overlap_with_wall ? " (a body and a wall)" : "") + ": " +
          num(max_overlap_m * 100.0, 1) + " cm at t = " + num(max_overlap_time_s, 1) + " s, " + num(share * 100.0, 0) +

@@ -325,6 +325,7 @@ std::string RunFileReader::TablesDigest() const {
       {"frame_time", "frame"},          {"event", "frame, rowid"}};
   if (sqlite::HasTable(*impl_->db, "person_load")) tables.emplace_back("person_load", "frame, id");
   if (sqlite::HasTable(*impl_->db, "census")) tables.emplace_back("census", "frame");
+  if (sqlite::HasTable(*impl_->db, "contact_summary")) tables.emplace_back("contact_summary", "frame");
   for (const auto& [table, order] : tables) {
     hash.Update(table, std::strlen(table) + 1);
     Statement s(*impl_->db, std::string("SELECT * FROM ") + table + " ORDER BY " + order);
@@ -519,9 +520,18 @@ ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {
   return stream;
 }
 
+bool RunFileReader::HasContactSummary() const { return sqlite::HasTable(*impl_->db, "contact_summary"); }
+
 std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverlap() const {
-  Statement q(*impl_->db, "SELECT frame, rowid, overlap_m, wall FROM contact ORDER BY overlap_m DESC, frame, rowid LIMIT 1");
-  q.Describe("contact", {0, 1});
+  // From the frames' briefs where the run has them (issue 66: every frame,
+  // whether or not its contacts were written; the same contact as the scan
+  // of table contact below finds: the largest, the earliest frame, the
+  // first row); else from every contact.
+  const bool brief = HasContactSummary();
+  Statement q(*impl_->db, brief ? "SELECT frame, 0, max_overlap_m, max_overlap_wall FROM contact_summary "
+                                  "WHERE contacts > 0 ORDER BY max_overlap_m DESC, frame LIMIT 1"
+                                : "SELECT frame, rowid, overlap_m, wall FROM contact ORDER BY overlap_m DESC, frame, rowid LIMIT 1");
+  q.Describe(brief ? "contact_summary" : "contact", {0, 1});
   if (!q.Next()) return std::nullopt;
   LargestOverlap largest;
   largest.frame = q.Int(0);

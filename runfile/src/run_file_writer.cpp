@@ -78,6 +78,8 @@ CREATE TABLE person_load(frame INTEGER NOT NULL, id INTEGER NOT NULL, chest_n RE
 CREATE INDEX person_load_idx ON person_load(frame, id);
 CREATE TABLE event(frame INTEGER NOT NULL, time_s REAL NOT NULL, kind TEXT NOT NULL, person INTEGER NOT NULL,
   other INTEGER NOT NULL, detail TEXT NOT NULL);
+CREATE TABLE contact_summary(frame INTEGER PRIMARY KEY, contacts INTEGER NOT NULL, wall_contacts INTEGER NOT NULL,
+  max_overlap_m REAL NOT NULL, max_overlap_wall INTEGER NOT NULL, max_force_n REAL NOT NULL);
 )SQL";
 
 // What was derived from the run's frames (an analysis stored with analyze
@@ -112,6 +114,7 @@ struct RunFileWriter::Impl {
   // The frame tables' inserts, prepared once (WriteFrame).
   std::unique_ptr<sqlite::BatchInsert> trajectory, person_state, contact, person_load;
   bool has_person_load = true;  // false for a resumed run file written before the table existed
+  bool has_contact_summary = true;  // likewise (issue 66)
   std::int64_t geometry_hash = 0;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
   double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
@@ -256,6 +259,8 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   w.impl_->has_person_load = sqlite::HasTable(db, "person_load");
   if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
   if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);
+  w.impl_->has_contact_summary = sqlite::HasTable(db, "contact_summary");
+  if (w.impl_->has_contact_summary) db.Exec("DELETE FROM contact_summary WHERE frame > " + after);
   {
     Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
     if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
@@ -310,6 +315,12 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
         if (f.chest_load_n[k] != 0.0 || f.lateral_load_n[k] != 0.0)
           loads.Add(frame).Add(static_cast<std::int64_t>(f.person[k]) + 1).Add(f.chest_load_n[k]).Add(f.lateral_load_n[k]);
       loads.Finish();
+    }
+    if (impl_->has_contact_summary) {
+      const ContactSummary c = SummarizeContacts(f.contacts);
+      Statement cs(db, "INSERT INTO contact_summary VALUES(?, ?, ?, ?, ?, ?)");
+      cs.Bind(1, frame).Bind(2, c.contacts).Bind(3, c.wall_contacts).Bind(4, c.max_overlap_m)
+          .Bind(5, static_cast<std::int64_t>(c.max_overlap_wall)).Bind(6, c.max_force_n).Run();
     }
     if (f.with_contacts) {
       sqlite::BatchInsert& contact = *impl_->contact;
@@ -460,6 +471,20 @@ void RunFileWriter::SetStatus(const std::string& status) { SetRunValue("status",
 void RunFileWriter::SetRunValue(const std::string& key, const std::string& value) {
   Statement s(*impl_->db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
   s.Bind(1, key).Bind(2, value).Run();
+}
+
+ContactSummary SummarizeContacts(const std::vector<Contact>& contacts) {
+  ContactSummary s;
+  for (const Contact& c : contacts) {
+    ++s.contacts;
+    s.wall_contacts += c.wall;
+    if (s.contacts == 1 || c.overlap_m > s.max_overlap_m) {  // the first of the largest
+      s.max_overlap_m = c.overlap_m;
+      s.max_overlap_wall = c.wall;
+    }
+    s.max_force_n = std::max(s.max_force_n, Length(c.Force()));
+  }
+  return s;
 }
 
 }  // namespace crowdrecon::runfile

@@ -102,13 +102,11 @@ void TakeSnapshot(const engine::Simulation& sim, std::int64_t frame, const std::
   f.chest_load_n.resize(kept);
   f.lateral_load_n.resize(kept);
   f.with_contacts = with_contacts;
-  f.contacts.clear();
-  if (with_contacts) {
-    f.contacts.reserve(sim.contacts().size());
-    for (const engine::Contact& c : sim.contacts())
-      f.contacts.push_back({b.id[c.a], c.wall ? c.b : b.id[c.b], c.wall, c.point_m, c.normal, c.overlap_m,
-                            c.normal_force_n, c.tangential_force_n});
-  }
+  f.contacts.clear();  // (every frame: their brief is written either way)
+  f.contacts.reserve(sim.contacts().size());
+  for (const engine::Contact& c : sim.contacts())
+    f.contacts.push_back({b.id[c.a], c.wall ? c.b : b.id[c.b], c.wall, c.point_m, c.normal, c.overlap_m,
+                          c.normal_force_n, c.tangential_force_n});
   f.events = events;
   f.with_census = false;
 }

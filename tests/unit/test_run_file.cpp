@@ -231,6 +231,74 @@ TEST(RunFileReader, GivesBackEveryTableTheWriterFilled) {
   EXPECT_DOUBLE_EQ(sums[1].x, -1.5);
 }
 
+// Issue 66: the largest overlap from the frames' briefs (table
+// contact_summary, written every frame) is the contact the scan of every
+// contact row finds (the largest, the earliest frame, the first row), each
+// brief counts its frame's rows, and a run written without its contacts
+// knows the same largest overlap.
+TEST(RunFileReader, TheLargestOverlapFromTheFramesBriefsIsTheScansOne) {
+  std::optional<runfile::RunFileReader::LargestOverlap> with, without;
+  std::string counts, brief_counts;
+  std::int64_t scan_frame = -1;
+  double scan_overlap = 0.0;
+  bool scan_wall = false;
+  for (const bool contacts : {true, false}) {
+    engine::Simulation sim(engine::testing::RandomGas(8, 0.5, 7, true));
+    const std::filesystem::path file =
+        std::filesystem::path(::testing::TempDir()) / (contacts ? "brief-with.sqlite" : "brief-without.sqlite");
+    std::filesystem::remove(file);
+    {
+      RunFileWriter writer = CreateRunFile(file, Header(sim), sim, {});
+      for (int k = 0; k <= 20; ++k) {
+        if (k > 0) sim.AdvanceTo(k / 10.0);
+        WriteFrame(writer, sim, k, {}, contacts);
+      }
+      writer.SetStatus("complete");
+    }
+    (contacts ? with : without) = runfile::RunFileReader(file).LargestContactOverlap();
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    auto rows = [&](const char* sql) {
+      std::string out;
+      sqlite3_stmt* stmt = nullptr;
+      EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &stmt, nullptr), SQLITE_OK) << sql;
+      while (sqlite3_step(stmt) == SQLITE_ROW)
+        for (int c = 0; c < sqlite3_column_count(stmt); ++c) {
+          const unsigned char* text = sqlite3_column_text(stmt, c);
+          out += text ? reinterpret_cast<const char*>(text) : "NULL";
+          out += c + 1 < sqlite3_column_count(stmt) ? "," : "\n";
+        }
+      sqlite3_finalize(stmt);
+      return out;
+    };
+    if (contacts) {
+      sqlite3_stmt* stmt = nullptr;
+      ASSERT_EQ(sqlite3_prepare_v2(db, "SELECT frame, overlap_m, wall FROM contact ORDER BY overlap_m DESC, frame, rowid LIMIT 1",
+                                   -1, &stmt, nullptr), SQLITE_OK);
+      ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+      scan_frame = sqlite3_column_int64(stmt, 0);
+      scan_overlap = sqlite3_column_double(stmt, 1);
+      scan_wall = sqlite3_column_int(stmt, 2) != 0;
+      sqlite3_finalize(stmt);
+      counts = rows("SELECT frame, COUNT(*), SUM(wall) FROM contact GROUP BY frame ORDER BY frame");
+      brief_counts = rows("SELECT frame, contacts, wall_contacts FROM contact_summary WHERE contacts > 0 ORDER BY frame");
+    } else {
+      EXPECT_EQ(rows("SELECT COUNT(*) FROM contact"), "0\n");  // the rows are not written, their brief is
+    }
+    sqlite3_close(db);
+  }
+  ASSERT_TRUE(with.has_value());
+  ASSERT_TRUE(without.has_value());
+  EXPECT_EQ(with->frame, scan_frame);
+  EXPECT_EQ(with->overlap_m, scan_overlap);
+  EXPECT_EQ(with->wall, scan_wall);
+  EXPECT_GT(with->overlap_m, 0.0);
+  EXPECT_EQ(counts, brief_counts);
+  EXPECT_EQ(without->frame, with->frame);
+  EXPECT_EQ(without->overlap_m, with->overlap_m);
+  EXPECT_EQ(without->wall, with->wall);
+}
+
 // A damaged periodic box names the file, the table, the row and what was expected.
 TEST(RunFileReader, ADamagedPeriodicBoxIsReported) {
   const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "box.sqlite";

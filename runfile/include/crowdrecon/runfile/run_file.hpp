@@ -120,6 +120,19 @@ struct Contact {
   constexpr Vec2 Force() const { return normal * normal_force_n + Perp(normal) * tangential_force_n; }
 };
 
+// A frame's contacts in brief (table contact_summary, issue 66): written
+// every frame whether or not the contacts are, so that what analysis needs of
+// them (the largest overlap, its frame and whether a wall made it) is read
+// without reading every contact of a run. The largest overlap is the first
+// contact with it in the frame's order (the order of table contact's rows).
+struct ContactSummary {
+  std::int64_t contacts = 0, wall_contacts = 0;
+  double max_overlap_m = 0.0;
+  bool max_overlap_wall = false;
+  double max_force_n = 0.0;  // the largest |Contact::Force()|
+};
+ContactSummary SummarizeContacts(const std::vector<Contact>& contacts);
+
 // A timeline's head count at a frame (table census).
 struct Census {
   std::int64_t walking = 0, fallen = 0, removed = 0, queued = 0, entered = 0;
@@ -156,8 +169,11 @@ struct FrameSnapshot {
   // The load across the chest and across the shoulders (reports/chest_load.hpp),
   // written to table person_load where not both zero; empty: none written.
   std::vector<double> chest_load_n, lateral_load_n;
+  // Every contact of the frame (their brief is written whatever
+  // with_contacts says: table contact_summary); the rows themselves (table
+  // contact) only when with_contacts.
   bool with_contacts = false;
-  std::vector<Contact> contacts;  // every contact when with_contacts, else empty
+  std::vector<Contact> contacts;
   std::vector<Event> events;
   bool with_census = false;  // a timeline's run: census holds the head count
   Census census;
@@ -396,6 +412,10 @@ class RunFileReader {
     bool wall = false;
   };
   std::optional<LargestOverlap> LargestContactOverlap() const;
+  // Whether the run has its frames' contact briefs (table contact_summary,
+  // runs from 2026-12-06 on): then its overlaps are known even where the
+  // contacts were not written, or none happened.
+  bool HasContactSummary() const;
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;
   // A timeline's head count per frame (empty for a run without a timeline).
