@@ -33,6 +33,16 @@ def add_comparison_arguments(parser, program):
     parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
 
 
+def add_whole_run_arguments(parser, repeat=3):
+    """The options every whole-run script of one program takes: --exe,
+    --repeat, --label, --no-results-md (checked_exe_and_repeat reads the
+    first two)."""
+    parser.add_argument("--exe", default="build/release/cli/crowdrecon", help="the crowdrecon program")
+    parser.add_argument("--repeat", type=int, default=repeat, help="rounds (default: %(default)s)")
+    parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
+    parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
+
+
 def parse_builds(args):
     """The builds of add_comparison_arguments' options: [(name, path)], paths
     made absolute from the repository root; at least two, and --repeat >= 1."""

@@ -78,11 +78,8 @@ def run_once(exe, scenario, threads, extra, env, busy, folder):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--exe", default="build/release/cli/crowdrecon", help="the crowdrecon program")
-    parser.add_argument("--repeat", type=int, default=5, help="rounds (default: %(default)s)")
+    bc.add_whole_run_arguments(parser, repeat=5)
     parser.add_argument("--scenario", action="append", choices=sorted(SCENARIOS), help="default: all")
-    parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
-    parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = parser.parse_args()
     exe = bc.checked_exe_and_repeat(args)
     started = bc.now()

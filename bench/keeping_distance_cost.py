@@ -77,11 +77,8 @@ def run_once(exe, scenario, folder, extra=()):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--exe", default="build/release/cli/crowdrecon", help="the crowdrecon program")
-    parser.add_argument("--repeat", type=int, default=3, help="rounds (default: %(default)s)")
+    bc.add_whole_run_arguments(parser, repeat=3)
     parser.add_argument("--profile", action="append", help="a profile file (may be repeated)")
-    parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
-    parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
     args = parser.parse_args()
     exe = bc.checked_exe_and_repeat(args)
     folder_of_study = bc.ROOT / "studies/keeping-distance/pilot2"

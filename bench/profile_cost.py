@@ -36,10 +36,7 @@ PROFILES = ["paper", "validated"]
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--exe", default="build/release/cli/crowdrecon", help="the crowdrecon program")
-    parser.add_argument("--repeat", type=int, default=3, help="rounds (default: %(default)s)")
-    parser.add_argument("--label", default="", help="names the RESULTS.md section and the JSON file")
-    parser.add_argument("--no-results-md", action="store_true", help="do not write bench/RESULTS.md")
+    bc.add_whole_run_arguments(parser, repeat=3)
     args = parser.parse_args()
     exe = bc.checked_exe_and_repeat(args)
     started = bc.now()
