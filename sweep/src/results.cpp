@@ -322,17 +322,27 @@ std::string SweepProfile(const ResultsTable& table) {
   auto named = [](const nlohmann::json& object, const char* key) -> std::string {
     return object.is_object() && object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : "";
   };
-  std::string base = sweep.is_object() && sweep.contains("set") ? named(sweep["set"], "profile") : "";
-  if (base.empty()) base = named(scenario, "profile");
-  if (base.empty()) base = scenario::kDefaultProfile;
-  std::vector<std::string> profiles{base};
+  std::string first = sweep.is_object() && sweep.contains("set") ? named(sweep["set"], "profile") : "";
+  if (first.empty()) first = named(scenario, "profile");
+  if (first.empty()) first = scenario::kDefaultProfile;
+  std::vector<std::string> profiles{first};
   if (sweep.is_object() && sweep.contains("variants") && sweep["variants"].is_array())
     for (const nlohmann::json& v : sweep["variants"]) {
       const std::string own = v.is_object() && v.contains("set") ? named(v["set"], "profile") : "";
       if (!own.empty() && std::find(profiles.begin(), profiles.end(), own) == profiles.end()) profiles.push_back(own);
     }
+  // A profile given as a file is named by its own name (as a run file
+  // names it): read relative to the scenario's folder, as the scenario does.
+  const auto file = table.sweep.find("scenario_file");
+  const fs::path folder = file == table.sweep.end() ? fs::path() : fs::path(file->second).parent_path();
   std::string out;
-  for (const std::string& p : profiles) out += (out.empty() ? "" : ", ") + p;
+  for (std::string p : profiles) {
+    if (!scenario::IsProfileName(p)) try {
+        p = scenario::LoadModelProfile(scenario::ProfilePath(p, folder)).name;
+      } catch (const InputError&) {  // (moved or gone since: its path is what there is)
+      }
+    out += (out.empty() ? "" : ", ") + p;
+  }
   return out;
 }
 

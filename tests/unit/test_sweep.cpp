@@ -551,6 +551,12 @@ TEST(SweepResults, TheProfileOfASweepsRuns) {
   t.sweep["sweep"] = R"({"set": {"profile": "paper"}, "variants": [{"name": "a", "set": {}},
                          {"name": "b", "set": {"profile": "validated"}}]})";
   EXPECT_EQ(SweepProfile(t), "paper, validated");
+  // A profile file is named by its name, read beside the scenario.
+  t.sweep["scenario_file"] = std::string(CROWDRECON_SOURCE_DIR) + "/studies/keeping-distance/x.json";
+  t.sweep["sweep"] = R"({"set": {"profile": "radius/validated-radius2.5.profile.json"}})";
+  EXPECT_EQ(SweepProfile(t), "validated-radius2.5");
+  t.sweep["sweep"] = R"({"set": {"profile": "radius/gone.profile.json"}})";
+  EXPECT_EQ(SweepProfile(t), "radius/gone.profile.json");
 }
 
 TEST(SweepResults, ColumnsAndRowRoundTrip) {

@@ -114,8 +114,9 @@ ResultsTable ReadResults(const std::filesystem::path& dir_or_file);
 
 // The model profile a sweep's runs ran (issue 64): the sweep's "set" of
 // "profile", else its scenario's "profile", else "paper" (a scenario without
-// one); "NAME, OTHER" where variants set their own. "" for results written
-// before the sweep table kept its sweep and scenario.
+// one); "NAME, OTHER" where variants set their own; a profile file by its
+// name. "" for results written before the sweep table kept its sweep and
+// scenario.
 std::string SweepProfile(const ResultsTable& table);
 
 // The build's version as stored with results (`git describe` at build time),
