@@ -164,15 +164,16 @@ void PlausibilityPass::AddPeople(const runfile::PersonFrame& frame) {
 }
 
 // The first largest overlap in the order of frames and rows, as the
-// reader's LargestContactOverlap picks it.
+// reader's LargestContactOverlap picks it (within a frame: the frame's brief,
+// runfile::SummarizeContacts, the rule the writer's table uses).
 void PlausibilityPass::AddContacts(std::int64_t frame, const std::vector<runfile::Contact>& contacts) {
-  for (const runfile::Contact& c : contacts)
-    if (!contacts_given_ || c.overlap_m > largest_overlap_m_) {
-      contacts_given_ = true;
-      largest_overlap_m_ = c.overlap_m;
-      largest_overlap_frame_ = frame;
-      largest_overlap_wall_ = c.wall;
-    }
+  const runfile::ContactSummary brief = runfile::SummarizeContacts(contacts);
+  if (brief.contacts > 0 && (!contacts_given_ || brief.max_overlap_m > largest_overlap_m_)) {
+    contacts_given_ = true;
+    largest_overlap_m_ = brief.max_overlap_m;
+    largest_overlap_frame_ = frame;
+    largest_overlap_wall_ = brief.max_overlap_wall;
+  }
 }
 
 Plausibility PlausibilityPass::Finish(const runfile::RunFileReader& reader) {

@@ -81,6 +81,14 @@ void ForEachNeighbour(const NeighbourList& list, const BodyStateT& bodies, std::
   }
 }
 
+// Whether person i wants to walk (desired speed > 0): the gait and the
+// choice of a velocity are a walker's; a person who stands by choice
+// (waiting for a pre-movement time, told to stand) has neither.
+template <class BodyStateT>
+bool WantsToWalk(const BodyStateT& bodies, std::size_t i) {
+  return bodies.desired_speed_m_per_s[i] > 0.0;
+}
+
 // What every term may read during one evaluation of the drive.
 struct DriveInputs {
   const BodyState& bodies;

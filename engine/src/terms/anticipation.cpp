@@ -51,7 +51,7 @@ class AnticipationTerm final : public BehaviourTerm {
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
     for (std::size_t n = 0; n < b.count; ++n) {
       const std::size_t i = b.first + n;
-      if (!b.driven[n] || !(in.bodies.desired_speed_m_per_s[i] > 0.0)) continue;
+      if (!b.driven[n] || !WantsToWalk(in.bodies, i)) continue;
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push{};

@@ -70,7 +70,7 @@ class GaitJitterTerm final : public BehaviourTerm {
     const auto seed = static_cast<std::uint64_t>(mp.gait_jitter_seed);
     for (std::size_t k = 0; k < b.count; ++k) {
       const std::size_t i = b.first + k;
-      if (!b.driven[k] || !(in.bodies.desired_speed_m_per_s[i] > 0.0)) continue;
+      if (!b.driven[k] || !WantsToWalk(in.bodies, i)) continue;
       b.force[k] += JitterVelocity(seed, in.bodies.id[i], in.time_s, mp) * (in.bodies.mass_kg[i] * in.inverse_tau);
     }
   }
