@@ -12,7 +12,10 @@
 #   bench/reference/checksums.sh --check [CROWDRECON]   # against checksums.txt (a ctest)
 # The two hallway-extensions-* scenes switch on every behaviour extension of
 # the drive (each one changes their results: switched off one at a time, each
-# gives other tables), the timeline a group's own back force and arrivals.
+# gives other tables), the timeline a group's own back force and arrivals;
+# hallway-validated and door-validated run the profile validated (anticipation
+# by time to collision across a periodic boundary and among walls, yielding,
+# gait jitter): they change when that profile's values change.
 # checksums.txt holds the values of the current model: a change of physics
 # changes them on purpose (then regenerate it and say so in the commit); a
 # change of structure must not.

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -314,6 +315,56 @@ TEST(Anticipation, TheForceOfOneCollisionCourseIsTheModelsExactly) {
   def.people.push_back(other);
   const Simulation sim(def);
   EXPECT_NEAR(sim.bodies().force_n[0].y, 0.0, 1e-12);
+}
+
+// A walker in a crowd (some 600 candidates, several of the term's chunks):
+// its force is the sum, in the order of the people, of the force of each
+// other person within the radius by the formula of one collision course
+// (the candidates are picked without branches, then summed: no one missed,
+// no one twice, nobody beyond the radius or moving away).
+TEST(Anticipation, ACrowdsForceIsTheSumOfEachPersonsInTheirOrder) {
+  ModelParameters p;
+  p.anticipation = Anticipation::kTimeToCollision;
+  WorldDef def = File(1, 10.0, 1.0, p);
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[0].velocity_m_per_s = {1.0, 0.0};  // its desired velocity: no drive
+  std::uint64_t state = 12345;
+  const auto uniform = [&state] {  // (a fixed sequence, the same on every compiler)
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  for (int n = 0; n < 700; ++n) {
+    PersonDef other = def.people[0];
+    const double r = 0.8 + 5.2 * std::sqrt(uniform()), angle = 6.283185307179586 * uniform();
+    other.position_m = {r * std::cos(angle), r * std::sin(angle)};
+    other.velocity_m_per_s = {2.0 * uniform() - 1.0, 2.0 * uniform() - 1.0};
+    other.state = PersonState::kFallen;  // (obstacles: they do not move themselves)
+    def.people.push_back(other);
+  }
+  const Simulation sim(def);
+  const BodyState& b = sim.bodies();
+  const BodyShape& shape = sim.definition().shapes[0];
+  const double reach = 2.0 * (shape.core_radius_m + shape.radius_m);
+  const double k = p.anticipation_strength_m2, t0 = p.anticipation_horizon_s;
+  Vec2 expected{};
+  int within = 0, acting = 0;
+  for (std::size_t j = 1; j < b.size(); ++j) {
+    const Vec2 x = b.position_m[0] - b.position_m[j], v = b.velocity_m_per_s[0] - b.velocity_m_per_s[j];
+    if (Dot(x, x) > p.anticipation_radius_m * p.anticipation_radius_m) continue;
+    ++within;
+    const double a = Dot(v, v), bb = Dot(x, v), c = Dot(x, x) - reach * reach, disc = bb * bb - a * c;
+    if (!(c > 0.0 && bb < 0.0 && disc > 0.0)) continue;
+    ++acting;
+    const double tau = c / (std::sqrt(disc) - bb);
+    const double size = k * std::exp(-tau / t0) / (tau * tau) * (2.0 / tau + 1.0 / t0) / std::sqrt(disc);
+    expected += (x + v * tau) * (std::min(size * reach, p.anticipation_max_acceleration_m_per_s2) / reach);
+  }
+  ASSERT_GT(within, 400);  // several chunks of candidates
+  ASSERT_GT(acting, 20);
+  const Vec2 on_walker = (b.force_n[0] - b.contact_force_n[0]) * (1.0 / def.people[0].mass_kg);
+  EXPECT_NEAR(on_walker.x, expected.x, 1e-9 * Length(expected)) << within << " within, " << acting << " acting";
+  EXPECT_NEAR(on_walker.y, expected.y, 1e-9 * Length(expected));
 }
 
 // Anticipation is a walker's: a person who stands by choice (desired speed
