@@ -293,6 +293,11 @@ auto MakeTable() {
                   "issue 64 (ours: Karamouzas et al. looked 10 m; half of it for the cost)",
                   "the centre distance within which people anticipate each other"),
            "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Number("anticipation_interval_s", &P::anticipation_interval_s, "s", 0.0, 0.5,
+                  "issue 66 (multiple time stepping, Tuckerman, Berne and Martyna 1992)",
+                  "how often the anticipation force is evaluated: 0 at every step, else once per interval, each "
+                  "person keeping its force per unit mass in between"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
   };
 }
 

@@ -367,6 +367,134 @@ TEST(Anticipation, ACrowdsForceIsTheSumOfEachPersonsInTheirOrder) {
   EXPECT_NEAR(on_walker.y, expected.y, 1e-9 * Length(expected));
 }
 
+// The anticipation's clock (anticipation_interval_s, issue 66). A periodic
+// crowd of 64 walkers, half heading +x, half -x, at 1.2 m/s, anticipating.
+WorldDef CrossingCrowd(double interval_s, unsigned seed = 7) {
+  WorldDef def = testing::RandomGas(8, 1.3, seed, true);
+  def.parameters = ModelParameters{};
+  def.parameters.anticipation = Anticipation::kTimeToCollision;
+  def.parameters.anticipation_interval_s = interval_s;
+  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+  for (std::size_t i = 0; i < def.people.size(); ++i) {  // (a checkerboard: head on along each row)
+    const bool east = (i + i / 8) % 2 == 0;
+    def.people[i].desired_speed_m_per_s = 1.2;
+    def.people[i].target = east ? 0 : 1;
+    def.people[i].velocity_m_per_s = {east ? 1.0 : -1.0, 0.2 * def.people[i].velocity_m_per_s.y};
+  }
+  return def;
+}
+
+bool SameBodies(const Simulation& a, const Simulation& b) {
+  const auto& x = a.bodies().position_m;
+  const auto& y = b.bodies().position_m;
+  const auto& u = a.bodies().velocity_m_per_s;
+  const auto& w = b.bodies().velocity_m_per_s;
+  return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(Vec2)) == 0 &&
+         std::memcmp(u.data(), w.data(), u.size() * sizeof(Vec2)) == 0;
+}
+
+// An interval shorter than the step is an evaluation at every step: the run
+// made without the clock, bit for bit; a longer one is another run.
+TEST(AnticipationClock, AnIntervalShorterThanTheStepIsEveryStep) {
+  Simulation every(CrossingCrowd(0.0)), clocked(CrossingCrowd(1e-6)), coarse(CrossingCrowd(0.05));
+  ASSERT_LT(1e-6, every.time_step_s());
+  for (int n = 0; n < 600; ++n) {
+    every.Step();
+    clocked.Step();
+    coarse.Step();
+  }
+  EXPECT_TRUE(SameBodies(every, clocked));
+  EXPECT_FALSE(SameBodies(every, coarse));
+}
+
+// Within an interval each walker's anticipation force per unit mass is the
+// one of the interval's first step; the next interval evaluates it anew. A
+// walker alone with people lying ahead of it (out of reach of any contact),
+// at its desired speed and with a long relaxation time (eq. 3's drive, m /
+// tau (v0 e - v) with the velocity the forces were evaluated with, the
+// step's second half kick before, is then small and subtracted).
+TEST(AnticipationClock, TheForceIsKeptThroughAnIntervalAndEvaluatedAnewAtTheNext) {
+  for (const double interval : {0.0, 0.02}) {
+    ModelParameters p;
+    p.anticipation = Anticipation::kTimeToCollision;
+    p.anticipation_interval_s = interval;
+    p.relaxation_time_s = 100.0;
+    WorldDef def = File(1, 10.0, 1.0, p);
+    def.periodic = PeriodicBox{};
+    def.people[0].position_m = {0.0, 0.0};
+    def.people[0].velocity_m_per_s = {1.0, 0.0};
+    for (int k = 0; k < 3; ++k) {
+      PersonDef lying = def.people[0];
+      lying.position_m = {3.0 + k, 0.3 * (k - 1)};
+      lying.velocity_m_per_s = {0.0, 0.0};
+      lying.state = PersonState::kFallen;
+      def.people.push_back(lying);
+    }
+    Simulation sim(def);
+    const double m = def.people[0].mass_kg, h = sim.time_step_s();
+    std::vector<std::pair<double, Vec2>> per_step;  // (time the forces were evaluated at, the force / m)
+    while (sim.time_s() < 0.1) {
+      sim.Step();
+      const BodyState& b = sim.bodies();
+      ASSERT_TRUE(sim.contacts().empty());
+      const Vec2 v_evaluated = b.velocity_m_per_s[0] - b.force_n[0] * (h / (2.0 * m));
+      const Vec2 drive = (Vec2{1.0, 0.0} - v_evaluated) * (m / p.relaxation_time_s);
+      per_step.push_back({sim.time_s(), (b.force_n[0] - drive) * (1.0 / m)});
+    }
+    int kept = 0, anew = 0;
+    for (std::size_t n = 1; n < per_step.size(); ++n) {
+      const Vec2 d = per_step[n].second - per_step[n - 1].second;
+      const bool same_interval = interval > 0.0 && std::floor(per_step[n].first / interval) ==
+                                                       std::floor(per_step[n - 1].first / interval);
+      if (same_interval) {
+        EXPECT_LT(Length(d), 1e-7) << "t " << per_step[n].first;
+        ++kept;
+      } else {
+        EXPECT_GT(Length(d), 1e-6) << "t " << per_step[n].first << ", interval " << interval;
+        ++anew;
+      }
+    }
+    EXPECT_GT(anew, interval > 0.0 ? 3 : 100);
+    if (interval > 0.0) {
+      EXPECT_GT(kept, 10 * anew);
+    }
+  }
+}
+
+// The kept forces are the term's state: a clocked run saved in the middle of
+// an interval and loaded into a new simulation goes on as the run made in
+// one go, on one thread or two.
+TEST(AnticipationClock, AResumeInTheMiddleOfAnIntervalIsTheRunMadeInOneGo) {
+  WorldDef def = CrossingCrowd(0.05);
+  Simulation whole(def);
+  while (whole.time_s() < 0.23) whole.Step();  // (0.2 + 0.03: within an interval)
+  const std::string saved = whole.SaveState();
+  for (int n = 0; n < 300; ++n) whole.Step();
+  for (const int threads : {1, 2}) {
+    WorldDef d = def;
+    d.threads = threads;
+    Simulation resumed(d);
+    resumed.LoadState(saved);
+    for (int n = 0; n < 300; ++n) resumed.Step();
+    EXPECT_TRUE(SameBodies(whole, resumed)) << threads << " thread(s)";
+  }
+  // (without the kept forces, the resumed run would evaluate at once: another run)
+}
+
+// The clock keeps state: switching it on or off during a run is refused
+// (its length may change).
+TEST(AnticipationClock, ItCannotBeSwitchedOnOrOffDuringARun) {
+  Simulation sim(CrossingCrowd(0.0));
+  ModelParameters p = sim.definition().parameters;
+  p.anticipation_interval_s = 0.02;
+  EXPECT_THROW(sim.SetParameters(p), InputError);
+  Simulation clocked(CrossingCrowd(0.02));
+  p.anticipation_interval_s = 0.04;
+  EXPECT_NO_THROW(clocked.SetParameters(p));
+  p.anticipation_interval_s = 0.0;
+  EXPECT_THROW(clocked.SetParameters(p), InputError);
+}
+
 // Anticipation is a walker's: a person who stands by choice (desired speed
 // 0, waiting for a pre-movement time) does not dodge a walker heading at
 // them; the walker dodges them all the same, and a person who wants to walk

@@ -27,7 +27,18 @@
 // avoid them all the same (their own force, with the standing person as j),
 // and the contact forces act as ever (as the gait jitter, gait_jitter.cpp).
 // Summed in the neighbour list's order: the same on any thread count.
-// No state.
+//
+// Its clock (anticipation_interval_s, issue 66): 0, evaluated at every step
+// (no state). Else each person's force is evaluated at the first step of
+// each interval [k h, (k+1) h) of the drive's time and kept, per unit mass,
+// until the next interval (multiple time stepping: the force of people
+// metres away changes over tenths of a second, the contacts' over
+// milliseconds; Tuckerman, Berne and Martyna, J. Chem. Phys. 97:1990, 1992).
+// The kept forces and the interval each was evaluated in are the term's
+// state (its checkpoint section: a resumed run is the run made in one go);
+// a person placed, stopped or quenched has none kept (evaluated at their
+// next step). The blocks write each their own people's entries (no two
+// threads the same person): the same on any thread count.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -39,7 +50,8 @@ namespace {
 
 class AnticipationTerm final : public BehaviourTerm {
  public:
-  explicit AnticipationTerm(const ModelParameters& p, const WorldDef& def) : radius_m_(p.anticipation_radius_m) {
+  explicit AnticipationTerm(const ModelParameters& p, const WorldDef& def)
+      : radius_m_(p.anticipation_radius_m), clocked_(p.anticipation_interval_s > 0.0) {
     bound_m_.reserve(def.shapes.size());
     for (const BodyShape& s : def.shapes) bound_m_.push_back(s.core_radius_m + s.radius_m);
   }
@@ -73,9 +85,16 @@ class AnticipationTerm final : public BehaviourTerm {
     const double k = mp.anticipation_strength_m2, inverse_horizon = 1.0 / mp.anticipation_horizon_s;
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
     const NeighbourList& list = in.neighbours;
+    const double interval = mp.anticipation_interval_s;
+    // (The interval the drive's time is in; a clocked run keeps a positive interval.)
+    const double tick = clocked_ ? std::floor(in.time_s / interval) : 0.0;
     for (std::size_t n = 0; n < b.count; ++n) {
       const std::size_t i = b.first + n;
       if (!b.driven[n] || !WantsToWalk(in.bodies, i)) continue;
+      if (clocked_ && evaluated_in_[i] == tick) {
+        b.force[n] += kept_[i] * in.bodies.mass_kg[i];
+        continue;
+      }
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push{};
@@ -105,14 +124,49 @@ class AnticipationTerm final : public BehaviourTerm {
           push += at_contact * (acceleration / p.reach);
         }
       }
+      if (clocked_) {
+        kept_[i] = push;
+        evaluated_in_[i] = tick;
+      }
       b.force[n] += push * in.bodies.mass_kg[i];
     }
   }
 
+  std::uint32_t state_version() const override { return clocked_ ? 1 : 0; }
+  void Start(const BodyState& bodies) override {
+    kept_.assign(bodies.size(), Vec2{});
+    evaluated_in_.assign(bodies.size(), kNever);
+  }
+  void Place(std::size_t slot, const BodyState&) override { Forget(slot); }
+  void Stop(std::size_t person) override { Forget(person); }
+  void Quench() override {
+    std::fill(kept_.begin(), kept_.end(), Vec2{});
+    std::fill(evaluated_in_.begin(), evaluated_in_.end(), kNever);
+  }
+  void Save(BinaryWriter& w) const override {
+    w.PutVector(kept_);
+    w.PutVector(evaluated_in_);
+  }
+  void Load(BinaryReader& r, std::size_t people) override {
+    GetTermVector(r, kept_, people, "kept anticipation force");
+    GetTermVector(r, evaluated_in_, people, "anticipation's interval");
+  }
+
  private:
   static constexpr std::uint32_t kChunk = 128;
+  static constexpr double kNever = -1.0;  // (no interval: times are >= 0)
+  void Forget(std::size_t person) {
+    kept_[person] = Vec2{};
+    evaluated_in_[person] = kNever;
+  }
   std::vector<double> bound_m_;  // per shape of the world
   double radius_m_;
+  bool clocked_;  // anticipation_interval_s > 0 when the run started (fixed for a run: it has state)
+  // Per person, when clocked: the force per unit mass of the last evaluation
+  // and the interval it was evaluated in (floor(t / h); kNever: none kept).
+  // Written by the block of the person's (Force is const: the blocks share the term).
+  mutable std::vector<Vec2> kept_;
+  mutable std::vector<double> evaluated_in_;
 };
 
 }  // namespace

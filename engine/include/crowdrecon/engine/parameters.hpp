@@ -290,6 +290,14 @@ struct ModelParameters {
   double anticipation_horizon_s = 3.0;
   double anticipation_max_acceleration_m_per_s2 = 5.0;
   double anticipation_radius_m = 5.0;
+  // How often the anticipation force is evaluated (issue 66): 0, at every
+  // step; else at the first step of each interval of this length (t in
+  // [k h, (k+1) h)), each person keeping the force per unit mass of that
+  // evaluation until the next (multiple time stepping: the slow force on a
+  // coarser clock than the contacts, Tuckerman, Berne and Martyna 1992: the
+  // force from people metres away changes over tenths of a second, the
+  // contacts' over milliseconds).
+  double anticipation_interval_s = 0.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
