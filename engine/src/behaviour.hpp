@@ -64,9 +64,15 @@ inline Vec2 Separation(const PeriodicBox& box, Vec2 a, Vec2 b) {
 // index, every one within radius_m of i and possibly some farther (up to
 // radius_m + the stage's skin): a term measures the distance itself. Empty
 // (start empty) when no active term asks for neighbours.
+// The near list (near_radius_m > 0, a term asked for one: BehaviourTerm::
+// near_radius_m): the same for a shorter radius, near_start / near_items,
+// every candidate within near_radius_m and possibly some farther (up to it +
+// the skin), in increasing index: a subset of the list, built with it.
 struct NeighbourList {
   double radius_m = 0.0;
   std::vector<std::uint32_t> start, items;
+  double near_radius_m = 0.0;
+  std::vector<std::uint32_t> near_start, near_items;
   bool empty() const { return start.empty(); }
 };
 
@@ -144,6 +150,9 @@ class BehaviourTerm {
   virtual bool needs_people_ahead() const { return false; }
   // The radius within which it needs each person's neighbours (0: none).
   virtual double neighbour_radius_m() const { return 0.0; }
+  // A shorter radius within which it needs them at every step (the near
+  // list; 0: none; at most neighbour_radius_m).
+  virtual double near_radius_m() const { return 0.0; }
 
   virtual void Direction(const DriveInputs&, DriveBlock&) const {}
   virtual void Steer(const DriveInputs&, DriveBlock&) const {}
@@ -151,6 +160,10 @@ class BehaviourTerm {
   virtual void Facing(const DriveInputs&, DriveBlock&) const {}
   virtual void Force(const DriveInputs&, DriveBlock&) const {}
   virtual void AfterStep(const StepInputs&) {}
+
+  // A term with state is kept through a change of the model's parameters
+  // (Simulation::SetParameters): it takes the new ones here.
+  virtual void Retune(const ModelParameters&) {}
 
   // Per-person state. state_version() 0: the term keeps none (then nothing
   // below is called but Start). Start: the run's people as placed; Place: a
@@ -191,6 +204,7 @@ struct ActiveTerms {
   std::vector<const char*> stateful_names;
   bool people_ahead = false;
   double neighbour_radius_m = 0.0;
+  double near_radius_m = 0.0;
 
   // The terms of `parameters` in `def` (every entry's make); `previous` (may be null) hands
   // over the terms it has that are still on, with their state. Throws

@@ -298,6 +298,13 @@ auto MakeTable() {
                   "how often the anticipation force is evaluated: 0 at every step, else once per interval, each "
                   "person keeping its force per unit mass in between"),
            "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Number("anticipation_near_m", &P::anticipation_near_m, "m", 0.0, 20.0,
+                  "issue 66 (multiple time stepping split by distance)",
+                  "with the clock, the centre distance within which the force is evaluated at every step (a smooth "
+                  "switch over its last 0.5 m); 0: every pair on the clock"),
+           "anticipation_interval_s > 0", [](const P& p) {
+             return p.anticipation == Anticipation::kTimeToCollision && p.anticipation_interval_s > 0.0;
+           }),
   };
 }
 

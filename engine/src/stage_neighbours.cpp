@@ -14,7 +14,10 @@
 // far, which rebuilds the list. Candidates are a superset of the people
 // within the radius whenever the list is used, so when it is rebuilt changes
 // no result; the list is built in one serial pass in a fixed order (the
-// same on any thread count) and is not in the checkpoint.
+// same on any thread count) and is not in the checkpoint. When a term asks
+// for a near list (a shorter radius it needs at every step), the list's
+// candidates within the near radius + skin are kept as a second list, built
+// and kept valid with the first.
 #include "simulation_internals.hpp"
 
 #include <algorithm>
@@ -78,6 +81,7 @@ GridAxis Axis(bool periodic, double box_min, double box_max, double low, double 
 void Simulation::Neighbours() {
   Internals& in = *in_;
   const double radius = std::max(in.terms.neighbour_radius_m, in.requested_neighbour_radius_m);
+  const double near_radius = std::min(in.terms.near_radius_m, radius);
   if (!(radius > 0.0)) {
     if (!in.neighbours.empty()) in.neighbours = NeighbourList{};
     return;
@@ -85,7 +89,8 @@ void Simulation::Neighbours() {
   ScopedTimer timer(profile_.stage_s[Index(Stage::kNeighbours)]);
   const std::size_t n = bodies_.size();
   // Still valid: built for this radius, and nobody has moved half the skin since.
-  if (!in.neighbours.empty() && in.neighbours.radius_m == radius && in.neighbours_position_at_build.size() == n) {
+  if (!in.neighbours.empty() && in.neighbours.radius_m == radius && in.neighbours.near_radius_m == near_radius &&
+      in.neighbours_position_at_build.size() == n) {
     const double half_skin = kNeighbourSkin_m / 2.0;
     bool valid = true;
     for (std::size_t i = 0; i < n && valid; ++i)
@@ -120,7 +125,11 @@ void Simulation::Neighbours() {
   list.radius_m = radius;
   list.start.assign(n + 1, 0);
   list.items.clear();
+  list.near_radius_m = near_radius;
+  list.near_start.assign(near_radius > 0.0 ? n + 1 : 0, 0);
+  list.near_items.clear();
   const double reach2 = reach * reach;
+  const double near_reach2 = (near_radius + kNeighbourSkin_m) * (near_radius + kNeighbourSkin_m);
   std::vector<std::uint32_t> mine;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 x = bodies_.position_m[i];
@@ -140,6 +149,13 @@ void Simulation::Neighbours() {
     std::sort(mine.begin(), mine.end());
     list.items.insert(list.items.end(), mine.begin(), mine.end());
     list.start[i + 1] = static_cast<std::uint32_t>(list.items.size());
+    if (near_radius > 0.0) {
+      for (const std::uint32_t j : mine) {
+        const Vec2 d = detail::Separation(box, x, bodies_.position_m[j]);
+        if (Dot(d, d) <= near_reach2) list.near_items.push_back(j);
+      }
+      list.near_start[i + 1] = static_cast<std::uint32_t>(list.near_items.size());
+    }
   }
   in.neighbours_position_at_build = bodies_.position_m;
 }

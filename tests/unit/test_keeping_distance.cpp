@@ -465,20 +465,47 @@ TEST(AnticipationClock, TheForceIsKeptThroughAnIntervalAndEvaluatedAnewAtTheNext
 // an interval and loaded into a new simulation goes on as the run made in
 // one go, on one thread or two.
 TEST(AnticipationClock, AResumeInTheMiddleOfAnIntervalIsTheRunMadeInOneGo) {
-  WorldDef def = CrossingCrowd(0.05);
-  Simulation whole(def);
-  while (whole.time_s() < 0.23) whole.Step();  // (0.2 + 0.03: within an interval)
-  const std::string saved = whole.SaveState();
-  for (int n = 0; n < 300; ++n) whole.Step();
-  for (const int threads : {1, 2}) {
-    WorldDef d = def;
-    d.threads = threads;
-    Simulation resumed(d);
-    resumed.LoadState(saved);
-    for (int n = 0; n < 300; ++n) resumed.Step();
-    EXPECT_TRUE(SameBodies(whole, resumed)) << threads << " thread(s)";
+  for (const double near : {0.0, 1.5}) {  // (every pair on the clock; the split by distance)
+    WorldDef def = CrossingCrowd(0.05);
+    def.parameters.anticipation_near_m = near;
+    Simulation whole(def);
+    while (whole.time_s() < 0.23) whole.Step();  // (0.2 + 0.03: within an interval)
+    const std::string saved = whole.SaveState();
+    for (int n = 0; n < 300; ++n) whole.Step();
+    for (const int threads : {1, 2}) {
+      WorldDef d = def;
+      d.threads = threads;
+      Simulation resumed(d);
+      resumed.LoadState(saved);
+      for (int n = 0; n < 300; ++n) resumed.Step();
+      EXPECT_TRUE(SameBodies(whole, resumed)) << threads << " thread(s), near " << near;
+    }
   }
   // (without the kept forces, the resumed run would evaluate at once: another run)
+}
+
+// The split by distance (anticipation_near_m): with every pair nearer than
+// the switch (a group of 16 within 3 m), every force is evaluated at every
+// step from the near list, and the run is the exact one, bit for bit; with
+// a near radius inside the group, another run.
+TEST(AnticipationClock, WithEveryPairNearTheSplitIsTheExactRun) {
+  auto group = [](double interval, double near) {
+    WorldDef def = CrossingCrowd(interval);
+    def.periodic = PeriodicBox{};
+    def.people.resize(16);
+    for (std::size_t i = 0; i < def.people.size(); ++i)
+      def.people[i].position_m = {0.7 * static_cast<double>(i % 4), 0.7 * static_cast<double>(i / 4)};
+    def.parameters.anticipation_near_m = near;
+    return def;
+  };
+  Simulation exact(group(0.0, 0.0)), all_near(group(0.05, 5.0)), split(group(0.05, 1.0));
+  for (int n = 0; n < 300; ++n) {  // (a quarter of a second: the group stays within 4 m)
+    exact.Step();
+    all_near.Step();
+    split.Step();
+  }
+  EXPECT_TRUE(SameBodies(exact, all_near));
+  EXPECT_FALSE(SameBodies(exact, split));
 }
 
 // The clock keeps state: switching it on or off during a run is refused

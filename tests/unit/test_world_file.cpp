@@ -306,11 +306,11 @@ TEST(WorldFile, DamagedDataIsRefusedWithItsOrigin) {
   // slope_response, integrator, 2 doubles, time_step_mode, 2 doubles,
   // gait_jitter, 4 doubles, yielding, 2 doubles, shoulder_turn, a double,
   // give_way, 4 doubles, drive_reaction, a double, headway, 4 doubles,
-  // social_force, 3 doubles, centrifugal, 8 doubles, anticipation, 5
+  // social_force, 3 doubles, centrifugal, 8 doubles, anticipation, 6
   // doubles; then the shape count.
   const std::size_t integrator_at = 8 + 5 * 8 + 1 + 8 + 1 + 2 + 2 * 8 + 1 + 3 * 8 + 1 + 1 * 8 + 1;
   const std::size_t shape_count_at =
-      integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 3 * 8 + 1 + 8 * 8 + 1 + 5 * 8;
+      integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 3 * 8 + 1 + 8 * 8 + 1 + 6 * 8;
   ASSERT_EQ(static_cast<unsigned char>(good[integrator_at]), static_cast<unsigned>(Integrator::kGear5));
   std::string bad_enum = good;
   bad_enum[integrator_at] = 7;
@@ -334,12 +334,12 @@ TEST(WorldFile, InvalidNavigationGridIsRefused) {
   def.targets = {NavigationField::Constant({0.0, 1.0}), GridTowardLine()};
   std::string bytes = SaveWorld(def);
   // The spacing of the grid (0.25) is the only double of that value after the
-  // parameters (whose last are anticipation's five numbers): make it negative.
-  const double last_parameters[5] = {1.5, 3.0, 5.0, 5.0, 0.0};
-  const std::size_t parameters_end = bytes.find(std::string(reinterpret_cast<const char*>(last_parameters), 40));
+  // parameters (whose last are anticipation's six numbers): make it negative.
+  const double last_parameters[6] = {1.5, 3.0, 5.0, 5.0, 0.0, 0.0};
+  const std::size_t parameters_end = bytes.find(std::string(reinterpret_cast<const char*>(last_parameters), 48));
   ASSERT_NE(parameters_end, std::string::npos);
   const double spacing = 0.25;
-  const std::size_t at = bytes.find(std::string(reinterpret_cast<const char*>(&spacing), 8), parameters_end + 40);
+  const std::size_t at = bytes.find(std::string(reinterpret_cast<const char*>(&spacing), 8), parameters_end + 48);
   ASSERT_NE(at, std::string::npos);
   const double negative = -0.25;
   std::memcpy(bytes.data() + at, &negative, 8);

@@ -29,11 +29,21 @@
 // Summed in the neighbour list's order: the same on any thread count.
 //
 // Its clock (anticipation_interval_s, issue 66): 0, evaluated at every step
-// (no state). Else each person's force is evaluated at the first step of
-// each interval [k h, (k+1) h) of the drive's time and kept, per unit mass,
-// until the next interval (multiple time stepping: the force of people
-// metres away changes over tenths of a second, the contacts' over
-// milliseconds; Tuckerman, Berne and Martyna, J. Chem. Phys. 97:1990, 1992).
+// (no state). Else the force from people beyond anticipation_near_m is
+// evaluated at the first step of each interval [k h, (k+1) h) of the drive's
+// time and kept, per unit mass, until the next interval, while the force
+// from people within it is evaluated at every step (multiple time stepping
+// with a split by distance, as molecular dynamics splits its long-range
+// forces from its short-range ones: Tuckerman, Berne and Martyna, J. Chem.
+// Phys. 97:1990, 1992; the force of people metres away changes over tenths
+// of a second, that of people an arm's length away with every jostle). The
+// split is smooth: a pair at centre distance r counts near with the share
+// S(r) = 1 within anticipation_near_m - w, falling linearly to 0 at
+// anticipation_near_m (w = min(kSwitch_m, anticipation_near_m)), and far
+// with 1 - S(r), so that a pair crossing the boundary changes the force
+// gradually. anticipation_near_m 0: every pair on the clock. The near pairs
+// come from the neighbour stage's near list (within anticipation_near_m +
+// its skin), so a step walks the near list only.
 // The kept forces and the interval each was evaluated in are the term's
 // state (its checkpoint section: a resumed run is the run made in one go);
 // a person placed, stopped or quenched has none kept (evaluated at their
@@ -48,85 +58,117 @@
 namespace crowdrecon::engine::detail {
 namespace {
 
+// The width of the switch between near and far.
+constexpr double kSwitch_m = 0.5;
+
 class AnticipationTerm final : public BehaviourTerm {
  public:
-  explicit AnticipationTerm(const ModelParameters& p, const WorldDef& def)
-      : radius_m_(p.anticipation_radius_m), clocked_(p.anticipation_interval_s > 0.0) {
+  explicit AnticipationTerm(const ModelParameters& p, const WorldDef& def) : clocked_(p.anticipation_interval_s > 0.0) {
+    Retune(p);
     bound_m_.reserve(def.shapes.size());
     for (const BodyShape& s : def.shapes) bound_m_.push_back(s.core_radius_m + s.radius_m);
   }
   unsigned phases() const override { return kForce; }
   double neighbour_radius_m() const override { return radius_m_; }
+  double near_radius_m() const override { return near_m_; }
+  void Retune(const ModelParameters& p) override {
+    radius_m_ = p.anticipation_radius_m;
+    near_m_ = clocked_ ? std::min(p.anticipation_near_m, radius_m_) : 0.0;
+    switch_m_ = std::min(kSwitch_m, near_m_);
+  }
 
   // A candidate j of person i (at xi, moving at vi, bounding radius ri): the
   // quadratic's terms, and whether the two would touch (within the radius,
   // not yet touching, closing in, not missing each other).
   struct Approach {
     Vec2 x, v;
-    double reach, bb, c, discriminant;
+    double xx, reach, bb, c, discriminant;
     bool collides;
   };
   Approach Approaching(const DriveInputs& in, Vec2 xi, Vec2 vi, double ri, std::uint32_t j) const {
     Approach p;
     p.x = Separation(in.def.periodic, xi, in.bodies.position_m[j]);  // x_i - x_j
-    const double xx = Dot(p.x, p.x);
+    p.xx = Dot(p.x, p.x);
     p.v = vi - in.bodies.velocity_m_per_s[j];
     p.reach = ri + bound_m_[in.bodies.shape[j]];
     const double a = Dot(p.v, p.v);
     p.bb = Dot(p.x, p.v);
-    p.c = xx - p.reach * p.reach;
+    p.c = p.xx - p.reach * p.reach;
     p.discriminant = p.bb * p.bb - a * p.c;
-    p.collides = !(xx > radius_m_ * radius_m_) & (p.c > 0.0) & (p.bb < 0.0) & (p.discriminant > 0.0);
+    p.collides = !(p.xx > radius_m_ * radius_m_) & (p.c > 0.0) & (p.bb < 0.0) & (p.discriminant > 0.0);
     return p;
   }
 
-  void Force(const DriveInputs& in, DriveBlock& b) const override {
+  // Which pairs of a sum count, and with what share.
+  enum class Pairs { kAll, kNear, kFar };
+
+  // The force per unit mass on i from its candidates items[begin, end) (the
+  // pairs of `which`), in their order. In chunks of the list: step one picks
+  // the candidates that would collide (most do not: they move apart, miss,
+  // or are out of reach), without a branch per candidate (which way a
+  // candidate goes is not predictable: the branches cost more than the
+  // arithmetic); step two computes the force of each, in the list's order.
+  // With kAll, the same arithmetic as one loop over the candidates, so the
+  // same sums.
+  template <Pairs which>
+  Vec2 Sum(const DriveInputs& in, const std::vector<std::uint32_t>& items, std::uint32_t begin, std::uint32_t end,
+           Vec2 xi, Vec2 vi, double ri) const {
     const ModelParameters& mp = in.def.parameters;
     const double k = mp.anticipation_strength_m2, inverse_horizon = 1.0 / mp.anticipation_horizon_s;
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
+    const double inner = near_m_ - switch_m_;  // S = 1 within it
+    Vec2 push{};
+    for (std::uint32_t m = begin; m < end;) {
+      const std::uint32_t chunk_end = std::min<std::uint32_t>(end, m + kChunk);
+      std::uint32_t hits[kChunk];
+      std::uint32_t count = 0;
+      for (; m < chunk_end; ++m) {
+        const std::uint32_t j = items[m];
+        const Approach p = Approaching(in, xi, vi, ri, j);
+        bool counts = p.collides & (in.bodies.state[j] != PersonState::kRemoved);
+        if constexpr (which == Pairs::kNear) counts = counts & (p.xx < near_m_ * near_m_);
+        if constexpr (which == Pairs::kFar) counts = counts & (p.xx > inner * inner);
+        hits[count] = j;
+        count += static_cast<std::uint32_t>(counts);
+      }
+      for (std::uint32_t h = 0; h < count; ++h) {
+        const Approach p = Approaching(in, xi, vi, ri, hits[h]);
+        const double root = std::sqrt(p.discriminant);
+        const double tau = p.c / (root - p.bb);
+        const double size = k * std::exp(-tau * inverse_horizon) / (tau * tau) * (2.0 / tau + inverse_horizon) / root;
+        const Vec2 at_contact = p.x + p.v * tau;  // |at_contact| = reach
+        double acceleration = std::min(size * p.reach, ceiling);
+        if constexpr (which != Pairs::kAll) {
+          const double near_share = std::clamp((near_m_ - std::sqrt(p.xx)) / switch_m_, 0.0, 1.0);
+          acceleration *= which == Pairs::kNear ? near_share : 1.0 - near_share;
+        }
+        push += at_contact * (acceleration / p.reach);
+      }
+    }
+    return push;
+  }
+
+  void Force(const DriveInputs& in, DriveBlock& b) const override {
     const NeighbourList& list = in.neighbours;
-    const double interval = mp.anticipation_interval_s;
     // (The interval the drive's time is in; a clocked run keeps a positive interval.)
-    const double tick = clocked_ ? std::floor(in.time_s / interval) : 0.0;
+    const double tick = clocked_ ? std::floor(in.time_s / in.def.parameters.anticipation_interval_s) : 0.0;
+    const bool split = near_m_ > 0.0;
     for (std::size_t n = 0; n < b.count; ++n) {
       const std::size_t i = b.first + n;
       if (!b.driven[n] || !WantsToWalk(in.bodies, i)) continue;
-      if (clocked_ && evaluated_in_[i] == tick) {
-        b.force[n] += kept_[i] * in.bodies.mass_kg[i];
-        continue;
-      }
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
-      Vec2 push{};
-      // In chunks of the list, in its order: step one picks the candidates
-      // that would collide (most do not: they move apart, miss, or are out of
-      // reach), without a branch per candidate (which way a candidate goes is
-      // not predictable: the branches cost more than the arithmetic); step
-      // two computes the force of each, in the list's order. The same
-      // arithmetic as one loop over the candidates (Approach), so the same sums.
-      for (std::uint32_t m = list.start[i], end = list.start[i + 1]; m < end;) {
-        const std::uint32_t chunk_end = std::min<std::uint32_t>(end, m + kChunk);
-        std::uint32_t hits[kChunk];
-        std::uint32_t count = 0;
-        for (; m < chunk_end; ++m) {
-          const std::uint32_t j = list.items[m];
-          const Approach p = Approaching(in, xi, vi, ri, j);
-          hits[count] = j;
-          count += static_cast<std::uint32_t>(p.collides & (in.bodies.state[j] != PersonState::kRemoved));
+      Vec2 push;
+      if (!clocked_) {
+        push = Sum<Pairs::kAll>(in, list.items, list.start[i], list.start[i + 1], xi, vi, ri);
+      } else {
+        if (evaluated_in_[i] != tick) {
+          kept_[i] = split ? Sum<Pairs::kFar>(in, list.items, list.start[i], list.start[i + 1], xi, vi, ri)
+                           : Sum<Pairs::kAll>(in, list.items, list.start[i], list.start[i + 1], xi, vi, ri);
+          evaluated_in_[i] = tick;
         }
-        for (std::uint32_t h = 0; h < count; ++h) {
-          const Approach p = Approaching(in, xi, vi, ri, hits[h]);
-          const double root = std::sqrt(p.discriminant);
-          const double tau = p.c / (root - p.bb);
-          const double size = k * std::exp(-tau * inverse_horizon) / (tau * tau) * (2.0 / tau + inverse_horizon) / root;
-          const Vec2 at_contact = p.x + p.v * tau;  // |at_contact| = reach
-          const double acceleration = std::min(size * p.reach, ceiling);
-          push += at_contact * (acceleration / p.reach);
-        }
-      }
-      if (clocked_) {
-        kept_[i] = push;
-        evaluated_in_[i] = tick;
+        push = kept_[i];
+        if (split) push += Sum<Pairs::kNear>(in, list.near_items, list.near_start[i], list.near_start[i + 1], xi, vi, ri);
       }
       b.force[n] += push * in.bodies.mass_kg[i];
     }
@@ -159,12 +201,14 @@ class AnticipationTerm final : public BehaviourTerm {
     kept_[person] = Vec2{};
     evaluated_in_[person] = kNever;
   }
+
   std::vector<double> bound_m_;  // per shape of the world
-  double radius_m_;
   bool clocked_;  // anticipation_interval_s > 0 when the run started (fixed for a run: it has state)
+  double radius_m_ = 0.0, near_m_ = 0.0, switch_m_ = 0.0;  // (the current parameters': Retune)
   // Per person, when clocked: the force per unit mass of the last evaluation
-  // and the interval it was evaluated in (floor(t / h); kNever: none kept).
-  // Written by the block of the person's (Force is const: the blocks share the term).
+  // (of the far pairs when split) and the interval it was evaluated in
+  // (floor(t / h); kNever: none kept). Written by the block of the person's
+  // (Force is const: the blocks share the term).
   mutable std::vector<Vec2> kept_;
   mutable std::vector<double> evaluated_in_;
 };

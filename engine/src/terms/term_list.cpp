@@ -61,7 +61,10 @@ ActiveTerms ActiveTerms::For(const ModelParameters& parameters, const WorldDef& 
   for (std::size_t t = 0; t < list.size(); ++t) {
     if (made[t] == nullptr) continue;
     // A term with state keeps it (the same object); a stateless one is the new one.
-    if (made[t]->state_version() != 0 && before[t] != nullptr) made[t] = std::move(before[t]->term);
+    if (made[t]->state_version() != 0 && before[t] != nullptr) {
+      made[t] = std::move(before[t]->term);
+      made[t]->Retune(parameters);
+    }
     a.terms.push_back({&list[t], std::move(made[t])});
   }
   for (Active& t : a.terms) {
@@ -79,6 +82,7 @@ ActiveTerms ActiveTerms::For(const ModelParameters& parameters, const WorldDef& 
     }
     a.people_ahead = a.people_ahead || term->needs_people_ahead();
     a.neighbour_radius_m = std::max(a.neighbour_radius_m, term->neighbour_radius_m());
+    a.near_radius_m = std::max(a.near_radius_m, term->near_radius_m());
   }
   return a;
 }

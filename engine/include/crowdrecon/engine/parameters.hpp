@@ -298,6 +298,10 @@ struct ModelParameters {
   // force from people metres away changes over tenths of a second, the
   // contacts' over milliseconds).
   double anticipation_interval_s = 0.0;
+  // With the clock: the force from people within this centre distance is
+  // evaluated at every step (a smooth switch over its last 0.5 m), only the
+  // rest on the clock; 0: every pair on the clock.
+  double anticipation_near_m = 0.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
