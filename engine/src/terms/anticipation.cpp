@@ -124,8 +124,11 @@ class AnticipationTerm final : public BehaviourTerm {
       std::uint32_t count = 0;
       for (; m < chunk_end; ++m) {
         const std::uint32_t j = items[m];
+        // (Empty slots are listed: an evening's engine holds hundreds,
+        // parked together in the list's order, so this branch is predictable.)
+        if (in.bodies.state[j] == PersonState::kRemoved) continue;
         const Approach p = Approaching(in, xi, vi, ri, j);
-        bool counts = p.collides & (in.bodies.state[j] != PersonState::kRemoved);
+        bool counts = p.collides;
         if constexpr (which == Pairs::kNear) counts = counts & (p.xx < near_m_ * near_m_);
         if constexpr (which == Pairs::kFar) counts = counts & (p.xx > inner * inner);
         hits[count] = j;
