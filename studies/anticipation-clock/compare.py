@@ -19,7 +19,7 @@ def per_run(folder, profile, test):
     for f in sorted(glob.glob(f"{folder}/runs/{profile}/{test}-*/measures/*.json")):
         d = json.load(open(f))
         for k, v in d["statistics"].items():
-            if len(v) == 1:  # (one value per run; lists of events are summarised elsewhere)
+            if len(v) == 1 and v[0] is not None:  # (one value per run; lists of events are summarised elsewhere)
                 runs.setdefault(k, []).append(float(v[0]))
             elif k == "lapse_s" and v:
                 runs.setdefault("lapse_s_mean", []).append(st.mean(v))
