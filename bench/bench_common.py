@@ -182,6 +182,18 @@ def checked_exe_and_repeat(args):
     return exe
 
 
+def cut_scenario_copy(path, duration_s, tag):
+    """The scenario with its duration set and no checkpoints, written next to
+    the original (its relative paths stay valid) as .bench-TAG-PID-NAME
+    (ignored by git); the caller removes it after the runs."""
+    data = json.loads(path.read_text())
+    data["run"]["duration_s"] = duration_s
+    data["run"]["checkpoint_interval_s"] = 0
+    copy = path.parent / f".bench-{tag}-{os.getpid()}-{path.name}"
+    copy.write_text(json.dumps(data))
+    return copy
+
+
 def fresh_run_file(folder):
     """FOLDER/run.sqlite with no run file (or its SQLite journals) left there
     by the previous run of a script."""

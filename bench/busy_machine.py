@@ -15,7 +15,6 @@ issue asks for: busy 2 threads / busy 1 thread (must stay <= 1.5), and idle
 to results/bench/ and a section of bench/RESULTS.md (bench_common)."""
 
 import argparse
-import json
 import os
 import pathlib
 import random
@@ -44,17 +43,6 @@ CONFIGS = [
     ("busy 2T governor", True, 2, [], {}),
     ("busy 2T fixed passive", True, 2, ["--fixed-threads"], PASSIVE),
 ]
-
-
-def scenario_copy(path, duration_s):
-    """The scenario with its duration set and no checkpoints, written next to
-    the original (its relative paths stay valid); removed after the runs."""
-    data = json.loads(path.read_text())
-    data["run"]["duration_s"] = duration_s
-    data["run"]["checkpoint_interval_s"] = 0
-    copy = path.parent / f".bench-busy-{os.getpid()}-{path.name}"
-    copy.write_text(json.dumps(data))
-    return copy
 
 
 def run_once(exe, scenario, threads, extra, env, busy, folder):
@@ -94,7 +82,7 @@ def main():
             scenarios = {}
             for s in names:
                 rel, duration = SCENARIOS[s]
-                scenarios[s] = scenario_copy(bc.ROOT / rel, duration)
+                scenarios[s] = bc.cut_scenario_copy(bc.ROOT / rel, duration, "busy")
                 copies.append(scenarios[s])
             for r in range(args.repeat):
                 order = [(s, c) for s in names for c in CONFIGS]
