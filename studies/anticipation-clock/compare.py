@@ -10,19 +10,26 @@ and its standard error (Welch), and whether it passes the study's test
 import glob
 import json
 import math
+import pathlib
 import statistics as st
 import sys
 
 
 def per_run(folder, profile, test):
+    """Per statistic (and per case of the test, when it has several: the
+    measure files are NNNN-CASE-seedK.json), the value of each run."""
     runs = {}
-    for f in sorted(glob.glob(f"{folder}/runs/{profile}/{test}-*/measures/*.json")):
+    files = sorted(glob.glob(f"{folder}/runs/{profile}/{test}-*/measures/*.json"))
+    cases = {pathlib.Path(f).stem.split("-", 1)[1].rsplit("-seed", 1)[0] for f in files}
+    for f in files:
         d = json.load(open(f))
+        case = pathlib.Path(f).stem.split("-", 1)[1].rsplit("-seed", 1)[0]
+        prefix = f"{case}: " if len(cases) > 1 else ""
         for k, v in d["statistics"].items():
             if len(v) == 1 and v[0] is not None:  # (one value per run; lists of events are summarised elsewhere)
-                runs.setdefault(k, []).append(float(v[0]))
+                runs.setdefault(prefix + k, []).append(float(v[0]))
             elif k == "lapse_s" and v:
-                runs.setdefault("lapse_s_mean", []).append(st.mean(v))
+                runs.setdefault(prefix + "lapse_s_mean", []).append(st.mean(v))
     return runs
 
 
@@ -30,7 +37,7 @@ def main():
     test, specs = sys.argv[1], sys.argv[2:]
     data = [(spec.split(":")[1], per_run(*spec.split(":"), test)) for spec in specs]
     base_name, base = data[0]
-    print(f"{test}: {len(next(iter(base.values())))} seeds; each against {base_name}")
+    print(f"{test}: each against {base_name}")
     print(f"| statistic | {' | '.join(n for n, _ in data)} | " +
           " | ".join(f"{n} - {base_name} (2 s.e.)" for n, _ in data[1:]) + " |")
     print("|" + " --- |" * (1 + 2 * len(data) - 1))
