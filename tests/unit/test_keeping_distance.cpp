@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -393,16 +394,18 @@ bool SameBodies(const Simulation& a, const Simulation& b) {
          std::memcmp(u.data(), w.data(), u.size() * sizeof(Vec2)) == 0;
 }
 
+// Steps each simulation `steps` times, in turn.
+void StepEach(int steps, std::initializer_list<Simulation*> simulations) {
+  for (int n = 0; n < steps; ++n)
+    for (Simulation* sim : simulations) sim->Step();
+}
+
 // An interval shorter than the step is an evaluation at every step: the run
 // made without the clock, bit for bit; a longer one is another run.
 TEST(AnticipationClock, AnIntervalShorterThanTheStepIsEveryStep) {
   Simulation every(CrossingCrowd(0.0)), clocked(CrossingCrowd(1e-6)), coarse(CrossingCrowd(0.05));
   ASSERT_LT(1e-6, every.time_step_s());
-  for (int n = 0; n < 600; ++n) {
-    every.Step();
-    clocked.Step();
-    coarse.Step();
-  }
+  StepEach(600, {&every, &clocked, &coarse});
   EXPECT_TRUE(SameBodies(every, clocked));
   EXPECT_FALSE(SameBodies(every, coarse));
 }
@@ -499,11 +502,7 @@ TEST(AnticipationClock, WithEveryPairNearTheSplitIsTheExactRun) {
     return def;
   };
   Simulation exact(group(0.0, 0.0)), all_near(group(0.05, 5.0)), split(group(0.05, 1.0));
-  for (int n = 0; n < 300; ++n) {  // (a quarter of a second: the group stays within 4 m)
-    exact.Step();
-    all_near.Step();
-    split.Step();
-  }
+  StepEach(300, {&exact, &all_near, &split});  // (a quarter of a second: the group stays within 4 m)
   EXPECT_TRUE(SameBodies(exact, all_near));
   EXPECT_FALSE(SameBodies(exact, split));
 }

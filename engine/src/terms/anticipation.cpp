@@ -105,9 +105,11 @@ class AnticipationTerm final : public BehaviourTerm {
   // The force per unit mass on i from its candidates items[begin, end) (the
   // pairs of `which`), in their order. In chunks of the list: step one picks
   // the candidates that would collide (most do not: they move apart, miss,
-  // or are out of reach), without a branch per candidate (which way a
+  // or are out of reach), without a branch on the geometry (which way a
   // candidate goes is not predictable: the branches cost more than the
-  // arithmetic); step two computes the force of each, in the list's order.
+  // arithmetic; only empty slots are skipped first); step two recomputes
+  // the pair's terms and its force for each pick, in the list's order
+  // (recomputing a few picks is cheaper than storing every candidate's).
   // With kAll, the same arithmetic as one loop over the candidates, so the
   // same sums.
   template <Pairs which>
