@@ -18,7 +18,7 @@ packages=(
   # vector drawing (SVG, PNG, PDF pictures and reports)
   libcairo2-dev
   # configuration, command line, floor plans, run files
-  nlohmann-json3-dev libcli11-dev libdxflib-dev libsqlite3-dev sqlite3
+  nlohmann-json3-dev libcli11-dev libdxflib-dev libsqlite3-dev sqlite3 libzstd-dev
   # sweeps spread over several machines (crowdrecon sweep under mpirun)
   libopenmpi-dev openmpi-bin
   # reports: report.pdf printed by headless Chromium; its pages checked as pictures (pdftoppm)

@@ -19,6 +19,7 @@
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "frame_pack.hpp"
 #include "jupedsim_tables.hpp"
 
 namespace crowdrecon::runfile {
@@ -61,12 +62,88 @@ double NumberFromText(const std::string& text, const std::string& file, const st
   return v;
 }
 
+// A packed run's frames (frame_pack.hpp) in order, from `first` (a key
+// frame) to `last`.
+class PackedFrames {
+ public:
+  PackedFrames(const Database& db, const std::string& file, std::size_t people, std::int64_t first, std::int64_t last)
+      : query_(db, "SELECT frame, data FROM frame_pack WHERE frame >= ?1 AND frame <= ?2 ORDER BY frame"),
+        file_(file),
+        people_(people) {
+    query_.Bind(1, first).Bind(2, last).Describe("frame_pack", {0});
+  }
+  bool Next(std::int64_t* frame, detail::PackedPeople* out) {
+    if (!query_.Next()) return false;
+    *frame = query_.Integer(0, 0, run_limits::kFrame);
+    if (query_.Type(1) != SQLITE_BLOB)
+      throw InputError(file_ + ": table frame_pack, row frame " + std::to_string(*frame) +
+                       ", column data: not a blob (the run file is damaged)");
+    const auto [data, size] = query_.Blob(1);
+    unpacker_.Unpack(*frame, data, size, people_, out, file_ + ": table frame_pack, row frame " + std::to_string(*frame));
+    return true;
+  }
+
+ private:
+  Statement query_;
+  std::string file_;
+  std::size_t people_;
+  detail::FrameUnpacker unpacker_;
+};
+
+// SQLite's REAL columns give -0.0 back as 0 (frame_pack.cpp's AsStored).
+double AsStored(double v) { return v == 0.0 ? 0.0 : v; }
+
 }  // namespace
 
 struct RunFileReader::Impl {
   std::unique_ptr<Database> db;
   std::string file;
   bool frames_checked = false;  // Frame's one check of trajectory_data's frame column
+  bool packed = false;          // table frame_pack holds the people
+  std::size_t people = 0;       // the largest id of table person (a packed frame's bound)
+  // Frame's last packed frame, so that frames asked for in order are each
+  // unpacked once (`render`).
+  std::unique_ptr<PackedFrames> cursor;
+  std::int64_t cursor_frame = -1, cursor_key = -1;
+  detail::PackedPeople cursor_people;
+
+  // The packed frames from the key frame at or before `first` to `last`.
+  std::int64_t KeyAtOrBefore(std::int64_t frame) const {
+    Statement k(*db, "SELECT MAX(frame) FROM frame_pack WHERE frame <= ?1 AND key = 1");
+    k.Bind(1, frame);
+    if (!k.Next() || k.Type(0) == SQLITE_NULL)
+      throw InputError(file + ": table frame_pack has no key frame at or before frame " + std::to_string(frame) +
+                       " (the run file is damaged)");
+    return k.Int(0);
+  }
+  std::unique_ptr<PackedFrames> Packed(std::int64_t first, std::int64_t last) const {
+    return std::make_unique<PackedFrames>(*db, file, people, first, last);
+  }
+  // The people of packed frame `frame`.
+  const detail::PackedPeople& PackedFrame(std::int64_t frame) {
+    if (cursor && cursor_frame == frame) return cursor_people;
+    try {
+      const std::int64_t key = KeyAtOrBefore(frame);
+      if (!(cursor && cursor_frame < frame && key == cursor_key)) {
+        cursor_key = key;
+        cursor = Packed(key, run_limits::kFrame);
+        cursor_frame = -1;
+      }
+      std::int64_t got = -1;
+      while (cursor_frame < frame) {
+        if (!cursor->Next(&got, &cursor_people)) break;
+        cursor_frame = got;
+      }
+      if (cursor_frame != frame)
+        throw InputError(file + ": table frame_pack has no row of frame " + std::to_string(frame) +
+                         " though table frame_time has (the run file is damaged)");
+    } catch (...) {
+      cursor.reset();
+      cursor_frame = -1;
+      throw;
+    }
+    return cursor_people;
+  }
 };
 
 RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
@@ -86,7 +163,15 @@ RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::mak
     throw InputError(impl_->file + ": not a crowdrecon run file (" + why + ")");
   }
   if (!ok) throw InputError(impl_->file + ": not a crowdrecon run file (missing tables trajectory_data, run or person)");
+  impl_->packed = sqlite::HasTable(*impl_->db, "frame_pack");
+  if (impl_->packed) {
+    Statement people(*impl_->db, "SELECT MAX(id) FROM person");
+    if (people.Next() && people.Type(0) == SQLITE_INTEGER)
+      impl_->people = static_cast<std::size_t>(std::clamp<std::int64_t>(people.Int(0), 0, run_limits::kPersonId));
+  }
 }
+
+bool RunFileReader::packed() const { return impl_->packed; }
 RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
 
 bool IsRunFile(const std::filesystem::path& file) {
@@ -230,10 +315,18 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
     f.time_s = t.Real(1, 0.0, run_limits::kTime_s);
   }
   using namespace run_limits;
+  if (impl_->packed) {
+    const detail::PackedPeople& p = impl_->PackedFrame(frame);
+    for (std::size_t k = 0; k < p.person.size(); ++k) {
+      f.ids.push_back(std::int64_t{p.person[k]} + 1);
+      f.position_m.push_back(p.position_m[k]);
+      f.orientation.push_back({AsStored(std::cos(p.angle_rad[k])), AsStored(std::sin(p.angle_rad[k]))});
+    }
+  }
   Statement s(*impl_->db,
               "SELECT frame, id, pos_x, pos_y, ori_x, ori_y FROM trajectory_data WHERE frame = ? ORDER BY id");
   s.Bind(1, frame).Describe("trajectory_data", {0, 1});
-  while (s.Next()) {
+  while (!impl_->packed && s.Next()) {
     f.ids.push_back(s.Integer(1, 1, kPersonId));
     f.position_m.push_back({s.Real(2, -kCoordinate_m, kCoordinate_m), s.Real(3, -kCoordinate_m, kCoordinate_m)});
     f.orientation.push_back({s.Real(4, -kUnit, kUnit), s.Real(5, -kUnit, kUnit)});
@@ -328,6 +421,44 @@ std::string RunFileReader::TablesDigest() const {
   if (sqlite::HasTable(*impl_->db, "contact_summary")) tables.emplace_back("contact_summary", "frame");
   for (const auto& [table, order] : tables) {
     hash.Update(table, std::strlen(table) + 1);
+    const std::string name = table;
+    if (impl_->packed && (name == "trajectory_data" || name == "person_state" || name == "person_load")) {
+      // The rows the tables would hold, value for value (frame_pack.hpp).
+      const auto real = [](std::string& row, double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "r%.17g;", v);
+        row += text;
+      };
+      const std::unique_ptr<PackedFrames> frames = impl_->Packed(0, run_limits::kFrame);
+      std::int64_t frame = 0;
+      detail::PackedPeople p;
+      std::string row;
+      while (frames->Next(&frame, &p))
+        for (std::size_t k = 0; k < p.person.size(); ++k) {
+          const std::string head = "i" + std::to_string(frame) + ";i" + std::to_string(std::int64_t{p.person[k]} + 1) + ";";
+          row = head;
+          if (name == "trajectory_data") {
+            real(row, p.position_m[k].x);
+            real(row, p.position_m[k].y);
+            real(row, AsStored(std::cos(p.angle_rad[k])));
+            real(row, AsStored(std::sin(p.angle_rad[k])));
+          } else if (name == "person_state") {
+            real(row, p.velocity_m_per_s[k].x);
+            real(row, p.velocity_m_per_s[k].y);
+            real(row, p.angle_rad[k]);
+            real(row, p.angular_velocity_rad_per_s[k]);
+            row += "i" + std::to_string(static_cast<int>(p.state[k])) + ";";
+            real(row, p.load_n[k]);
+          } else {
+            if (!p.has_loads || (p.chest_n[k] == 0.0 && p.lateral_n[k] == 0.0)) continue;
+            real(row, p.chest_n[k]);
+            real(row, p.lateral_n[k]);
+          }
+          row += '\n';
+          hash.Update(row.data(), row.size());
+        }
+      continue;
+    }
     Statement s(*impl_->db, std::string("SELECT * FROM ") + table + " ORDER BY " + order);
     while (s.Next()) {
       std::string row;
@@ -373,6 +504,8 @@ std::vector<FrameTime> RunFileReader::FrameTimes() const {
 
 struct PersonFrameStream::Impl {
   std::unique_ptr<Statement> query;
+  std::unique_ptr<PackedFrames> packed;  // a packed run's frames instead of `query`
+  detail::PackedPeople people;
   bool have_row = false;
   // For the check at the end that the join with person_state left no row
   // of trajectory_data out (a damaged file: an id or frame person_state lacks).
@@ -409,6 +542,18 @@ PersonFrameStream::~PersonFrameStream() = default;
 
 bool PersonFrameStream::Next(PersonFrame* out) {
   using namespace run_limits;
+  if (impl_->packed) {
+    detail::PackedPeople& p = impl_->people;
+    if (!impl_->packed->Next(&out->frame, &p)) return false;
+    out->person = p.person;
+    out->position_m = p.position_m;
+    out->velocity_m_per_s = p.velocity_m_per_s;
+    out->angle_rad = p.angle_rad;
+    out->angular_velocity_rad_per_s = p.angular_velocity_rad_per_s;
+    out->state = p.state;
+    out->load_n = p.load_n;
+    return true;
+  }
   if (!impl_->have_row) return false;
   Statement& q = *impl_->query;
   out->frame = q.Integer(0, 0, kFrame);
@@ -437,6 +582,10 @@ bool PersonFrameStream::Next(PersonFrame* out) {
 
 PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
   PersonFrameStream stream;
+  if (impl_->packed) {
+    stream.impl_->packed = impl_->Packed(0, last_frame);
+    return stream;
+  }
   // Column aliases name person_state's columns, so that a damaged value is
   // reported in the table it was read from.
   stream.impl_->query = std::make_unique<Statement>(
@@ -479,6 +628,8 @@ bool ContactFrameStream::Next(std::int64_t* frame, std::vector<Contact>* out) {
 
 struct PersonLoadStream::Impl {
   std::unique_ptr<Statement> query;
+  std::unique_ptr<PackedFrames> packed;  // a packed run's frames instead of `query`
+  detail::PackedPeople people;
   bool have_row = false;
 };
 
@@ -488,6 +639,18 @@ PersonLoadStream::~PersonLoadStream() = default;
 
 bool PersonLoadStream::Next(std::int64_t* frame, std::vector<PersonLoad>* out) {
   using namespace run_limits;
+  if (impl_->packed) {
+    // The rows table person_load would hold: people with a load, frames with one.
+    detail::PackedPeople& p = impl_->people;
+    out->clear();
+    while (out->empty()) {
+      if (!impl_->packed->Next(frame, &p)) return false;
+      if (!p.has_loads) continue;
+      for (std::size_t k = 0; k < p.person.size(); ++k)
+        if (p.chest_n[k] != 0.0 || p.lateral_n[k] != 0.0) out->push_back({p.person[k], p.chest_n[k], p.lateral_n[k]});
+    }
+    return true;
+  }
   if (!impl_->have_row) return false;
   Statement& q = *impl_->query;
   *frame = q.Int(0);
@@ -504,6 +667,10 @@ bool RunFileReader::HasPersonLoads() const { return sqlite::HasTable(*impl_->db,
 
 PersonLoadStream RunFileReader::PersonLoads(std::int64_t last_frame) const {
   PersonLoadStream stream;
+  if (impl_->packed) {
+    stream.impl_->packed = impl_->Packed(0, last_frame);
+    return stream;
+  }
   stream.impl_->query = std::make_unique<Statement>(
       *impl_->db, "SELECT frame, id, chest_n, lateral_n FROM person_load WHERE frame <= ?1 ORDER BY frame, id");
   stream.impl_->query->Bind(1, last_frame).Describe("person_load", {0, 1});
@@ -541,16 +708,37 @@ std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverla
 }
 
 std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
-  std::vector<Vec2> sums;
-  Statement q(*impl_->db,
-              "SELECT p.grp, SUM(s.vel_x), SUM(s.vel_y) FROM person_state s JOIN person p ON p.id = s.id "
-              "GROUP BY p.grp ORDER BY p.grp");
-  while (q.Next()) {
-    const std::int64_t g = q.Int(0);
-    if (g < 0 || g > run_limits::kGroup) continue;  // PersonGroups() reports such a row
-    if (static_cast<std::size_t>(g) >= sums.size()) sums.resize(static_cast<std::size_t>(g) + 1);
-    sums[static_cast<std::size_t>(g)] = {q.Double(1), q.Double(2)};
+  // Added in the order of frames and ids, from either storage, so that both
+  // give the same sums to the last bit (SQLite's SUM adds in an order its
+  // query plan chooses).
+  std::vector<std::int64_t> group;
+  {
+    Statement q(*impl_->db, "SELECT id, grp FROM person");
+    while (q.Next()) {
+      const std::int64_t id = q.Int(0);
+      if (id < 1 || id > run_limits::kPersonId) continue;  // People() reports such a row
+      if (static_cast<std::size_t>(id) > group.size()) group.resize(static_cast<std::size_t>(id), -1);
+      group[static_cast<std::size_t>(id - 1)] = q.Int(1);
+    }
   }
+  std::vector<Vec2> sums;
+  const auto add = [&](std::int64_t id, Vec2 v) {
+    if (id < 1 || static_cast<std::size_t>(id) > group.size()) return;
+    const std::int64_t g = group[static_cast<std::size_t>(id - 1)];
+    if (g < 0 || g > run_limits::kGroup) return;  // PersonGroups() reports such a row
+    if (static_cast<std::size_t>(g) >= sums.size()) sums.resize(static_cast<std::size_t>(g) + 1);
+    sums[static_cast<std::size_t>(g)] += v;
+  };
+  if (impl_->packed) {
+    const std::unique_ptr<PackedFrames> frames = impl_->Packed(0, run_limits::kFrame);
+    std::int64_t frame = 0;
+    detail::PackedPeople p;
+    while (frames->Next(&frame, &p))
+      for (std::size_t k = 0; k < p.person.size(); ++k) add(std::int64_t{p.person[k]} + 1, p.velocity_m_per_s[k]);
+    return sums;
+  }
+  Statement q(*impl_->db, "SELECT id, vel_x, vel_y FROM person_state ORDER BY frame, id");
+  while (q.Next()) add(q.Int(0), {q.Double(1), q.Double(2)});
   return sums;
 }
 

@@ -24,6 +24,7 @@
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/common/fnv.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "frame_pack.hpp"
 #include "jupedsim_tables.hpp"
 
 namespace crowdrecon::runfile {
@@ -82,6 +83,13 @@ CREATE TABLE contact_summary(frame INTEGER PRIMARY KEY, contacts INTEGER NOT NUL
   max_overlap_m REAL NOT NULL, max_overlap_wall INTEGER NOT NULL, max_force_n REAL NOT NULL);
 )SQL";
 
+// The people of a packed run (frame_pack.hpp), instead of rows of
+// trajectory_data, person_state and person_load (which stay, empty).
+constexpr const char* kPackSchema = R"SQL(
+CREATE TABLE frame_pack(frame INTEGER PRIMARY KEY, key INTEGER NOT NULL, xmin REAL, xmax REAL, ymin REAL, ymax REAL,
+  data BLOB NOT NULL);
+)SQL";
+
 // What was derived from the run's frames (an analysis stored with analyze
 // --write: tables metric_*, and the run values it lists under
 // "derived_keys") no longer describes a run whose frames change (issue 65: a
@@ -115,6 +123,10 @@ struct RunFileWriter::Impl {
   std::unique_ptr<sqlite::BatchInsert> trajectory, person_state, contact, person_load;
   bool has_person_load = true;  // false for a resumed run file written before the table existed
   bool has_contact_summary = true;  // likewise (issue 66)
+  // A packed run (RunHeader::packed): its packer, and the frames this writer
+  // has written (its first one, and every kKeyInterval-th, is a key frame).
+  std::unique_ptr<detail::FramePacker> packer;
+  std::int64_t packed_frames = 0;
   std::int64_t geometry_hash = 0;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
   double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
@@ -184,6 +196,10 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
     db.Exec("BEGIN");
     db.Exec(detail::kJuPedSimSchema);
     db.Exec(kSchema);
+    if (header.packed) {
+      db.Exec(kPackSchema);
+      w.impl_->packer = std::make_unique<detail::FramePacker>();
+    }
     w.impl_->geometry_hash = GeometryHash(header.walkable_wkt);
     {
       Statement meta(db, "INSERT INTO metadata VALUES(?, ?)");
@@ -201,6 +217,7 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
       put("time_step_s", NumberText(header.time_step_s));
       put("output_fps", NumberText(header.output_fps));
       put("status", "running");
+      if (header.packed) put("frames", "packed");
       if (!header.venue_json.empty()) put("venue", header.venue_json);
       const PeriodicBox& box = header.periodic_box;
       if (box.any()) {
@@ -261,11 +278,17 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);
   w.impl_->has_contact_summary = sqlite::HasTable(db, "contact_summary");
   if (w.impl_->has_contact_summary) db.Exec("DELETE FROM contact_summary WHERE frame > " + after);
+  const bool packed = sqlite::HasTable(db, "frame_pack");
+  if (packed) {
+    db.Exec("DELETE FROM frame_pack WHERE frame > " + after);
+    w.impl_->packer = std::make_unique<detail::FramePacker>();  // its first frame a key frame
+  }
   {
     Statement geo(db, "SELECT hash FROM geometry LIMIT 1");
     if (!geo.Next()) throw InputError(file.string() + ": not a crowdrecon run file (no geometry)");
     w.impl_->geometry_hash = geo.Int(0);
-    Statement bounds(db, "SELECT MIN(pos_x), MAX(pos_x), MIN(pos_y), MAX(pos_y), COUNT(*) FROM trajectory_data");
+    Statement bounds(db, packed ? "SELECT MIN(xmin), MAX(xmax), MIN(ymin), MAX(ymax), COUNT(xmin) FROM frame_pack"
+                                : "SELECT MIN(pos_x), MAX(pos_x), MIN(pos_y), MAX(pos_y), COUNT(*) FROM trajectory_data");
     if (bounds.Next() && bounds.Int(4) > 0) {
       w.impl_->xmin = bounds.Double(0);
       w.impl_->xmax = bounds.Double(1);
@@ -293,7 +316,31 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
     sqlite::BatchInsert& state = *impl_->person_state;
     for (sqlite::BatchInsert* batch : {&traj, &state, impl_->contact.get()}) batch->Discard();
     if (impl_->person_load) impl_->person_load->Discard();
-    for (std::size_t k = 0; k < f.person.size(); ++k) {
+    if (impl_->packer) {
+      const bool key = impl_->packed_frames % detail::kKeyInterval == 0;
+      const std::string data = impl_->packer->Pack(f, key);
+      ++impl_->packed_frames;
+      Statement pack(db, "INSERT INTO frame_pack VALUES(?, ?, ?, ?, ?, ?, ?)");
+      pack.Bind(1, frame).Bind(2, std::int64_t{key});
+      if (f.person.empty()) {
+        for (int c = 3; c <= 6; ++c) pack.BindNull(c);
+      } else {
+        double x0 = f.position_m[0].x, x1 = x0, y0 = f.position_m[0].y, y1 = y0;
+        for (const Vec2& x : f.position_m) {
+          x0 = std::min(x0, x.x);
+          x1 = std::max(x1, x.x);
+          y0 = std::min(y0, x.y);
+          y1 = std::max(y1, x.y);
+        }
+        pack.Bind(3, x0).Bind(4, x1).Bind(5, y0).Bind(6, y1);
+        impl_->xmin = std::min(impl_->xmin, x0);
+        impl_->xmax = std::max(impl_->xmax, x1);
+        impl_->ymin = std::min(impl_->ymin, y0);
+        impl_->ymax = std::max(impl_->ymax, y1);
+      }
+      pack.BindBlob(7, data).Run();
+    }
+    for (std::size_t k = 0; !impl_->packer && k < f.person.size(); ++k) {
       const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
       const Vec2 x = f.position_m[k];
       const double angle = f.angle_rad[k];
@@ -309,7 +356,8 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
     }
     traj.Finish();
     state.Finish();
-    if (impl_->person_load && f.chest_load_n.size() == f.person.size() && f.lateral_load_n.size() == f.person.size()) {
+    if (!impl_->packer && impl_->person_load && f.chest_load_n.size() == f.person.size() &&
+        f.lateral_load_n.size() == f.person.size()) {
       sqlite::BatchInsert& loads = *impl_->person_load;
       for (std::size_t k = 0; k < f.person.size(); ++k)
         if (f.chest_load_n[k] != 0.0 || f.lateral_load_n[k] != 0.0)

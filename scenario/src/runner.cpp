@@ -290,6 +290,7 @@ OpenedRun OpenRunFile(const Scenario& scenario, const RunOptions& options, const
   header.output_fps = scenario.run.output_fps;
   header.time_step_s = sim.tick_s();
   header.seed = scenario.population.seed;
+  header.packed = scenario.run.packed_frames;
   if (!scenario.timeline.enabled) return {CreateRunFile(options.output, header, sim, built.target_names), -1, {}};
   // A timeline's people: those of the start, then every arrival the schedule
   // may bring, each at its id (BuiltTimeline), whether or not they come.

@@ -246,6 +246,7 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     s.run.output_fps = run->Number("output_fps", s.run.output_fps, 0.01, 1000.0);
     s.run.checkpoint_interval_s = run->Number("checkpoint_interval_s", s.run.checkpoint_interval_s, 0.0, 1e6);
     s.run.write_contacts = run->Bool("contacts", s.run.write_contacts);
+    s.run.packed_frames = run->Choice("frames", s.run.packed_frames ? "packed" : "tables", {"tables", "packed"}) == "packed";
     if (auto settle = run->Find("stop_when_settled")) s.run.settle = ReadSettleOptions(*settle);
     run->Finish();
   }

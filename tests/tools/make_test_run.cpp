@@ -6,6 +6,7 @@
 //                    bodies from BODY.json (crowdrecon-body, e.g.
 //                    venues/bodies/thorax-18.json) or the 8-vertex test thorax
 // DIR/empty.sqlite   the same run's header with no frame (a run that died at once)
+// DIR/packed.sqlite  run.sqlite with its frames packed (run.frames = "packed")
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -52,7 +53,11 @@ int main(int argc, char** argv) {
       Simulation sim(testing::CounterFlowCorridor(shape, scene));
       testing::WriteCorridorRun(dir / "empty.sqlite", sim, scene, 0, 10.0, false);
     }
-    std::printf("wrote %s/run.sqlite and %s/empty.sqlite\n", dir.c_str(), dir.c_str());
+    {
+      Simulation sim(testing::CounterFlowCorridor(shape, scene));
+      testing::WriteCorridorRun(dir / "packed.sqlite", sim, scene, 21, 10.0, true, /*packed=*/true);
+    }
+    std::printf("wrote %s/run.sqlite, %s/empty.sqlite and %s/packed.sqlite\n", dir.c_str(), dir.c_str(), dir.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "crowdrecon_make_test_run: %s\n", e.what());
     return 1;

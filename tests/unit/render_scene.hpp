@@ -56,8 +56,9 @@ inline std::string RectangleWkt(double length_m, double width_m) {
 // Without `record_periodic_box` the run table's periodic_box is blanked, as in
 // a run file that does not record it.
 inline void WriteCorridorRun(const std::filesystem::path& file, Simulation& sim, const CorridorScene& c,
-                             int frames, double fps, bool record_periodic_box) {
+                             int frames, double fps, bool record_periodic_box, bool packed = false) {
   runfile::RunHeader header;
+  header.packed = packed;
   header.scenario_json = "{\"test\": \"counter-flow corridor\"}";
   header.scenario_origin = "tests/unit/render_scene.hpp";
   header.walkable_wkt = RectangleWkt(c.length_m, c.width_m);

@@ -21,6 +21,12 @@
 //           normal and along Perp(normal) = (-normal_y, normal_x)
 //   event(frame, time_s, kind TEXT, person INTEGER, other INTEGER, detail TEXT)
 //   wall(id INTEGER PRIMARY KEY, closed INTEGER, radius_m REAL, points TEXT)
+//   frame_pack(frame INTEGER PRIMARY KEY, key, xmin, xmax, ymin, ymax, data BLOB)
+//           a packed run's people (run value frames = "packed"; src/frame_pack.hpp):
+//           every frame's rows of trajectory_data, person_state and person_load,
+//           without loss, in a tenth of their bytes; those tables are then
+//           empty, and this reader gives the same frames, loads and digest
+//           from either storage (PedPy reads `crowdrecon export`'s file)
 //   census(frame INTEGER PRIMARY KEY, time_s, walking, fallen, removed, queued, entered)
 //           a timeline's head count per frame (runs with a timeline only):
 //           people walking and fallen in the venue, removed through an exit,
@@ -74,6 +80,10 @@ struct RunHeader {
   double output_fps = 10.0;
   double time_step_s = 0.0;
   std::uint64_t seed = 0;
+  // The people's frames packed without loss (table frame_pack, run value
+  // frames = "packed"; run_file_reader reads them as the tables) instead of
+  // rows of trajectory_data, person_state and person_load (issue 66).
+  bool packed = false;
 };
 
 // A body shape in its own frame: a convex polygon swept by a disc of radius_m.
@@ -426,6 +436,8 @@ class RunFileReader {
   std::vector<std::uint32_t> PersonShapes() const;
   std::vector<std::uint32_t> PersonGroups() const;
   std::vector<Wall> Walls() const;
+  // Whether the people's frames are packed (table frame_pack).
+  bool packed() const;
 
  private:
   struct Impl;

@@ -90,6 +90,10 @@ class Statement {
     Check(sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
     return *this;
   }
+  Statement& BindBlob(int i, const std::string& bytes) {
+    Check(sqlite3_bind_blob(stmt_, i, bytes.data(), static_cast<int>(bytes.size()), SQLITE_TRANSIENT));
+    return *this;
+  }
   Statement& BindNull(int i) {
     Check(sqlite3_bind_null(stmt_, i));
     return *this;
@@ -140,6 +144,12 @@ class Statement {
   std::string Text(int col) const {
     const auto* t = sqlite3_column_text(stmt_, col);
     return t ? reinterpret_cast<const char*>(t) : "";
+  }
+  // The bytes of a blob column (empty for NULL); valid until the next step.
+  std::pair<const unsigned char*, std::size_t> Blob(int col) const {
+    const auto* b = static_cast<const unsigned char*>(sqlite3_column_blob(stmt_, col));
+    const int n = sqlite3_column_bytes(stmt_, col);
+    return {b, b ? static_cast<std::size_t>(n) : 0};
   }
 
  private:

@@ -65,6 +65,11 @@ struct RunSpec {
   double output_fps = 10.0;
   double checkpoint_interval_s = 10.0;  // 0 = none
   bool write_contacts = true;
+  // run.frames: "tables" (rows of trajectory_data, person_state and
+  // person_load: PedPy reads the run file itself) or "packed" (table
+  // frame_pack, without loss, about a tenth of the bytes: crowdrecon reads
+  // it as the tables, PedPy reads `crowdrecon export`'s file; issue 66).
+  bool packed_frames = false;
   // Stop once the regime has settled (run.stop_when_settled: an object,
   // possibly empty, of SettleOptions; absent = run the whole duration).
   SettleOptions settle;

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# Issue 66: a run whose frames are packed (run.frames = "packed") is the run
+# with tables, number for number. The same scenario written both ways: the
+# tables' digest is equal (every row of trajectory_data, person_state,
+# person_load, contact, events, census, briefs, value for value); the packed
+# file's own tables are empty and table frame_pack holds every frame; what
+# analyze, timeline, report and export write from either file is the same
+# (their file names aside); the packed run stopped and resumed from its
+# checkpoint, and the packed run on one thread, are the run made in one go
+# on two; and the packed file is the smaller.
+#   packed_frames.sh CROWDRECON SCENARIO_TABLES SCENARIO_PACKED
+set -euo pipefail
+cr=$1 tables=$2 packed=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+mkdir "$tmp/t" "$tmp/p"
+"$cr" simulate "$tables" -o "$tmp/t/run.sqlite" -q
+"$cr" simulate "$packed" -o "$tmp/p/run.sqlite" -q
+digest_t=$("$cr" analyze "$tmp/t/run.sqlite" --digest)
+digest_p=$("$cr" analyze "$tmp/p/run.sqlite" --digest)
+[[ $digest_t == "$digest_p" ]] || fail "digests differ: $digest_t / $digest_p"
+echo "digest equal: $digest_p"
+[[ $(sqlite3 "$tmp/p/run.sqlite" "SELECT value FROM run WHERE key = 'frames'") == packed ]] || fail "run value frames"
+rows=$(sqlite3 "$tmp/p/run.sqlite" "SELECT (SELECT COUNT(*) FROM trajectory_data) + (SELECT COUNT(*) FROM person_state) + (SELECT COUNT(*) FROM person_load)")
+[[ $rows == 0 ]] || fail "the packed file has $rows rows in its tables"
+[[ $(sqlite3 "$tmp/p/run.sqlite" "SELECT COUNT(*) FROM frame_pack") == $(sqlite3 "$tmp/t/run.sqlite" "SELECT COUNT(*) FROM frame_time") ]] ||
+  fail "frame_pack lacks frames"
+[[ $(sqlite3 "$tmp/t/run.sqlite" "SELECT COUNT(*) FROM person_load") -gt 0 ]] || fail "the scenario has no chest loads to compare"
+
+# Outputs with their folders made alike.
+# The report's provenance differs where it should: the run file's bytes and
+# the scenario (its text and hash: run.frames); its venue's hash is kept.
+# The report's summary ends with the seconds it took.
+alike() {
+  sed -E -e "s#$tmp/[tp]/#DIR/#g" -e '/&quot;/d' -e '/^  [0-9.]+ s$/d' \
+    -e '/^<tr><td>runs<\/td>/s#<code>[0-9a-f]{64}</code></td><td><code>[0-9a-f]{64}</code>#FILE</td><td>SCENARIO#' "$1"
+}
+same() {  # same WHAT FILE (in t/ and in p/)
+  if ! cmp -s <(alike "$tmp/t/$2") <(alike "$tmp/p/$2"); then
+    diff <(alike "$tmp/t/$2") <(alike "$tmp/p/$2") | head -20 >&2
+    fail "$1 differs"
+  fi
+  echo "$1: the same"
+}
+for r in t p; do
+  # In each folder with the same names: figures print the run file's name.
+  (cd "$tmp/$r"
+   "$cr" analyze run.sqlite --full --json analysis.json > analysis.txt
+   "$cr" timeline run.sqlite -o timeline.svg --density-maps density.svg > timeline.txt
+   "$cr" report run.sqlite -o report --no-pdf -q > report.txt
+   "$cr" export run.sqlite -o export.sqlite > /dev/null
+   "$cr" render run.sqlite -o frames --frames 0:4 > /dev/null
+   sqlite3 export.sqlite ".mode quote" "SELECT * FROM trajectory_data ORDER BY frame, id" > export.txt)
+done
+same "analyze (text)" analysis.txt
+same "analyze (JSON)" analysis.json
+same "timeline (text)" timeline.txt
+same "timeline figure" timeline.svg
+same "density maps" density.svg
+same "report (text)" report.txt
+same "report (HTML)" report/report.html
+same "report (people.csv)" report/people.csv
+same "export" export.txt
+drawn=0
+for f in "$tmp"/t/frames/*; do same "render $(basename "$f")" "frames/$(basename "$f")" > /dev/null; drawn=$((drawn + 1)); done
+(( drawn == 41 )) || fail "render drew $drawn frames, expected 41"
+echo "render: $drawn frames the same"
+
+# Stopped, then resumed from its checkpoint: the run made in one go.
+"$cr" simulate "$packed" -o "$tmp/r.sqlite" -q --stop-after 2.25 > /dev/null 2>&1 || true
+"$cr" simulate "$packed" -o "$tmp/r.sqlite" -q --resume
+[[ $("$cr" analyze "$tmp/r.sqlite" --digest) == "$digest_p" ]] || fail "the resumed packed run differs"
+echo "resumed: the same digest"
+"$cr" simulate "$packed" -o "$tmp/one.sqlite" -q --threads 1 > /dev/null 2>&1
+[[ $("$cr" analyze "$tmp/one.sqlite" --digest) == "$digest_p" ]] || fail "the packed run on one thread differs"
+echo "one thread: the same digest"
+
+size_t=$(stat -c %s "$tmp/t/run.sqlite") size_p=$(stat -c %s "$tmp/p/run.sqlite")
+echo "bytes: tables $size_t, packed $size_p"
+(( size_p < size_t )) || fail "the packed file is not smaller"
+echo "packed frames: the same run"
