@@ -300,6 +300,10 @@ ReportSummary WriteReport(const ReportOptions& options) {
   std::size_t figures = 0;
   h += "<h2>2. The force network at the worst moment</h2>\n";
   const auto network = [&](const RunRisk& r, const std::string& label, const std::string& prefix) {
+    if (!r.has_contacts && !r.contacts_note.empty())
+      return "<p class=\"note\">" + Escape(label) + ": " + Escape(r.file.filename().string()) + " " +
+             Escape(r.contacts_note) + ", so its force network at that moment cannot be drawn; a report with the "
+             "defaults of F0 and smoothing draws it.</p>\n";
     if (!r.has_contacts)
       return "<p class=\"note\">" + Escape(label) + ": " + Escape(r.file.filename().string()) +
              " records no contacts, so its force network cannot be drawn (its chest loads come from table "
@@ -392,7 +396,8 @@ ReportSummary WriteReport(const ReportOptions& options) {
     add(other_runs, options.compare_label, kOtherColor);
     h += "<figure>" + c.ToSvg() + "<figcaption>Every contact of every frame (" + std::to_string(first.contact_rows) +
          " contact records in the first run), binned in " + std::to_string(ForceHistogram::kPerDecade) +
-         " bins per decade.</figcaption></figure>\n";
+         " bins per decade" + (first.contact_forces_from.empty() ? "" : " (" + Escape(first.contact_forces_from) + ")") +
+         ".</figcaption></figure>\n";
     ++figures;
     }
     std::vector<std::pair<std::string, std::vector<double>>> loads;

@@ -61,58 +61,7 @@ Zone RiskOptions::ZoneOf(double load_n) const {
   return Zone::kSafe;
 }
 
-void ForceHistogram::Add(double force_over_f0) {
-  ++total;
-  if (!(force_over_f0 > 0.0)) {
-    ++zero;
-    return;
-  }
-  const int bin = static_cast<int>(std::floor((std::log10(force_over_f0) - kLow) * kPerDecade));
-  ++counts[static_cast<std::size_t>(std::clamp(bin, 0, kBins - 1))];
-}
-
-double ForceHistogram::UpperEdge(int bin) { return std::pow(10.0, kLow + double(bin + 1) / kPerDecade); }
-
-double ForceHistogram::FractionAbove(double force_over_f0) const {
-  if (total == 0) return 0.0;
-  std::uint64_t above = 0;
-  for (int b = 0; b < kBins; ++b)
-    if (UpperEdge(b) > force_over_f0 * (1.0 + 1e-12)) above += counts[static_cast<std::size_t>(b)];
-  return double(above) / double(total);
-}
-
 namespace {
-
-// A moving mean over the last `window` samples of one person.
-class Smoother {
- public:
-  explicit Smoother(std::size_t window) : window_(std::max<std::size_t>(window, 1)) {}
-  double Add(double v) {
-    samples_.push_back(v);
-    sum_ += v;
-    if (samples_.size() > window_) {
-      sum_ -= samples_.front();
-      samples_.pop_front();
-    }
-    // Re-add from scratch now and then: no drift from round-off.
-    if (++since_exact_ >= 4096) {
-      sum_ = 0.0;
-      for (double s : samples_) sum_ += s;
-      since_exact_ = 0;
-    }
-    return std::max(0.0, sum_ / double(samples_.size()));
-  }
-  void Reset() {
-    samples_.clear();
-    sum_ = 0.0;
-  }
-
- private:
-  std::size_t window_;
-  std::deque<double> samples_;
-  double sum_ = 0.0;
-  std::size_t since_exact_ = 0;
-};
 
 std::string JsonName(const std::string& json_text) {
   try {
@@ -123,6 +72,43 @@ std::string JsonName(const std::string& json_text) {
   } catch (const std::exception&) {
   }
   return "";
+}
+
+// A run that keeps some frames' contacts (contact_keeper.hpp): whether it
+// kept the worst moment's, and its force distribution from every frame's
+// histogram (binned by |F| / 400 N: the same bins as the rows give where F0
+// is 400 N or a whole number of bins from it; else the nearest bins).
+void KeptContacts(const runfile::RunFileReader& reader, std::int64_t last_frame, const RiskOptions& options,
+                  RunRisk* risk) {
+  bool kept = false;
+  std::string kept_text;
+  for (const auto& [frame, why] : reader.ContactKeptFrames()) {
+    if (frame == risk->worst_frame) kept = true;
+    if (kept_text.size() < 200) kept_text += (kept_text.empty() ? "" : ", ") + std::to_string(frame);
+  }
+  risk->has_contacts = kept;
+  if (!kept)
+    risk->contacts_note = "keeps the contacts of some frames only (frames " + kept_text +
+                          "; run.contacts: the run's own worst moment for F0 = " + FormatNumber(kDefaultF0_n) +
+                          " N and a smoothing of " + FormatNumber(kDefaultSmoothing_s) + " s), not of this report's "
+                          "worst moment (frame " + std::to_string(risk->worst_frame) + ")";
+  const std::optional<runfile::ContactForceBins> bins = reader.ContactForces(last_frame, ForceHistogram::kBins);
+  if (!bins || bins->total == 0) return;
+  const double shift = std::log10(bins->f0_n / options.f0_n) * ForceHistogram::kPerDecade;
+  const long whole = std::lround(shift);
+  const bool exact = std::abs(shift - double(whole)) < 1e-9;
+  ForceHistogram& h = risk->contact_forces;
+  h = ForceHistogram{};
+  h.zero = bins->zero;
+  h.total = bins->total;
+  for (int b = 0; b < ForceHistogram::kBins; ++b) {
+    const int to = std::clamp(b + static_cast<int>(whole), 0, ForceHistogram::kBins - 1);
+    h.counts[static_cast<std::size_t>(to)] += bins->counts[static_cast<std::size_t>(b)];
+  }
+  risk->contact_rows = bins->total;
+  risk->contact_forces_from =
+      exact ? "" : "binned by the run as |F| / " + FormatNumber(bins->f0_n) + " N and moved to the nearest bins of F0 = " +
+                       FormatNumber(options.f0_n) + " N (within half a bin, 1/40 decade)";
 }
 
 }  // namespace
@@ -156,8 +142,8 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     risk.people[i].id = static_cast<std::uint32_t>(i + 1);
     risk.people[i].group = setup[i].group;
   }
-  const std::size_t window = static_cast<std::size_t>(std::lround(options.smoothing_s * risk.fps));
-  std::vector<Smoother> smooth(n, Smoother(window));
+  const std::size_t window = SmoothingWindow(options.smoothing_s, risk.fps);
+  std::vector<LoadSmoother> smooth(n, LoadSmoother(window));
   std::vector<double> smoothed(n, 0.0), run_above(n, 0.0);
   std::vector<bool> was_present(n, false);
   std::vector<Pose> poses(n);
@@ -185,6 +171,11 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     throw InputError(run_file.string() + ": the run records neither chest loads (table person_load) nor contacts; "
                      "expected a run written by this crowdrecon, or one simulated with \"run\": {\"contacts\": true}");
   risk.has_contacts = more_contacts;
+  // A run that keeps some frames' contacts: their rows are those frames'; its
+  // overlaps come from the frames' briefs, its force distribution from their
+  // histograms (below).
+  risk.keeps_some_contacts = reader.KeepsSomeContacts();
+  const bool overlaps_from_briefs = reader.HasContactSummary();
   std::optional<runfile::PersonLoadStream> load_stream;
   std::int64_t load_frame = -1;
   std::vector<runfile::PersonLoad> recorded;
@@ -197,7 +188,7 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   double previous_time = times.front().time_s;
   std::size_t done = 0;
   std::size_t time_index = 0;
-  bool worst_set = false;
+  std::optional<Moment> worst_moment;  // (worst_moment.hpp: the run loop finds the same frame)
   while (people.Next(&pf)) {
     while (time_index < times.size() && times[time_index].frame < pf.frame) ++time_index;
     const double t = time_index < times.size() && times[time_index].frame == pf.frame ? times[time_index].time_s
@@ -221,14 +212,14 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
     fr.frame = pf.frame;
     fr.time_s = t;
     if (have_contacts) {
-      if (validity) validity->AddContacts(pf.frame, contacts);
+      if (validity && !overlaps_from_briefs) validity->AddContacts(pf.frame, contacts);
       for (const runfile::Contact& c : contacts) {
         const Vec2 f = c.Force();
         load_contacts.push_back({c.a, c.b, c.wall, c.point_m, f});
-        risk.contact_forces.Add(Length(f) / options.f0_n);
+        if (!risk.keeps_some_contacts) risk.contact_forces.Add(Length(f) / options.f0_n);
       }
       fr.contacts = static_cast<std::uint32_t>(contacts.size());
-      risk.contact_rows += contacts.size();
+      if (!risk.keeps_some_contacts) risk.contact_rows += contacts.size();
     }
     std::vector<ChestLoad> loads;
     if (risk.loads_recorded) {
@@ -293,14 +284,12 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
       fr.max_load_n = std::max(fr.max_load_n, s);
     }
     fr.present = static_cast<std::uint32_t>(pf.person.size());
-    const bool worse = !worst_set || fr.above_f0 > risk.frames[static_cast<std::size_t>(risk.worst_frame)].above_f0 ||
-                       (fr.above_f0 == risk.frames[static_cast<std::size_t>(risk.worst_frame)].above_f0 &&
-                        fr.max_load_n > risk.frames[static_cast<std::size_t>(risk.worst_frame)].max_load_n);
+    const bool worse = IsWorse({fr.above_f0, fr.max_load_n}, worst_moment);
+    if (worse) worst_moment = Moment{fr.above_f0, fr.max_load_n};
     risk.frames.push_back(fr);
     if (worse) {
       // worst_frame holds the index into frames while streaming (the frame number at the end)
       risk.worst_frame = static_cast<std::int64_t>(risk.frames.size() - 1);
-      worst_set = true;
       risk.worst_contact_forces_n.clear();
       for (const LoadContact& c : load_contacts) risk.worst_contact_forces_n.push_back(Length(c.force_on_a_n));
       risk.worst_person_loads_n.clear();
@@ -319,13 +308,15 @@ RunRisk AnalyseRunRisk(const std::filesystem::path& run_file, const RiskOptions&
   }
   if (risk.frames.empty()) throw InputError(run_file.string() + ": the run has no people in any frame");
   if (validity) {
-    for (; more_contacts; more_contacts = contact_stream->Next(&contact_frame, &contacts))
+    for (; more_contacts && !overlaps_from_briefs; more_contacts = contact_stream->Next(&contact_frame, &contacts))
       validity->AddContacts(contact_frame, contacts);  // rows after the last frame of people, if any
     risk.validity = validity->Finish(reader);
   }
   const FrameRisk& worst = risk.frames[static_cast<std::size_t>(risk.worst_frame)];
   risk.worst_time_s = worst.time_s;
   risk.worst_frame = worst.frame;
+  if (risk.keeps_some_contacts && (options.read_contacts || !risk.loads_recorded))
+    KeptContacts(reader, times.back().frame, options, &risk);
   // Everyone who appeared: their zone, and the counts.
   std::vector<PersonRisk> appeared;
   for (PersonRisk& pr : risk.people) {

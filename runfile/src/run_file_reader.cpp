@@ -419,6 +419,8 @@ std::string RunFileReader::TablesDigest() const {
   if (sqlite::HasTable(*impl_->db, "person_load")) tables.emplace_back("person_load", "frame, id");
   if (sqlite::HasTable(*impl_->db, "census")) tables.emplace_back("census", "frame");
   if (sqlite::HasTable(*impl_->db, "contact_summary")) tables.emplace_back("contact_summary", "frame");
+  for (const char* table : {"contact_kept", "contact_forces"})
+    if (sqlite::HasTable(*impl_->db, table)) tables.emplace_back(table, "frame");
   for (const auto& [table, order] : tables) {
     hash.Update(table, std::strlen(table) + 1);
     const std::string name = table;
@@ -688,6 +690,63 @@ ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {
 }
 
 bool RunFileReader::HasContactSummary() const { return sqlite::HasTable(*impl_->db, "contact_summary"); }
+
+bool RunFileReader::KeepsSomeContacts() const { return sqlite::HasTable(*impl_->db, "contact_kept"); }
+
+std::vector<std::pair<std::int64_t, std::string>> RunFileReader::ContactKeptFrames() const {
+  std::vector<std::pair<std::int64_t, std::string>> kept;
+  if (!KeepsSomeContacts()) return kept;
+  Statement s(*impl_->db, "SELECT frame, why FROM contact_kept ORDER BY frame");
+  s.Describe("contact_kept", {0});
+  while (s.Next()) kept.emplace_back(s.Integer(0, 0, run_limits::kFrame), s.Text(1));
+  return kept;
+}
+
+std::optional<ContactForceBins> RunFileReader::ContactForces(std::int64_t last_frame, std::size_t bins) const {
+  if (!sqlite::HasTable(*impl_->db, "contact_forces")) return std::nullopt;
+  ContactForceBins sum;
+  sum.counts.assign(bins, 0);
+  Statement s(*impl_->db, "SELECT frame, f0_n, zero, total, bins FROM contact_forces WHERE frame <= ?1 ORDER BY frame");
+  s.Bind(1, last_frame).Describe("contact_forces", {0});
+  constexpr std::int64_t kCount = std::int64_t{1} << 40;
+  bool first = true;
+  while (s.Next()) {
+    const double f0 = s.Real(1, 1e-9, run_limits::kForce_n);
+    if (!first && f0 != sum.f0_n)
+      throw InputError(impl_->file + ": table contact_forces, row frame " + s.Text(0) + ", column f0_n: " +
+                       FormatNumber(f0) + " N, but earlier frames are binned by " + FormatNumber(sum.f0_n) +
+                       " N (the run file is damaged)");
+    sum.f0_n = f0;
+    first = false;
+    const std::uint64_t zero = static_cast<std::uint64_t>(s.Integer(2, 0, kCount));
+    const std::uint64_t total = static_cast<std::uint64_t>(s.Integer(3, 0, kCount));
+    std::uint64_t binned = 0;
+    const std::string text = s.Text(4);
+    std::size_t at = 0;
+    while (at < text.size()) {
+      std::size_t end = text.find(' ', at);
+      if (end == std::string::npos) end = text.size();
+      const std::string pair = text.substr(at, end - at);
+      unsigned long long bin = 0, count = 0;
+      char tail = 0;
+      if (std::sscanf(pair.c_str(), "%llu:%llu%c", &bin, &count, &tail) != 2 || bin >= bins ||
+          count > static_cast<unsigned long long>(kCount))
+        throw InputError(impl_->file + ": table contact_forces, row frame " + s.Text(0) + ", column bins: \"" +
+                         ShortText(pair, 40) + "\"; expected BIN:COUNT pairs with bins below " +
+                         std::to_string(bins) + " (the run file is damaged)");
+      sum.counts[bin] += count;
+      binned += count;
+      at = end + 1;
+    }
+    if (binned + zero != total)
+      throw InputError(impl_->file + ": table contact_forces, row frame " + s.Text(0) + ": " + std::to_string(binned) +
+                       " forces binned and " + std::to_string(zero) + " of zero, but a total of " +
+                       std::to_string(total) + " (the run file is damaged)");
+    sum.zero += zero;
+    sum.total += total;
+  }
+  return sum;
+}
 
 std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverlap() const {
   // From the frames' briefs where the run has them (issue 66: every frame,

@@ -115,6 +115,17 @@ void ForgetDerived(Database& db) {
   erase.Bind(1, std::string("derived_keys")).Run();
 }
 
+// The rows of these frames in tables contact and contact_kept.
+void DropContactRows(Database& db, const std::vector<std::int64_t>& frames) {
+  if (frames.empty()) return;
+  Statement drop_rows(db, "DELETE FROM contact WHERE frame = ?");
+  Statement drop_kept(db, "DELETE FROM contact_kept WHERE frame = ?");
+  for (const std::int64_t d : frames) {
+    drop_rows.Bind(1, d).Run();
+    drop_kept.Bind(1, d).Run();
+  }
+}
+
 }  // namespace
 
 struct RunFileWriter::Impl {
@@ -275,7 +286,8 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   ForgetDerived(db);
   w.impl_->has_person_load = sqlite::HasTable(db, "person_load");
   if (w.impl_->has_person_load) db.Exec("DELETE FROM person_load WHERE frame > " + after);
-  if (sqlite::HasTable(db, "census")) db.Exec("DELETE FROM census WHERE frame > " + after);
+  for (const char* table : {"census", "contact_kept", "contact_forces"})
+    if (sqlite::HasTable(db, table)) db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
   w.impl_->has_contact_summary = sqlite::HasTable(db, "contact_summary");
   if (w.impl_->has_contact_summary) db.Exec("DELETE FROM contact_summary WHERE frame > " + after);
   const bool packed = sqlite::HasTable(db, "frame_pack");
@@ -380,6 +392,22 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
             .Add(c.overlap_m).Add(c.normal_force_n).Add(c.tangential_force_n);
       contact.Finish();
     }
+    if (f.lean_contacts) {
+      db.Exec("CREATE TABLE IF NOT EXISTS contact_kept(frame INTEGER PRIMARY KEY, why TEXT NOT NULL)");
+      db.Exec("CREATE TABLE IF NOT EXISTS contact_forces(frame INTEGER PRIMARY KEY, f0_n REAL NOT NULL, "
+              "zero INTEGER NOT NULL, total INTEGER NOT NULL, bins TEXT NOT NULL)");
+      DropContactRows(db, f.drop_contacts_of);
+      if (f.with_contacts) {
+        Statement kept(db, "INSERT INTO contact_kept VALUES(?, ?)");
+        kept.Bind(1, frame).Bind(2, f.kept_because).Run();
+      }
+      std::string bins;
+      for (const auto& [bin, count] : f.force_bins)
+        bins += (bins.empty() ? "" : " ") + std::to_string(bin) + ":" + std::to_string(count);
+      Statement forces(db, "INSERT INTO contact_forces VALUES(?, ?, ?, ?, ?)");
+      forces.Bind(1, frame).Bind(2, f.force_f0_n).Bind(3, static_cast<std::int64_t>(f.force_zero))
+          .Bind(4, static_cast<std::int64_t>(f.force_total)).Bind(5, bins).Run();
+    }
     Statement ft(db, "INSERT INTO frame_time VALUES(?, ?)");
     ft.Bind(1, frame).Bind(2, f.time_s).Run();
     Statement fd(db, "INSERT INTO frame_data VALUES(?, ?)");
@@ -405,6 +433,14 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
       meta.Bind(1, std::string("ymax")).Bind(2, NumberText(impl_->ymax)).Run();
     }
   }
+  db.Exec("COMMIT");
+}
+
+void RunFileWriter::DropContacts(const std::vector<std::int64_t>& frames) {
+  if (frames.empty()) return;
+  Database& db = *impl_->db;
+  db.Exec("BEGIN");
+  DropContactRows(db, frames);
   db.Exec("COMMIT");
 }
 

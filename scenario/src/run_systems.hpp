@@ -28,16 +28,19 @@
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/settle.hpp"
+#include "contact_keeper.hpp"
 #include "timeline_systems.hpp"
 
 namespace crowdrecon::scenario::detail {
 
 // Frame `frame` into the run file; with a timeline, with its head count and
 // the events since the last frame (which are then cleared).
+// Which of its contacts the frame keeps, `contacts` decides.
 inline void WriteTimelineFrame(runfile::FrameWriterThread& frames, const engine::Simulation& sim, std::int64_t frame,
-                               bool with_contacts, TimelineState* timeline) {
+                               ContactKeeper& contacts, TimelineState* timeline) {
   frames.Write([&](runfile::FrameSnapshot& f) {
-    TakeSnapshot(sim, frame, timeline ? timeline->events : std::vector<runfile::Event>{}, with_contacts, &f);
+    TakeSnapshot(sim, frame, timeline ? timeline->events : std::vector<runfile::Event>{}, true, &f);
+    contacts.Decide(f);
     if (timeline) {
       f.with_census = true;
       f.census = timeline->Count(sim);
@@ -74,14 +77,17 @@ class WallCheckSystem : public RunSystem {
 // since the last frame (timeline_systems.hpp).
 class FrameOutputSystem : public RunSystem {
  public:
-  FrameOutputSystem(runfile::FrameWriterThread& frames, bool with_contacts, TimelineState* timeline = nullptr)
-      : frames_(frames), with_contacts_(with_contacts), timeline_(timeline) {}
+  FrameOutputSystem(runfile::FrameWriterThread& frames, ContactKeeper& contacts, TimelineState* timeline = nullptr)
+      : frames_(frames), contacts_(contacts), timeline_(timeline) {}
   std::string_view name() const override { return "frames"; }
-  void AtFrame(FrameContext& c) override { WriteTimelineFrame(frames_, c.sim, c.frame, with_contacts_, timeline_); }
+  void AtFrame(FrameContext& c) override { WriteTimelineFrame(frames_, c.sim, c.frame, contacts_, timeline_); }
+  // Which frames' contacts are kept and still to drop (run.contacts as an object).
+  std::string SaveState() const override { return contacts_.SaveState(); }
+  void LoadState(const std::string& state) override { contacts_.LoadState(state); }
 
  private:
   runfile::FrameWriterThread& frames_;
-  bool with_contacts_;
+  ContactKeeper& contacts_;
   TimelineState* timeline_;
 };
 

@@ -524,8 +524,9 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   //    naming the last frame, an event, the status) waits for them with Flush.
   const bool core_free = static_cast<unsigned>(std::max(1, options.threads)) < std::thread::hardware_concurrency();
   runfile::FrameWriterThread frames(writer, core_free);
+  detail::ContactKeeper contacts(scenario.run, checkpoint_every);  // (its state: the frames system's)
   if (last_frame < 0) {
-    detail::WriteTimelineFrame(frames, sim, 0, scenario.run.write_contacts, timeline.get());
+    detail::WriteTimelineFrame(frames, sim, 0, contacts, timeline.get());
     last_frame = 0;
   }
 
@@ -568,7 +569,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
     loop.Add(detail::MakeLeftSystem(*timeline));
   }
   loop.Add(std::make_unique<detail::WallCheckSystem>(sim));
-  loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, scenario.run.write_contacts, timeline.get()));
+  loop.Add(std::make_unique<detail::FrameOutputSystem>(frames, contacts, timeline.get()));
   loop.Add(std::make_unique<detail::DeviceFallbackSystem>(options.show_progress));
   if (scenario.run.settle.enabled) {
     // Directions of travel by group, named after their target.
@@ -658,6 +659,7 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options) {
   if (adapt_threads)  // how many engine threads the governor chose (several asked for)
     writer.SetRunValue("engine_threads", governor.summary().BriefReport() + (options.resume ? " (since the resume)" : ""));
   record_wall_time();
+  if (status == "complete") writer.DropContacts(contacts.Finish());  // worst moments superseded since the last checkpoint
   writer.SetStatus(status);
   if (status == "complete") {
     std::error_code ec;

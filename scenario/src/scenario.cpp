@@ -245,7 +245,15 @@ Scenario ParseScenario(const std::string& json_text, const std::string& origin,
     s.run.duration_s = run->Number("duration_s", s.run.duration_s, 0.0, 1e6);
     s.run.output_fps = run->Number("output_fps", s.run.output_fps, 0.01, 1000.0);
     s.run.checkpoint_interval_s = run->Number("checkpoint_interval_s", s.run.checkpoint_interval_s, 0.0, 1e6);
-    s.run.write_contacts = run->Bool("contacts", s.run.write_contacts);
+    if (auto contacts = run->Find("contacts"); contacts && contacts->IsObject()) {
+      s.run.lean_contacts = true;
+      s.run.write_contacts = true;
+      s.run.contacts_every_s = contacts->Number("every_s", s.run.contacts_every_s, 0.0, 1e6);
+      s.run.contacts_worst = contacts->Bool("worst", s.run.contacts_worst);
+      contacts->Finish();
+    } else {
+      s.run.write_contacts = run->Bool("contacts", s.run.write_contacts);
+    }
     s.run.packed_frames = run->Choice("frames", s.run.packed_frames ? "packed" : "tables", {"tables", "packed"}) == "packed";
     if (auto settle = run->Find("stop_when_settled")) s.run.settle = ReadSettleOptions(*settle);
     run->Finish();

@@ -23,6 +23,7 @@
 
 #include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/vec2.hpp"
+#include "crowdrecon/reports/worst_moment.hpp"
 
 namespace crowdrecon::reports {
 
@@ -35,7 +36,7 @@ const char* ToString(Zone z);
 struct RiskOptions {
   // F0: the load the paper takes as the onset of risk ("a reasonable
   // estimation of the load might be 400 N"; Figure 6 scales forces by it).
-  double f0_n = 400.0;
+  double f0_n = kDefaultF0_n;
   // The danger zone's lower edge: the smallest load Hopkins et al. (1993)
   // report as fatal (death after 4-6 minutes at 1112 N).
   double danger_n = 1112.0;
@@ -46,7 +47,7 @@ struct RiskOptions {
   double lethal_long_n = 1112.0, lethal_long_s = 300.0;
   // The chest load is a moving mean over this window (s): a contact model's
   // loads spike within single steps; a chest is compressed over a breath.
-  double smoothing_s = 1.0;
+  double smoothing_s = kDefaultSmoothing_s;
   // Called after each frame with (frames done, frames in all); may be empty.
   std::function<void(std::size_t, std::size_t)> progress;
   // People (ids, 1-based) whose smoothed chest-load series RunRisk::series
@@ -100,22 +101,6 @@ struct FrameRisk {
   double max_load_n = 0.0;
 };
 
-// Counts of a histogram over log10(force / F0) from kLow to kHigh in
-// kPerDecade bins per decade (below: bin 0, above: the last bin), for the
-// distribution of contact forces over a whole run without holding them.
-struct ForceHistogram {
-  static constexpr double kLow = -4.0, kHigh = 3.0;
-  static constexpr int kPerDecade = 20;
-  static constexpr int kBins = static_cast<int>((kHigh - kLow) * kPerDecade);
-  std::array<std::uint64_t, kBins> counts{};
-  std::uint64_t zero = 0;   // contacts with no force
-  std::uint64_t total = 0;
-  void Add(double force_over_f0);
-  // The fraction of recorded forces above force_over_f0 (at bin edges).
-  double FractionAbove(double force_over_f0) const;
-  static double UpperEdge(int bin);  // in units of F0
-};
-
 struct RunRisk {
   std::filesystem::path file;
   std::string scenario_name;
@@ -147,6 +132,13 @@ struct RunRisk {
   std::vector<std::vector<std::pair<double, double>>> series;
   bool loads_recorded = false;  // chest loads from table person_load (else computed from the contacts)
   bool has_contacts = false;    // the run has a contact table with rows, read: force network and force distributions
+  // A run that keeps some frames' contacts (run.contacts as an object;
+  // contact_keeper.hpp): its whole-run force distribution comes from its
+  // frames' histograms (contact_forces_from says how), and has_contacts says
+  // whether it kept the worst moment's rows; if not, contacts_note says why.
+  bool keeps_some_contacts = false;
+  std::string contact_forces_from;
+  std::string contacts_note;
   std::optional<analysis::Plausibility> validity;  // if RiskOptions::validity asked for it
 };
 

@@ -27,6 +27,12 @@
 //           without loss, in a tenth of their bytes; those tables are then
 //           empty, and this reader gives the same frames, loads and digest
 //           from either storage (PedPy reads `crowdrecon export`'s file)
+//   contact_kept(frame INTEGER PRIMARY KEY, why TEXT)   a run that keeps some
+//           frames' contacts (run.contacts as an object): the frames whose rows
+//           table contact holds, and why
+//   contact_forces(frame INTEGER PRIMARY KEY, f0_n, zero, total, bins TEXT)  the
+//           same runs: each frame's contact forces in the report's histogram
+//           (|F| / f0_n, reports::ForceHistogram's bins, "bin:count ...")
 //   census(frame INTEGER PRIMARY KEY, time_s, walking, fallen, removed, queued, entered)
 //           a timeline's head count per frame (runs with a timeline only):
 //           people walking and fallen in the venue, removed through an exit,
@@ -187,6 +193,27 @@ struct FrameSnapshot {
   std::vector<Event> events;
   bool with_census = false;  // a timeline's run: census holds the head count
   Census census;
+  // A run that keeps the contacts of some frames only (run.contacts as an
+  // object; issue 66): with_contacts says whether this frame's rows are
+  // kept and kept_because why (table contact_kept: "every 10 s", "worst
+  // moment"); the rows of frames in drop_contacts_of go now (worst moments
+  // since superseded); every contact's force in the histogram of the report
+  // (reports::ForceHistogram's bins of |F| / force_f0_n, as "bin:count"
+  // pairs; table contact_forces), so that its distribution needs no rows.
+  bool lean_contacts = false;
+  std::string kept_because;
+  std::vector<std::int64_t> drop_contacts_of;
+  double force_f0_n = 0.0;
+  std::uint64_t force_zero = 0, force_total = 0;
+  std::vector<std::pair<std::uint32_t, std::uint64_t>> force_bins;
+};
+
+// A run's contact forces binned as its frames recorded them (table
+// contact_forces): the sum over frames.
+struct ContactForceBins {
+  double f0_n = 0.0;
+  std::uint64_t zero = 0, total = 0;
+  std::vector<std::uint64_t> counts;  // by bin
 };
 
 // Held while a run file is written (simulate, a resume, analyze --write):
@@ -228,6 +255,9 @@ class RunFileWriter {
   void WriteFrame(const FrameSnapshot& snapshot);
   // Records an event outside a frame (e.g. a failure), committed at once.
   void WriteEvent(std::int64_t frame, const Event& event);
+  // Drops the contact rows (and table contact_kept's rows) of these frames,
+  // in one transaction: a run that keeps some frames' contacts, at its end.
+  void DropContacts(const std::vector<std::int64_t>& frames);
   // run.status = "running" | "complete" | "interrupted" | "failed: ..."
   void SetStatus(const std::string& status);
   void SetRunValue(const std::string& key, const std::string& value);
@@ -426,6 +456,13 @@ class RunFileReader {
   // runs from 2026-12-06 on): then its overlaps are known even where the
   // contacts were not written, or none happened.
   bool HasContactSummary() const;
+  // Whether the run keeps the contacts of some frames only (table
+  // contact_kept), and which (with why: "every 10 s", "worst moment").
+  bool KeepsSomeContacts() const;
+  std::vector<std::pair<std::int64_t, std::string>> ContactKeptFrames() const;
+  // The contact forces of every frame up to `last_frame` binned (table
+  // contact_forces; nullopt without it); `bins` bounds the bin numbers.
+  std::optional<ContactForceBins> ContactForces(std::int64_t last_frame, std::size_t bins) const;
   std::vector<Vec2> GroupVelocitySums() const;
   std::vector<Event> Events() const;
   // A timeline's head count per frame (empty for a run without a timeline).

@@ -64,7 +64,15 @@ struct RunSpec {
   double duration_s = 60.0;
   double output_fps = 10.0;
   double checkpoint_interval_s = 10.0;  // 0 = none
-  bool write_contacts = true;
+  bool write_contacts = true;  // run.contacts true: every frame's contacts; false: none
+  // run.contacts as an object (issue 66): the contacts of some frames only --
+  // every `contacts_every_s` seconds (0: none at a rate) and, with
+  // `contacts_worst`, those of the report's worst moment (F0 and smoothing
+  // of reports::RiskOptions' defaults; worst_moment.hpp); every frame's
+  // contact forces in the report's histogram (table contact_forces).
+  bool lean_contacts = false;
+  double contacts_every_s = 0.0;
+  bool contacts_worst = true;
   // run.frames: "tables" (rows of trajectory_data, person_state and
   // person_load: PedPy reads the run file itself) or "packed" (table
   // frame_pack, without loss, about a tenth of the bytes: crowdrecon reads
