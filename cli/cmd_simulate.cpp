@@ -1,4 +1,4 @@
-// crowdrecon simulate SCENARIO -o RUN.sqlite [--profile NAME] [--threads N] [--device cpu|cuda] [--resume | --branch-from RUN]
+// crowdrecon simulate SCENARIO -o RUN.sqlite [--profile NAME] [--threads N] [--device cpu|cuda] [--resume | --branch-from RUN | --continue-from RUN]
 #include <unistd.h>
 
 #include <cstdio>
@@ -26,6 +26,7 @@ struct SimulateArgs {
   std::string device = "cpu";
   bool resume = false;
   std::string branch_from;
+  std::string continue_from;
   bool force = false;
   bool quiet = false;
   double log_every_s = kLogEveryDefaultS;  // --log-every
@@ -45,12 +46,18 @@ int RunSimulate(const SimulateArgs& args) {
                 {"the venue", sc.venue_file},
                 {"the reference body", sc.population.reference_body},
                 {"the anthropometry extract", sc.population.anthropometry},
-                {"the run to branch from", args.branch_from}},
+                {"the run to branch from", args.branch_from},
+                {"the segment to continue", args.continue_from}},
                args.force);
   if (!args.branch_from.empty()) {
     // CheckOutputs allowed replacing -o: a branch starts it anew.
     const double t_s = scenario::BranchRun(sc, args.branch_from, args.output);
     std::fprintf(stderr, "crowdrecon: branched from %s at t = %.3f s\n", args.branch_from.c_str(), t_s);
+  }
+  if (!args.continue_from.empty()) {
+    const double t_s = scenario::ContinueRun(sc, args.continue_from, args.output);
+    std::fprintf(stderr, "crowdrecon: continuing %s from t = %.3f s into %s\n", args.continue_from.c_str(), t_s,
+                 args.output.c_str());
   }
   scenario::RunOptions options;
   options.output = args.output;
@@ -58,7 +65,7 @@ int RunSimulate(const SimulateArgs& args) {
   if (!engine::FromString(args.device, &options.device))
     throw InputError("--device: \"" + args.device + "\", expected \"cpu\" or \"cuda\"");
   options.adapt_threads = !args.fixed_threads;
-  options.resume = args.resume || !args.branch_from.empty();
+  options.resume = args.resume || !args.branch_from.empty() || !args.continue_from.empty();
   options.show_progress = !args.quiet && isatty(STDERR_FILENO);
   options.log_progress_every_s = LogProgressEvery(args.log_every_s, args.quiet);
   options.stop_after_s = args.stop_after_s;
@@ -138,6 +145,12 @@ void RegisterSimulateCommand(CLI::App& app) {
                   "scenario, which may differ from that run's only in its name, notes and timeline events from the "
                   "checkpoint's time on (a what-if from a moment of a long run)")
       ->excludes(resume);
+  cmd->add_option("--continue-from", args->continue_from,
+                  "Continue a stopped run (status interrupted, e.g. by --stop-after) from its checkpoint into -o, a new "
+                  "file: the next segment of the run, which every command reads with the segments before it as one "
+                  "run (a long run over several machines or days; docs/scenarios.md, \"Runs in segments\")")
+      ->excludes(resume)
+      ->excludes("--branch-from");
   AddForceFlag(cmd, &args->force);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress line");
   AddLogEveryOption(cmd, &args->log_every_s);

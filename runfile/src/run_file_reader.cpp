@@ -11,6 +11,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -106,6 +107,13 @@ struct RunFileReader::Impl {
   std::unique_ptr<PackedFrames> cursor;
   std::int64_t cursor_frame = -1, cursor_key = -1;
   detail::PackedPeople cursor_people;
+  // A run in segments, read from its last: every segment's own reader, first
+  // to last, and each one's first and last frame (empty: a run in one file).
+  std::vector<std::unique_ptr<RunFileReader>> segments;
+  std::vector<std::pair<std::int64_t, std::int64_t>> ranges;
+  // Frames of this segment whose contact rows a later segment dropped
+  // (its table contact_dropped: a worst moment since superseded).
+  std::set<std::int64_t> dropped;
 
   // The packed frames from the key frame at or before `first` to `last`.
   std::int64_t KeyAtOrBefore(std::int64_t frame) const {
@@ -146,7 +154,76 @@ struct RunFileReader::Impl {
   }
 };
 
-RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
+// The chain of a run in segments, and what the readers of its segments
+// share (run_file.hpp: RunFileReader).
+struct ChainAccess {
+  static void Open(RunFileReader& last, const std::filesystem::path& file) {
+    std::vector<std::unique_ptr<RunFileReader>> chain;
+    chain.push_back(std::unique_ptr<RunFileReader>(new RunFileReader(file, false)));
+    std::set<std::string> seen;
+    std::error_code ec;
+    seen.insert(std::filesystem::weakly_canonical(file, ec).string());
+    for (;;) {
+      const RunFileReader& after = *chain.back();
+      const std::string next = after.RunValue("continues");
+      if (next.empty()) break;
+      const auto at = static_cast<std::int64_t>(after.RunNumber("continues_at_frame", -1.0, 0.0, double(run_limits::kFrame)));
+      std::filesystem::path path = next;
+      if (path.is_relative()) path = std::filesystem::path(after.file()).parent_path() / path;
+      path = path.lexically_normal();
+      if (!std::filesystem::exists(path, ec))
+        throw InputError(after.file() + ": continues the run of " + path.string() + " (run value continues), which is "
+                         "not there; a run in segments is read whole: keep its segments together, at the same "
+                         "relative paths");
+      if (!seen.insert(std::filesystem::weakly_canonical(path, ec).string()).second)
+        throw InputError(after.file() + ": its chain of segments comes back to " + path.string() +
+                         " (run values continues; the run file is damaged)");
+      auto segment = std::unique_ptr<RunFileReader>(new RunFileReader(path, false));
+      const std::vector<FrameTime> times = segment->FrameTimes();
+      if (times.empty() || times.back().frame != at)
+        throw InputError(after.file() + ": continues " + path.string() + " after its frame " + std::to_string(at) +
+                         ", but that file's last frame is " +
+                         (times.empty() ? std::string("none") : std::to_string(times.back().frame)) +
+                         " (not the segment it continued: written again or resumed since)");
+      if (segment->RunValue("scenario") != after.RunValue("scenario"))
+        throw InputError(after.file() + ": continues " + path.string() + ", which is a run of another scenario");
+      chain.push_back(std::move(segment));
+    }
+    std::reverse(chain.begin(), chain.end());
+    // A later segment's dropped contact rows (superseded worst moments) are
+    // of the segments before it.
+    std::set<std::int64_t> later;
+    for (std::size_t i = chain.size(); i-- > 0;) {
+      chain[i]->impl_->dropped = later;
+      if (sqlite::HasTable(*chain[i]->impl_->db, "contact_dropped")) {
+        Statement d(*chain[i]->impl_->db, "SELECT frame FROM contact_dropped");
+        while (d.Next()) later.insert(d.Int(0));
+      }
+    }
+    std::int64_t previous_last = -1;
+    for (const auto& segment : chain) {
+      const std::vector<FrameTime> times = segment->FrameTimes();
+      if (!times.empty() && times.front().frame <= previous_last)
+        throw InputError(segment->file() + ": its first frame " + std::to_string(times.front().frame) +
+                         " is not after the last of the segment before it (" + std::to_string(previous_last) +
+                         "; the run file is damaged)");
+      last.impl_->ranges.emplace_back(times.empty() ? -1 : times.front().frame, times.empty() ? -1 : times.back().frame);
+      if (!times.empty()) previous_last = times.back().frame;
+    }
+    last.impl_->segments = std::move(chain);
+  }
+
+  // The rows of one table of one segment into `hash` (TablesDigest).
+  static void DigestRows(const RunFileReader& r, Sha256& hash, const std::string& name, const char* order);
+  // One segment's velocities added to `sums` by group, in frame/id order.
+  static void AddGroupVelocities(const RunFileReader& r, const std::vector<std::int64_t>& group, std::vector<Vec2>& sums);
+};
+
+RunFileReader::RunFileReader(const std::filesystem::path& file) : RunFileReader(file, true) {}
+
+RunFileReader RunFileReader::OneSegment(const std::filesystem::path& file) { return RunFileReader(file, false); }
+
+RunFileReader::RunFileReader(const std::filesystem::path& file, bool follow_segments) : impl_(std::make_unique<Impl>()) {
   impl_->file = file.string();
   if (!std::filesystem::exists(file)) throw InputError(impl_->file + ": run file does not exist");
   if (std::filesystem::is_directory(file)) throw InputError(impl_->file + ": is a folder, not a run file");
@@ -169,9 +246,17 @@ RunFileReader::RunFileReader(const std::filesystem::path& file) : impl_(std::mak
     if (people.Next() && people.Type(0) == SQLITE_INTEGER)
       impl_->people = static_cast<std::size_t>(std::clamp<std::int64_t>(people.Int(0), 0, run_limits::kPersonId));
   }
+  if (follow_segments && !RunValue("continues").empty()) ChainAccess::Open(*this, file);
 }
 
 bool RunFileReader::packed() const { return impl_->packed; }
+
+std::vector<std::string> RunFileReader::SegmentFiles() const {
+  if (impl_->segments.empty()) return {impl_->file};
+  std::vector<std::string> files;
+  for (const auto& segment : impl_->segments) files.push_back(segment->file());
+  return files;
+}
 RunFileReader::RunFileReader(RunFileReader&&) noexcept = default;
 
 bool IsRunFile(const std::filesystem::path& file) {
@@ -179,7 +264,7 @@ bool IsRunFile(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file, ec) || !FileStartsWith(file, std::string("SQLite format 3\0", 16)))
     return false;
   try {
-    return RunFileReader(file).RunValue("format") == "crowdrecon-run";
+    return RunFileReader::OneSegment(file).RunValue("format") == "crowdrecon-run";
   } catch (const std::exception&) {  // unreadable or foreign: not ours
     return false;
   }
@@ -191,7 +276,7 @@ std::string DescribeNonRunFile(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file, ec) || !FileStartsWith(file, std::string("SQLite format 3\0", 16)))
     return what;
   try {
-    (void)RunFileReader(file).RunValue("format");
+    (void)RunFileReader::OneSegment(file).RunValue("format");
   } catch (const std::exception& e) {
     const std::string why = e.what();
     const std::size_t at = why.find("SQLite error: ");
@@ -240,12 +325,18 @@ std::string RunFileReader::UnfinishedNote() const {
                           : failed                  ? "it went numerically wrong and stopped"
                                                     : "it did not finish";
   Statement last(*impl_->db, "SELECT MAX(time_s) FROM frame_time");
-  const bool has = last.Next() && last.Type(0) != SQLITE_NULL;
+  bool has = last.Next() && last.Type(0) != SQLITE_NULL;
+  double last_s = has ? last.Double(0) : 0.0;
+  if (!impl_->segments.empty()) {  // the run's last frame, in whichever segment
+    const std::vector<FrameTime> times = FrameTimes();
+    has = !times.empty();
+    last_s = has ? times.back().time_s : 0.0;
+  }
   // A failed run cannot be resumed (simulate --resume refuses it: issue 65,
   // V03, the advice could not be followed); its frames up to the failure are
   // what it has.
   return impl_->file + " is unfinished (status \"" + status + "\": " + why + "): what follows covers " +
-         (has ? "its frames up to t = " + FormatNumber(last.Double(0)) + " s only" : "no frame") +
+         (has ? "its frames up to t = " + FormatNumber(last_s) + " s only" : "no frame") +
          (failed ? "; it cannot be resumed: change what made it fail (its message above) and run it again"
                  : "; resume it with crowdrecon simulate --resume to finish it");
 }
@@ -297,6 +388,11 @@ Contact ReadContact(Statement& c) {
 }  // namespace
 
 RunFrame RunFileReader::Frame(std::int64_t frame) const {
+  if (!impl_->segments.empty()) {
+    for (std::size_t i = 0; i < impl_->segments.size(); ++i)
+      if (impl_->ranges[i].first <= frame && frame <= impl_->ranges[i].second) return impl_->segments[i]->Frame(frame);
+    throw InputError(impl_->file + ": no frame " + std::to_string(frame) + " in the run's segments");
+  }
   if (!impl_->frames_checked) {
     // Frame by frame, a row whose frame is not a whole number is never
     // asked for: look for one once (a scan of the frame index).
@@ -334,6 +430,7 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
   Statement c(*impl_->db, std::string(kContactColumns) + " FROM contact WHERE frame = ? ORDER BY rowid");
   c.Bind(1, frame).Describe("contact", {0, 1});
   while (c.Next()) f.contacts.push_back(ReadContact(c));
+  if (impl_->dropped.count(frame)) f.contacts.clear();  // a later segment dropped them
   return f;
 }
 
@@ -423,73 +520,95 @@ std::string RunFileReader::TablesDigest() const {
     if (sqlite::HasTable(*impl_->db, table)) tables.emplace_back(table, "frame");
   for (const auto& [table, order] : tables) {
     hash.Update(table, std::strlen(table) + 1);
-    const std::string name = table;
-    if (impl_->packed && (name == "trajectory_data" || name == "person_state" || name == "person_load")) {
-      // The rows the tables would hold, value for value (frame_pack.hpp).
-      const auto real = [](std::string& row, double v) {
-        char text[32];
-        std::snprintf(text, sizeof text, "r%.17g;", v);
-        row += text;
-      };
-      const std::unique_ptr<PackedFrames> frames = impl_->Packed(0, run_limits::kFrame);
-      std::int64_t frame = 0;
-      detail::PackedPeople p;
-      std::string row;
-      while (frames->Next(&frame, &p))
-        for (std::size_t k = 0; k < p.person.size(); ++k) {
-          const std::string head = "i" + std::to_string(frame) + ";i" + std::to_string(std::int64_t{p.person[k]} + 1) + ";";
-          row = head;
-          if (name == "trajectory_data") {
-            real(row, p.position_m[k].x);
-            real(row, p.position_m[k].y);
-            real(row, AsStored(std::cos(p.angle_rad[k])));
-            real(row, AsStored(std::sin(p.angle_rad[k])));
-          } else if (name == "person_state") {
-            real(row, p.velocity_m_per_s[k].x);
-            real(row, p.velocity_m_per_s[k].y);
-            real(row, p.angle_rad[k]);
-            real(row, p.angular_velocity_rad_per_s[k]);
-            row += "i" + std::to_string(static_cast<int>(p.state[k])) + ";";
-            real(row, p.load_n[k]);
-          } else {
-            if (!p.has_loads || (p.chest_n[k] == 0.0 && p.lateral_n[k] == 0.0)) continue;
-            real(row, p.chest_n[k]);
-            real(row, p.lateral_n[k]);
-          }
-          row += '\n';
-          hash.Update(row.data(), row.size());
-        }
-      continue;
-    }
-    Statement s(*impl_->db, std::string("SELECT * FROM ") + table + " ORDER BY " + order);
-    while (s.Next()) {
-      std::string row;
-      for (int c = 0; c < s.ColumnCount(); ++c) {
-        switch (s.Type(c)) {
-          case SQLITE_INTEGER: row += "i" + std::to_string(s.Int(c)); break;
-          case SQLITE_FLOAT: {
-            char text[32];
-            std::snprintf(text, sizeof text, "r%.17g", s.Double(c));
-            row += text;
-            break;
-          }
-          case SQLITE_NULL: row += "n"; break;
-          default: {  // text and blobs: their length, then their bytes
-            const std::string v = s.Text(c);
-            row += "t" + std::to_string(v.size()) + ":" + v;
-          }
-        }
-        row += ';';
-      }
-      row += '\n';
-      hash.Update(row.data(), row.size());
+    if (impl_->segments.empty()) {
+      ChainAccess::DigestRows(*this, hash, table, order);
+    } else {  // a run in segments: the rows of each, in order, as the run made in one go has them
+      for (const auto& segment : impl_->segments) ChainAccess::DigestRows(*segment, hash, table, order);
     }
   }
   return hash.HexDigest();
 }
 
+void ChainAccess::DigestRows(const RunFileReader& r, Sha256& hash, const std::string& name, const char* order) {
+  const RunFileReader::Impl* impl_ = r.impl_.get();
+  if (!sqlite::HasTable(*impl_->db, name)) return;
+  if (impl_->packed && (name == "trajectory_data" || name == "person_state" || name == "person_load")) {
+    // The rows the tables would hold, value for value (frame_pack.hpp).
+    const auto real = [](std::string& row, double v) {
+      char text[32];
+      std::snprintf(text, sizeof text, "r%.17g;", v);
+      row += text;
+    };
+    const std::unique_ptr<PackedFrames> frames = impl_->Packed(0, run_limits::kFrame);
+    std::int64_t frame = 0;
+    detail::PackedPeople p;
+    std::string row;
+    while (frames->Next(&frame, &p))
+      for (std::size_t k = 0; k < p.person.size(); ++k) {
+        row = "i" + std::to_string(frame) + ";i" + std::to_string(std::int64_t{p.person[k]} + 1) + ";";
+        if (name == "trajectory_data") {
+          real(row, p.position_m[k].x);
+          real(row, p.position_m[k].y);
+          real(row, AsStored(std::cos(p.angle_rad[k])));
+          real(row, AsStored(std::sin(p.angle_rad[k])));
+        } else if (name == "person_state") {
+          real(row, p.velocity_m_per_s[k].x);
+          real(row, p.velocity_m_per_s[k].y);
+          real(row, p.angle_rad[k]);
+          real(row, p.angular_velocity_rad_per_s[k]);
+          row += "i" + std::to_string(static_cast<int>(p.state[k])) + ";";
+          real(row, p.load_n[k]);
+        } else {
+          if (!p.has_loads || (p.chest_n[k] == 0.0 && p.lateral_n[k] == 0.0)) continue;
+          real(row, p.chest_n[k]);
+          real(row, p.lateral_n[k]);
+        }
+        row += '\n';
+        hash.Update(row.data(), row.size());
+      }
+    return;
+  }
+  // Rows a later segment dropped (contacts of a superseded worst moment) are not the run's.
+  const bool droppable = !impl_->dropped.empty() && (name == "contact" || name == "contact_kept");
+  Statement s(*impl_->db, "SELECT * FROM " + name + " ORDER BY " + order);
+  while (s.Next()) {
+    if (droppable && impl_->dropped.count(s.Int(0))) continue;
+    std::string row;
+    for (int c = 0; c < s.ColumnCount(); ++c) {
+      switch (s.Type(c)) {
+        case SQLITE_INTEGER: row += "i" + std::to_string(s.Int(c)); break;
+        case SQLITE_FLOAT: {
+          char text[32];
+          std::snprintf(text, sizeof text, "r%.17g", s.Double(c));
+          row += text;
+          break;
+        }
+        case SQLITE_NULL: row += "n"; break;
+        default: {  // text and blobs: their length, then their bytes
+          const std::string v = s.Text(c);
+          row += "t" + std::to_string(v.size()) + ":" + v;
+        }
+      }
+      row += ';';
+    }
+    row += '\n';
+    hash.Update(row.data(), row.size());
+  }
+}
+
 std::vector<FrameTime> RunFileReader::FrameTimes() const {
   std::vector<FrameTime> times;
+  if (!impl_->segments.empty()) {  // (ChainAccess::Open checked that each segment's frames follow the last's)
+    for (const auto& segment : impl_->segments) {
+      const std::vector<FrameTime> part = segment->FrameTimes();
+      if (!part.empty() && !times.empty() && !(part.front().time_s > times.back().time_s))
+        throw InputError(segment->file() + ": table frame_time, row frame " + std::to_string(part.front().frame) +
+                         ": time_s " + FormatNumber(part.front().time_s) + " s is not after the segment before it (" +
+                         FormatNumber(times.back().time_s) + " s; the run file is damaged)");
+      times.insert(times.end(), part.begin(), part.end());
+    }
+    return times;
+  }
   Statement s(*impl_->db, "SELECT frame, time_s FROM frame_time ORDER BY frame");
   s.Describe("frame_time", {0});
   while (s.Next()) {
@@ -505,6 +624,8 @@ std::vector<FrameTime> RunFileReader::FrameTimes() const {
 }
 
 struct PersonFrameStream::Impl {
+  std::vector<PersonFrameStream> parts;  // a run in segments: each one's stream, in order
+  std::size_t part = 0;
   std::unique_ptr<Statement> query;
   std::unique_ptr<PackedFrames> packed;  // a packed run's frames instead of `query`
   detail::PackedPeople people;
@@ -544,6 +665,9 @@ PersonFrameStream::~PersonFrameStream() = default;
 
 bool PersonFrameStream::Next(PersonFrame* out) {
   using namespace run_limits;
+  for (; impl_->part < impl_->parts.size(); ++impl_->part)
+    if (impl_->parts[impl_->part].Next(out)) return true;
+  if (!impl_->parts.empty()) return false;
   if (impl_->packed) {
     detail::PackedPeople& p = impl_->people;
     if (!impl_->packed->Next(&out->frame, &p)) return false;
@@ -584,6 +708,10 @@ bool PersonFrameStream::Next(PersonFrame* out) {
 
 PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
   PersonFrameStream stream;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) stream.impl_->parts.push_back(segment->PersonFrames(last_frame));
+    return stream;
+  }
   if (impl_->packed) {
     stream.impl_->packed = impl_->Packed(0, last_frame);
     return stream;
@@ -608,8 +736,11 @@ PersonFrameStream RunFileReader::PersonFrames(std::int64_t last_frame) const {
 }
 
 struct ContactFrameStream::Impl {
+  std::vector<ContactFrameStream> parts;  // a run in segments: each one's stream, in order
+  std::size_t part = 0;
   std::unique_ptr<Statement> query;
   bool have_row = false;
+  const std::set<std::int64_t>* dropped = nullptr;  // frames whose rows a later segment dropped
 };
 
 ContactFrameStream::ContactFrameStream() : impl_(std::make_unique<Impl>()) {}
@@ -617,18 +748,25 @@ ContactFrameStream::ContactFrameStream(ContactFrameStream&&) noexcept = default;
 ContactFrameStream::~ContactFrameStream() = default;
 
 bool ContactFrameStream::Next(std::int64_t* frame, std::vector<Contact>* out) {
-  if (!impl_->have_row) return false;
-  Statement& q = *impl_->query;
-  *frame = q.Int(0);
-  out->clear();
-  while (impl_->have_row && q.Int(0) == *frame) {
-    out->push_back(ReadContact(q));
-    impl_->have_row = q.Next();
+  for (; impl_->part < impl_->parts.size(); ++impl_->part)
+    if (impl_->parts[impl_->part].Next(frame, out)) return true;
+  if (!impl_->parts.empty()) return false;
+  for (;;) {
+    if (!impl_->have_row) return false;
+    Statement& q = *impl_->query;
+    *frame = q.Int(0);
+    out->clear();
+    while (impl_->have_row && q.Int(0) == *frame) {
+      out->push_back(ReadContact(q));
+      impl_->have_row = q.Next();
+    }
+    if (!(impl_->dropped && impl_->dropped->count(*frame))) return true;
   }
-  return true;
 }
 
 struct PersonLoadStream::Impl {
+  std::vector<PersonLoadStream> parts;  // a run in segments: each one's stream, in order
+  std::size_t part = 0;
   std::unique_ptr<Statement> query;
   std::unique_ptr<PackedFrames> packed;  // a packed run's frames instead of `query`
   detail::PackedPeople people;
@@ -641,6 +779,9 @@ PersonLoadStream::~PersonLoadStream() = default;
 
 bool PersonLoadStream::Next(std::int64_t* frame, std::vector<PersonLoad>* out) {
   using namespace run_limits;
+  for (; impl_->part < impl_->parts.size(); ++impl_->part)
+    if (impl_->parts[impl_->part].Next(frame, out)) return true;
+  if (!impl_->parts.empty()) return false;
   if (impl_->packed) {
     // The rows table person_load would hold: people with a load, frames with one.
     detail::PackedPeople& p = impl_->people;
@@ -669,6 +810,10 @@ bool RunFileReader::HasPersonLoads() const { return sqlite::HasTable(*impl_->db,
 
 PersonLoadStream RunFileReader::PersonLoads(std::int64_t last_frame) const {
   PersonLoadStream stream;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) stream.impl_->parts.push_back(segment->PersonLoads(last_frame));
+    return stream;
+  }
   if (impl_->packed) {
     stream.impl_->packed = impl_->Packed(0, last_frame);
     return stream;
@@ -682,6 +827,11 @@ PersonLoadStream RunFileReader::PersonLoads(std::int64_t last_frame) const {
 
 ContactFrameStream RunFileReader::ContactFrames(std::int64_t last_frame) const {
   ContactFrameStream stream;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) stream.impl_->parts.push_back(segment->ContactFrames(last_frame));
+    return stream;
+  }
+  if (!impl_->dropped.empty()) stream.impl_->dropped = &impl_->dropped;
   stream.impl_->query = std::make_unique<Statement>(
       *impl_->db, std::string(kContactColumns) + " FROM contact WHERE frame <= ?1 ORDER BY frame, rowid");
   stream.impl_->query->Bind(1, last_frame).Describe("contact", {0, 1});
@@ -695,14 +845,42 @@ bool RunFileReader::KeepsSomeContacts() const { return sqlite::HasTable(*impl_->
 
 std::vector<std::pair<std::int64_t, std::string>> RunFileReader::ContactKeptFrames() const {
   std::vector<std::pair<std::int64_t, std::string>> kept;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) {
+      const auto part = segment->ContactKeptFrames();
+      kept.insert(kept.end(), part.begin(), part.end());
+    }
+    return kept;
+  }
   if (!KeepsSomeContacts()) return kept;
   Statement s(*impl_->db, "SELECT frame, why FROM contact_kept ORDER BY frame");
   s.Describe("contact_kept", {0});
-  while (s.Next()) kept.emplace_back(s.Integer(0, 0, run_limits::kFrame), s.Text(1));
+  while (s.Next())
+    if (const std::int64_t frame = s.Integer(0, 0, run_limits::kFrame); !impl_->dropped.count(frame))
+      kept.emplace_back(frame, s.Text(1));
   return kept;
 }
 
 std::optional<ContactForceBins> RunFileReader::ContactForces(std::int64_t last_frame, std::size_t bins) const {
+  if (!impl_->segments.empty()) {
+    std::optional<ContactForceBins> sum;
+    for (const auto& segment : impl_->segments) {
+      const auto part = segment->ContactForces(last_frame, bins);
+      if (!part) continue;
+      if (!sum) {
+        sum = part;
+        continue;
+      }
+      if (part->total > 0 && sum->total > 0 && part->f0_n != sum->f0_n)
+        throw InputError(segment->file() + ": table contact_forces bins by " + FormatNumber(part->f0_n) +
+                         " N, the segment before it by " + FormatNumber(sum->f0_n) + " N (the run file is damaged)");
+      if (sum->total == 0) sum->f0_n = part->f0_n;
+      sum->zero += part->zero;
+      sum->total += part->total;
+      for (std::size_t b = 0; b < bins; ++b) sum->counts[b] += part->counts[b];
+    }
+    return sum;
+  }
   if (!sqlite::HasTable(*impl_->db, "contact_forces")) return std::nullopt;
   ContactForceBins sum;
   sum.counts.assign(bins, 0);
@@ -749,6 +927,12 @@ std::optional<ContactForceBins> RunFileReader::ContactForces(std::int64_t last_f
 }
 
 std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverlap() const {
+  if (!impl_->segments.empty()) {  // the largest; of equal ones the earliest
+    std::optional<LargestOverlap> best;
+    for (const auto& segment : impl_->segments)
+      if (const auto o = segment->LargestContactOverlap(); o && (!best || o->overlap_m > best->overlap_m)) best = o;
+    return best;
+  }
   // From the frames' briefs where the run has them (issue 66: every frame,
   // whether or not its contacts were written; the same contact as the scan
   // of table contact below finds: the largest, the earliest frame, the
@@ -767,9 +951,9 @@ std::optional<RunFileReader::LargestOverlap> RunFileReader::LargestContactOverla
 }
 
 std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
-  // Added in the order of frames and ids, from either storage, so that both
-  // give the same sums to the last bit (SQLite's SUM adds in an order its
-  // query plan chooses).
+  // Added in the order of frames and ids, from either storage and across
+  // segments, so that every way of writing a run gives the same sums to the
+  // last bit (SQLite's SUM adds in an order its query plan chooses).
   std::vector<std::int64_t> group;
   {
     Statement q(*impl_->db, "SELECT id, grp FROM person");
@@ -781,6 +965,13 @@ std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
     }
   }
   std::vector<Vec2> sums;
+  if (impl_->segments.empty()) ChainAccess::AddGroupVelocities(*this, group, sums);
+  for (const auto& segment : impl_->segments) ChainAccess::AddGroupVelocities(*segment, group, sums);
+  return sums;
+}
+
+void ChainAccess::AddGroupVelocities(const RunFileReader& r, const std::vector<std::int64_t>& group,
+                                     std::vector<Vec2>& sums) {
   const auto add = [&](std::int64_t id, Vec2 v) {
     if (id < 1 || static_cast<std::size_t>(id) > group.size()) return;
     const std::int64_t g = group[static_cast<std::size_t>(id - 1)];
@@ -788,21 +979,27 @@ std::vector<Vec2> RunFileReader::GroupVelocitySums() const {
     if (static_cast<std::size_t>(g) >= sums.size()) sums.resize(static_cast<std::size_t>(g) + 1);
     sums[static_cast<std::size_t>(g)] += v;
   };
-  if (impl_->packed) {
-    const std::unique_ptr<PackedFrames> frames = impl_->Packed(0, run_limits::kFrame);
+  if (r.impl_->packed) {
+    const std::unique_ptr<PackedFrames> frames = r.impl_->Packed(0, run_limits::kFrame);
     std::int64_t frame = 0;
     detail::PackedPeople p;
     while (frames->Next(&frame, &p))
       for (std::size_t k = 0; k < p.person.size(); ++k) add(std::int64_t{p.person[k]} + 1, p.velocity_m_per_s[k]);
-    return sums;
+    return;
   }
-  Statement q(*impl_->db, "SELECT id, vel_x, vel_y FROM person_state ORDER BY frame, id");
+  Statement q(*r.impl_->db, "SELECT id, vel_x, vel_y FROM person_state ORDER BY frame, id");
   while (q.Next()) add(q.Int(0), {q.Double(1), q.Double(2)});
-  return sums;
 }
 
 std::vector<Event> RunFileReader::Events() const {
   std::vector<Event> events;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) {
+      std::vector<Event> part = segment->Events();
+      events.insert(events.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
+    }
+    return events;
+  }
   Statement s(*impl_->db, "SELECT frame, rowid, time_s, kind, person, other, detail FROM event ORDER BY frame, rowid");
   s.Describe("event", {0, 1});
   while (s.Next()) {
@@ -819,6 +1016,13 @@ std::vector<Event> RunFileReader::Events() const {
 
 std::vector<CensusRow> RunFileReader::CensusRows() const {
   std::vector<CensusRow> rows;
+  if (!impl_->segments.empty()) {
+    for (const auto& segment : impl_->segments) {
+      const std::vector<CensusRow> part = segment->CensusRows();
+      rows.insert(rows.end(), part.begin(), part.end());
+    }
+    return rows;
+  }
   if (!sqlite::HasTable(*impl_->db, "census")) return rows;
   Statement s(*impl_->db,
               "SELECT frame, time_s, walking, fallen, removed, queued, entered FROM census ORDER BY frame");

@@ -115,12 +115,26 @@ void ForgetDerived(Database& db) {
   erase.Bind(1, std::string("derived_keys")).Run();
 }
 
-// The rows of these frames in tables contact and contact_kept.
-void DropContactRows(Database& db, const std::vector<std::int64_t>& frames) {
+// The rows of these frames in tables contact and contact_kept; in a
+// segment of a run, frames of the segments before it (at or before
+// `continues_at`) are listed in table contact_dropped instead (with the
+// frame at which they were dropped, undone by a resume before it), which
+// readers of the chain apply to them.
+void DropContactRows(Database& db, const std::vector<std::int64_t>& frames, std::int64_t continues_at,
+                     std::int64_t at_frame) {
   if (frames.empty()) return;
   Statement drop_rows(db, "DELETE FROM contact WHERE frame = ?");
   Statement drop_kept(db, "DELETE FROM contact_kept WHERE frame = ?");
+  std::unique_ptr<Statement> dropped;
   for (const std::int64_t d : frames) {
+    if (d <= continues_at) {
+      if (!dropped) {
+        db.Exec("CREATE TABLE IF NOT EXISTS contact_dropped(frame INTEGER PRIMARY KEY, at_frame INTEGER NOT NULL)");
+        dropped = std::make_unique<Statement>(db, "INSERT OR IGNORE INTO contact_dropped VALUES(?, ?)");
+      }
+      dropped->Bind(1, d).Bind(2, at_frame).Run();
+      continue;
+    }
     drop_rows.Bind(1, d).Run();
     drop_kept.Bind(1, d).Run();
   }
@@ -138,6 +152,8 @@ struct RunFileWriter::Impl {
   // has written (its first one, and every kKeyInterval-th, is a key frame).
   std::unique_ptr<detail::FramePacker> packer;
   std::int64_t packed_frames = 0;
+  std::int64_t continues_at = -1;  // a segment of a run: the last frame of the segments before it
+  std::int64_t last_frame = -1;    // the last frame written (or kept by a resume)
   std::int64_t geometry_hash = 0;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -std::numeric_limits<double>::infinity();
   double ymin = std::numeric_limits<double>::infinity(), ymax = -std::numeric_limits<double>::infinity();
@@ -202,6 +218,11 @@ RunFileWriter RunFileWriter::Create(const std::filesystem::path& file, const Run
   try {
     w.impl_->db = std::make_unique<Database>(file, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | kWriterMutexMode);
     Database& db = *w.impl_->db;
+    // A packed frame is a blob of a few kB to a few hundred: in SQLite's
+    // 4 kB pages a third of the file was the pages' unused ends (measured on
+    // the Madrid night: 64 bytes a person-frame in the file for 47 in the
+    // blobs); in 16 kB pages a few percent. Set before anything is written.
+    if (header.packed) db.Exec("PRAGMA page_size=16384");
     db.Exec(kJournal);
     db.Exec("PRAGMA synchronous=NORMAL");
     db.Exec("BEGIN");
@@ -290,6 +311,12 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
     if (sqlite::HasTable(db, table)) db.Exec(std::string("DELETE FROM ") + table + " WHERE frame > " + after);
   w.impl_->has_contact_summary = sqlite::HasTable(db, "contact_summary");
   if (w.impl_->has_contact_summary) db.Exec("DELETE FROM contact_summary WHERE frame > " + after);
+  {
+    Statement at(db, "SELECT value FROM run WHERE key = 'continues_at_frame'");
+    if (at.Next()) w.impl_->continues_at = std::strtoll(at.Text(0).c_str(), nullptr, 10);
+  }
+  if (sqlite::HasTable(db, "contact_dropped")) db.Exec("DELETE FROM contact_dropped WHERE at_frame > " + after);
+  w.impl_->last_frame = last_frame;
   const bool packed = sqlite::HasTable(db, "frame_pack");
   if (packed) {
     db.Exec("DELETE FROM frame_pack WHERE frame > " + after);
@@ -313,9 +340,60 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
   return w;
 }
 
+void RunFileWriter::StartSegment(const std::filesystem::path& file, const std::filesystem::path& previous,
+                                 std::int64_t at_frame) {
+  const RunFileReader before = RunFileReader::OneSegment(previous);
+  RunHeader header;
+  header.scenario_json = before.RunValue("scenario");
+  header.scenario_origin = before.RunValue("scenario_file");
+  header.venue_json = before.venue_json();
+  header.walkable_wkt = before.walkable_wkt();
+  header.periodic_box = before.periodic_box();
+  header.output_fps = before.fps();
+  header.time_step_s = before.RunNumber("time_step_s", 0.0, 0.0, 1e6);
+  header.seed = static_cast<std::uint64_t>(before.RunNumber("seed", 0.0, 0.0, 1.9e19));
+  header.packed = before.packed();
+  RunSetup setup;
+  setup.shapes = before.Shapes();
+  setup.people = before.People();
+  setup.walls = before.Walls();
+  // Its run values as they were (profile, people, ...), then the chain's.
+  std::vector<std::pair<std::string, std::string>> values;
+  {
+    const Database db(previous.string(), SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
+    Statement s(db, "SELECT key, value FROM run ORDER BY key");
+    while (s.Next()) values.emplace_back(s.Text(0), s.Text(1));
+  }
+  const std::string segment = std::to_string(static_cast<std::int64_t>(before.RunNumber("segment", 0.0, 0.0, 1e9)) + 1);
+  std::error_code ec;
+  const std::filesystem::path folder = std::filesystem::absolute(file, ec).parent_path();
+  std::string from = std::filesystem::absolute(previous, ec).lexically_relative(folder).string();
+  if (from.empty()) from = std::filesystem::absolute(previous, ec).string();
+  RunFileWriter w = Create(file, header, setup);
+  try {
+    Database& db = *w.impl_->db;
+    db.Exec("BEGIN");
+    Statement put(db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
+    for (const auto& [key, value] : values)
+      if (key != "status") put.Bind(1, key).Bind(2, value).Run();
+    ForgetDerived(db);  // (what an analysis stored describes the segment before)
+    put.Bind(1, std::string("continues")).Bind(2, from).Run();
+    put.Bind(1, std::string("continues_at_frame")).Bind(2, std::to_string(at_frame)).Run();
+    put.Bind(1, std::string("segment")).Bind(2, segment).Run();
+    put.Bind(1, std::string("status")).Bind(2, std::string("interrupted")).Run();
+    db.Exec("COMMIT");
+  } catch (...) {
+    w.impl_->db.reset();
+    std::filesystem::remove(file, ec);
+    sqlite::RemoveSidecars(file);
+    throw;
+  }
+}
+
 void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
   Database& db = *impl_->db;
   const std::int64_t frame = f.frame;
+  impl_->last_frame = frame;
   db.Exec("BEGIN");
   {
     if (!impl_->trajectory) {
@@ -396,7 +474,7 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
       db.Exec("CREATE TABLE IF NOT EXISTS contact_kept(frame INTEGER PRIMARY KEY, why TEXT NOT NULL)");
       db.Exec("CREATE TABLE IF NOT EXISTS contact_forces(frame INTEGER PRIMARY KEY, f0_n REAL NOT NULL, "
               "zero INTEGER NOT NULL, total INTEGER NOT NULL, bins TEXT NOT NULL)");
-      DropContactRows(db, f.drop_contacts_of);
+      DropContactRows(db, f.drop_contacts_of, impl_->continues_at, frame);
       if (f.with_contacts) {
         Statement kept(db, "INSERT INTO contact_kept VALUES(?, ?)");
         kept.Bind(1, frame).Bind(2, f.kept_because).Run();
@@ -440,7 +518,7 @@ void RunFileWriter::DropContacts(const std::vector<std::int64_t>& frames) {
   if (frames.empty()) return;
   Database& db = *impl_->db;
   db.Exec("BEGIN");
-  DropContactRows(db, frames);
+  DropContactRows(db, frames, impl_->continues_at, impl_->last_frame);
   db.Exec("COMMIT");
 }
 

@@ -19,6 +19,7 @@
 #include "crowdrecon/engine/simulation.hpp"
 #include "crowdrecon/engine/thread_governor.hpp"
 #include "crowdrecon/geometry/venue.hpp"
+#include "crowdrecon/runfile/sqlite.hpp"
 #include "crowdrecon/scenario/run_record.hpp"
 #include "crowdrecon/scenario/run_loop.hpp"
 #include "crowdrecon/scenario/world_builder.hpp"
@@ -436,6 +437,43 @@ double BranchRun(const Scenario& scenario, const std::filesystem::path& from, co
     throw;
   }
   return t_s;
+}
+
+double ContinueRun(const Scenario& scenario, const std::filesystem::path& from, const std::filesystem::path& output) {
+  const std::string name = from.string();
+  if (!runfile::IsRunFile(from))
+    throw InputError(name + ": " + runfile::DescribeNonRunFile(from) + ", not a crowdrecon run file (the segment to continue)");
+  std::error_code ec;
+  if (std::filesystem::equivalent(from, output, ec))
+    throw InputError(output.string() + ": is the segment to continue itself; a continuation is written into a new file");
+  const runfile::RunFileReader reader = runfile::RunFileReader::OneSegment(from);
+  const std::string status = reader.RunValue("status");
+  if (status != "interrupted")
+    throw InputError(name + ": its status is \"" + status + "\"; only a segment stopped at its checkpoint (status "
+                     "\"interrupted\": simulate --stop-after, or a run stopped with Ctrl-C or SIGTERM) can be continued" +
+                     (status == "running" ? " (a killed run: resume it first with --resume, then stop it)" : ""));
+  if (!std::filesystem::exists(CheckpointPath(from), ec))
+    throw InputError(name + ": has no checkpoint to continue from (" + CheckpointPath(from).string() + ")");
+  const Checkpoint c = ReadCheckpoint(CheckpointPath(from), ScenarioFingerprint(scenario));
+  const std::vector<runfile::FrameTime> times = reader.FrameTimes();
+  if (times.empty() || times.back().frame != c.last_frame)
+    throw InputError(name + ": its checkpoint is at frame " + std::to_string(c.last_frame) + ", but its last frame is " +
+                     (times.empty() ? std::string("none") : std::to_string(times.back().frame)) +
+                     " (the file and the checkpoint are not of one segment)");
+  const auto remove_output = [&] {
+    std::filesystem::remove(output, ec);
+    sqlite::RemoveSidecars(output);
+    std::filesystem::remove(CheckpointPath(output), ec);
+  };
+  remove_output();
+  try {
+    runfile::RunFileWriter::StartSegment(output, from, c.last_frame);
+    WriteCheckpoint(CheckpointPath(output), ScenarioFingerprint(scenario), c);
+  } catch (...) {
+    remove_output();
+    throw;
+  }
+  return times.back().time_s;
 }
 
 EngineAtCheckpoint ReadEngineAtCheckpoint(const Scenario& scenario, const std::filesystem::path& run_file, int threads) {

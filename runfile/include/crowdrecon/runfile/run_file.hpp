@@ -247,6 +247,16 @@ class RunFileWriter {
   // what was derived from the frames is dropped: tables metric_* and the run
   // values listed (a JSON list) under the run value "derived_keys".
   static RunFileWriter Resume(const std::filesystem::path& file, std::int64_t last_frame);
+  // Starts a new segment of run `previous` (issue 66: a long run continued
+  // into a new file, on another machine or day): `file` gets `previous`'s
+  // header (scenario, venue, shapes, people, walls, storage, run values) and
+  // no frame; run values continues (`previous`'s path from `file`'s
+  // folder), continues_at_frame (`previous`'s last frame, its checkpoint's)
+  // and segment (1 for the first continuation). Readers of `file` read the
+  // chain from its first segment as one run. Status "interrupted": the caller
+  // continues it with Resume(file, at_frame).
+  static void StartSegment(const std::filesystem::path& file, const std::filesystem::path& previous,
+                           std::int64_t at_frame);
   RunFileWriter(RunFileWriter&&) noexcept;
   RunFileWriter& operator=(RunFileWriter&&) noexcept;
   ~RunFileWriter();
@@ -403,9 +413,18 @@ class ContactFrameStream {
   std::unique_ptr<Impl> impl_;
 };
 
+// A run written in segments (simulate --continue-from; run value
+// `continues`) is read as one run from its last segment: the reader opens the
+// segments before it (each named by the next, relative to its folder) and
+// gives their frames, contacts, events and digest in order, as the run made
+// in one go; header values (scenario, people, shapes, walls) are the last
+// segment's, which are every segment's, and so are its status and run values.
 class RunFileReader {
  public:
   explicit RunFileReader(const std::filesystem::path& file);
+  // `file` alone, without the segments before it (its header, run values and
+  // own frames): to continue or check a segment whose predecessors are elsewhere.
+  static RunFileReader OneSegment(const std::filesystem::path& file);
   RunFileReader(RunFileReader&&) noexcept;
   ~RunFileReader();
 
@@ -475,8 +494,12 @@ class RunFileReader {
   std::vector<Wall> Walls() const;
   // Whether the people's frames are packed (table frame_pack).
   bool packed() const;
+  // The run's segment files, first to last (one: a run in one file).
+  std::vector<std::string> SegmentFiles() const;
 
  private:
+  friend struct ChainAccess;
+  RunFileReader(const std::filesystem::path& file, bool follow_segments);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -95,6 +95,17 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options);
 // that it may: CheckOutputs). Returns the checkpoint's time (s).
 double BranchRun(const Scenario& scenario, const std::filesystem::path& from, const std::filesystem::path& output);
 
+// A run continued into a new file (issue 66: a long run in segments, each
+// on whatever machine and day): writes `output` as the next segment of the
+// run `from` (runfile::RunFileWriter::StartSegment: its header, no frame,
+// run value continues naming `from`) with `from`'s checkpoint, so that
+// RunScenario with `resume` writes the frames after it there; readers read
+// the chain as one run, the same run as made in one go. `from` must be a
+// segment stopped at its checkpoint (status "interrupted", its last frame
+// the checkpoint's) of this very scenario (the checkpoint's fingerprint).
+// Returns the checkpoint's time (s).
+double ContinueRun(const Scenario& scenario, const std::filesystem::path& from, const std::filesystem::path& output);
+
 // The engine's world and its state at the checkpoint of an interrupted run
 // (CheckpointPath(run_file)), built as RunScenario builds them (the same
 // world, time step and state a resumed run continues from), with `threads`.
