@@ -14,6 +14,7 @@
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
+#include "crowdrecon/runfile/tables_export.hpp"
 #include "crowdrecon/runfile/trajectory_export.hpp"
 #include "crowdrecon/scenario/runner.hpp"
 
@@ -25,6 +26,7 @@ struct ExportArgs {
   std::string run_file;
   std::string output;
   bool force = false;
+  bool tables = false;  // --tables: the run as one run file with tables
 };
 
 // "x in [0, 12) m" for the periodic axes of `box`.
@@ -37,8 +39,8 @@ std::string DescribeSeams(const PeriodicBox& box) {
 }
 
 void RunExport(const ExportArgs& args) {
-  CheckOutputs({{"-o", args.output, runfile::TrajectoryExportOutput()}}, {{"the run file", args.run_file}},
-               args.force);
+  CheckOutputs({{"-o", args.output, args.tables ? runfile::RunFileOutput() : runfile::TrajectoryExportOutput()}},
+               {{"the run file", args.run_file}}, args.force);
   // Said here rather than as SQLite's "file is not a database".
   std::error_code ec;
   if (!std::filesystem::exists(args.run_file, ec))
@@ -47,6 +49,14 @@ void RunExport(const ExportArgs& args) {
     throw InputError(args.run_file + ": is " + runfile::DescribeNonRunFile(args.run_file) +
                      ", not a crowdrecon run file; expected a run file (.sqlite) written by `crowdrecon simulate`");
   const runfile::RunFileReader run(args.run_file);
+  if (args.tables) {
+    const runfile::TablesExportSummary t = runfile::WriteRunTables(run, args.output);
+    std::printf("run file with tables: %lld segment(s) joined, %lld packed frames unpacked (%lld people's rows)\n",
+                static_cast<long long>(t.segments), static_cast<long long>(t.frames), static_cast<long long>(t.rows));
+    std::printf("wrote %s\n", args.output.c_str());
+    SayIfUnfinished(args.run_file);
+    return;
+  }
   const runfile::ExportSummary s = runfile::ExportTrajectories(run, args.output);
   std::printf("export: %lld rows in %lld frames, %lld people\n", static_cast<long long>(s.rows),
               static_cast<long long>(s.frames), static_cast<long long>(s.people));
@@ -81,6 +91,10 @@ void RegisterExportCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->output,
                   "the trajectory file to write (.sqlite; an existing one must be a previous export)")
       ->required();
+  cmd->add_flag("--tables", args->tables,
+                "Write instead the whole run as one run file with tables (run.frames \"tables\"): packed frames "
+                "unpacked, a run in segments joined; for scripts that read the tables (docs/scenarios.md, "
+                "\"Packed frames\"); -o must not exist or be a run file");
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] { RunExport(*args); });
 }

@@ -301,10 +301,32 @@ def table_columns(path, table):
         con.close()
 
 
+# The tables a packed run file (run.frames "packed") leaves empty, holding its
+# people in table frame_pack instead (docs/scenarios.md, "Packed frames").
+PACKED_TABLES = ("trajectory_data", "person_state", "person_load")
+
+
 def check_run_file(path, tables=(), expected=None):
-    """A run file: an SQLite file whose `run` table exists (and the other tables the script reads)."""
-    return require_tables(path, ["run", *tables],
+    """A run file: an SQLite file whose `run` table exists (and the other tables the script reads).
+
+    A script reads the tables itself: a run whose frames are packed, or a
+    segment of a run in segments (its earlier frames in other files), is
+    refused with what to do instead."""
+    have = require_tables(path, ["run", *tables],
                           expected or "a crowdrecon run file (an SQLite file of `crowdrecon simulate`)")
+    con = open_readonly(path)
+    try:
+        continues = con.execute("SELECT value FROM run WHERE key = 'continues'").fetchone()
+    finally:
+        con.close()
+    if "frame_pack" in have and any(t in PACKED_TABLES for t in tables):
+        raise ScriptError(f"{path}: its people's frames are packed (run.frames \"packed\"; table frame_pack), which this "
+                          f"script does not read; give it the run with tables: crowdrecon export {path} -o RUN.sqlite "
+                          "--tables")
+    if continues:
+        raise ScriptError(f"{path}: is a segment of a run in segments (it continues {continues[0]}); this script "
+                          f"reads one file: give it the whole run: crowdrecon export {path} -o RUN.sqlite --tables")
+    return have
 
 
 def run_file(text):

@@ -60,6 +60,12 @@ expected=41
 [[ -z $lean ]] || expected=$(tr ',' '\n' <<< "$kept" | wc -l)
 (( drawn == expected )) || fail "render: $drawn frames drawn, expected $expected"
 
+# Unpacked into one file with tables: the packed run's digest.
+"$cr" export "$tmp/p/run.sqlite" -o "$tmp/unpacked.sqlite" --tables > /dev/null
+[[ $("$cr" analyze "$tmp/unpacked.sqlite" --digest) == "$digest_p" ]] || fail "export --tables differs"
+[[ $(sqlite3 "$tmp/unpacked.sqlite" "SELECT COUNT(*) FROM sqlite_master WHERE name = 'frame_pack'") == 0 ]] || fail "still packed"
+echo "export --tables: the same digest, with tables"
+
 # Stopped, then resumed from its checkpoint: the run made in one go.
 "$cr" simulate "$packed" -o "$tmp/r.sqlite" -q --stop-after 2.25 > /dev/null 2>&1 || true
 "$cr" simulate "$packed" -o "$tmp/r.sqlite" -q --resume

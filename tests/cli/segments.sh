@@ -6,7 +6,7 @@
 # table, value for value: also packed frames, and contacts kept at the worst
 # moment, whose superseded rows a later segment drops in an earlier one);
 # analyze, timeline, report, export and render read the last segment as the
-# whole run; a segment killed is resumed in place; and what cannot be a
+# whole run, and export --tables writes it as one file with the same digest; a segment killed is resumed in place; and what cannot be a
 # chain is refused: a missing segment, a complete run, another scenario, the
 # segment itself as the output.
 #   segments.sh CROWDRECON SCENARIO [OTHER_SCENARIO]
@@ -30,6 +30,10 @@ chain=$("$cr" analyze "$tmp/chain/run.sqlite" --digest)
 [[ $chain == "$whole" ]] || fail "the chain's digest differs from the whole run's: $chain / $whole"
 echo "three segments: the whole run's digest ($whole)"
 [[ $(sqlite3 "$tmp/chain/run.sqlite" "SELECT MIN(frame) FROM frame_time") -gt 30 ]] || fail "the last segment holds early frames"
+
+"$cr" export "$tmp/chain/run.sqlite" -o "$tmp/joined.sqlite" --tables > /dev/null
+[[ $("$cr" analyze "$tmp/joined.sqlite" --digest) == "$whole" ]] || fail "export --tables of the chain differs"
+echo "export --tables: one file, the whole run's digest"
 
 write_outputs "$cr" "$tmp/whole"
 write_outputs "$cr" "$tmp/chain"
