@@ -40,7 +40,6 @@ class SlopeTerm final : public BehaviourTerm {
   // (An empty region: the whole floor.)
   static bool OnSlope(const FloorSlope& slope, Vec2 x) { return slope.region.empty() || PointInPolygon(slope.region, x); }
   bool held_;
-  double pull_per_kg_;
 };
 
 }  // namespace
