@@ -251,6 +251,28 @@ RunFileReader::RunFileReader(const std::filesystem::path& file, bool follow_segm
 
 bool RunFileReader::packed() const { return impl_->packed; }
 
+RunHeader RunFileReader::Header() const {
+  RunHeader header;
+  header.scenario_json = RunValue("scenario");
+  header.scenario_origin = RunValue("scenario_file");
+  header.venue_json = venue_json();
+  header.walkable_wkt = walkable_wkt();
+  header.periodic_box = periodic_box();
+  header.output_fps = fps();
+  header.time_step_s = RunNumber("time_step_s", 0.0, 0.0, 1e6);
+  header.seed = static_cast<std::uint64_t>(RunNumber("seed", 0.0, 0.0, 1.9e19));
+  header.packed = packed();
+  return header;
+}
+
+RunSetup RunFileReader::Setup() const {
+  RunSetup setup;
+  setup.shapes = Shapes();
+  setup.people = People();
+  setup.walls = Walls();
+  return setup;
+}
+
 std::vector<std::string> RunFileReader::SegmentFiles() const {
   if (impl_->segments.empty()) return {impl_->file};
   std::vector<std::string> files;

@@ -343,20 +343,8 @@ RunFileWriter RunFileWriter::Resume(const std::filesystem::path& file, std::int6
 void RunFileWriter::StartSegment(const std::filesystem::path& file, const std::filesystem::path& previous,
                                  std::int64_t at_frame) {
   const RunFileReader before = RunFileReader::OneSegment(previous);
-  RunHeader header;
-  header.scenario_json = before.RunValue("scenario");
-  header.scenario_origin = before.RunValue("scenario_file");
-  header.venue_json = before.venue_json();
-  header.walkable_wkt = before.walkable_wkt();
-  header.periodic_box = before.periodic_box();
-  header.output_fps = before.fps();
-  header.time_step_s = before.RunNumber("time_step_s", 0.0, 0.0, 1e6);
-  header.seed = static_cast<std::uint64_t>(before.RunNumber("seed", 0.0, 0.0, 1.9e19));
-  header.packed = before.packed();
-  RunSetup setup;
-  setup.shapes = before.Shapes();
-  setup.people = before.People();
-  setup.walls = before.Walls();
+  const RunHeader header = before.Header();
+  const RunSetup setup = before.Setup();
   // Its run values as they were (profile, people, ...), then the chain's.
   std::vector<std::pair<std::string, std::string>> values;
   {

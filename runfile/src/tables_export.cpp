@@ -42,19 +42,9 @@ TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesyst
   try {
     {  // The header as the run's, no frame.
       const RunFileReader last = RunFileReader::OneSegment(segments.back());
-      RunHeader header;
-      header.scenario_json = last.RunValue("scenario");
-      header.scenario_origin = last.RunValue("scenario_file");
-      header.venue_json = last.venue_json();
-      header.walkable_wkt = last.walkable_wkt();
-      header.periodic_box = last.periodic_box();
-      header.output_fps = last.fps();
-      header.time_step_s = last.RunNumber("time_step_s", 0.0, 0.0, 1e6);
-      header.seed = static_cast<std::uint64_t>(last.RunNumber("seed", 0.0, 0.0, 1.9e19));
-      RunSetup setup;
-      setup.shapes = last.Shapes();
-      setup.people = last.People();
-      setup.walls = last.Walls();
+      RunHeader header = last.Header();
+      header.packed = false;
+      const RunSetup setup = last.Setup();
       (void)RunFileWriter::Create(partial, header, setup);
     }
     Database db(partial.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX);

@@ -496,6 +496,11 @@ class RunFileReader {
   bool packed() const;
   // The run's segment files, first to last (one: a run in one file).
   std::vector<std::string> SegmentFiles() const;
+  // What RunFileWriter::Create wrote of the run before its first frame
+  // (header: its storage included; setup: shapes, people, walls), to write
+  // another file of the same run (a segment, the run with tables).
+  RunHeader Header() const;
+  RunSetup Setup() const;
 
  private:
   friend struct ChainAccess;
