@@ -20,10 +20,6 @@ constexpr unsigned char kMagic = 'P';
 constexpr unsigned kKeyFlag = 1, kLoadsFlag = 2;
 constexpr int kZstdLevel = 3;
 
-// SQLite stores -0.0 in a REAL column as 0: the pack does the same, so that
-// both storages give the same numbers.
-double AsStored(double v) { return v == 0.0 ? 0.0 : v; }
-
 void PutVarint(std::string& out, std::uint64_t v) {
   while (v >= 0x80) {
     out.push_back(static_cast<char>((v & 0x7f) | 0x80));

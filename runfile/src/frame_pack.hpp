@@ -27,6 +27,7 @@
 // a writer writes, e.g. after a resume).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -43,6 +44,13 @@ using ZSTD_DCtx = ZSTD_DCtx_s;
 namespace crowdrecon::runfile::detail {
 
 inline constexpr int kPackVersion = 1;
+
+// A number as a REAL column of SQLite gives it back (-0 as 0): the pack
+// stores numbers so, and a reader of packed frames gives them so.
+inline double AsStored(double v) { return v == 0.0 ? 0.0 : v; }
+// The direction the chest faces, as table trajectory_data holds it
+// (ori_x, ori_y) for `angle`: every writer and reader of that table.
+inline Vec2 OrientationOf(double angle) { return {AsStored(std::cos(angle)), AsStored(std::sin(angle))}; }
 inline constexpr std::int64_t kKeyInterval = 64;  // frames
 
 // The people of one frame as the pack holds them.

@@ -91,8 +91,6 @@ class PackedFrames {
   detail::FrameUnpacker unpacker_;
 };
 
-// SQLite's REAL columns give -0.0 back as 0 (frame_pack.cpp's AsStored).
-double AsStored(double v) { return v == 0.0 ? 0.0 : v; }
 
 }  // namespace
 
@@ -158,8 +156,14 @@ struct RunFileReader::Impl {
 // share (run_file.hpp: RunFileReader).
 struct ChainAccess {
   static void Open(RunFileReader& last, const std::filesystem::path& file) {
+    // Each segment's first and last frame (-1 for none), read once.
+    const auto range_of = [](const std::vector<FrameTime>& times) {
+      return times.empty() ? std::pair<std::int64_t, std::int64_t>{-1, -1}
+                           : std::pair<std::int64_t, std::int64_t>{times.front().frame, times.back().frame};
+    };
     std::vector<std::unique_ptr<RunFileReader>> chain;
     chain.push_back(std::unique_ptr<RunFileReader>(new RunFileReader(file, false)));
+    std::vector<std::pair<std::int64_t, std::int64_t>> ranges = {range_of(chain.back()->FrameTimes())};
     std::set<std::string> seen;
     std::error_code ec;
     seen.insert(std::filesystem::weakly_canonical(file, ec).string());
@@ -188,8 +192,10 @@ struct ChainAccess {
       if (segment->RunValue("scenario") != after.RunValue("scenario"))
         throw InputError(after.file() + ": continues " + path.string() + ", which is a run of another scenario");
       chain.push_back(std::move(segment));
+      ranges.push_back(range_of(times));
     }
     std::reverse(chain.begin(), chain.end());
+    std::reverse(ranges.begin(), ranges.end());
     // A later segment's dropped contact rows (superseded worst moments) are
     // of the segments before it.
     std::set<std::int64_t> later;
@@ -201,15 +207,15 @@ struct ChainAccess {
       }
     }
     std::int64_t previous_last = -1;
-    for (const auto& segment : chain) {
-      const std::vector<FrameTime> times = segment->FrameTimes();
-      if (!times.empty() && times.front().frame <= previous_last)
-        throw InputError(segment->file() + ": its first frame " + std::to_string(times.front().frame) +
+    for (std::size_t i = 0; i < chain.size(); ++i) {
+      const auto [first, end] = ranges[i];
+      if (first >= 0 && first <= previous_last)
+        throw InputError(chain[i]->file() + ": its first frame " + std::to_string(first) +
                          " is not after the last of the segment before it (" + std::to_string(previous_last) +
                          "; the run file is damaged)");
-      last.impl_->ranges.emplace_back(times.empty() ? -1 : times.front().frame, times.empty() ? -1 : times.back().frame);
-      if (!times.empty()) previous_last = times.back().frame;
+      if (first >= 0) previous_last = end;
     }
+    last.impl_->ranges = std::move(ranges);
     last.impl_->segments = std::move(chain);
   }
 
@@ -438,7 +444,7 @@ RunFrame RunFileReader::Frame(std::int64_t frame) const {
     for (std::size_t k = 0; k < p.person.size(); ++k) {
       f.ids.push_back(std::int64_t{p.person[k]} + 1);
       f.position_m.push_back(p.position_m[k]);
-      f.orientation.push_back({AsStored(std::cos(p.angle_rad[k])), AsStored(std::sin(p.angle_rad[k]))});
+      f.orientation.push_back(detail::OrientationOf(p.angle_rad[k]));
     }
   }
   Statement s(*impl_->db,
@@ -571,8 +577,9 @@ void ChainAccess::DigestRows(const RunFileReader& r, Sha256& hash, const std::st
         if (name == "trajectory_data") {
           real(row, p.position_m[k].x);
           real(row, p.position_m[k].y);
-          real(row, AsStored(std::cos(p.angle_rad[k])));
-          real(row, AsStored(std::sin(p.angle_rad[k])));
+          const Vec2 ori = detail::OrientationOf(p.angle_rad[k]);
+          real(row, ori.x);
+          real(row, ori.y);
         } else if (name == "person_state") {
           real(row, p.velocity_m_per_s[k].x);
           real(row, p.velocity_m_per_s[k].y);

@@ -422,7 +422,8 @@ void RunFileWriter::WriteFrame(const FrameSnapshot& f) {
       const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
       const Vec2 x = f.position_m[k];
       const double angle = f.angle_rad[k];
-      traj.Add(frame).Add(id).Add(x.x).Add(x.y).Add(std::cos(angle)).Add(std::sin(angle));
+      const Vec2 ori = detail::OrientationOf(angle);
+      traj.Add(frame).Add(id).Add(x.x).Add(x.y).Add(ori.x).Add(ori.y);
       state.Add(frame).Add(id)
           .Add(f.velocity_m_per_s[k].x).Add(f.velocity_m_per_s[k].y)
           .Add(angle).Add(f.angular_velocity_rad_per_s[k])

@@ -8,6 +8,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/runfile/sqlite.hpp"
+#include "frame_pack.hpp"
 
 namespace crowdrecon::runfile {
 
@@ -92,7 +93,8 @@ TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesyst
         for (std::size_t k = 0; k < f.person.size(); ++k) {
           const auto id = static_cast<std::int64_t>(f.person[k]) + 1;
           const double angle = f.angle_rad[k];
-          traj.Add(f.frame).Add(id).Add(f.position_m[k].x).Add(f.position_m[k].y).Add(std::cos(angle)).Add(std::sin(angle));
+          const Vec2 ori = detail::OrientationOf(angle);
+          traj.Add(f.frame).Add(id).Add(f.position_m[k].x).Add(f.position_m[k].y).Add(ori.x).Add(ori.y);
           state.Add(f.frame).Add(id).Add(f.velocity_m_per_s[k].x).Add(f.velocity_m_per_s[k].y).Add(angle)
               .Add(f.angular_velocity_rad_per_s[k]).Add(static_cast<std::int64_t>(f.state[k])).Add(f.load_n[k]);
           ++summary.rows;
