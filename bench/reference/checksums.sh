@@ -15,7 +15,9 @@
 # gives other tables), the timeline a group's own back force and arrivals;
 # hallway-validated and door-validated run the profile validated (anticipation
 # by time to collision across a periodic boundary and among walls, yielding,
-# gait jitter): they change when that profile's values change.
+# gait jitter), timeline-validated with arrivals into empty slots (the
+# neighbour stage's list at a placement, ListComebacks): they change when
+# that profile's values change.
 # checksums.txt holds the values of the current model: a change of physics
 # changes them on purpose (then regenerate it and say so in the commit); a
 # change of structure must not.

@@ -77,7 +77,8 @@ struct NeighbourList {
 };
 
 // Calls visit(j) for each of person i's candidates that is in the venue
-// (walking or fallen: the list holds every slot, removed ones too), in the
+// (walking or fallen: the list holds those in the venue at its build and
+// those come back since; some may have left), in the
 // list's order (so that sums are the same on any thread count).
 template <class BodyStateT, class Visit>
 void ForEachNeighbour(const NeighbourList& list, const BodyStateT& bodies, std::size_t i, Visit&& visit) {

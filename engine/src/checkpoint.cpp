@@ -369,6 +369,7 @@ void Simulation::LoadState(const std::string& data) {
   in_->pairs_valid = false;  // rebuilt on the next step; results do not depend on when
   in_->cuda_has_history = false;  // the device's last contacts are not these
   PlaceShapes();  // orientations of the restored angles (Drive reads them)
+  ListComebacks();  // the people in slots that were empty at the neighbour list's build
 }
 
 }  // namespace crowdrecon::engine

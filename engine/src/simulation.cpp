@@ -333,6 +333,7 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
   // after each exit measured every pair afresh: in the evacuation, whose
   // people leave about 60 times a second, one step in 31.
   if (before == PersonState::kRemoved) in_->pairs_valid = false;
+  if (before == PersonState::kRemoved && state != PersonState::kRemoved) ListComebacks();
 }
 
 // ---------------------------------------------------------------------------
@@ -395,6 +396,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
   for (BehaviourTerm* t : in.terms.stateful) t->Place(slot, bodies_);
   in.pairs_valid = false;
   in.cuda_has_history = false;
+  ListComebacks();
   Drive();  // the newcomer's own forces enter the current evaluation (the others' are unchanged)
 }
 

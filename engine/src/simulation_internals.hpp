@@ -283,8 +283,11 @@ struct Simulation::Internals {
   std::vector<double> held_back_n;
   // The neighbour stage's list (empty unless a term asks for neighbours),
   // with the positions at its build and the skin its candidates carry.
+  // Which slots are candidates in it (those in the venue at its build and
+  // those come back since: Simulation::ListComebacks).
   detail::NeighbourList neighbours;
   std::vector<Vec2> neighbours_position_at_build;
+  std::vector<std::uint8_t> neighbours_listed;
   double requested_neighbour_radius_m = 0.0;  // Simulation::RequestNeighbours
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.

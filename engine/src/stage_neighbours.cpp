@@ -9,12 +9,20 @@
 // The list is a Verlet list of its own: candidates within radius + skin of
 // each person, found with a grid of cells of that size (minimum image in a
 // periodic box), and kept until someone has moved half the skin since it
-// was built; a term measures the distance itself. Every slot is listed,
-// whatever its state (a term reads the state), and a newcomer's slot moves
-// far, which rebuilds the list. Candidates are a superset of the people
-// within the radius whenever the list is used, so when it is rebuilt changes
-// no result; the list is built in one serial pass in a fixed order (the
-// same on any thread count) and is not in the checkpoint. When a term asks
+// was built; a term measures the distance itself. Every slot has a list;
+// its candidates are the slots in the venue at the build (a term reads their
+// state: someone may have left since), not the empty ones, which the
+// scenarios park together by the hundred (listing them cost most of a
+// night's engine time). A slot filled between builds (Spawn, a state set
+// back, a checkpoint loaded) is listed at once where it would have been as
+// a candidate at the build's positions (ListComebacks): the drive evaluated
+// at a placement, before the next build, sees the same candidates as when
+// every slot was listed, so the runs are those of then, bit for bit. A
+// newcomer's slot moves far, which rebuilds the list at the next step.
+// Candidates are a superset of the people within the radius whenever the
+// list is used by a step, so when it is rebuilt changes no result; the list
+// is built in one serial pass in a fixed order (the same on any thread
+// count) and is not in the checkpoint. When a term asks
 // for a near list (a shorter radius it needs at every step), the list's
 // candidates within the near radius + skin are kept as a second list, built
 // and kept valid with the first.
@@ -76,6 +84,74 @@ GridAxis Axis(bool periodic, double box_min, double box_max, double low, double 
   return a;
 }
 
+// The list of every slot's candidates: the slots `eligible` within `radius`
+// + the skin of it at the positions `at` (each slot has a list, eligible or
+// not; the candidates of each in increasing index), and the near list.
+void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, const std::vector<std::uint8_t>& eligible,
+                        double radius, double near_radius, NeighbourList& list) {
+  const std::size_t n = at.size();
+  const double reach = radius + kNeighbourSkin_m;
+  Vec2 low{0.0, 0.0}, high{0.0, 0.0};
+  if (n > 0) low = high = at[0];
+  for (const Vec2& x : at) {
+    low = {std::min(low.x, x.x), std::min(low.y, x.y)};
+    high = {std::max(high.x, x.x), std::max(high.y, x.y)};
+  }
+  const auto most = static_cast<std::int64_t>(std::sqrt(4.0 * static_cast<double>(n))) + 1;
+  const GridAxis ax = Axis(box.x, box.min_m.x, box.max_m.x, low.x, high.x, reach, most);
+  const GridAxis ay = Axis(box.y, box.min_m.y, box.max_m.y, low.y, high.y, reach, most);
+  // The eligible slots by cell (counting sort: within a cell in increasing
+  // index); every slot's cell, for its own list.
+  std::vector<std::uint32_t> cell_start(static_cast<std::size_t>(ax.count * ay.count) + 1, 0), cell_items;
+  std::vector<std::uint32_t> cell_of(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    cell_of[i] = static_cast<std::uint32_t>(ay.Cell(at[i].y) * ax.count + ax.Cell(at[i].x));
+    if (eligible[i]) ++cell_start[cell_of[i] + 1];
+  }
+  for (std::size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
+  cell_items.resize(cell_start.back());
+  {
+    std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      if (eligible[i]) cell_items[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  list.radius_m = radius;
+  list.start.assign(n + 1, 0);
+  list.items.clear();
+  list.near_radius_m = near_radius;
+  list.near_start.assign(near_radius > 0.0 ? n + 1 : 0, 0);
+  list.near_items.clear();
+  const double reach2 = reach * reach;
+  const double near_reach2 = (near_radius + kNeighbourSkin_m) * (near_radius + kNeighbourSkin_m);
+  std::vector<std::uint32_t> mine;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 x = at[i];
+    std::int64_t cx[3], cy[3];
+    const int mx = ax.Around(ax.Cell(x.x), cx), my = ay.Around(ay.Cell(x.y), cy);
+    mine.clear();
+    for (int a = 0; a < my; ++a)
+      for (int b = 0; b < mx; ++b) {
+        const auto c = static_cast<std::size_t>(cy[a] * ax.count + cx[b]);
+        for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
+          const std::uint32_t j = cell_items[k];
+          if (j == i) continue;
+          const Vec2 d = detail::Separation(box, x, at[j]);
+          if (Dot(d, d) <= reach2) mine.push_back(j);
+        }
+      }
+    std::sort(mine.begin(), mine.end());
+    list.items.insert(list.items.end(), mine.begin(), mine.end());
+    list.start[i + 1] = static_cast<std::uint32_t>(list.items.size());
+    if (near_radius > 0.0) {
+      for (const std::uint32_t j : mine) {
+        const Vec2 d = detail::Separation(box, x, at[j]);
+        if (Dot(d, d) <= near_reach2) list.near_items.push_back(j);
+      }
+      list.near_start[i + 1] = static_cast<std::uint32_t>(list.near_items.size());
+    }
+  }
+}
+
 }  // namespace
 
 void Simulation::Neighbours() {
@@ -97,67 +173,26 @@ void Simulation::Neighbours() {
       valid = Length(detail::Separation(def_.periodic, bodies_.position_m[i], in.neighbours_position_at_build[i])) <= half_skin;
     if (valid) return;
   }
-  const double reach = radius + kNeighbourSkin_m;
-  Vec2 low{0.0, 0.0}, high{0.0, 0.0};
-  if (n > 0) low = high = bodies_.position_m[0];
-  for (const Vec2& x : bodies_.position_m) {
-    low = {std::min(low.x, x.x), std::min(low.y, x.y)};
-    high = {std::max(high.x, x.x), std::max(high.y, x.y)};
-  }
-  const PeriodicBox& box = def_.periodic;
-  const auto most = static_cast<std::int64_t>(std::sqrt(4.0 * static_cast<double>(n))) + 1;
-  const GridAxis ax = Axis(box.x, box.min_m.x, box.max_m.x, low.x, high.x, reach, most);
-  const GridAxis ay = Axis(box.y, box.min_m.y, box.max_m.y, low.y, high.y, reach, most);
-  // People by cell (counting sort: within a cell in increasing index).
-  std::vector<std::uint32_t> cell_start(static_cast<std::size_t>(ax.count * ay.count) + 1, 0), cell_items(n);
-  std::vector<std::uint32_t> cell_of(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 x = bodies_.position_m[i];
-    cell_of[i] = static_cast<std::uint32_t>(ay.Cell(x.y) * ax.count + ax.Cell(x.x));
-    ++cell_start[cell_of[i] + 1];
-  }
-  for (std::size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
-  {
-    std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) cell_items[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
-  }
-  NeighbourList& list = in.neighbours;
-  list.radius_m = radius;
-  list.start.assign(n + 1, 0);
-  list.items.clear();
-  list.near_radius_m = near_radius;
-  list.near_start.assign(near_radius > 0.0 ? n + 1 : 0, 0);
-  list.near_items.clear();
-  const double reach2 = reach * reach;
-  const double near_reach2 = (near_radius + kNeighbourSkin_m) * (near_radius + kNeighbourSkin_m);
-  std::vector<std::uint32_t> mine;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 x = bodies_.position_m[i];
-    std::int64_t cx[3], cy[3];
-    const int mx = ax.Around(ax.Cell(x.x), cx), my = ay.Around(ay.Cell(x.y), cy);
-    mine.clear();
-    for (int a = 0; a < my; ++a)
-      for (int b = 0; b < mx; ++b) {
-        const auto c = static_cast<std::size_t>(cy[a] * ax.count + cx[b]);
-        for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
-          const std::uint32_t j = cell_items[k];
-          if (j == i) continue;
-          const Vec2 d = detail::Separation(box, x, bodies_.position_m[j]);
-          if (Dot(d, d) <= reach2) mine.push_back(j);
-        }
-      }
-    std::sort(mine.begin(), mine.end());
-    list.items.insert(list.items.end(), mine.begin(), mine.end());
-    list.start[i + 1] = static_cast<std::uint32_t>(list.items.size());
-    if (near_radius > 0.0) {
-      for (const std::uint32_t j : mine) {
-        const Vec2 d = detail::Separation(box, x, bodies_.position_m[j]);
-        if (Dot(d, d) <= near_reach2) list.near_items.push_back(j);
-      }
-      list.near_start[i + 1] = static_cast<std::uint32_t>(list.near_items.size());
-    }
-  }
+  in.neighbours_listed.resize(n);
+  for (std::size_t i = 0; i < n; ++i) in.neighbours_listed[i] = bodies_.state[i] != PersonState::kRemoved;
+  BuildNeighbourList(def_.periodic, bodies_.position_m, in.neighbours_listed, radius, near_radius, in.neighbours);
   in.neighbours_position_at_build = bodies_.position_m;
+}
+
+void Simulation::ListComebacks() {
+  Internals& in = *in_;
+  const std::size_t n = bodies_.size();
+  if (in.neighbours.empty() || in.neighbours_position_at_build.size() != n || in.neighbours_listed.size() != n) return;
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!in.neighbours_listed[i] && bodies_.state[i] != PersonState::kRemoved) {
+      in.neighbours_listed[i] = 1;
+      any = true;
+    }
+  if (!any) return;
+  ScopedTimer timer(profile_.stage_s[Index(Stage::kNeighbours)]);
+  BuildNeighbourList(def_.periodic, in.neighbours_position_at_build, in.neighbours_listed, in.neighbours.radius_m,
+                     in.neighbours.near_radius_m, in.neighbours);
 }
 
 void Simulation::RequestNeighbours(double radius_m) {

@@ -168,6 +168,34 @@ TEST(NeighbourStage, PeopleFarApartNeedNoMoreCellsThanPeople) {
   EXPECT_TRUE(sim.NeighboursWithin(2, 1.0).empty());
 }
 
+// Empty slots (parked together by the hundred in a timeline's engine) are
+// nobody's candidates; a slot filled between builds is listed at once where
+// it was at the build (so that a drive evaluated at a placement sees what it
+// saw when every slot was listed: bench/reference's timeline-validated), and
+// where it is now from the next build on.
+TEST(NeighbourStage, EmptySlotsAreNobodysCandidatesAndSlotsFilledAgainAreListedAtOnce) {
+  WorldDef def = Walkers(ModelParameters{}, 2);
+  def.periodic = PeriodicBox{};
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[1].position_m = {1.0, 0.5};
+  def.people[2].position_m = {0.5, -0.6};  // parked beside person 0
+  def.people[3].position_m = {8.0, 8.0};   // parked far away
+  def.people[2].state = def.people[3].state = PersonState::kRemoved;
+  PersonDef newcomer = def.people[0];
+  Simulation sim(def);
+  sim.RequestNeighbours(2.0);
+  using Ids = std::vector<std::uint32_t>;
+  EXPECT_EQ(sim.NeighboursWithin(0, 2.0), (Ids{1}));
+  sim.SetPersonState(2, PersonState::kWalking);  // back where they were parked: no rebuild
+  EXPECT_EQ(sim.NeighboursWithin(0, 2.0), (Ids{1, 2}));
+  newcomer.position_m = {0.2, 0.9};
+  sim.Spawn(3, newcomer, 3);  // far from the build's place of slot 3: not yet person 0's candidate
+  EXPECT_EQ(sim.NeighboursWithin(0, 2.0), (Ids{1, 2}));
+  sim.AdvanceTo(1e-3);  // the newcomer moved far since the build: rebuilt
+  EXPECT_EQ(sim.NeighboursWithin(0, 2.0), (Ids{1, 2, 3}));
+  EXPECT_EQ(sim.NeighboursWithin(3, 2.0), BruteForceWithin(sim, 3, 2.0));
+}
+
 TEST(NeighbourStage, CostsNothingAndListsNothingWhenNoTermAsks) {
   Simulation sim(Walkers(ModelParameters{}));
   sim.AdvanceTo(0.05);

@@ -233,6 +233,7 @@ class Simulation {
   void Drive();
   void UpdateBehaviourTerms();  // after each step (stage_drive.cpp)
   void Neighbours();
+  void ListComebacks();  // empty slots filled since the neighbour list's build (stage_neighbours.cpp)
   void ComputeForces();
   void VerletKickDrift();
   void VerletKick();
