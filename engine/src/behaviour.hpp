@@ -143,7 +143,9 @@ struct StepInputs {
 
 class BehaviourTerm {
  public:
-  enum Phase : unsigned { kDirection = 1u, kDesire = 2u, kFacing = 4u, kForce = 8u, kAfterStep = 16u, kSteer = 32u };
+  enum Phase : unsigned {
+    kDirection = 1u, kDesire = 2u, kFacing = 4u, kForce = 8u, kAfterStep = 16u, kSteer = 32u, kPrepare = 64u
+  };
   virtual ~BehaviourTerm() = default;
   // The phases it takes part in (a sum of Phase).
   virtual unsigned phases() const = 0;
@@ -155,6 +157,9 @@ class BehaviourTerm {
   // list; 0: none; at most neighbour_radius_m).
   virtual double near_radius_m() const { return 0.0; }
 
+  // Before the blocks of an evaluation, once, serially: what the blocks
+  // share (a copy of the people's state laid out for the term's loops).
+  virtual void Prepare(const DriveInputs&) const {}
   virtual void Direction(const DriveInputs&, DriveBlock&) const {}
   virtual void Steer(const DriveInputs&, DriveBlock&) const {}
   virtual void Desire(const DriveInputs&, DriveBlock&) const {}
@@ -200,7 +205,7 @@ struct ActiveTerms {
     std::unique_ptr<BehaviourTerm> term;
   };
   std::vector<Active> terms;
-  std::vector<const BehaviourTerm*> direction, steer, desire, facing, force;
+  std::vector<const BehaviourTerm*> prepare, direction, steer, desire, facing, force;
   std::vector<BehaviourTerm*> after_step, stateful;
   std::vector<const char*> stateful_names;
   bool people_ahead = false;

@@ -68,6 +68,7 @@ void Simulation::Drive() {
   const DriveInputs inputs{bodies_,        def_,          1.0 / mp.relaxation_time_s, in.drive_time_s,
                            in.cos_angle,   in.sin_angle,  in.held_back_n,             in.group_gamma,
                            in.group_lambda, in.neighbours};
+  for (const BehaviourTerm* t : terms.prepare) t->Prepare(inputs);
   std::vector<geometry::NavigationField::CellCache>& field_cache = in.field_cache;
   const std::int64_t n = static_cast<std::int64_t>(bodies_.size());
   constexpr auto kBlock = static_cast<std::int64_t>(kDriveBlock);

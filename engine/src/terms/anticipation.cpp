@@ -52,10 +52,87 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define CROWDRECON_WIDE_FILTER 1
+#endif
 
 #include "../behaviour.hpp"
 
 namespace crowdrecon::engine::detail {
+namespace {
+
+bool wide_allowed = true;
+
+// A person as the pair loops read them: position, velocity and bounding
+// radius in one cache line (a copy made for each evaluation; x NaN for an
+// empty slot: it then fails the wide filter's test, as the scalar loop
+// skips it).
+struct alignas(64) Candidate {
+  double x, y, vx, vy, bound, unused[3];
+};
+
+#ifdef CROWDRECON_WIDE_FILTER
+// MinimumImage, four at a time: |d| > p/2 ? d - p * nearbyint(d / p) : d.
+__attribute__((target("avx2"), always_inline)) inline __m256d MinimumImageWide(__m256d d, __m256d p, __m256d half) {
+  const __m256d far = _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), d), half, _CMP_GT_OQ);
+  const __m256d k = _mm256_round_pd(_mm256_div_pd(d, p), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  return _mm256_blendv_pd(d, _mm256_sub_pd(d, _mm256_mul_pd(p, k)), far);
+}
+
+// The candidates of person i (at xi, moving at vi, bounding radius ri) among
+// items[m, end) that would collide, while four are left (m is advanced; the
+// caller tests the last few one at a time): Approaching's test, four at a
+// time (AVX2), with the same IEEE operations in the same order (no fused
+// multiply-add): the same picks, bit for bit. Their indices are appended to
+// hits[count..] in the list's order; returns the new count.
+__attribute__((target("avx2"))) std::uint32_t PickCollidingWide(const Candidate* q, const PeriodicBox& box,
+                                                                 const std::uint32_t* items, std::uint32_t& m,
+                                                                 std::uint32_t end, Vec2 xi, Vec2 vi, double ri,
+                                                                 double radius, std::uint32_t* hits,
+                                                                 std::uint32_t count) {
+  const __m256d xix = _mm256_set1_pd(xi.x), xiy = _mm256_set1_pd(xi.y);
+  const __m256d vix = _mm256_set1_pd(vi.x), viy = _mm256_set1_pd(vi.y);
+  const __m256d rib = _mm256_set1_pd(ri), radius2 = _mm256_set1_pd(radius * radius), zero = _mm256_setzero_pd();
+  const double period_x = box.max_m.x - box.min_m.x, period_y = box.max_m.y - box.min_m.y;
+  const __m256d px = _mm256_set1_pd(period_x), hx = _mm256_set1_pd(period_x / 2.0);
+  const __m256d py = _mm256_set1_pd(period_y), hy = _mm256_set1_pd(period_y / 2.0);
+  for (; m + 4 <= end; m += 4) {
+    const std::uint32_t j0 = items[m], j1 = items[m + 1], j2 = items[m + 2], j3 = items[m + 3];
+    const __m256d r0 = _mm256_load_pd(&q[j0].x), r1 = _mm256_load_pd(&q[j1].x);
+    const __m256d r2 = _mm256_load_pd(&q[j2].x), r3 = _mm256_load_pd(&q[j3].x);
+    // (x, y, vx, vy) of four people transposed to x4, y4, vx4, vy4
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    const __m256d x4 = _mm256_permute2f128_pd(t0, t2, 0x20), y4 = _mm256_permute2f128_pd(t1, t3, 0x20);
+    const __m256d vx4 = _mm256_permute2f128_pd(t0, t2, 0x31), vy4 = _mm256_permute2f128_pd(t1, t3, 0x31);
+    __m256d dx = _mm256_sub_pd(xix, x4);
+    __m256d dy = _mm256_sub_pd(xiy, y4);
+    if (box.x) dx = MinimumImageWide(dx, px, hx);
+    if (box.y) dy = MinimumImageWide(dy, py, hy);
+    const __m256d wx = _mm256_sub_pd(vix, vx4);
+    const __m256d wy = _mm256_sub_pd(viy, vy4);
+    const __m256d reach = _mm256_add_pd(rib, _mm256_set_pd(q[j3].bound, q[j2].bound, q[j1].bound, q[j0].bound));
+    const __m256d xx = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+    const __m256d a = _mm256_add_pd(_mm256_mul_pd(wx, wx), _mm256_mul_pd(wy, wy));
+    const __m256d bb = _mm256_add_pd(_mm256_mul_pd(dx, wx), _mm256_mul_pd(dy, wy));
+    const __m256d c = _mm256_sub_pd(xx, _mm256_mul_pd(reach, reach));
+    const __m256d discriminant = _mm256_sub_pd(_mm256_mul_pd(bb, bb), _mm256_mul_pd(a, c));
+    __m256d collides = _mm256_cmp_pd(xx, radius2, _CMP_NGT_UQ);  // !(xx > radius^2)
+    collides = _mm256_and_pd(collides, _mm256_cmp_pd(c, zero, _CMP_GT_OQ));
+    collides = _mm256_and_pd(collides, _mm256_cmp_pd(bb, zero, _CMP_LT_OQ));
+    collides = _mm256_and_pd(collides, _mm256_cmp_pd(discriminant, zero, _CMP_GT_OQ));
+    for (auto mask = static_cast<unsigned>(_mm256_movemask_pd(collides)); mask != 0; mask &= mask - 1)
+      hits[count++] = items[m + static_cast<std::uint32_t>(__builtin_ctz(mask))];
+  }
+  return count;
+}
+#endif
+
+}  // namespace
+
 namespace {
 
 // The width of the switch between near and far.
@@ -68,13 +145,28 @@ class AnticipationTerm final : public BehaviourTerm {
     bound_m_.reserve(def.shapes.size());
     for (const BodyShape& s : def.shapes) bound_m_.push_back(s.core_radius_m + s.radius_m);
   }
-  unsigned phases() const override { return kForce; }
+  unsigned phases() const override { return kForce | kPrepare; }
+
   double neighbour_radius_m() const override { return radius_m_; }
   double near_radius_m() const override { return near_m_; }
   void Retune(const ModelParameters& p) override {
     radius_m_ = p.anticipation_radius_m;
     near_m_ = clocked_ ? std::min(p.anticipation_near_m, radius_m_) : 0.0;
     switch_m_ = std::min(kSwitch_m, near_m_);
+  }
+
+  // The copy of the people the pair loops read, and whether the wide
+  // filter is in use.
+  void Prepare(const DriveInputs& in) const override {
+    wide_ = WideInstructions();
+    const std::size_t n = in.bodies.size();
+    copy_.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      const Vec2 x = in.bodies.position_m[j], v = in.bodies.velocity_m_per_s[j];
+      const bool empty = in.bodies.state[j] == PersonState::kRemoved;
+      copy_[j] = Candidate{empty ? std::numeric_limits<double>::quiet_NaN() : x.x, x.y, v.x, v.y,
+                           bound_m_[in.bodies.shape[j]], {}};
+    }
   }
 
   // A candidate j of person i (at xi, moving at vi, bounding radius ri): the
@@ -87,10 +179,11 @@ class AnticipationTerm final : public BehaviourTerm {
   };
   Approach Approaching(const DriveInputs& in, Vec2 xi, Vec2 vi, double ri, std::uint32_t j) const {
     Approach p;
-    p.x = Separation(in.def.periodic, xi, in.bodies.position_m[j]);  // x_i - x_j
+    const Candidate& q = copy_[j];  // (j is in the venue: its x is its own)
+    p.x = Separation(in.def.periodic, xi, Vec2{q.x, q.y});  // x_i - x_j
     p.xx = Dot(p.x, p.x);
-    p.v = vi - in.bodies.velocity_m_per_s[j];
-    p.reach = ri + bound_m_[in.bodies.shape[j]];
+    p.v = vi - Vec2{q.vx, q.vy};
+    p.reach = ri + q.bound;
     const double a = Dot(p.v, p.v);
     p.bb = Dot(p.x, p.v);
     p.c = p.xx - p.reach * p.reach;
@@ -110,8 +203,9 @@ class AnticipationTerm final : public BehaviourTerm {
   // arithmetic; only empty slots are skipped first); step two recomputes
   // the pair's terms and its force for each pick, in the list's order
   // (recomputing a few picks is cheaper than storing every candidate's).
-  // With kAll, the same arithmetic as one loop over the candidates, so the
-  // same sums.
+  // With kAll, step one takes four candidates at a time where the processor
+  // has AVX2 (PickCollidingWide: the same picks). With kAll, the same
+  // arithmetic as one loop over the candidates, so the same sums.
   template <Pairs which>
   Vec2 Sum(const DriveInputs& in, const std::vector<std::uint32_t>& items, std::uint32_t begin, std::uint32_t end,
            Vec2 xi, Vec2 vi, double ri) const {
@@ -124,6 +218,12 @@ class AnticipationTerm final : public BehaviourTerm {
       const std::uint32_t chunk_end = std::min<std::uint32_t>(end, m + kChunk);
       std::uint32_t hits[kChunk];
       std::uint32_t count = 0;
+#ifdef CROWDRECON_WIDE_FILTER
+      if constexpr (which == Pairs::kAll)
+        if (wide_)
+          count = PickCollidingWide(copy_.data(), in.def.periodic, items.data(), m, chunk_end, xi, vi, ri, radius_m_,
+                                    hits, count);
+#endif
       for (; m < chunk_end; ++m) {
         const std::uint32_t j = items[m];
         // (Empty slots are listed: an evening's engine holds hundreds,
@@ -216,9 +316,31 @@ class AnticipationTerm final : public BehaviourTerm {
   // (Force is const: the blocks share the term).
   mutable std::vector<Vec2> kept_;
   mutable std::vector<double> evaluated_in_;
+  // The evaluation's copy of the people (Prepare), and whether the wide
+  // filter is in use.
+  mutable std::vector<Candidate> copy_;
+  mutable bool wide_ = false;
 };
 
 }  // namespace
+
+}  // namespace crowdrecon::engine::detail
+
+namespace crowdrecon::engine {
+
+void UseWideInstructions(bool use) { detail::wide_allowed = use; }
+bool WideInstructions() {
+#ifdef CROWDRECON_WIDE_FILTER
+  static const bool has = __builtin_cpu_supports("avx2");
+  return detail::wide_allowed && has;
+#else
+  return false;
+#endif
+}
+
+}  // namespace crowdrecon::engine
+
+namespace crowdrecon::engine::detail {
 
 std::unique_ptr<BehaviourTerm> MakeAnticipation(const ModelParameters& p, const WorldDef& def) {
   if (p.anticipation != Anticipation::kTimeToCollision) return nullptr;

@@ -71,6 +71,7 @@ ActiveTerms ActiveTerms::For(const ModelParameters& parameters, const WorldDef& 
     BehaviourTerm* term = t.term.get();
     const unsigned phases = term->phases();
     if (phases & BehaviourTerm::kDirection) a.direction.push_back(term);
+    if (phases & BehaviourTerm::kPrepare) a.prepare.push_back(term);
     if (phases & BehaviourTerm::kSteer) a.steer.push_back(term);
     if (phases & BehaviourTerm::kDesire) a.desire.push_back(term);
     if (phases & BehaviourTerm::kFacing) a.facing.push_back(term);

@@ -80,6 +80,13 @@ namespace detail {
 class PairCollider;  // engine/src/stage_collide.cpp
 }  // namespace detail
 
+// Whether the engine may use the processor's wide (AVX2) instructions where
+// it has them (default: yes; the anticipation's pick of collision courses).
+// The results are the same either way, bit for bit: a switch for tests and
+// benchmarks. WideInstructions: allowed, and the processor has them.
+void UseWideInstructions(bool use);
+bool WideInstructions();
+
 class Simulation {
  public:
   // Validates the definition; throws InputError with a precise message.
