@@ -82,12 +82,34 @@ __attribute__((target("avx2"), always_inline)) inline __m256d MinimumImageWide(_
   return _mm256_blendv_pd(d, _mm256_sub_pd(d, _mm256_mul_pd(p, k)), far);
 }
 
+// For each mask of four lanes, the bytes that move the chosen lanes' 32-bit
+// values to the front (in order), and how many there are.
+alignas(16) constexpr std::uint8_t kPack[16][16] = {
+    {0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {4, 5, 6, 7, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 4, 5, 6, 7, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {8, 9, 10, 11, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 8, 9, 10, 11, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {4, 5, 6, 7, 8, 9, 10, 11, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 0x80, 0x80, 0x80, 0x80},
+    {12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {4, 5, 6, 7, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 4, 5, 6, 7, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80},
+    {8, 9, 10, 11, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 8, 9, 10, 11, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80},
+    {4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 0x80, 0x80, 0x80, 0x80},
+    {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15}};
+constexpr std::uint32_t kPackCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
 // The candidates of person i (at xi, moving at vi, bounding radius ri) among
 // items[m, end) that would collide, while four are left (m is advanced; the
 // caller tests the last few one at a time): Approaching's test, four at a
 // time (AVX2), with the same IEEE operations in the same order (no fused
 // multiply-add): the same picks, bit for bit. Their indices are appended to
-// hits[count..] in the list's order; returns the new count.
+// hits[count..] in the list's order (four are written each time: hits has
+// room for three more than the candidates); returns the new count.
 __attribute__((target("avx2"))) std::uint32_t PickCollidingWide(const Candidate* q, const PeriodicBox& box,
                                                                  const std::uint32_t* items, std::uint32_t& m,
                                                                  std::uint32_t end, Vec2 xi, Vec2 vi, double ri,
@@ -124,8 +146,13 @@ __attribute__((target("avx2"))) std::uint32_t PickCollidingWide(const Candidate*
     collides = _mm256_and_pd(collides, _mm256_cmp_pd(c, zero, _CMP_GT_OQ));
     collides = _mm256_and_pd(collides, _mm256_cmp_pd(bb, zero, _CMP_LT_OQ));
     collides = _mm256_and_pd(collides, _mm256_cmp_pd(discriminant, zero, _CMP_GT_OQ));
-    for (auto mask = static_cast<unsigned>(_mm256_movemask_pd(collides)); mask != 0; mask &= mask - 1)
-      hits[count++] = items[m + static_cast<std::uint32_t>(__builtin_ctz(mask))];
+    // The picks' indices packed to the front (no branch: whether one of four
+    // collides is not predictable), four stored, the count advanced.
+    const auto mask = static_cast<unsigned>(_mm256_movemask_pd(collides));
+    const __m128i packed = _mm_shuffle_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(items + m)),
+                                            _mm_load_si128(reinterpret_cast<const __m128i*>(kPack[mask])));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(hits + count), packed);
+    count += kPackCount[mask];
   }
   return count;
 }
@@ -216,7 +243,7 @@ class AnticipationTerm final : public BehaviourTerm {
     Vec2 push{};
     for (std::uint32_t m = begin; m < end;) {
       const std::uint32_t chunk_end = std::min<std::uint32_t>(end, m + kChunk);
-      std::uint32_t hits[kChunk];
+      std::uint32_t hits[kChunk + 3];
       std::uint32_t count = 0;
 #ifdef CROWDRECON_WIDE_FILTER
       if constexpr (which == Pairs::kAll)
