@@ -78,6 +78,11 @@ void Simulation::Drive() {
     DriveBlock b;
     b.first = static_cast<std::size_t>(block * kBlock);
     b.count = static_cast<std::size_t>(std::min(n, (block + 1) * kBlock)) - b.first;
+    // A block of empty slots (a timeline's engine keeps hundreds, filled
+    // from the lowest): nothing to drive, nothing written.
+    bool anyone = false;
+    for (std::size_t k = 0; k < b.count && !anyone; ++k) anyone = bodies_.state[b.first + k] != PersonState::kRemoved;
+    if (!anyone) continue;
     // What every person starts from: their target's direction (looked up
     // already where the terms needed people ahead), v0, v, no facing, and
     // the forces of the contacts and the external force.
