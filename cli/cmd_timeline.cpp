@@ -46,6 +46,8 @@ struct TimelineArgs {
   std::vector<std::string> scores;
   double tolerance_s = 120.0;
   bool area_avalanches = false;
+  std::vector<std::string> compare;  // a second ensemble (of the same incident)
+  std::string label, compare_label;  // their names (default: their runs' profile)
   bool force = false;
 };
 
@@ -111,27 +113,55 @@ void RunEnsemble(const TimelineArgs& args) {
   }
   std::vector<NamedInput> inputs;
   for (const std::string& r : args.runs) inputs.push_back({"a run file", r});
+  for (const std::string& r : args.compare) inputs.push_back({"a run file (--compare)", r});
   CheckOutputs(outputs, inputs, args.force);
-  RefuseRepeatedFiles({args.runs.begin(), args.runs.end()}, "each run counts once in an ensemble");
-  reports::CheckSeedsOfOneScenario({args.runs.begin(), args.runs.end()}, "an ensemble");
-  std::vector<reports::EnsembleRun> runs;
-  for (std::size_t k = 0; k < args.runs.size(); ++k) {
-    std::fprintf(stderr, "reading %s (%zu of %zu)\n", args.runs[k].c_str(), k + 1, args.runs.size());
-    runs.push_back(reports::ReadEnsembleRun(args.runs[k], options));
-  }
-  const reports::EnsembleScore score = reports::ScoreEnsemble(std::move(runs), options);
+  std::vector<std::filesystem::path> every(args.runs.begin(), args.runs.end());
+  every.insert(every.end(), args.compare.begin(), args.compare.end());
+  RefuseRepeatedFiles(every, "each run counts once in an ensemble");
+  reports::CheckSeedsOfOneScenario({args.runs.begin(), args.runs.end()}, "an ensemble",
+                                   "give another scenario's runs with --compare");
+  if (!args.compare.empty())
+    reports::CheckSeedsOfOneScenario({args.compare.begin(), args.compare.end()}, "the --compare ensemble");
+  const auto read = [&](const std::vector<std::string>& files) {
+    std::vector<reports::EnsembleRun> runs;
+    for (std::size_t k = 0; k < files.size(); ++k) {
+      std::fprintf(stderr, "reading %s (%zu of %zu)\n", files[k].c_str(), k + 1, files.size());
+      runs.push_back(reports::ReadEnsembleRun(files[k], options));
+    }
+    return reports::ScoreEnsemble(std::move(runs), options);
+  };
+  const reports::EnsembleScore score = read(args.runs);
   const std::string name = ScenarioNameOf(args.runs.front());
+  std::vector<reports::LabelledEnsemble> ensembles{{"", &score}};
+  reports::EnsembleScore compared;
+  std::string title = (name.empty() ? std::string("Ensemble") : name) + ": " + std::to_string(score.runs.size()) + " runs";
+  if (!args.compare.empty()) {
+    compared = read(args.compare);
+    // Named by their runs' profiles unless told (the profile is what a comparison is usually of).
+    const std::string profile_a = runfile::RunFileReader(args.runs.front()).RunValue("profile");
+    const std::string profile_b = runfile::RunFileReader(args.compare.front()).RunValue("profile");
+    const bool by_profile = !profile_a.empty() && !profile_b.empty() && profile_a != profile_b;
+    ensembles.front().label = !args.label.empty() ? args.label : by_profile ? "profile " + profile_a : "runs";
+    ensembles.push_back({!args.compare_label.empty() ? args.compare_label : by_profile ? "profile " + profile_b : "comparison",
+                         &compared});
+    if (ensembles[0].label == ensembles[1].label)
+      throw InputError("--label and --compare-label: the two ensembles need different names (both \"" +
+                       ensembles[0].label + "\")");
+    reports::CheckComparable(ensembles);
+    title = (name.empty() ? std::string("Ensembles") : name) + ": " + ensembles[0].label + " beside " +
+            ensembles[1].label;
+  }
   for (const std::string& f : args.figures) {
     // (Every picture replaces its file only when complete: viz::Canvas.)
-    reports::DrawEnsembleFigure(score, (name.empty() ? std::string("Ensemble") : name) + ": " +
-                                           std::to_string(score.runs.size()) + " runs", f);
+    reports::DrawEnsemblesFigure(ensembles, title, f);
     std::printf("wrote %s\n", f.c_str());
   }
+  const std::string markdown = reports::EnsemblesMarkdown(ensembles);
   for (const std::string& f : args.scores) {
-    WriteFileAtomically(f, std::filesystem::path(f).extension() == ".csv" ? score.Csv() : score.Markdown());
+    WriteFileAtomically(f, std::filesystem::path(f).extension() == ".csv" ? reports::EnsemblesCsv(ensembles) : markdown);
     std::printf("wrote %s\n", f.c_str());
   }
-  std::printf("%s", score.Markdown().c_str());
+  std::printf("%s", markdown.c_str());
 }
 
 void RunTimeline(const TimelineArgs& args) {
@@ -248,10 +278,18 @@ void RegisterTimelineCommand(CLI::App& app) {
                 "The local reading of avalanches: a stop and release inside one of the venue's measurement areas, "
                 "while it held at least 3.6 persons/m2, counts too (one release seen in several places once; "
                 "docs/analysis.md, \"Local avalanches\")");
+  cmd->add_option("--compare", args->compare,
+                  "Run files of a second ensemble of the same incident (another profile, another calibration): drawn "
+                  "and scored beside the first, one column per ensemble");
+  cmd->add_option("--label", args->label, "Name of the first ensemble with --compare (default: its runs' profile)");
+  cmd->add_option("--compare-label", args->compare_label,
+                  "Name of the --compare ensemble (default: its runs' profile)");
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] {
     args->run = args->runs.front();
-    if (args->runs.size() > 1 || !args->scores.empty())
+    if ((!args->label.empty() || !args->compare_label.empty()) && args->compare.empty())
+      throw InputError("--label and --compare-label name the ensembles of --compare; give --compare RUN...");
+    if (args->runs.size() > 1 || !args->scores.empty() || !args->compare.empty())
       RunEnsemble(*args);
     else
       RunTimeline(*args);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -223,60 +224,138 @@ EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions
   return s;
 }
 
-std::string EnsembleScore::Markdown() const {
-  std::ostringstream o;
-  const analysis::RunClock clock = runs.front().clock;
-  const std::size_t n = runs.size();
-  o << "| recorded | at | runs with an avalanche within ±" << FormatNumber(options.tolerance_s) << " s |\n";
-  o << "| --- | --- | --- |\n";
-  for (const RecordedScore& r : avalanches)
-    o << "| " << r.mark.label << " | " << Clock(clock, r.mark.time_s) << " | " << r.runs_matching << " of " << n << " ("
-      << FormatFixed(100.0 * static_cast<double>(r.runs_matching) / static_cast<double>(n), 0) << " %) |\n";
-  o << "\n| over the " << n << " runs | median (range) |\n| --- | --- |\n";
-  o << "| avalanches in the run | " << SpreadText(avalanche_count_spread, 1) << " |\n";
-  o << "| of them matching no recorded avalanche | " << SpreadText(unmatched_spread, 1) << " |\n";
-  o << "| rise time of the avalanches (all runs' together; a free start takes 0.17 s) | "
-    << SpreadText(rise_time_spread, 2, "s") << (rise_time_spread.runs > 0 ? " over " + std::to_string(rise_time_spread.runs) + " avalanches" : "") << " |\n";
-  o << "| runs whose venue clogs for good | " << runs_clogging_for_good << " of " << n << " |\n";
-  if (clog_spread.runs > 0) {
-    o << "| it clogs for good at | " << Clock(clock, clog_spread.median) << " (" << Clock(clock, clog_spread.low) << "–"
-      << Clock(clock, clog_spread.high) << ")";
-    if (!fatal.empty()) o << "; recorded fatal clog " << Clock(clock, fatal.front().time_s);
-    o << " |\n";
-    if (!fatal.empty())
-      o << "| clog for good minus the recorded fatal clog | " << SpreadText(clog_minus_fatal_spread, 0, "s") << " |\n";
+std::string EnsembleScore::Markdown() const { return EnsemblesMarkdown({{"", this}}); }
+std::string EnsembleScore::Csv() const { return EnsemblesCsv({{"", this}}); }
+
+void CheckComparable(const std::vector<LabelledEnsemble>& ensembles) {
+  if (ensembles.empty()) throw InputError("no ensemble to score");
+  const EnsembleRun& first = ensembles.front().score->runs.front();
+  for (const LabelledEnsemble& e : ensembles) {
+    const EnsembleRun& r = e.score->runs.front();
+    bool same = r.recorded.size() == first.recorded.size() && r.clock == first.clock &&
+                e.score->options.tolerance_s == ensembles.front().score->options.tolerance_s;
+    for (std::size_t k = 0; same && k < r.recorded.size(); ++k)
+      same = r.recorded[k].time_s == first.recorded[k].time_s && r.recorded[k].kind == first.recorded[k].kind &&
+             r.recorded[k].label == first.recorded[k].label;
+    if (!same)
+      throw InputError(r.run_file + " (" + e.label + "): its recorded marks, clock or tolerance differ from those of " +
+                       first.run_file + " (" + ensembles.front().label +
+                       "); ensembles compared side by side are runs of one incident, scored with one tolerance");
   }
-  o << "| falls before the clog for good (all falls where none) | " << SpreadText(falls_before_clog_spread, 1) << " |\n";
-  o << "| people in the danger zone (chest load above " << FormatNumber(options.danger_n)
-    << " N, 1-s mean) at the worst moment | " << SpreadText(danger_spread, 1) << " |\n";
-  o << "| peak local density, model persons/m² (~1 m²) | " << SpreadText(density_spread, 1) << " |\n";
-  o << "| the same floor covered by real-size persons/m² | " << SpreadText(equivalent_density_spread, 1) << " |\n";
-  o << "\n| run | avalanches (matching none) | falls | clogs for good | danger peak | peak density (real-size) |\n";
-  o << "| --- | --- | --- | --- | --- | --- |\n";
-  for (std::size_t k = 0; k < n; ++k) {
-    const EnsembleRun& r = runs[k];
-    o << "| " << r.label << " | " << r.avalanche_s.size() << " (" << unmatched[k] << ") | " << r.fall_s.size() << " | "
-      << Clock(clock, r.clog_for_good_s) << " | " << (r.loads_available ? std::to_string(r.danger_peak) : "no loads")
-      << " | " << FormatFixed(r.peak_density_per_m2, 1) << " (" << FormatFixed(r.peak_equivalent_density_per_m2, 1)
-      << ") |\n";
+}
+
+std::string EnsemblesMarkdown(const std::vector<LabelledEnsemble>& ensembles) {
+  CheckComparable(ensembles);
+  std::ostringstream o;
+  const EnsembleScore& head = *ensembles.front().score;
+  const analysis::RunClock clock = head.runs.front().clock;
+  const bool several = ensembles.size() > 1;
+  // One column per ensemble (one ensemble: the table of before, unlabelled).
+  const auto row = [&](const std::string& what, const std::function<std::string(const EnsembleScore&)>& cell) {
+    o << "| " << what << " |";
+    for (const LabelledEnsemble& e : ensembles) o << ' ' << cell(*e.score) << " |";
+    o << '\n';
+  };
+  const auto rule = [&](int leading) {
+    o << '|';
+    for (int k = 0; k < leading; ++k) o << " --- |";
+    for (std::size_t k = 0; k < ensembles.size(); ++k) o << " --- |";
+    o << '\n';
+  };
+  o << "| recorded | at | runs with an avalanche within ±" << FormatNumber(head.options.tolerance_s) << " s";
+  if (several) {
+    o << ": " << ensembles.front().label;
+    for (std::size_t k = 1; k < ensembles.size(); ++k) o << " | " << ensembles[k].label;
+  }
+  o << " |\n";
+  rule(2);
+  for (std::size_t a = 0; a < head.avalanches.size(); ++a) {
+    o << "| " << head.avalanches[a].mark.label << " | " << Clock(clock, head.avalanches[a].mark.time_s) << " |";
+    for (const LabelledEnsemble& e : ensembles) {
+      const std::size_t n = e.score->runs.size(), hits = e.score->avalanches[a].runs_matching;
+      o << ' ' << hits << " of " << n << " ("
+        << FormatFixed(100.0 * static_cast<double>(hits) / static_cast<double>(n), 0) << " %) |";
+    }
+    o << '\n';
+  }
+  if (several) {
+    o << "\n| over the runs |";
+    for (const LabelledEnsemble& e : ensembles)
+      o << ' ' << e.label << " (" << e.score->runs.size() << " runs): median (range) |";
+    o << '\n';
+  } else {
+    o << "\n| over the " << head.runs.size() << " runs | median (range) |\n";
+  }
+  rule(1);
+  row("avalanches in the run", [](const EnsembleScore& s) { return SpreadText(s.avalanche_count_spread, 1); });
+  row("of them matching no recorded avalanche", [](const EnsembleScore& s) { return SpreadText(s.unmatched_spread, 1); });
+  row("rise time of the avalanches (all runs' together; a free start takes 0.17 s)", [](const EnsembleScore& s) {
+    return SpreadText(s.rise_time_spread, 2, "s") +
+           (s.rise_time_spread.runs > 0 ? " over " + std::to_string(s.rise_time_spread.runs) + " avalanches" : "");
+  });
+  row("runs whose venue clogs for good", [](const EnsembleScore& s) {
+    return std::to_string(s.runs_clogging_for_good) + " of " + std::to_string(s.runs.size());
+  });
+  const bool any_clog = std::any_of(ensembles.begin(), ensembles.end(),
+                                    [](const LabelledEnsemble& e) { return e.score->clog_spread.runs > 0; });
+  if (any_clog) {
+    row("it clogs for good at", [&](const EnsembleScore& s) {
+      if (s.clog_spread.runs == 0) return std::string("never");
+      std::string text = Clock(clock, s.clog_spread.median) + " (" + Clock(clock, s.clog_spread.low) + "–" +
+                         Clock(clock, s.clog_spread.high) + ")";
+      if (!s.fatal.empty()) text += "; recorded fatal clog " + Clock(clock, s.fatal.front().time_s);
+      return text;
+    });
+    if (!head.fatal.empty())
+      row("clog for good minus the recorded fatal clog", [](const EnsembleScore& s) {
+        return s.clog_spread.runs == 0 ? std::string("never") : SpreadText(s.clog_minus_fatal_spread, 0, "s");
+      });
+  }
+  row("falls before the clog for good (all falls where none)",
+      [](const EnsembleScore& s) { return SpreadText(s.falls_before_clog_spread, 1); });
+  row("people in the danger zone (chest load above " + FormatNumber(head.options.danger_n) +
+          " N, 1-s mean) at the worst moment",
+      [](const EnsembleScore& s) { return SpreadText(s.danger_spread, 1); });
+  row("peak local density, model persons/m² (~1 m²)", [](const EnsembleScore& s) { return SpreadText(s.density_spread, 1); });
+  row("the same floor covered by real-size persons/m²",
+      [](const EnsembleScore& s) { return SpreadText(s.equivalent_density_spread, 1); });
+  for (const LabelledEnsemble& e : ensembles) {
+    const EnsembleScore& s = *e.score;
+    if (several) o << "\n**" << e.label << "** (" << s.runs.size() << " runs)\n";
+    o << "\n| run | avalanches (matching none) | falls | clogs for good | danger peak | peak density (real-size) |\n";
+    o << "| --- | --- | --- | --- | --- | --- |\n";
+    for (std::size_t k = 0; k < s.runs.size(); ++k) {
+      const EnsembleRun& r = s.runs[k];
+      o << "| " << r.label << " | " << r.avalanche_s.size() << " (" << s.unmatched[k] << ") | " << r.fall_s.size()
+        << " | " << Clock(clock, r.clog_for_good_s) << " | "
+        << (r.loads_available ? std::to_string(r.danger_peak) : "no loads") << " | "
+        << FormatFixed(r.peak_density_per_m2, 1) << " (" << FormatFixed(r.peak_equivalent_density_per_m2, 1) << ") |\n";
+    }
   }
   return o.str();
 }
 
-std::string EnsembleScore::Csv() const {
+std::string EnsemblesCsv(const std::vector<LabelledEnsemble>& ensembles) {
+  CheckComparable(ensembles);
   std::ostringstream o;
+  const bool several = ensembles.size() > 1;
   o << "run_file,label,avalanches,avalanches_matching_none";
-  for (std::size_t a = 0; a < avalanches.size(); ++a) o << ",matches_recorded_" << (a + 1);
+  for (std::size_t a = 0; a < ensembles.front().score->avalanches.size(); ++a) o << ",matches_recorded_" << (a + 1);
   o << ",falls,falls_before_clog,clog_for_good_s,danger_peak,danger_peak_time_s,peak_density_per_m2,"
-       "peak_equivalent_density_per_m2,end_s\n";
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const EnsembleRun& r = runs[k];
-    o << CsvField(r.run_file) << ',' << CsvField(r.label) << ',' << r.avalanche_s.size() << ',' << unmatched[k];
-    for (const RecordedScore& rec : avalanches) o << ',' << (rec.matched[k] ? 1 : 0);
-    o << ',' << r.fall_s.size() << ',' << falls_before_clog[k] << ',' << Num(r.clog_for_good_s, 2) << ','
-      << (r.loads_available ? std::to_string(r.danger_peak) : "") << ',' << Num(r.danger_peak_time_s, 2) << ','
-      << Num(r.peak_density_per_m2, 3) << ',' << Num(r.peak_equivalent_density_per_m2, 3) << ',' << Num(r.end_s, 2)
-      << '\n';
+       "peak_equivalent_density_per_m2,end_s"
+    << (several ? ",ensemble" : "") << "\n";
+  for (const LabelledEnsemble& e : ensembles) {
+    const EnsembleScore& s = *e.score;
+    for (std::size_t k = 0; k < s.runs.size(); ++k) {
+      const EnsembleRun& r = s.runs[k];
+      o << CsvField(r.run_file) << ',' << CsvField(r.label) << ',' << r.avalanche_s.size() << ',' << s.unmatched[k];
+      for (const RecordedScore& rec : s.avalanches) o << ',' << (rec.matched[k] ? 1 : 0);
+      o << ',' << r.fall_s.size() << ',' << s.falls_before_clog[k] << ',' << Num(r.clog_for_good_s, 2) << ','
+        << (r.loads_available ? std::to_string(r.danger_peak) : "") << ',' << Num(r.danger_peak_time_s, 2) << ','
+        << Num(r.peak_density_per_m2, 3) << ',' << Num(r.peak_equivalent_density_per_m2, 3) << ',' << Num(r.end_s, 2);
+      if (several) o << ',' << CsvField(e.label);
+      o << '\n';
+    }
   }
   return o.str();
 }
@@ -298,37 +377,70 @@ const viz::Color kInk = viz::Color::Hex(0x222222), kGrid = viz::Color::Hex(0xe3e
 const viz::Color kFatal = viz::RecordedMarkStyleOf("fatal").color, kDetected = viz::Color::Hex(0x6a3d9a),
                  kClog = viz::Color::Hex(0x525252);
 
+// Each ensemble's colour in a figure of several (one ensemble: the blue of before).
+viz::Color EnsembleColor(std::size_t k) {
+  static const std::uint32_t kColors[] = {0x2166ac, 0xd95f02, 0x1b9e77, 0x7570b3};
+  return viz::Color::Hex(kColors[k % 4], 0.55);
+}
+
 }  // namespace
 
 void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, const std::filesystem::path& file) {
-  const std::size_t n = score.runs.size();
-  // The density panel grows with the legend's lines for measurement areas.
-  const double density_h = kDensity + 22.0 * static_cast<double>(score.runs.front().area_names.size());
+  DrawEnsemblesFigure({{"", &score}}, title, file);
+}
+
+void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const std::string& title,
+                         const std::filesystem::path& file) {
+  CheckComparable(ensembles);
+  const bool several = ensembles.size() > 1;
+  const EnsembleScore& head = *ensembles.front().score;
+  const EnsembleRun& first = head.runs.front();
+  // Rows: each ensemble's runs, under a row with its name when there are several.
+  struct Row {
+    const EnsembleScore* score = nullptr;
+    std::size_t run = 0;  // in score->runs
+    std::string heading;  // a heading row (no run)
+  };
+  std::vector<Row> rows;
+  for (const LabelledEnsemble& e : ensembles) {
+    if (several) rows.push_back({nullptr, 0, e.label + " (" + std::to_string(e.score->runs.size()) + " runs)"});
+    for (std::size_t k = 0; k < e.score->runs.size(); ++k) rows.push_back({e.score, k, ""});
+  }
+  const std::size_t n = rows.size();
+  // The density panel grows with the legend's lines for measurement areas and ensembles.
+  const double density_h = kDensity + 22.0 * static_cast<double>(first.area_names.size()) +
+                           (several ? 22.0 * static_cast<double>(ensembles.size() - 1) : 0.0);
   const double rows_top = kTop + density_h + 30;
   const double height = rows_top + static_cast<double>(n) * kRow + 70;
   viz::Canvas canvas(file, {0, 0}, {kWidth, height}, 1.0, 0.0);
   const auto P = [&](double x, double y) { return Vec2{x, height - y}; };
-  const analysis::RunClock clock = score.runs.front().clock;
+  const analysis::RunClock clock = first.clock;
   double t1 = 1.0;
-  for (const EnsembleRun& r : score.runs) t1 = std::max(t1, r.end_s);
+  for (const LabelledEnsemble& e : ensembles)
+    for (const EnsembleRun& r : e.score->runs) t1 = std::max(t1, r.end_s);
   const double t0 = 0.0;
   const auto X = [&](double t) { return kLeft + (std::clamp(t, t0, t1) - t0) / (t1 - t0) * (kRight - kLeft); };
   canvas.FillPolygon({P(0, 0), P(kWidth, 0), P(kWidth, height), P(0, height)}, viz::Color::White());
   canvas.TextPxAligned(kLeft, 26, title, 18, 0.0, 0.5, kInk, 0.0, true, kWidth - kLeft - 20);
+  std::string counted;
+  for (const LabelledEnsemble& e : ensembles)
+    counted += (counted.empty() ? "" : ", ") + std::to_string(e.score->runs.size()) + " runs" +
+               (several ? " " + e.label : "");
   canvas.TextPxAligned(kLeft, 52,
-                       std::to_string(n) + " runs; a run's avalanche matches a recorded one within ±" +
-                           FormatNumber(score.options.tolerance_s) + " s (shaded); density: centred " +
-                           FormatNumber(score.options.smooth_s) + "-s means",
+                       counted + "; a run's avalanche matches a recorded one within ±" +
+                           FormatNumber(head.options.tolerance_s) + " s (shaded); density: centred " +
+                           FormatNumber(head.options.smooth_s) + "-s means",
                        12, 0.0, 0.5, viz::Color::Hex(0x555555), 0.0, false, kWidth - kLeft - 20);
   // Density panel.
   double d_hi = 1.0;
-  for (const EnsembleRun& r : score.runs) {
-    for (double d : r.density_per_m2)
-      if (!std::isnan(d)) d_hi = std::max(d_hi, d);
-    for (const std::vector<double>& area : r.area_density_per_m2)
-      for (double d : area)
+  for (const LabelledEnsemble& e : ensembles)
+    for (const EnsembleRun& r : e.score->runs) {
+      for (double d : r.density_per_m2)
         if (!std::isnan(d)) d_hi = std::max(d_hi, d);
-  }
+      for (const std::vector<double>& area : r.area_density_per_m2)
+        for (double d : area)
+          if (!std::isnan(d)) d_hi = std::max(d_hi, d);
+    }
   d_hi = std::ceil(d_hi / 2.0) * 2.0;
   const double top = kTop, bottom = kTop + density_h;
   const auto Y = [&](double v) { return bottom - std::clamp(v / d_hi, 0.0, 1.0) * (bottom - top); };
@@ -340,39 +452,49 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
   canvas.TextPxAligned(kLeft - 56, 0.5 * (top + bottom), "persons / m^2", 12, 0.5, 1.0, kInk, 1.5707963267948966);
   // Recorded marks and tolerance bands across the density panel and every row.
   const double rows_bottom = rows_top + static_cast<double>(n) * kRow;
-  for (const RecordedScore& r : score.avalanches) {
-    const double a = X(r.mark.time_s - score.options.tolerance_s), b = X(r.mark.time_s + score.options.tolerance_s);
+  for (const RecordedScore& r : head.avalanches) {
+    const double a = X(r.mark.time_s - head.options.tolerance_s), b = X(r.mark.time_s + head.options.tolerance_s);
     canvas.FillPolygon({P(a, rows_top), P(b, rows_top), P(b, rows_bottom), P(a, rows_bottom)},
                        viz::Color::Hex(0xfdd0a2, 0.45));
   }
-  for (const analysis::TimelineMark& m : score.runs.front().recorded) {
+  for (const analysis::TimelineMark& m : first.recorded) {
     if (m.time_s < t0 || m.time_s > t1) continue;
     const viz::RecordedMarkStyle style = viz::RecordedMarkStyleOf(m.kind);
     for (auto [y0, y1] : {std::pair{top, bottom}, std::pair{rows_top, rows_bottom}})
       canvas.StrokePolyline({P(X(m.time_s), y0), P(X(m.time_s), y1)}, style.color, style.width_px, style.dashed);
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    const EnsembleRun& r = score.runs[k];
-    std::vector<Vec2> line;
-    for (std::size_t i = 0; i < r.time_s.size(); ++i)
-      if (!std::isnan(r.density_per_m2[i])) line.push_back(P(X(r.time_s[i]), Y(r.density_per_m2[i])));
-    if (line.size() >= 2) canvas.StrokePolyline(line, viz::Color::Hex(0x2166ac, 0.55), 1.4);
-    // Each measurement area's own density (dashed, one colour per area).
-    for (std::size_t a = 0; a < r.area_density_per_m2.size(); ++a) {
-      std::vector<Vec2> dashed;
-      for (std::size_t i = 0; i < r.time_s.size() && i < r.area_density_per_m2[a].size(); ++i)
-        if (!std::isnan(r.area_density_per_m2[a][i])) dashed.push_back(P(X(r.time_s[i]), Y(r.area_density_per_m2[a][i])));
-      if (dashed.size() >= 2) canvas.StrokePolyline(dashed, viz::AreaColor(a), 1.2, true);
+  for (std::size_t g = 0; g < ensembles.size(); ++g)
+    for (const EnsembleRun& r : ensembles[g].score->runs) {
+      std::vector<Vec2> line;
+      for (std::size_t i = 0; i < r.time_s.size(); ++i)
+        if (!std::isnan(r.density_per_m2[i])) line.push_back(P(X(r.time_s[i]), Y(r.density_per_m2[i])));
+      if (line.size() >= 2) canvas.StrokePolyline(line, EnsembleColor(g), 1.4);
+      // Each measurement area's own density (dashed, one colour per area).
+      for (std::size_t a = 0; a < r.area_density_per_m2.size(); ++a) {
+        std::vector<Vec2> dashed;
+        for (std::size_t i = 0; i < r.time_s.size() && i < r.area_density_per_m2[a].size(); ++i)
+          if (!std::isnan(r.area_density_per_m2[a][i])) dashed.push_back(P(X(r.time_s[i]), Y(r.area_density_per_m2[a][i])));
+        if (dashed.size() >= 2) canvas.StrokePolyline(dashed, viz::AreaColor(a), 1.2, true);
+      }
     }
-  }
   canvas.StrokePolygon({P(kLeft, top), P(kRight, top), P(kRight, bottom), P(kLeft, bottom)}, kInk, 1.0);
   // Recorded marks' labels over the density panel.
-  viz::DrawRecordedMarkLabels(canvas, score.runs.front().recorded, t0, t1, X, top);
-  // One row per run.
+  viz::DrawRecordedMarkLabels(canvas, first.recorded, t0, t1, X, top);
+  // One row per run (and a heading row per ensemble when there are several).
+  std::size_t shade = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const EnsembleRun& r = score.runs[k];
     const double y0 = rows_top + static_cast<double>(k) * kRow, yc = y0 + 0.5 * kRow;
-    if (k % 2 == 1)
+    if (rows[k].score == nullptr) {
+      canvas.FillPolygon({P(0, y0), P(kWidth, y0), P(kWidth, y0 + kRow), P(0, y0 + kRow)}, viz::Color::White());
+      canvas.TextPxAligned(12, yc, rows[k].heading, 13, 0.0, 0.5, kInk, 0.0, true, kWidth - 24);
+      canvas.Line(P(kLeft, y0 + kRow), P(kRight, y0 + kRow), kInk, 1.0);
+      shade = 0;
+      continue;
+    }
+    const EnsembleScore& score = *rows[k].score;
+    const std::size_t run = rows[k].run;
+    const EnsembleRun& r = score.runs[run];
+    if (shade++ % 2 == 1)
       canvas.FillPolygon({P(kLeft, y0), P(kRight, y0), P(kRight, y0 + kRow), P(kLeft, y0 + kRow)},
                          viz::Color::Hex(0x000000, 0.04));
     canvas.TextPxAligned(kLeft - 8, yc, r.label, 12, 1.0, 0.5, kInk, 0.0, false, kLeft - 16);
@@ -391,7 +513,7 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
       canvas.Line(P(x - 5, yc + 5), P(x + 5, yc - 5), kFatal, 2.0);
     }
     const std::size_t matched = static_cast<std::size_t>(std::count_if(
-        score.avalanches.begin(), score.avalanches.end(), [&](const RecordedScore& rec) { return rec.matched[k]; }));
+        score.avalanches.begin(), score.avalanches.end(), [&](const RecordedScore& rec) { return rec.matched[run]; }));
     canvas.TextPxAligned(kRight + 10, yc,
                          std::to_string(r.avalanche_s.size()) + " aval., " + std::to_string(matched) + "/" +
                              std::to_string(score.avalanches.size()) + " matched, " + std::to_string(r.fall_s.size()) +
@@ -421,13 +543,15 @@ void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, co
     canvas.TextPxAligned(lx + 30, ly + 6, t, 12, 0.0, 0.5, kInk, 0.0, false, kWidth - lx - 36);
     ly += 22;
   };
-  canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::Color::Hex(0x2166ac, 0.55), 2.0);
-  text("density, one line per run");
-  for (std::size_t a = 0; a < score.runs.front().area_names.size(); ++a) {
-    canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::AreaColor(a), 2.0, true);
-    text("density in " + score.runs.front().area_names[a]);
+  for (std::size_t g = 0; g < ensembles.size(); ++g) {
+    canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, EnsembleColor(g), 2.0);
+    text(several ? "density: " + ensembles[g].label : "density, one line per run");
   }
-  for (const std::string& kind : viz::RecordedMarkKinds(score.runs.front().recorded, t0, t1)) {
+  for (std::size_t a = 0; a < first.area_names.size(); ++a) {
+    canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::AreaColor(a), 2.0, true);
+    text("density in " + first.area_names[a]);
+  }
+  for (const std::string& kind : viz::RecordedMarkKinds(first.recorded, t0, t1)) {
     const viz::RecordedMarkStyle style = viz::RecordedMarkStyleOf(kind);
     canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, style.color, std::max(2.0, style.width_px), style.dashed);
     text(style.legend);

@@ -2,7 +2,9 @@
 # An ensemble of two seeds of a timeline scenario (issue 39): the figure and
 # both score files are written, one row per run; the same run given twice is
 # refused and nothing is written; the local reading of avalanches
-# (--area-avalanches) scores and draws too.
+# (--area-avalanches) scores and draws too; two ensembles (the same seeds
+# under the profile validated) are drawn and scored side by side with
+# --compare, named by their profiles, and a run in both is refused.
 # Usage: ensemble_two_seeds.sh CROWDRECON SCENARIO
 set -euo pipefail
 crowdrecon=$1
@@ -19,6 +21,14 @@ s["venue"] = os.path.normpath(os.path.join(base, s["venue"]))
 s["population"]["body"]["reference"] = os.path.normpath(os.path.join(base, s["population"]["body"]["reference"]))
 s["population"]["seed"] = s["population"]["seed"] + 1
 json.dump(s, open(dst, "w"))
+PY
+python3 - "$d/b.json" "$d/va.json" "$d/vb.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["profile"] = "validated"
+json.dump(s, open(sys.argv[3], "w"))
+s["population"]["seed"] -= 1
+json.dump(s, open(sys.argv[2], "w"))
 PY
 "$crowdrecon" simulate "$scenario" -o "$d/a.sqlite" -q
 "$crowdrecon" simulate "$d/b.json" -o "$d/b.sqlite" -q
@@ -42,4 +52,26 @@ if "$crowdrecon" timeline "$d/a.sqlite" "$d/a.sqlite" -o "$d/f.png" > "$d/twice.
 fi
 grep -q 'given twice' "$d/twice.txt"
 test ! -e "$d/f.png"
+# Two ensembles side by side (timeline --compare).
+"$crowdrecon" simulate "$d/va.json" -o "$d/va.sqlite" -q
+"$crowdrecon" simulate "$d/vb.json" -o "$d/vb.sqlite" -q
+"$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" --compare "$d/va.sqlite" "$d/vb.sqlite" -o "$d/c.png" \
+  --scores "$d/c.md" --scores "$d/c.csv" --tolerance 1 > "$d/c.txt"
+test -s "$d/c.png"
+grep -q '| over the runs | profile paper (2 runs): median (range) | profile validated (2 runs): median (range) |' "$d/c.md"
+grep -q '^\*\*profile validated\*\* (2 runs)$' "$d/c.md"
+test "$(wc -l < "$d/c.csv")" -eq 5
+grep -q ',profile validated$' "$d/c.csv"
+"$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" --compare "$d/va.sqlite" "$d/vb.sqlite" -o "$d/c.png" \
+  --scores "$d/c.md" --tolerance 1 --label "the paper's model" --compare-label "validated crowd" > /dev/null
+grep -q "runs with an avalanche within ±1 s: the paper's model | validated crowd |" "$d/c.md"
+if "$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" --compare "$d/va.sqlite" "$d/b.sqlite" -o "$d/g.png" > "$d/g.txt" 2>&1; then
+  echo "a run in both ensembles was accepted"; exit 1
+fi
+grep -q 'given twice' "$d/g.txt"
+test ! -e "$d/g.png"
+if "$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" -o "$d/h.png" --label x > "$d/h.txt" 2>&1; then
+  echo "--label without --compare was accepted"; exit 1
+fi
+grep -q 'give --compare' "$d/h.txt"
 echo "ensemble of two seeds: OK"

@@ -5,6 +5,7 @@
 // avalanches that match none, its clog for good against the fatal mark,
 // its falls before it; medians and ranges; runs of another incident
 // refused; the score files recognised as previous outputs.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -117,6 +118,59 @@ TEST(Ensemble, RunsOfOneSeedAreLabelledByTheirFiles) {
   const EnsembleScore distinct =
       ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0), MakeRun("seed 2", {}, {}, kNaN, 0, 8.0)}, EnsembleOptions{});
   EXPECT_EQ(distinct.runs[0].label, "seed 1");
+}
+
+// Two ensembles of one incident side by side (timeline --compare): a column
+// each in the score table, each one's runs under its name, an `ensemble`
+// column in the CSV; the score files known as previous outputs; ensembles
+// of other incidents or with another tolerance refused. One ensemble: the
+// table of before.
+TEST(Ensemble, TwoEnsemblesAreScoredSideBySide) {
+  EnsembleOptions o;
+  o.tolerance_s = 60.0;
+  const EnsembleScore a = ScoreEnsemble({MakeRun("seed 1", {130.0}, {}, 880.0, 3, 12.0),
+                                         MakeRun("seed 2", {659.0}, {}, kNaN, 0, 8.0)}, o);
+  const EnsembleScore b = ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 1, 4.0), MakeRun("seed 2", {}, {}, kNaN, 0, 3.0),
+                                         MakeRun("seed 3", {605.0}, {}, kNaN, 0, 5.0)}, o);
+  const std::vector<LabelledEnsemble> both{{"paper", &a}, {"validated", &b}};
+  const std::string md = EnsemblesMarkdown(both);
+  EXPECT_EQ(md.rfind("| recorded | at | runs with an avalanche within ±60 s: paper | validated |\n| --- | --- | --- | --- |\n", 0), 0u) << md;
+  EXPECT_NE(md.find("| avalanche A | 100.0 s | 1 of 2 (50 %) | 0 of 3 (0 %) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| avalanche C | 600.0 s | 1 of 2 (50 %) | 1 of 3 (33 %) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| over the runs | paper (2 runs): median (range) | validated (3 runs): median (range) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| runs whose venue clogs for good | 1 of 2 | 0 of 3 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| clog for good minus the recorded fatal clog | -20 s | never |"), std::string::npos) << md;
+  EXPECT_NE(md.find("**validated** (3 runs)\n\n| run |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| seed 3 | 1 (0) | 0 | never | 0 | 5.0 (3.0) |"), std::string::npos) << md;
+  const std::string csv = EnsemblesCsv(both);
+  EXPECT_NE(csv.find(",end_s,ensemble\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("seed 3.sqlite,seed 3,1,0,0,0,1,"), std::string::npos) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);
+  const std::filesystem::path figure = crowdrecon::testing::ScratchFile("two-ensembles.png");
+  DrawEnsemblesFigure(both, "Two ensembles", figure);
+  EXPECT_GT(std::filesystem::file_size(figure), 1000u);
+  const OutputKind kind = EnsembleScoresOutput();
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"both.md", md}, {"both.csv", csv}}) {
+    const std::filesystem::path f = crowdrecon::testing::ScratchFile(name);
+    std::ofstream(f) << text;
+    EXPECT_TRUE(kind.is_previous(f)) << name;
+  }
+  EXPECT_EQ(EnsemblesMarkdown({{"", &a}}), a.Markdown());
+  // Another incident's runs, or another tolerance, are not compared.
+  EnsembleRun other = MakeRun("seed 9", {}, {}, kNaN, 0, 8.0);
+  other.recorded.pop_back();
+  const EnsembleScore c = ScoreEnsemble({other}, o);
+  try {
+    CheckComparable({{"paper", &a}, {"elsewhere", &c}});
+    ADD_FAILURE() << "ensembles of two incidents were compared";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("seed 9.sqlite (elsewhere): its recorded marks, clock or tolerance differ from those of seed 1.sqlite (paper)"),
+              std::string::npos) << e.what();
+  }
+  EnsembleOptions wider = o;
+  wider.tolerance_s = 120.0;
+  const EnsembleScore d = ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0)}, wider);
+  EXPECT_THROW(EnsemblesMarkdown({{"paper", &a}, {"wider", &d}}), InputError);
 }
 
 TEST(Ensemble, ItsScoreFilesAreKnownAsPreviousOutputs) {

@@ -127,4 +127,21 @@ OutputKind EnsembleScoresOutput();
 // avalanches and their +-tolerance across every row. PNG, SVG or PDF.
 void DrawEnsembleFigure(const EnsembleScore& score, const std::string& title, const std::filesystem::path& file);
 
+// Ensembles of one incident side by side (`timeline RUN... --compare
+// RUN...`: the validated crowd beside the paper's model, a fitted night
+// beside the free one): each with its label. One score table with a column
+// per ensemble, one CSV with an `ensemble` column, one figure with each
+// ensemble's densities in its colour and its rows under its name. With one
+// ensemble, the outputs above. CheckComparable refuses ensembles whose
+// recorded marks, clock or tolerance differ (InputError naming a run of each).
+struct LabelledEnsemble {
+  std::string label;
+  const EnsembleScore* score = nullptr;
+};
+void CheckComparable(const std::vector<LabelledEnsemble>& ensembles);
+std::string EnsemblesMarkdown(const std::vector<LabelledEnsemble>& ensembles);
+std::string EnsemblesCsv(const std::vector<LabelledEnsemble>& ensembles);
+void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const std::string& title,
+                         const std::filesystem::path& file);
+
 }  // namespace crowdrecon::reports
