@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "crowdrecon/reports/report.hpp"
+#include "crowdrecon/validate/validate.hpp"
 
 namespace crowdrecon::cli {
 
@@ -27,6 +28,7 @@ struct ReportArgs {
   double close_up_m = 12.0;
   std::string envelope_metric = "people_danger";
   double envelope_level = 0.0;
+  std::string validation;  // a validation's results.json
   bool force = false, quiet = false;
 };
 
@@ -45,6 +47,12 @@ void RunReport(const ReportArgs& args) {
   o.envelope_metric = args.envelope_metric;
   o.envelope_level = args.envelope_level;
   o.force = args.force;
+  if (!args.validation.empty()) {
+    const validate::ValidationSummary v = validate::LoadValidationSummary(args.validation);
+    o.validation_source = args.validation + ", judged by crowdrecon " + v.build;
+    for (const validate::ProfileVerdicts& p : v.profiles)
+      o.validation.push_back({p.name, p.tests, p.passed, p.failed});
+  }
   o.command_line = CommandLine();
   if (!args.quiet) o.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   const reports::ReportSummary summary = reports::WriteReport(o);
@@ -68,6 +76,9 @@ void RegisterReportCommand(CLI::App& app) {
   cmd->add_option("--compare", args->compare, "Run files or folders of a second ensemble to compare with");
   cmd->add_option("-o,--output", args->output, "Folder of the report")->required();
   cmd->add_option("--label", args->label, "Name of the first ensemble in the report");
+  cmd->add_option("--validation", args->validation,
+                  "A validation's results.json (crowdrecon validate): the methods page says which tests the runs' "
+                  "profiles pass and fail");
   cmd->add_option("--compare-label", args->compare_label, "Name of the second ensemble");
   cmd->add_option("--f0", args->risk.f0_n, "F0 (N): the load above which a person is at risk (paper: 400 N)");
   cmd->add_option("--danger", args->risk.danger_n, "Lower edge of the danger zone (N; Hopkins et al.: 1112 N)");

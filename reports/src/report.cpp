@@ -609,6 +609,33 @@ ReportSummary WriteReport(const ReportOptions& options) {
        "tolerance was reached. Two points from one source fix the curve: its shape between and beyond them, and "
        "individual differences (the Surrey subjects differed sevenfold), are not known; the counts beyond the dose are an "
        "order of magnitude, not a prediction of deaths.</p>\n";
+  // The crowd model: each profile of the runs and what the validation suite says of it.
+  {
+    std::vector<std::string> profiles{first.profile};
+    if (!other_runs.empty() && other_runs.front().profile != first.profile) profiles.push_back(other_runs.front().profile);
+    h += "<p><b>The crowd model.</b> ";
+    for (const std::string& name : profiles) {
+      const auto found = std::find_if(options.validation.begin(), options.validation.end(),
+                                      [&](const ReportOptions::ProfileValidation& v) { return v.profile == name; });
+      h += "Profile <b>" + Escape(name) + "</b>";
+      if (found == options.validation.end()) {
+        h += options.validation.empty()
+                 ? ": its verdicts on the validation suite were not given to this report (<code>crowdrecon validate</code>, "
+                   "docs/validation.md; <code>report --validation results.json</code>). "
+                 : ": not among the profiles of the validation results given (" + Escape(options.validation_source) + "). ";
+        continue;
+      }
+      h += ": on the validation suite (the field's standard tests and experiments, " + Escape(options.validation_source) +
+           ") it passes " + std::to_string(found->passed) + " of " + std::to_string(found->tests) + " tests";
+      if (!found->failed.empty()) {
+        h += "; it fails ";
+        for (std::size_t k = 0; k < found->failed.size(); ++k)
+          h += (k == 0 ? "" : k + 1 == found->failed.size() ? " and " : ", ") + Escape(found->failed[k]);
+      }
+      h += ". ";
+    }
+    h += "A result that rests on what a profile fails (a door's flow, a counter-flow) carries that limit.</p>\n";
+  }
   h += "<p><b>The model's simplifications.</b> A 2D model of torsos (spheropolygons) with contact forces, a drive "
        "toward the target, a back force and a torque (the paper's equations 1–19); loads are horizontal forces on the "
        "torso; people cannot climb, stack or be lifted; a fall (when the run's timeline has them) turns a person into a "

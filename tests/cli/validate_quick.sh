@@ -8,7 +8,7 @@
 # RiMEA 7 (walking speeds by group) fails: on a 10 m wide way some walkers
 # are slowed or hurried by others, out of their group's narrow band. A second run on the same
 # folder runs nothing again and gives the same table; a folder that is not a
-# validation's is refused.
+# validation's is refused; a report cites its results (report --validation).
 #   validate_quick.sh CROWDRECON SOURCE_DIR
 set -euo pipefail
 exe=$1; src=$2
@@ -63,4 +63,16 @@ mkdir "$d/other"; echo keep > "$d/other/notes.txt"
 if "$exe" validate --quick -o "$d/other" --no-pdf -q > "$d/out3.txt" 2>&1; then echo "expected a refusal"; exit 1; fi
 grep -q "other" "$d/out3.txt"; cat "$d/out3.txt"
 test "$(cat "$d/other/notes.txt")" = keep
+# Its results cited by a report (report --validation): the methods page says
+# which tests the runs' profile passes and fails; a file that is not a
+# validation's results is refused, naming it, and no report is written.
+"$exe" simulate bench/reference/timeline-validated.json -o "$d/run.sqlite" -q
+"$exe" report "$d/run.sqlite" -o "$d/rep" --no-pdf -q --validation "$d/v/results.json" > /dev/null
+grep -q "it passes 3 of 4 tests; it fails rimea-07-demographics (verification)" "$d/rep/report.html"
+echo '{"format": "crowdrecon-validation-results", "version": 1, "build": "x", "sources": "y", "profiles": []}' > "$d/bad.json"
+if "$exe" report "$d/run.sqlite" -o "$d/rep2" --no-pdf -q --validation "$d/bad.json" > "$d/out4.txt" 2>&1; then
+  echo "a broken validation file was accepted"; exit 1
+fi
+grep -q "bad.json: /profiles" "$d/out4.txt"
+test ! -e "$d/rep2"
 echo "validate_quick.sh: ok"

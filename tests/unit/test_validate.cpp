@@ -527,5 +527,43 @@ TEST(ValidationFiles, StatisticsSurviveTheirJson) {
   EXPECT_THROW(StatisticsFromJson("{\"a\": [\"x\"]}", "x"), InputError);
 }
 
+// A validation's results.json read for other outputs (report --validation):
+// per profile the tests passed and those failed, in the suite's order, with
+// their roles; a file that is not one is refused naming the place.
+TEST(ValidationFiles, TheResultsSummaryCountsEachProfilesVerdicts) {
+  const std::string ok = R"({"format": "crowdrecon-validation-results", "version": 1, "build": "abc", "sources": "f00",
+    "profiles": [{"name": "validated", "description": "d"}, {"name": "paper"}],
+    "tests": [{"id": "t-one", "role": "fit", "results": {"validated": {"verdict": "pass"}, "paper": {"verdict": "fail"}}},
+              {"id": "t-two", "role": "held-out", "results": {"validated": {"verdict": "fail"}, "paper": {"verdict": "error"}}},
+              {"id": "t-three", "role": "verification", "results": {"validated": {"verdict": "documents"}, "paper": {"verdict": "pass"}}}]})";
+  const ValidationSummary v = ParseValidationSummary(ok, "results.json");
+  EXPECT_EQ(v.build, "abc");
+  ASSERT_EQ(v.profiles.size(), 2u);
+  const ProfileVerdicts* validated = v.Find("validated");
+  ASSERT_NE(validated, nullptr);
+  EXPECT_EQ(validated->tests, 3u);
+  EXPECT_EQ(validated->passed, 1u);
+  EXPECT_EQ(validated->failed, (std::vector<std::string>{"t-two (held-out)"}));
+  EXPECT_EQ(v.Find("paper")->failed, (std::vector<std::string>{"t-one (fit)", "t-two (held-out, an error)"}));
+  EXPECT_EQ(v.Find("polite"), nullptr);
+  const auto refused = [](const std::string& text, const std::string& where) {
+    try {
+      (void)ParseValidationSummary(text, "r.json");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  };
+  refused("[1]", "r.json");
+  refused(R"({"format": "crowdrecon-scenario", "version": 1})", "r.json: /format");
+  const std::string head = R"({"format": "crowdrecon-validation-results", "version": 1, "build": "b", "sources": "s", )";
+  refused(head + R"("profiles": [], "tests": []})", "r.json: /profiles");
+  refused(head + R"("profiles": [{"name": "a"}, {"name": "a"}], "tests": []})", "r.json: /profiles/1/name");
+  refused(head + R"("profiles": [{"name": "a"}], "tests": [{"id": "t", "role": "fit", "results": {}}]})",
+          "r.json: /tests/0/results");
+  refused(head + R"("profiles": [{"name": "a"}], "tests": [{"id": "t", "role": "fit", "results": {"a": {"verdict": "maybe"}}}]})",
+          "r.json: /tests/0/results/a/verdict");
+}
+
 }  // namespace
 }  // namespace crowdrecon::validate

@@ -15,6 +15,7 @@
 
 #include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/json_reader.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/observe/fundamental_diagram.hpp"
@@ -571,6 +572,60 @@ void WriteValidationReport(const ValidateOptions& options, const std::string& ch
     fs::rename(partial, dir / "report.pdf");
     summary->pdf = dir / "report.pdf";
   }
+}
+
+const ProfileVerdicts* ValidationSummary::Find(const std::string& profile) const {
+  for (const ProfileVerdicts& p : profiles)
+    if (p.name == profile) return &p;
+  return nullptr;
+}
+
+ValidationSummary ParseValidationSummary(const std::string& text, const std::string& origin) {
+  const JsonDocument doc = JsonDocument::Parse(text, origin);
+  const JsonReader root = doc.Root();
+  if (!root.IsObject()) root.Fail("expected a validation's results (an object), found " + root.ValueText());
+  if (root.String("format") != "crowdrecon-validation-results")
+    root.At("format").Fail("expected \"crowdrecon-validation-results\" (a validation's results.json), found " +
+                           root.At("format").ValueText());
+  (void)root.Integer("version", 1, 1);
+  ValidationSummary summary;
+  summary.origin = origin;
+  summary.build = root.String("build");
+  summary.sources = root.String("sources");
+  const JsonReader profiles = root.At("profiles");
+  if (!profiles.IsArray() || profiles.Size() == 0) profiles.Fail("expected a list of the profiles judged");
+  for (std::size_t k = 0; k < profiles.Size(); ++k) {
+    const JsonReader p = profiles.Element(k);
+    if (!p.IsObject()) p.Fail("expected a profile (an object), found " + p.ValueText());
+    ProfileVerdicts v;
+    v.name = p.At("name").AsName();
+    if (summary.Find(v.name) != nullptr) p.At("name").Fail("the profile \"" + v.name + "\" is listed twice");
+    summary.profiles.push_back(std::move(v));
+  }
+  const JsonReader tests = root.At("tests");
+  if (!tests.IsArray()) tests.Fail("expected a list of tests, found " + tests.ValueText());
+  for (std::size_t t = 0; t < tests.Size(); ++t) {
+    const JsonReader test = tests.Element(t);
+    if (!test.IsObject()) test.Fail("expected a test (an object), found " + test.ValueText());
+    const std::string id = test.At("id").AsName();
+    const std::string role = test.String("role");
+    const JsonReader results = test.At("results");
+    if (!results.IsObject()) results.Fail("expected each profile's result (an object), found " + results.ValueText());
+    for (ProfileVerdicts& v : summary.profiles) {
+      if (!results.Has(v.name)) results.Fail("no result of the profile \"" + v.name + "\"");
+      const JsonReader r = results.At(v.name);
+      if (!r.IsObject()) r.Fail("expected a result (an object), found " + r.ValueText());
+      const std::string verdict = r.Choice("verdict", {"pass", "fail", "documents", "error"});
+      ++v.tests;
+      if (verdict == "pass") ++v.passed;
+      if (verdict == "fail" || verdict == "error") v.failed.push_back(id + " (" + role + (verdict == "error" ? ", an error" : "") + ")");
+    }
+  }
+  return summary;
+}
+
+ValidationSummary LoadValidationSummary(const fs::path& results_json) {
+  return ParseValidationSummary(ReadInputFile(results_json, "validation results"), results_json.string());
 }
 
 }  // namespace crowdrecon::validate

@@ -51,6 +51,17 @@ struct ReportOptions {
   double envelope_level = 0.0;
   bool force = false;           // replace what is at output_dir (never an input)
   std::function<void(const std::string&)> progress;  // one line per step (may be empty)
+  // What the validation suite says of the model profiles (report
+  // --validation: a validation's results.json, read by
+  // validate::LoadValidationSummary), for the methods page: per profile, the
+  // tests it passes and those it fails. Empty: the page says where to look.
+  struct ProfileValidation {
+    std::string profile;
+    std::size_t tests = 0, passed = 0;
+    std::vector<std::string> failed;  // "test-id (role)"
+  };
+  std::vector<ProfileValidation> validation;
+  std::string validation_source;  // the results file and the build that judged
 
   bool IsValid(std::string* error) const;
 };

@@ -109,6 +109,27 @@ ValidateSummary RunValidation(const ValidateOptions& options);
 // validation may write into (docs/validation.md).
 OutputKind ValidationFolderOutput();
 
+// What a validation's results.json (ResultsJson: `crowdrecon validate`
+// writes it) says of each profile, for other outputs to cite (the injury-risk
+// report's methods page, `report --validation`): per profile, how many
+// tests it passes and which it fails, with their roles. The file's other
+// contents (criteria, values) are not read here.
+struct ProfileVerdicts {
+  std::string name;
+  std::size_t tests = 0, passed = 0;
+  std::vector<std::string> failed;  // "test-id (role)", in the suite's order; errors too
+};
+struct ValidationSummary {
+  std::string origin;          // the file
+  std::string build, sources;  // the build that judged (its version and source fingerprint)
+  std::vector<ProfileVerdicts> profiles;
+  const ProfileVerdicts* Find(const std::string& profile) const;  // null: not in it
+};
+// Throws InputError naming the file and JSON path where the text is not a
+// validation's results (format "crowdrecon-validation-results", version 1).
+ValidationSummary ParseValidationSummary(const std::string& text, const std::string& origin);
+ValidationSummary LoadValidationSummary(const std::filesystem::path& results_json);
+
 // Statistics to and from JSON (NaN as null): the measures' files.
 std::string StatisticsToJson(const Statistics& statistics);
 Statistics StatisticsFromJson(const std::string& text, const std::string& origin);
