@@ -387,11 +387,18 @@ std::string Html(const ValidateOptions& options, const ValidateSummary& s) {
                   Esc(profiles_text) + "</title>\n<style>" + reports::html::Css() +
                   "\nsection.test { page-break-before: always; }\ntd, th { text-align: left; }\n</style></head><body>\n";
   h += "<h1>crowdrecon validation: profile " + Esc(profiles_text) + "</h1>\n";
-  char line[400];
-  std::snprintf(line, sizeof line, "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; %.0f s of wall time; build %s (sources %s); %s.",
+  // The runs' own wall time (their single-core seconds summed, whichever
+  // call ran them: runs reused from earlier calls count), and this call's.
+  double runs_s = 0.0;
+  for (const auto& per_profile : s.results)
+    for (const TestResult& r : per_profile) runs_s += r.wall_s;
+  char line[480];
+  std::snprintf(line, sizeof line,
+                "%zu tests, %d pass, %d fail, %d document behaviour only, %d could not run; the runs: %.1f h of "
+                "single-core wall time in all (this call: %.0f s); build %s (sources %s); %s.",
                 s.tests.size() * np, s.Count(Verdict::kPass), s.Count(Verdict::kFail), s.Count(Verdict::kDocuments),
-                s.Count(Verdict::kError), s.wall_s, sweep::BuildVersion().c_str(), sweep::SourceFingerprint().c_str(),
-                Today().c_str());
+                s.Count(Verdict::kError), runs_s / 3600.0, s.wall_s, sweep::BuildVersion().c_str(),
+                sweep::SourceFingerprint().c_str(), Today().c_str());
   h += "<p class=\"sub\">" + Esc(line) + "</p>\n";
   h += "<p class=\"note\">Every test is a file of the suite (" + Esc(options.suite.string()) +
        "): its source, setup, criterion and tolerance. Runs and experiments are measured by the same code; a criterion "
