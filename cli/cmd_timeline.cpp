@@ -3,8 +3,10 @@
 // avalanches and falls, the incident's recorded marks) and the run's path
 // through density x counter-flow over a sweep's phase diagrams (issue 20;
 // analysis/timeline_series.hpp, viz/timeline_figure.hpp).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +49,7 @@ struct TimelineArgs {
   double tolerance_s = 120.0;
   bool area_avalanches = false;
   std::vector<std::string> compare;  // a second ensemble (of the same incident)
+  std::string summaries;             // a folder for each run's summary (ensembles over several sessions)
   std::string label, compare_label;  // their names (default: their runs' profile)
   bool force = false;
 };
@@ -74,15 +77,6 @@ sweep::PathOverlay PathOf(const analysis::TimelineSeries& s, double step_s) {
   path.caption = "path of " + s.run_file + ": density and counter-flow share, " + FormatNumber(step_s) +
                  "-s means (clamped to the diagram's range)";
   return path;
-}
-
-// The scenario's name, from the scenario stored in the run ("" if none):
-// the figures' titles.
-std::string ScenarioNameOf(const std::string& run) {
-  const nlohmann::json scenario = nlohmann::json::parse(runfile::RunFileReader(run).RunValue("scenario"), nullptr, false);
-  return scenario.is_object() && scenario.contains("name") && scenario["name"].is_string()
-             ? scenario["name"].get<std::string>()
-             : "";
 }
 
 // Several runs of one incident (seeds): one row per run beside the recorded
@@ -114,6 +108,22 @@ void RunEnsemble(const TimelineArgs& args) {
   std::vector<NamedInput> inputs;
   for (const std::string& r : args.runs) inputs.push_back({"a run file", r});
   for (const std::string& r : args.compare) inputs.push_back({"a run file (--compare)", r});
+  // Each run's summary (reports/ensemble.hpp): DIR/<the run file's name>.json.
+  std::map<std::string, std::filesystem::path> summary_of;
+  if (!args.summaries.empty()) {
+    std::vector<std::string> every_run(args.runs.begin(), args.runs.end());
+    every_run.insert(every_run.end(), args.compare.begin(), args.compare.end());
+    for (const std::string& r : every_run) {
+      if (std::filesystem::path(r).extension() == ".json")
+        throw InputError("--summaries: " + r + " is a summary already; give run files to summarise");
+      const std::filesystem::path out =
+          std::filesystem::path(args.summaries) / (std::filesystem::path(r).stem().string() + ".json");
+      if (!summary_of.emplace(std::filesystem::absolute(out).lexically_normal().string(), r).second)
+        throw InputError("--summaries: two runs have the name " + std::filesystem::path(r).stem().string() +
+                         "; summarise them into different folders");
+      outputs.push_back({"--summaries", out.string(), reports::EnsembleSummaryOutput()});
+    }
+  }
   CheckOutputs(outputs, inputs, args.force);
   std::vector<std::filesystem::path> every(args.runs.begin(), args.runs.end());
   every.insert(every.end(), args.compare.begin(), args.compare.end());
@@ -127,19 +137,27 @@ void RunEnsemble(const TimelineArgs& args) {
     for (std::size_t k = 0; k < files.size(); ++k) {
       std::fprintf(stderr, "reading %s (%zu of %zu)\n", files[k].c_str(), k + 1, files.size());
       runs.push_back(reports::ReadEnsembleRun(files[k], options));
+      if (!args.summaries.empty()) {
+        const std::filesystem::path out =
+            std::filesystem::path(args.summaries) / (std::filesystem::path(files[k]).stem().string() + ".json");
+        WriteFileAtomically(out, reports::EnsembleSummaryJson(files[k], runs.back(), options));
+        std::printf("wrote %s\n", out.string().c_str());
+      }
     }
     return reports::ScoreEnsemble(std::move(runs), options);
   };
   const reports::EnsembleScore score = read(args.runs);
-  const std::string name = ScenarioNameOf(args.runs.front());
+  const std::string name = reports::EnsembleRunScenarioName(args.runs.front());
   std::vector<reports::LabelledEnsemble> ensembles{{"", &score}};
   reports::EnsembleScore compared;
-  std::string title = (name.empty() ? std::string("Ensemble") : name) + ": " + std::to_string(score.runs.size()) + " runs";
+  // (The number of runs is in the figure's second line: a long scenario name
+  // and a count ran off the sheet.)
+  std::string title = name.empty() ? std::string("Ensemble") : name;
   if (!args.compare.empty()) {
     compared = read(args.compare);
     // Named by their runs' profiles unless told (the profile is what a comparison is usually of).
-    const std::string profile_a = runfile::RunFileReader(args.runs.front()).RunValue("profile");
-    const std::string profile_b = runfile::RunFileReader(args.compare.front()).RunValue("profile");
+    const std::string profile_a = reports::EnsembleRunProfile(args.runs.front());
+    const std::string profile_b = reports::EnsembleRunProfile(args.compare.front());
     const bool by_profile = !profile_a.empty() && !profile_b.empty() && profile_a != profile_b;
     ensembles.front().label = !args.label.empty() ? args.label : by_profile ? "profile " + profile_a : "runs";
     ensembles.push_back({!args.compare_label.empty() ? args.compare_label : by_profile ? "profile " + profile_b : "comparison",
@@ -213,7 +231,7 @@ void RunTimeline(const TimelineArgs& args) {
     const sweep::PhaseSummary summary = sweep::DrawPhaseDiagrams(phase);
     std::printf("%s", summary.BriefReport().c_str());
   }
-  const std::string title = ScenarioNameOf(args.run);
+  const std::string title = reports::EnsembleRunScenarioName(args.run);
   for (const std::string& f : args.figures) {
     viz::DrawTimelineFigure(s, title.empty() ? "Timeline of " + args.run : title, f);
     std::printf("wrote %s\n", f.c_str());
@@ -281,6 +299,10 @@ void RegisterTimelineCommand(CLI::App& app) {
   cmd->add_option("--compare", args->compare,
                   "Run files of a second ensemble of the same incident (another profile, another calibration): drawn "
                   "and scored beside the first, one column per ensemble");
+  cmd->add_option("--summaries", args->summaries,
+                  "An existing folder for each run's summary (RUN's name with .json): what scoring and drawing need, small enough "
+                  "to keep in a repository; give the summaries instead of the run files later (an ensemble run over "
+                  "several sessions)");
   cmd->add_option("--label", args->label, "Name of the first ensemble with --compare (default: its runs' profile)");
   cmd->add_option("--compare-label", args->compare_label,
                   "Name of the --compare ensemble (default: its runs' profile)");
@@ -289,7 +311,11 @@ void RegisterTimelineCommand(CLI::App& app) {
     args->run = args->runs.front();
     if ((!args->label.empty() || !args->compare_label.empty()) && args->compare.empty())
       throw InputError("--label and --compare-label name the ensembles of --compare; give --compare RUN...");
-    if (args->runs.size() > 1 || !args->scores.empty() || !args->compare.empty())
+    const bool summaries = std::any_of(args->runs.begin(), args->runs.end(), [](const std::string& r) {
+      return std::filesystem::path(r).extension() == ".json";
+    });
+    if (args->runs.size() > 1 || !args->scores.empty() || !args->compare.empty() || !args->summaries.empty() ||
+        summaries)
       RunEnsemble(*args);
     else
       RunTimeline(*args);

@@ -15,6 +15,9 @@
 #include "crowdrecon/analysis/plausibility.hpp"
 #include "crowdrecon/common/csv.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
+#include "crowdrecon/common/json_reader.hpp"
+#include "crowdrecon/common/sha256.hpp"
 #include "crowdrecon/reports/risk.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/viz/canvas.hpp"
@@ -77,46 +80,89 @@ void FileNamesOnly(nlohmann::json& j) {
 
 }  // namespace
 
+namespace {
+
+// What makes runs the seeds of one scenario: the scenario as stored (its
+// seed apart, file names only), the seed, the walkable area (by digest).
+struct RunIdentity {
+  nlohmann::json scenario;
+  std::uint64_t seed = 0;
+  std::string walkable_sha256;
+};
+
+bool IsSummaryFile(const std::filesystem::path& file) { return file.extension() == ".json"; }
+
+EnsembleRunSummary ReadSummary(const std::filesystem::path& file) {
+  return ParseEnsembleSummary(ReadInputFile(file, "ensemble run summary"), file.string());
+}
+
+RunIdentity IdentityOf(const std::filesystem::path& run) {
+  RunIdentity id;
+  if (IsSummaryFile(run)) {
+    const EnsembleRunSummary summary = ReadSummary(run);
+    id.scenario = nlohmann::json::parse(summary.scenario_json);
+    id.seed = summary.seed;
+    id.walkable_sha256 = summary.walkable_sha256;
+    return id;
+  }
+  const runfile::RunFileReader reader(run);
+  id.scenario = nlohmann::json::parse(reader.RunValue("scenario"), nullptr, false);
+  if (!id.scenario.is_object())
+    throw InputError(run.string() + ": the run holds no scenario of its own (run value \"scenario\"); "
+                     "expected a run file written by crowdrecon simulate");
+  if (id.scenario.contains("population") && id.scenario["population"].is_object()) {
+    nlohmann::json& population = id.scenario["population"];
+    if (population.contains("seed") && population["seed"].is_number_unsigned())
+      id.seed = population["seed"].get<std::uint64_t>();
+    population.erase("seed");
+  }
+  FileNamesOnly(id.scenario);
+  id.walkable_sha256 = Sha256Hex(reader.walkable_wkt());
+  return id;
+}
+
+}  // namespace
+
 void CheckSeedsOfOneScenario(const std::vector<std::filesystem::path>& runs, const std::string& what,
                              const std::string& apart) {
-  nlohmann::json first;
-  std::string first_venue;
+  RunIdentity first;
   std::map<std::uint64_t, std::filesystem::path> seed_of;
   for (std::size_t k = 0; k < runs.size(); ++k) {
-    const runfile::RunFileReader reader(runs[k]);
-    nlohmann::json scenario = nlohmann::json::parse(reader.RunValue("scenario"), nullptr, false);
-    if (!scenario.is_object())
-      throw InputError(runs[k].string() + ": the run holds no scenario of its own (run value \"scenario\"); "
-                       "expected a run file written by crowdrecon simulate");
-    std::uint64_t seed = 0;
-    if (scenario.contains("population") && scenario["population"].is_object()) {
-      nlohmann::json& population = scenario["population"];
-      if (population.contains("seed") && population["seed"].is_number_unsigned())
-        seed = population["seed"].get<std::uint64_t>();
-      population.erase("seed");
-    }
-    FileNamesOnly(scenario);
-    const std::string venue = reader.walkable_wkt();
+    RunIdentity id = IdentityOf(runs[k]);
     if (k == 0) {
-      first = std::move(scenario);
-      first_venue = venue;
-    } else if (venue != first_venue) {
+      first = id;
+    } else if (id.walkable_sha256 != first.walkable_sha256) {
       throw InputError(runs[k].string() + ": not a seed of the scenario of " + runs[0].string() +
                        " (their walkable areas differ); " + what + " is the seeds of one scenario: " + apart);
-    } else if (scenario != first) {
-      const nlohmann::json patch = nlohmann::json::diff(first, scenario);
+    } else if (id.scenario != first.scenario) {
+      const nlohmann::json patch = nlohmann::json::diff(first.scenario, id.scenario);
       const std::string path = patch.empty() ? "/" : patch[0].value("path", "/");
       throw InputError(runs[k].string() + ": not a seed of the scenario of " + runs[0].string() + " (they differ at " +
                        path + "); " + what + " is the seeds of one scenario: " + apart);
     }
-    const auto [at, added] = seed_of.emplace(seed, runs[k]);
+    const auto [at, added] = seed_of.emplace(id.seed, runs[k]);
     if (!added)
       throw InputError(runs[k].string() + ": the same run as " + at->second.string() + " (seed " +
-                       std::to_string(seed) + " of the same scenario): each run counts once in " + what);
+                       std::to_string(id.seed) + " of the same scenario): each run counts once in " + what);
   }
 }
 
 EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options) {
+  if (IsSummaryFile(run_file)) {
+    EnsembleRunSummary summary = ReadSummary(run_file);
+    const EnsembleOptions& o = summary.options;
+    if (o.smooth_s != options.smooth_s || o.area_avalanches != options.area_avalanches ||
+        o.danger_n != options.danger_n || o.clog_speed_m_per_s != options.clog_speed_m_per_s ||
+        o.clog_min_s != options.clog_min_s)
+      throw InputError(run_file.string() + ": summarised with smoothing " + FormatNumber(o.smooth_s) + " s" +
+                       (o.area_avalanches ? ", the local reading of avalanches" : "") + ", danger " +
+                       FormatNumber(o.danger_n) + " N; this ensemble is read with smoothing " +
+                       FormatNumber(options.smooth_s) + " s" + (options.area_avalanches ? ", the local reading" : "") +
+                       ", danger " + FormatNumber(options.danger_n) +
+                       " N: give the same options, or the run file itself");
+    summary.run.run_file = run_file.string();
+    return summary.run;
+  }
   if (!runfile::IsRunFile(run_file)) throw InputError(run_file.string() + ": not a crowdrecon run file");
   EnsembleRun r;
   r.run_file = run_file.string();
@@ -156,6 +202,181 @@ EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const Ensembl
   r.peak_density_per_m2 = s.validity.peak_density_per_m2;
   r.peak_equivalent_density_per_m2 = s.validity.peak_equivalent_density_per_m2;
   return r;
+}
+
+// ---------------------------------------------------------------------------
+// A run's summary (ensembles over several sessions).
+
+namespace {
+
+constexpr const char* kSummaryFormat = "crowdrecon-ensemble-run";
+
+nlohmann::json Nullable(double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); }
+
+// Every `stride`-th value and the last; `digits` > 0 rounds them to that
+// many decimals (a figure's series), 0 keeps them exact (scores).
+nlohmann::json Numbers(const std::vector<double>& values, std::size_t stride, int digits = 0) {
+  const double scale = std::pow(10.0, digits);
+  const auto value = [&](double v) { return Nullable(digits > 0 ? std::round(v * scale) / scale : v); };
+  nlohmann::json a = nlohmann::json::array();
+  for (std::size_t i = 0; i < values.size(); i += stride) a.push_back(value(values[i]));
+  if (!values.empty() && (values.size() - 1) % stride != 0) a.push_back(value(values.back()));
+  return a;
+}
+
+}  // namespace
+
+std::string EnsembleSummaryJson(const std::filesystem::path& run_file, const EnsembleRun& run,
+                                const EnsembleOptions& options) {
+  const RunIdentity id = IdentityOf(run_file);
+  nlohmann::json j = {{"format", kSummaryFormat}, {"version", 1}};
+  j["run_file"] = run_file.filename().string();
+  j["profile"] = EnsembleRunProfile(run_file);
+  j["scenario_name"] = EnsembleRunScenarioName(run_file);
+  j["run_sha256"] = Sha256OfFile(run_file);
+  j["label"] = run.label;
+  j["seed"] = id.seed;
+  j["scenario"] = id.scenario;
+  j["walkable_sha256"] = id.walkable_sha256;
+  j["options"] = {{"smooth_s", options.smooth_s},
+                  {"area_avalanches", options.area_avalanches},
+                  {"danger_n", options.danger_n},
+                  {"clog_speed_m_per_s", options.clog_speed_m_per_s},
+                  {"clog_min_s", options.clog_min_s}};
+  j["clock"] = {{"start", run.clock.start}, {"scale", run.clock.scale}};
+  j["end_s"] = run.end_s;
+  j["avalanche_s"] = Numbers(run.avalanche_s, 1);
+  j["rise_time_s"] = Numbers(run.rise_time_s, 1);
+  j["fall_s"] = Numbers(run.fall_s, 1);
+  j["clog_for_good_s"] = Nullable(run.clog_for_good_s);
+  j["danger_peak"] = run.danger_peak;
+  j["danger_peak_time_s"] = Nullable(run.danger_peak_time_s);
+  j["loads_available"] = run.loads_available;
+  j["peak_density_per_m2"] = run.peak_density_per_m2;
+  j["peak_equivalent_density_per_m2"] = run.peak_equivalent_density_per_m2;
+  j["recorded"] = nlohmann::json::array();
+  for (const analysis::TimelineMark& m : run.recorded)
+    j["recorded"].push_back({{"time_s", m.time_s}, {"label", m.label}, {"kind", m.kind}});
+  const std::size_t stride = std::max<std::size_t>(1, (run.time_s.size() + kSummaryPoints - 1) / kSummaryPoints);
+  j["series"] = {{"time_s", Numbers(run.time_s, stride, 3)}, {"density_per_m2", Numbers(run.density_per_m2, stride, 4)}};
+  j["series"]["areas"] = nlohmann::json::array();
+  for (std::size_t a = 0; a < run.area_names.size(); ++a)
+    j["series"]["areas"].push_back({{"name", run.area_names[a]},
+                                    {"density_per_m2", Numbers(run.area_density_per_m2[a], stride, 4)}});
+  return j.dump(1) + "\n";
+}
+
+EnsembleRunSummary ParseEnsembleSummary(const std::string& text, const std::string& origin) {
+  const JsonDocument doc = JsonDocument::Parse(text, origin);
+  const JsonReader root = doc.Root();
+  if (!root.IsObject()) root.Fail("expected a run's summary for an ensemble (an object), found " + root.ValueText());
+  if (root.String("format") != kSummaryFormat)
+    root.At("format").Fail(std::string("expected \"") + kSummaryFormat + "\" (timeline --summaries), found " +
+                           root.At("format").ValueText());
+  (void)root.Integer("version", 1, 1);
+  const auto number = [](const JsonReader& r) { return r.AsNumber(-1e12, 1e12); };
+  const auto nullable = [&](const JsonReader& r) {
+    return r.IsNull() ? std::numeric_limits<double>::quiet_NaN() : number(r);
+  };
+  const auto list = [&](const JsonReader& r, bool nulls) {
+    if (!r.IsArray()) r.Fail("expected a list of numbers, found " + r.ValueText());
+    std::vector<double> v;
+    for (std::size_t k = 0; k < r.Size(); ++k) {
+      const JsonReader e = r.Element(k);
+      if (e.IsNull() && !nulls) e.Fail("expected a number, found null");
+      v.push_back(nullable(e));
+    }
+    return v;
+  };
+  EnsembleRunSummary s;
+  EnsembleRun& r = s.run;
+  (void)root.String("run_file");
+  s.profile = root.String("profile");
+  s.scenario_name = root.String("scenario_name");
+  s.run_sha256 = root.String("run_sha256");
+  r.label = root.String("label");
+  s.seed = static_cast<std::uint64_t>(root.Integer("seed", 0, std::numeric_limits<long long>::max()));
+  const JsonReader scenario = root.At("scenario");
+  if (!scenario.IsObject()) scenario.Fail("expected the run's scenario (an object), found " + scenario.ValueText());
+  s.scenario_json = scenario.Raw().dump();
+  s.walkable_sha256 = root.String("walkable_sha256");
+  const JsonReader o = root.At("options");
+  s.options.smooth_s = o.Number("smooth_s", 0.0, 3600.0);
+  s.options.area_avalanches = o.Bool("area_avalanches", false);
+  s.options.danger_n = o.Number("danger_n", 1e-9, 1e9);
+  s.options.clog_speed_m_per_s = o.Number("clog_speed_m_per_s", 0.0, 100.0);
+  s.options.clog_min_s = o.Number("clog_min_s", 0.0, 1e9);
+  o.Finish();
+  const JsonReader clock = root.At("clock");
+  r.clock.start = clock.String("start");
+  r.clock.scale = clock.Number("scale", 1e-6, 1e6);
+  clock.Finish();
+  r.end_s = number(root.At("end_s"));
+  r.avalanche_s = list(root.At("avalanche_s"), false);
+  r.rise_time_s = list(root.At("rise_time_s"), true);
+  if (r.rise_time_s.size() != r.avalanche_s.size())
+    root.At("rise_time_s").Fail("expected one rise time (or null) per avalanche (" + std::to_string(r.avalanche_s.size()) + ")");
+  r.fall_s = list(root.At("fall_s"), false);
+  r.clog_for_good_s = nullable(root.At("clog_for_good_s"));
+  r.danger_peak = static_cast<std::size_t>(root.Integer("danger_peak", 0, 1000000000));
+  r.danger_peak_time_s = nullable(root.At("danger_peak_time_s"));
+  r.loads_available = root.Bool("loads_available", false);
+  r.peak_density_per_m2 = root.Number("peak_density_per_m2", 0.0, 1e6);
+  r.peak_equivalent_density_per_m2 = root.Number("peak_equivalent_density_per_m2", 0.0, 1e6);
+  const JsonReader recorded = root.At("recorded");
+  if (!recorded.IsArray()) recorded.Fail("expected a list of recorded marks, found " + recorded.ValueText());
+  for (std::size_t k = 0; k < recorded.Size(); ++k) {
+    const JsonReader m = recorded.Element(k);
+    analysis::TimelineMark mark;
+    mark.time_s = m.Number("time_s", -1e12, 1e12);
+    mark.label = m.String("label");
+    mark.kind = m.String("kind");
+    m.Finish();
+    r.recorded.push_back(mark);
+  }
+  const JsonReader series = root.At("series");
+  r.time_s = list(series.At("time_s"), false);
+  r.density_per_m2 = list(series.At("density_per_m2"), true);
+  if (r.density_per_m2.size() != r.time_s.size())
+    series.At("density_per_m2").Fail("expected one value per time (" + std::to_string(r.time_s.size()) + ")");
+  const JsonReader areas = series.At("areas");
+  if (!areas.IsArray()) areas.Fail("expected a list of areas, found " + areas.ValueText());
+  for (std::size_t a = 0; a < areas.Size(); ++a) {
+    const JsonReader area = areas.Element(a);
+    r.area_names.push_back(area.String("name"));
+    r.area_density_per_m2.push_back(list(area.At("density_per_m2"), true));
+    if (r.area_density_per_m2.back().size() != r.time_s.size())
+      area.At("density_per_m2").Fail("expected one value per time (" + std::to_string(r.time_s.size()) + ")");
+    area.Finish();
+  }
+  series.Finish();
+  root.Finish();
+  return s;
+}
+
+std::string EnsembleRunProfile(const std::filesystem::path& run_or_summary) {
+  if (IsSummaryFile(run_or_summary)) return ReadSummary(run_or_summary).profile;
+  return runfile::RunFileReader(run_or_summary).RunValue("profile");
+}
+
+std::string EnsembleRunScenarioName(const std::filesystem::path& run_or_summary) {
+  if (IsSummaryFile(run_or_summary)) return ReadSummary(run_or_summary).scenario_name;
+  const nlohmann::json scenario =
+      nlohmann::json::parse(runfile::RunFileReader(run_or_summary).RunValue("scenario"), nullptr, false);
+  return scenario.is_object() && scenario.contains("name") && scenario["name"].is_string()
+             ? scenario["name"].get<std::string>()
+             : "";
+}
+
+OutputKind EnsembleSummaryOutput() {
+  return {"ensemble run summary", false, [](const std::filesystem::path& f) {
+            try {
+              const nlohmann::json j = nlohmann::json::parse(ReadInputFile(f, "ensemble run summary"));
+              return j.is_object() && j.value("format", "") == kSummaryFormat;
+            } catch (...) {
+              return false;
+            }
+          }};
 }
 
 EnsembleScore ScoreEnsemble(std::vector<EnsembleRun> runs, const EnsembleOptions& options) {

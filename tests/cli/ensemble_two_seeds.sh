@@ -4,7 +4,8 @@
 # refused and nothing is written; the local reading of avalanches
 # (--area-avalanches) scores and draws too; two ensembles (the same seeds
 # under the profile validated) are drawn and scored side by side with
-# --compare, named by their profiles, and a run in both is refused.
+# --compare, named by their profiles, and a run in both is refused; each
+# run's summary scores the same as the run (--summaries).
 # Usage: ensemble_two_seeds.sh CROWDRECON SCENARIO
 set -euo pipefail
 crowdrecon=$1
@@ -52,6 +53,25 @@ if "$crowdrecon" timeline "$d/a.sqlite" "$d/a.sqlite" -o "$d/f.png" > "$d/twice.
 fi
 grep -q 'given twice' "$d/twice.txt"
 test ! -e "$d/f.png"
+# Each run's summary (--summaries, an existing folder): the ensemble scored
+# from the summaries is the one scored from the runs (the same table); a
+# summary beside its own run is the same seed twice, refused; a summary is
+# not summarised again.
+mkdir "$d/sum"
+"$crowdrecon" timeline "$d/a.sqlite" "$d/b.sqlite" -o "$d/s1.png" --scores "$d/s1.md" --tolerance 1 --summaries "$d/sum" > /dev/null
+test -s "$d/sum/a.json"; test -s "$d/sum/b.json"
+"$crowdrecon" timeline "$d/sum/a.json" "$d/sum/b.json" -o "$d/s2.png" --scores "$d/s2.md" --tolerance 1 > /dev/null
+cmp "$d/s1.md" "$d/s2.md"
+test -s "$d/s2.png"
+if "$crowdrecon" timeline "$d/sum/a.json" "$d/a.sqlite" -o "$d/s3.png" > "$d/s3.txt" 2>&1; then
+  echo "a summary beside its own run was accepted"; exit 1
+fi
+grep -q 'the same run as' "$d/s3.txt"
+mkdir "$d/sum2"
+if "$crowdrecon" timeline "$d/sum/a.json" "$d/b.sqlite" -o "$d/s4.png" --summaries "$d/sum2" > "$d/s4.txt" 2>&1; then
+  echo "a summary was summarised again"; exit 1
+fi
+grep -q 'is a summary already' "$d/s4.txt"
 # Two ensembles side by side (timeline --compare).
 "$crowdrecon" simulate "$d/va.json" -o "$d/va.sqlite" -q
 "$crowdrecon" simulate "$d/vb.json" -o "$d/vb.sqlite" -q

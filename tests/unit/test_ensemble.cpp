@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -171,6 +172,59 @@ TEST(Ensemble, TwoEnsemblesAreScoredSideBySide) {
   wider.tolerance_s = 120.0;
   const EnsembleScore d = ScoreEnsemble({MakeRun("seed 1", {}, {}, kNaN, 0, 8.0)}, wider);
   EXPECT_THROW(EnsemblesMarkdown({{"paper", &a}, {"wider", &d}}), InputError);
+}
+
+// A run's summary (timeline --summaries) read back: the fuzz seed is a
+// real night's summary cut short; each inconsistency is refused naming the
+// JSON path; a summary made with other options is not mixed in.
+TEST(Ensemble, ARunsSummaryIsReadBackOrRefusedNamingThePlace) {
+  const std::filesystem::path seed =
+      std::filesystem::path(CROWDRECON_SOURCE_DIR) / "fuzz/corpus/fuzz_ensemble_summary/night-seed1-short.json";
+  std::ifstream in(seed);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const EnsembleRunSummary s = ParseEnsembleSummary(text, "s.json");
+  EXPECT_EQ(s.run.label, "seed 1");
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_EQ(s.profile, "validated");
+  EXPECT_EQ(s.run.avalanche_s, (std::vector<double>{1100.5, 2000.0}));
+  ASSERT_EQ(s.run.rise_time_s.size(), 2u);
+  EXPECT_TRUE(std::isnan(s.run.rise_time_s[1]));
+  EXPECT_EQ(s.run.clog_for_good_s, 4000.0);
+  EXPECT_EQ(s.run.time_s.size(), 5u);
+  EXPECT_EQ(s.run.area_names.size(), 3u);
+  EXPECT_EQ(s.run.recorded.size(), 6u);
+  EXPECT_EQ(s.options.smooth_s, 10.0);
+  const auto refused = [&](const std::string& from, const std::string& to, const std::string& where) {
+    std::string changed = text;
+    const std::size_t at = changed.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    changed.replace(at, from.size(), to);
+    try {
+      (void)ParseEnsembleSummary(changed, "s.json");
+      ADD_FAILURE() << "accepted with " << to;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
+  };
+  refused("\"crowdrecon-ensemble-run\"", "\"crowdrecon-scenario\"", "s.json: /format");
+  refused("\"rise_time_s\": [\n  0.4,\n  null\n ]", "\"rise_time_s\": [0.4]", "s.json: /rise_time_s");
+  refused("\"avalanche_s\": [\n  1100.5,", "\"avalanche_s\": [\n  null,", "s.json: /avalanche_s/0");
+  refused("\"smooth_s\": 10.0", "\"smooth_s\": -1", "s.json: /options/smooth_s");
+  refused("\"scale\": 1.0", "\"scale\": 1.0, \"extra\": 1", "s.json: /clock");
+  // Read as a run of an ensemble with other options: refused, naming them.
+  const std::filesystem::path file = crowdrecon::testing::ScratchFile("seed1.json");
+  std::ofstream(file) << text;
+  EnsembleOptions wider;
+  wider.smooth_s = 5.0;
+  try {
+    (void)ReadEnsembleRun(file, wider);
+    ADD_FAILURE() << "a summary made with 10-s smoothing was read with 5 s";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("summarised with smoothing 10 s"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ReadEnsembleRun(file, EnsembleOptions{}).clog_for_good_s, 4000.0);
+  EXPECT_TRUE(EnsembleSummaryOutput().is_previous(file));
+  EXPECT_FALSE(EnsembleSummaryOutput().is_previous(seed.parent_path() / "missing.json"));
 }
 
 TEST(Ensemble, ItsScoreFilesAreKnownAsPreviousOutputs) {

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -77,8 +78,39 @@ struct EnsembleRun {
 };
 
 // Reads one run (throws InputError naming the file if it is not a finished
-// timeline run).
+// timeline run), or a run's summary (a file ending in .json written by
+// WriteEnsembleSummary: what scoring and drawing need, so that an ensemble
+// run over several sessions keeps each finished run's part in the
+// repository instead of its run file), which must have been made with the
+// same options (else InputError naming them).
 EnsembleRun ReadEnsembleRun(const std::filesystem::path& run_file, const EnsembleOptions& options);
+
+// A run's summary for an ensemble (format "crowdrecon-ensemble-run",
+// version 1; docs/reports.md, "Ensembles over several sessions"): the
+// EnsembleRun read with these options, the options, the run's scenario as
+// the seeds' check compares it (its seed apart, file names only), its seed,
+// the SHA-256 of its walkable area and of its run file; the density series
+// thinned to at most kSummaryPoints points each, times to 1 ms and densities
+// to 1e-4 /m² (for the figure; every score comes from exact numbers).
+inline constexpr std::size_t kSummaryPoints = 2000;
+std::string EnsembleSummaryJson(const std::filesystem::path& run_file, const EnsembleRun& run,
+                                const EnsembleOptions& options);
+struct EnsembleRunSummary {
+  EnsembleRun run;
+  EnsembleOptions options;
+  std::string profile, scenario_name;  // the run's model profile and its scenario's name
+  std::string scenario_json;   // compared across seeds
+  std::uint64_t seed = 0;
+  std::string walkable_sha256, run_sha256;
+};
+// Throws InputError naming `origin` and the JSON path where the text is not
+// such a summary.
+EnsembleRunSummary ParseEnsembleSummary(const std::string& text, const std::string& origin);
+// Recognises an earlier summary (for writing into its place).
+OutputKind EnsembleSummaryOutput();
+// A run file's or a summary's model profile and scenario name ("" where none).
+std::string EnsembleRunProfile(const std::filesystem::path& run_or_summary);
+std::string EnsembleRunScenarioName(const std::filesystem::path& run_or_summary);
 
 // An ensemble is the seeds of one scenario: runs whose stored scenarios
 // (the run value "scenario", with its overrides; files by their names, the
