@@ -25,8 +25,9 @@
 #include "crowdrecon/analysis/run_analysis.hpp"
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/common/wall_clock.hpp"
-#include "crowdrecon/scenario/runner.hpp"
+#include "crowdrecon/reports/ensemble.hpp"
 #include "crowdrecon/reports/risk.hpp"
+#include "crowdrecon/scenario/runner.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/sweep/results.hpp"
 #include "crowdrecon/sweep/sweep_file.hpp"
@@ -180,6 +181,14 @@ std::optional<ResultRow> ExecuteRun(const RunContext& ctx, const RunPlan& run) {
     earlier_wall_s = summary.total_wall_s - summary.wall_s;  // (all of it for a run simulated before)
     row = RowOf(run, analysis::AnalyzeRun(file, ctx.analysis));
     AddRiskColumns(file, &row);
+    if (ctx.spec.ensemble_summaries) {
+      // (Before the run file may go: its summary is what an ensemble keeps.)
+      const reports::EnsembleOptions ensemble;
+      const fs::path folder = ctx.runs_dir.parent_path() / "summaries";
+      fs::create_directories(folder);
+      WriteFileAtomically(folder / (run.id + ".json"),
+                          reports::EnsembleSummaryJson(file, reports::ReadEnsembleRun(file, ensemble), ensemble));
+    }
   } catch (const InputError& e) {
     // The crowd cannot be placed, or the run went numerically wrong: a result
     // of these parameters, recorded as such. Messages name run files as

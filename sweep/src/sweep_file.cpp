@@ -375,6 +375,7 @@ SweepSpec ParseSweep(const std::string& json_text, const std::string& origin, co
     diagram->Finish();
   }
   s.keep_runs = root.Bool("keep_runs", false);
+  s.ensemble_summaries = root.Bool("ensemble_summaries", false);
   root.Finish();
   if (s.RunCount() > kMaxSweepRuns) {
     std::string sizes = std::to_string(s.variants.size()) + " variant(s) x ";

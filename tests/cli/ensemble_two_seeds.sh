@@ -72,6 +72,16 @@ if "$crowdrecon" timeline "$d/sum/a.json" "$d/b.sqlite" -o "$d/s4.png" --summari
   echo "a summary was summarised again"; exit 1
 fi
 grep -q 'is a summary already' "$d/s4.txt"
+# A sweep of the same two seeds that writes each run's summary as it ends
+# (ensemble_summaries): scored from those, the same table again.
+cat > "$d/seeds.json" <<JSON
+{"format": "crowdrecon-sweep", "version": 1, "scenario": "$scenario", "seeds": {"first": 11, "count": 2},
+ "ensemble_summaries": true}
+JSON
+"$crowdrecon" sweep "$d/seeds.json" -o "$d/sweep" --jobs 2 -q > /dev/null
+test "$(ls "$d/sweep/summaries" | wc -l)" -eq 2
+"$crowdrecon" timeline "$d"/sweep/summaries/*.json -o "$d/s5.png" --scores "$d/s5.md" --tolerance 1 > /dev/null
+cmp "$d/s1.md" "$d/s5.md"
 # Two ensembles side by side (timeline --compare).
 "$crowdrecon" simulate "$d/va.json" -o "$d/va.sqlite" -q
 "$crowdrecon" simulate "$d/vb.json" -o "$d/vb.sqlite" -q

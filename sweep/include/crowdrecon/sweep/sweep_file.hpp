@@ -80,6 +80,10 @@ struct SweepSpec {
   std::vector<Variant> variants;        // at least one ("base" if none given)
   std::string diagram_x, diagram_y;     // axis paths ("" if the sweep has fewer axes)
   bool keep_runs = false;               // keep each run's file in DIR/runs/
+  // Write each finished run's summary for an ensemble (reports/ensemble.hpp,
+  // timeline's default options) to DIR/summaries/RUN_ID.json: the part of a
+  // long ensemble to keep in a repository while its runs go on elsewhere.
+  bool ensemble_summaries = false;
 
   // variants x axis values x seeds, saturating at SIZE_MAX (never wraps).
   std::size_t RunCount() const;
