@@ -48,7 +48,7 @@ echo "   venues/madrid-arena/scenarios/evacuation-6800.json, docs/scenarios.md)"
 echo "== Injury-risk report: the Madrid night (demo) compared with the evacuation (docs/reports.md)"
 "$exe" report "$out/madrid-night/run.sqlite" --label "Madrid night (demo)" \
   --compare "$out/evacuation/run.sqlite" --compare-label "evacuation, first 20 s" -o "$out/report" \
-  | tee "$out/report-summary.txt"
+  --validation results/validation-validated/results.json | tee "$out/report-summary.txt"
 
 echo "== Phase diagrams of the shipped Madrid Arena sweeps (results/sweeps/madrid-arena/)"
 for sweep in hallway-bodies hallway-gamma hallway-lambda; do
