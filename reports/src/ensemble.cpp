@@ -61,6 +61,8 @@ std::string SpreadText(const Spread& s, int decimals, const std::string& unit = 
 
 std::string Num(double v, int decimals) { return std::isnan(v) ? "" : FormatFixed(v, decimals); }
 
+std::string Runs(std::size_t n) { return std::to_string(n) + (n == 1 ? " run" : " runs"); }
+
 }  // namespace
 
 namespace {
@@ -502,10 +504,10 @@ std::string EnsemblesMarkdown(const std::vector<LabelledEnsemble>& ensembles) {
   if (several) {
     o << "\n| over the runs |";
     for (const LabelledEnsemble& e : ensembles)
-      o << ' ' << e.label << " (" << e.score->runs.size() << " runs): median (range) |";
+      o << ' ' << e.label << " (" << Runs(e.score->runs.size()) << "): median (range) |";
     o << '\n';
   } else {
-    o << "\n| over the " << head.runs.size() << " runs | median (range) |\n";
+    o << "\n| over the " << Runs(head.runs.size()) << " | median (range) |\n";
   }
   rule(1);
   row("avalanches in the run", [](const EnsembleScore& s) { return SpreadText(s.avalanche_count_spread, 1); });
@@ -542,7 +544,7 @@ std::string EnsemblesMarkdown(const std::vector<LabelledEnsemble>& ensembles) {
       [](const EnsembleScore& s) { return SpreadText(s.equivalent_density_spread, 1); });
   for (const LabelledEnsemble& e : ensembles) {
     const EnsembleScore& s = *e.score;
-    if (several) o << "\n**" << e.label << "** (" << s.runs.size() << " runs)\n";
+    if (several) o << "\n**" << e.label << "** (" << Runs(s.runs.size()) << ")\n";
     o << "\n| run | avalanches (matching none) | falls | clogs for good | danger peak | peak density (real-size) |\n";
     o << "| --- | --- | --- | --- | --- | --- |\n";
     for (std::size_t k = 0; k < s.runs.size(); ++k) {
@@ -624,7 +626,7 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
   };
   std::vector<Row> rows;
   for (const LabelledEnsemble& e : ensembles) {
-    if (several) rows.push_back({nullptr, 0, e.label + " (" + std::to_string(e.score->runs.size()) + " runs)"});
+    if (several) rows.push_back({nullptr, 0, e.label + " (" + Runs(e.score->runs.size()) + ")"});
     for (std::size_t k = 0; k < e.score->runs.size(); ++k) rows.push_back({e.score, k, ""});
   }
   const std::size_t n = rows.size();
@@ -645,7 +647,7 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
   canvas.TextPxAligned(kLeft, 26, title, 18, 0.0, 0.5, kInk, 0.0, true, kWidth - kLeft - 20);
   std::string counted;
   for (const LabelledEnsemble& e : ensembles)
-    counted += (counted.empty() ? "" : ", ") + std::to_string(e.score->runs.size()) + " runs" +
+    counted += (counted.empty() ? "" : ", ") + Runs(e.score->runs.size()) +
                (several ? " " + e.label : "");
   canvas.TextPxAligned(kLeft, 52,
                        counted + "; a run's avalanche matches a recorded one within ±" +
