@@ -166,8 +166,9 @@ void RunEnsemble(const TimelineArgs& args) {
       throw InputError("--label and --compare-label: the two ensembles need different names (both \"" +
                        ensembles[0].label + "\")");
     reports::CheckComparable(ensembles);
-    title = (name.empty() ? std::string("Ensembles") : name) + ": " + ensembles[0].label + " beside " +
-            ensembles[1].label;
+    // (Which ensembles: the figure's second line and its legend; a long
+    // scenario name with both labels ran off the sheet.)
+    if (name.empty()) title = ensembles[0].label + " beside " + ensembles[1].label;
   }
   for (const std::string& f : args.figures) {
     // (Every picture replaces its file only when complete: viz::Canvas.)

@@ -631,8 +631,8 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
   }
   const std::size_t n = rows.size();
   // The density panel grows with the legend's lines for measurement areas and ensembles.
-  const double density_h = kDensity + 22.0 * static_cast<double>(first.area_names.size()) +
-                           (several ? 22.0 * static_cast<double>(ensembles.size() - 1) : 0.0);
+  const double density_h = kDensity + (several ? 22.0 * static_cast<double>(ensembles.size() - 1)
+                                               : 22.0 * static_cast<double>(first.area_names.size()));
   const double rows_top = kTop + density_h + 30;
   const double height = rows_top + static_cast<double>(n) * kRow + 70;
   viz::Canvas canvas(file, {0, 0}, {kWidth, height}, 1.0, 0.0);
@@ -692,8 +692,10 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
       for (std::size_t i = 0; i < r.time_s.size(); ++i)
         if (!std::isnan(r.density_per_m2[i])) line.push_back(P(X(r.time_s[i]), Y(r.density_per_m2[i])));
       if (line.size() >= 2) canvas.StrokePolyline(line, EnsembleColor(g), 1.4);
-      // Each measurement area's own density (dashed, one colour per area).
-      for (std::size_t a = 0; a < r.area_density_per_m2.size(); ++a) {
+      // Each measurement area's own density (dashed, one colour per area;
+      // one ensemble only: with several, which ensemble a dashed line is of
+      // could not be told).
+      for (std::size_t a = 0; !several && a < r.area_density_per_m2.size(); ++a) {
         std::vector<Vec2> dashed;
         for (std::size_t i = 0; i < r.time_s.size() && i < r.area_density_per_m2[a].size(); ++i)
           if (!std::isnan(r.area_density_per_m2[a][i])) dashed.push_back(P(X(r.time_s[i]), Y(r.area_density_per_m2[a][i])));
@@ -740,7 +742,7 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
     canvas.TextPxAligned(kRight + 10, yc,
                          std::to_string(r.avalanche_s.size()) + " aval., " + std::to_string(matched) + "/" +
                              std::to_string(score.avalanches.size()) + " matched, " + std::to_string(r.fall_s.size()) +
-                             " falls",
+                             (r.fall_s.size() == 1 ? " fall" : " falls"),
                          11, 0.0, 0.5, kInk, 0.0, false, kWidth - kRight - 16);
   }
   canvas.StrokePolygon({P(kLeft, rows_top), P(kRight, rows_top), P(kRight, rows_bottom), P(kLeft, rows_bottom)}, kInk, 1.0);
@@ -770,7 +772,7 @@ void DrawEnsemblesFigure(const std::vector<LabelledEnsemble>& ensembles, const s
     canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, EnsembleColor(g), 2.0);
     text(several ? "density: " + ensembles[g].label : "density, one line per run");
   }
-  for (std::size_t a = 0; a < first.area_names.size(); ++a) {
+  for (std::size_t a = 0; !several && a < first.area_names.size(); ++a) {
     canvas.StrokePolyline({P(lx, ly + 6), P(lx + 24, ly + 6)}, viz::AreaColor(a), 2.0, true);
     text("density in " + first.area_names[a]);
   }
