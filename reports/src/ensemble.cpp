@@ -234,7 +234,6 @@ std::string EnsembleSummaryJson(const std::filesystem::path& run_file, const Ens
   nlohmann::json j = {{"format", kSummaryFormat}, {"version", 1}};
   j["run_file"] = run_file.filename().string();
   j["profile"] = EnsembleRunProfile(run_file);
-  j["scenario_name"] = EnsembleRunScenarioName(run_file);
   j["run_sha256"] = Sha256OfFile(run_file);
   j["label"] = run.label;
   j["seed"] = id.seed;
@@ -294,7 +293,6 @@ EnsembleRunSummary ParseEnsembleSummary(const std::string& text, const std::stri
   EnsembleRun& r = s.run;
   (void)root.String("run_file");
   s.profile = root.String("profile");
-  s.scenario_name = root.String("scenario_name");
   s.run_sha256 = root.String("run_sha256");
   r.label = root.String("label");
   s.seed = static_cast<std::uint64_t>(root.Integer("seed", 0, std::numeric_limits<long long>::max()));
@@ -362,9 +360,10 @@ std::string EnsembleRunProfile(const std::filesystem::path& run_or_summary) {
 }
 
 std::string EnsembleRunScenarioName(const std::filesystem::path& run_or_summary) {
-  if (IsSummaryFile(run_or_summary)) return ReadSummary(run_or_summary).scenario_name;
   const nlohmann::json scenario =
-      nlohmann::json::parse(runfile::RunFileReader(run_or_summary).RunValue("scenario"), nullptr, false);
+      IsSummaryFile(run_or_summary)
+          ? nlohmann::json::parse(ReadSummary(run_or_summary).scenario_json)
+          : nlohmann::json::parse(runfile::RunFileReader(run_or_summary).RunValue("scenario"), nullptr, false);
   return scenario.is_object() && scenario.contains("name") && scenario["name"].is_string()
              ? scenario["name"].get<std::string>()
              : "";

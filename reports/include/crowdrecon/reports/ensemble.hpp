@@ -98,7 +98,7 @@ std::string EnsembleSummaryJson(const std::filesystem::path& run_file, const Ens
 struct EnsembleRunSummary {
   EnsembleRun run;
   EnsembleOptions options;
-  std::string profile, scenario_name;  // the run's model profile and its scenario's name
+  std::string profile;  // the run's model profile
   std::string scenario_json;   // compared across seeds
   std::uint64_t seed = 0;
   std::string walkable_sha256, run_sha256;
