@@ -48,6 +48,48 @@ Spread SpreadOf(std::vector<double> v) {
   return s;
 }
 
+DangerRatio DangerRatioOf(const std::vector<std::pair<double, double>>& main,
+                          const std::vector<std::pair<double, double>>& other) {
+  DangerRatio r;
+  std::vector<double> ratios;
+  for (const auto& [danger_a, people_a] : main)
+    for (const auto& [danger_b, people_b] : other) {
+      const double fa = people_a > 0.0 ? danger_a / people_a : 0.0;
+      const double fb = people_b > 0.0 ? danger_b / people_b : 0.0;
+      if (fa > 0.0)
+        ratios.push_back(fb / fa);
+      else if (fb > 0.0)
+        r.main_none += 1;
+      else
+        r.neither += 1;
+    }
+  r.finite = SpreadOf(std::move(ratios));
+  return r;
+}
+
+std::string DangerRatioText(const DangerRatio& r, const std::string& main_label, const std::string& other_label,
+                            bool html) {
+  if (r.Pairs() == 0) return "";
+  const std::string a = html ? Escape(main_label) : main_label, b = html ? Escape(other_label) : other_label;
+  const std::string open = html ? "<b>" : "", close = html ? "</b>" : "";
+  const std::string pairs = std::to_string(r.Pairs()) + (r.Pairs() == 1 ? " pair" : " pairs");
+  std::string s;
+  if (r.finite.runs == 0 && r.main_none == 0)
+    return open + "No ratio of the fractions in danger" + close + ": nobody reached the danger zone in " + a +
+           " or " + b + ".";
+  if (r.finite.runs == 0)
+    return open + "No finite ratio of the fractions in danger" + close + ": nobody reached the danger zone in " + a +
+           ", and someone did in " + b + " (in " + std::to_string(r.main_none) + " of " + pairs + " of runs).";
+  s = open + "Fraction of people in danger, " + b + " / " + a + ": " + Short(r.finite.median) + close + " (range " +
+      Short(r.finite.low) + "–" + Short(r.finite.high) + " over the " + std::to_string(r.finite.runs) + " of " + pairs +
+      " of runs in which " + a + " had someone in danger)";
+  if (r.main_none > 0)
+    s += "; in " + std::to_string(r.main_none) + " more " + a + " had nobody in danger and " + b +
+         " had someone: no finite ratio, so the ratio over all pairs is larger than these figures";
+  if (r.neither > 0) s += "; in " + std::to_string(r.neither) + " nobody was in danger in either run";
+  return s + ".";
+}
+
 namespace {
 
 EnsembleSummary Summarise(const std::string& label, const std::vector<RunRisk>& runs) {
@@ -150,14 +192,12 @@ ReportSummary WriteReport(const ReportOptions& options) {
   summary.main = Summarise(options.label, main_runs);
   summary.other = Summarise(options.compare_label, other_runs);
   if (!other_runs.empty()) {
-    std::vector<double> ratios;
-    for (const RunRisk& a : main_runs)
-      for (const RunRisk& b : other_runs) {
-        const double fa = a.people.empty() ? 0.0 : a.counts[2] / double(a.people.size());
-        const double fb = b.people.empty() ? 0.0 : b.counts[2] / double(b.people.size());
-        if (fa > 0.0) ratios.push_back(fb / fa);
-      }
-    summary.danger_ratio = SpreadOf(ratios);
+    const auto danger = [](const std::vector<RunRisk>& runs) {
+      std::vector<std::pair<double, double>> out;
+      for (const RunRisk& r : runs) out.emplace_back(double(r.counts[2]), double(r.people.size()));
+      return out;
+    };
+    summary.danger_ratio = DangerRatioOf(danger(main_runs), danger(other_runs));
   }
   const RiskOptions& o = options.risk;
 
@@ -243,14 +283,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
          "is one seed, one possible course of events. Zones from each person's largest chest load (mean over " +
          Short(o.smoothing_s) + " s): safe up to F0 = " + Short(o.f0_n) + " N, uncomfortable up to " + Short(o.danger_n) +
          " N, danger above (section 7).</p>\n";
-    if (summary.danger_ratio.runs > 0)
-      h += "<p><b>Fraction of people in danger, " + Escape(options.compare_label) + " / " + Escape(options.label) +
-           ": " + Short(summary.danger_ratio.median) + "</b> (range " + Short(summary.danger_ratio.low) + "–" +
-           Short(summary.danger_ratio.high) + " over " + std::to_string(summary.danger_ratio.runs) +
-           " pairs of runs).</p>\n";
-    else if (!other_runs.empty())
-      h += "<p><b>No ratio of the fractions in danger</b>: nobody reached the danger zone in " + Escape(options.label) +
-           ".</p>\n";
+    if (!other_runs.empty()) h += "<p>" + DangerRatioText(summary.danger_ratio, options.label, options.compare_label, true) + "</p>\n";
   }
 
   // Validity: whether the states are ones a human crowd can reach (issue 39).

@@ -160,10 +160,7 @@ std::string ReportSummary::BriefReport() const {
   s += line(main);
   if (other.runs > 0) s += line(other);
   for (const std::string& v : validity_lines) s += "  validity: " + v + "\n";
-  if (danger_ratio.runs > 0)
-    s += "  danger fraction, " + other.label + " / " + main.label + ": " + Short(danger_ratio.median) + " [" +
-         Short(danger_ratio.low) + ", " + Short(danger_ratio.high) + "] over " + std::to_string(danger_ratio.runs) +
-         " pairs of runs\n";
+  if (danger_ratio.Pairs() > 0) s += "  " + DangerRatioText(danger_ratio, main.label, other.label, false) + "\n";
   s += "  " + Short(seconds) + " s\n";
   return s;
 }

@@ -18,6 +18,7 @@
 
 #include "crowdrecon/common/error.hpp"
 #include "crowdrecon/reports/ensemble.hpp"
+#include "crowdrecon/reports/report.hpp"
 #include "scratch.hpp"
 
 namespace crowdrecon::reports {
@@ -240,3 +241,35 @@ TEST(Ensemble, ItsScoreFilesAreKnownAsPreviousOutputs) {
 
 }  // namespace
 }  // namespace crowdrecon::reports
+
+// The ratio of the fractions in danger between two ensembles: the pairs
+// whose main run had nobody in danger are counted and said, not dropped (a
+// report once gave "1055" over the 6 of 24 pairs with a finite ratio while
+// the other 18 had none).
+TEST(Report, TheRatioOfTheFractionsInDangerSaysThePairsWithoutAFiniteRatio) {
+  using crowdrecon::reports::DangerRatioOf;
+  using crowdrecon::reports::DangerRatioText;
+  // main: 1 of 100 in danger, 0 of 100, 0 of 100; other: 10 of 100, 0 of 100
+  const auto r = DangerRatioOf({{1, 100}, {0, 100}, {0, 100}}, {{10, 100}, {0, 100}});
+  EXPECT_EQ(r.finite.runs, 2u);
+  EXPECT_DOUBLE_EQ(r.finite.low, 0.0);
+  EXPECT_DOUBLE_EQ(r.finite.high, 10.0);
+  EXPECT_EQ(r.main_none, 2u);
+  EXPECT_EQ(r.neither, 2u);
+  EXPECT_EQ(r.Pairs(), 6u);
+  const std::string text = DangerRatioText(r, "validated <crowd>", "paper", true);
+  EXPECT_NE(text.find("over the 2 of 6 pairs of runs in which validated &lt;crowd&gt; had someone in danger"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("in 2 more validated &lt;crowd&gt; had nobody in danger and paper had someone: no finite ratio"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("in 2 nobody was in danger in either run"), std::string::npos) << text;
+
+  const auto none = DangerRatioOf({{0, 100}}, {{3, 100}, {5, 100}});
+  EXPECT_EQ(none.finite.runs, 0u);
+  EXPECT_EQ(DangerRatioText(none, "a", "b", false),
+            "No finite ratio of the fractions in danger: nobody reached the danger zone in a, and someone did in b "
+            "(in 2 of 2 pairs of runs).");
+  EXPECT_EQ(DangerRatioText(DangerRatioOf({{0, 10}}, {{0, 10}}), "a", "b", false),
+            "No ratio of the fractions in danger: nobody reached the danger zone in a or b.");
+  EXPECT_EQ(DangerRatioText(DangerRatioOf({}, {}), "a", "b", false), "");
+}

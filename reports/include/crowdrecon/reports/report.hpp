@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowdrecon/common/output_path.hpp"
@@ -75,6 +76,24 @@ struct Spread {
 // The spread of values over runs (NaN values, runs without the figure, left out).
 Spread SpreadOf(std::vector<double> values);
 
+// The ratio of the fractions of people in danger, other / main, over every
+// pair of a run of each ensemble. A pair whose main run had nobody in danger
+// has no finite ratio: it is counted apart (where the other run had someone)
+// or not at all (nobody in either), never left out silently, so that a
+// median over the finite pairs alone is not read as the ensembles' ratio.
+struct DangerRatio {
+  Spread finite;                      // the pairs whose main run had someone in danger
+  std::size_t main_none = 0;          // pairs: nobody in the main run, someone in the other (ratio not finite)
+  std::size_t neither = 0;            // pairs: nobody in danger in either run
+  std::size_t Pairs() const { return finite.runs + main_none + neither; }
+};
+// Each run given as (people in danger, people in the run).
+DangerRatio DangerRatioOf(const std::vector<std::pair<double, double>>& main,
+                          const std::vector<std::pair<double, double>>& other);
+// The ratio in a sentence naming both ensembles (html: escaped, its figure in bold).
+std::string DangerRatioText(const DangerRatio& ratio, const std::string& main_label, const std::string& other_label,
+                            bool html);
+
 struct EnsembleSummary {
   std::string label;
   std::size_t runs = 0;
@@ -89,10 +108,9 @@ struct EnsembleSummary {
 struct ReportSummary {
   std::filesystem::path html, pdf, csv;
   EnsembleSummary main, other;  // other.runs = 0 without --compare
-  // Ratio of the fraction of people in danger (other / main), median and
-  // range over every pair of runs; runs = 0 when there is nothing to compare
-  // or the main ensemble has nobody in danger.
-  Spread danger_ratio;
+  // Ratio of the fraction of people in danger (other / main) over every
+  // pair of runs (DangerRatioOf).
+  DangerRatio danger_ratio;
   bool envelope = false;            // a sweep's design envelope (then main/other are empty)
   std::size_t envelope_runs = 0;
   std::vector<std::string> envelope_lines;  // per variant and row of the diagram: the envelope's reach
