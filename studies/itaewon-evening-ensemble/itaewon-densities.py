@@ -9,6 +9,10 @@ the model's bodies and as real-size people (the same floor covered by ANSUR II
 median bodies, 0.0868 m², the runs' validity statements' measure).
 
     studies/itaewon-evening-ensemble/itaewon-densities.py RUN.sqlite... -o DENSITIES.md [--csv DENSITIES.csv]
+        [--also 22:00,22:10]
+
+--also adds evening times without a recorded density (HH:MM between 21:45 and
+22:30), measured the same way, to compare runs before the recorded times.
 
 A run that ended before a time (or, still running, has not reached it) gives no
 figure for it (said in the table). The outputs are checked before any work and
@@ -53,7 +57,24 @@ def body_area(radius, vertices):
     return ring_area(ring) + perimeter * radius + math.pi * radius * radius
 
 
-def read_run(path, scale):
+EVENING_START_MIN = 21 * 60 + 45  # t = 0 of the evening's runs
+
+
+def evening_time(text):
+    """HH:MM of the evening (21:45-22:30) as (text, run seconds); ScriptError otherwise."""
+    try:
+        h, m = text.split(":")
+        minutes = int(h) * 60 + int(m)
+        if len(m) != 2 or not 0 <= int(m) < 60:
+            raise ValueError
+    except ValueError:
+        raise guard.ScriptError(f"--also: {text!r} is not a time HH:MM; expected times such as 22:00") from None
+    if not EVENING_START_MIN <= minutes <= EVENING_START_MIN + 45:
+        raise guard.ScriptError(f"--also: {text} is outside the evening; expected a time from 21:45 to 22:30")
+    return f"{minutes // 60}:{minutes % 60:02d}", 60.0 * (minutes - EVENING_START_MIN)
+
+
+def read_run(path, scale, times=RECORDED):
     db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
     run = dict(db.execute("select key, value from run"))
     venue = json.loads(run["venue"])
@@ -65,12 +86,13 @@ def read_run(path, scale):
     person_area = {i: shapes[s] for i, s in db.execute("select id, shape from person")}
     end_s = db.execute("select max(time_s) from frame_time").fetchone()[0]
     rows = []
-    for clock, t, low, high in RECORDED:
+    for clock, t, low, high in times:
         t *= scale
         frames = [f for (f,) in db.execute("select frame from frame_time where time_s >= ? and time_s <= ? order by frame",
                                           (t - WINDOW_S / 2, t + WINDOW_S / 2))]
-        if end_s is None or end_s < t + WINDOW_S / 2:
-            rows.append({"clock": clock, "recorded": (low, high), "ended": end_s, "areas": None})
+        if end_s is None or end_s < t + WINDOW_S / 2 or not frames:
+            rows.append({"clock": clock, "recorded": (low, high), "ended": end_s, "areas": None,
+                         "reached": end_s is not None and end_s >= t + WINDOW_S / 2})
             continue
         counts = {name: [] for name, _ in areas}
         covered = {name: [] for name, _ in areas}
@@ -123,9 +145,13 @@ def main():
     p.add_argument("--scale", type=guard.float_between(0.0, low_open=True, what="run time per evening time, "
                                                                               "such as 0.1 for the shortened evening"),
                    default=1.0, help="run time per evening time (the shortened evening's clock: 0.1)")
+    p.add_argument("--also", default="", help="more evening times, comma-separated HH:MM (no recorded density)")
     guard.add_force(p)
     args = p.parse_args()
     guard.refuse_repeated(args.runs, "run file")
+    also = [evening_time(t.strip()) for t in args.also.split(",") if t.strip()]
+    times = sorted([(c, t, None, None) for c, t in also if t not in {r[1] for r in RECORDED}] + RECORDED,
+                   key=lambda r: r[1])
     first = None
     for path in args.runs:
         names = venue_areas(path)
@@ -141,7 +167,7 @@ def main():
     table = []
     names = None
     for path in args.runs:
-        seed, rows, area_names = read_run(path, args.scale)
+        seed, rows, area_names = read_run(path, args.scale, times)
         names = names or area_names
         for r in rows:
             table.append((path, seed, r))
@@ -150,17 +176,20 @@ def main():
     csv_rows = []
     for path, seed, r in table:
         low, high = r["recorded"]
+        recorded = "–" if low is None else f"{low}–{high}"
         stem = path.rsplit("/", 1)[-1].removesuffix(".sqlite")
         if r["areas"] is None:
-            ended = "no frames" if r["ended"] is None else f"not reached (the last frame at {r['ended']:.1f} s)"
-            lines.append(f"| {stem} ({seed}) | {r['clock']} | {low}–{high} | " + " | ".join(ended for _ in names) + " |")
+            ended = ("no frames" if r["ended"] is None else "no frames within the window" if r["reached"]
+                     else f"not reached (the last frame at {r['ended']:.1f} s)")
+            lines.append(f"| {stem} ({seed}) | {r['clock']} | {recorded} | " + " | ".join(ended for _ in names) + " |")
             continue
         cells = []
         for n in names:
             model, real, area = r["areas"][n]
             cells.append(f"{model:.1f} ({real:.1f})")
-            csv_rows.append([stem, seed, r["clock"], n, f"{area:.2f}", f"{model:.3f}", f"{real:.3f}", low, high, r["frames"]])
-        lines.append(f"| {stem} ({seed}) | {r['clock']} | {low}–{high} | " + " | ".join(cells) + " |")
+            csv_rows.append([stem, seed, r["clock"], n, f"{area:.2f}", f"{model:.3f}", f"{real:.3f}",
+                             "" if low is None else low, "" if high is None else high, r["frames"]])
+        lines.append(f"| {stem} ({seed}) | {r['clock']} | {recorded} | " + " | ".join(cells) + " |")
     note = (f"\nMeans over the {WINDOW_S:.0f} s around each time; persons/m² of the model's bodies and, in brackets, "
             f"the same floor covered by real-size people ({REFERENCE_BODY_M2} m² each). 'whole alley' is the slope's region "
             "(the alley from the sidewalk to the food street). Recorded: the National Forensic Service's densities in the "

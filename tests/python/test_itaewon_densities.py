@@ -73,9 +73,23 @@ def main(script, venue_path, scratch):
 
     out_md = os.path.join(scratch, "d.md")
     out_csv = os.path.join(scratch, "d.csv")
-    r = subprocess.run([sys.executable, script, path, "-o", out_md, "--csv", out_csv], capture_output=True, text=True)
+    r = subprocess.run([sys.executable, script, path, "-o", out_md, "--csv", out_csv, "--also", "22:00,22:15"],
+                       capture_output=True, text=True)
     if r.returncode != 0:
         fail(f"the script failed: {r.stderr}")
+    # --also: 22:00 has no frames near it here (the run's frames start at 1795 s) and no recorded range; 22:15,
+    # a recorded time given again, is measured once.
+    md = open(out_md).read()
+    lines_2200 = [l for l in md.splitlines() if "| 22:00 |" in l]
+    if len(lines_2200) != 1 or "| – | no frames within the window |" not in lines_2200[0]:
+        fail(f"--also 22:00: expected one row without a recorded range:\n{md}")
+    if md.count("| 22:15 |") != 1:
+        fail(f"--also 22:15 (a recorded time): expected it once:\n{md}")
+    for bad, said in [("22:61", "is not a time HH:MM"), ("21:30", "is outside the evening"), ("x", "is not a time HH:MM")]:
+        rb = subprocess.run([sys.executable, script, path, "-o", out_md, "--also", bad, "--force"], capture_output=True,
+                            text=True)
+        if rb.returncode == 0 or said not in rb.stderr:
+            fail(f"--also {bad}: expected a refusal saying {said!r}: {rb.returncode} {rb.stderr}")
     rows = {row["area"]: row for row in csv.DictReader(open(out_csv)) if row["clock"] == "22:15"}
     body = math.pi * RADIUS ** 2
     expected = {name: sum(count(k) for k in range(len(frames))) / len(frames) for name, count in per_frame.items()}
