@@ -35,18 +35,23 @@ void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geomet
   const int columns = maps.size() == 1 ? 1 : 2;
   const int rows = static_cast<int>((maps.size() + 1) / static_cast<std::size_t>(columns));
   const double gap = 0.12 * w, title_m = 0.16 * h, legend_m = 0.22 * h;
+  const double sheet_w = columns * w + (columns - 1) * gap;
+  const double ppm = 1300.0 / sheet_w;
+  // The title on one line where it fits the sheet (about 0.56 of the font
+  // size per character), else on two, broken at a space; its band at the
+  // top in pixels (a long, low venue leaves too little of its height for
+  // two lines: the second once ran into the first map's label).
+  const std::size_t fits = static_cast<std::size_t>(1300.0 / (0.56 * 20.0));
+  const bool one_line = title.size() <= fits;
+  const double top_m = std::max(title_m, (one_line ? 44.0 : 66.0) / ppm);
   const Vec2 sheet_min{0.0, 0.0};
-  const Vec2 sheet_max{columns * w + (columns - 1) * gap, rows * (h + title_m) + legend_m + title_m};
-  const double ppm = 1300.0 / sheet_max.x;
+  const Vec2 sheet_max{sheet_w, rows * (h + title_m) + legend_m + top_m};
   Canvas c(file, sheet_min, sheet_max, ppm, 20.0);
   // The scale: 0 to the largest density of any map, rounded up to a whole number.
   double top = 1.0;
   for (const auto& m : maps) top = std::max(top, m.max_per_m2);
   top = std::ceil(top / 4.0) * 4.0;  // whole ticks at its quarters
-  // The title on one line where it fits the sheet (about 0.56 of the font
-  // size per character), else on two, broken at a space.
-  const std::size_t fits = static_cast<std::size_t>(1300.0 / (0.56 * 20.0));
-  if (title.size() <= fits) {
+  if (one_line) {
     c.TextPx(20, 30, title, 20);
   } else {
     std::size_t cut = title.rfind(' ', fits);
@@ -57,7 +62,7 @@ void DrawDensityMaps(const std::vector<analysis::DensityMap>& maps, const geomet
   for (std::size_t k = 0; k < maps.size(); ++k) {
     const analysis::DensityMap& m = maps[k];
     const double ox = double(k % columns) * (w + gap);
-    const double oy = sheet_max.y - title_m - double(k / columns + 1) * (h + title_m) + title_m * 0.2;
+    const double oy = sheet_max.y - top_m - double(k / columns + 1) * (h + title_m) + title_m * 0.2;
     const Vec2 shift{ox - m.origin_m.x, oy - m.origin_m.y};
     for (std::size_t iy = 0; iy < m.ny; ++iy)
       for (std::size_t ix = 0; ix < m.nx; ++ix) {
