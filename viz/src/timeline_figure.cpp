@@ -43,6 +43,14 @@ std::string Number(double v) {
   return text;
 }
 
+// A duration in seconds as people read it: whole seconds from 10 s on, one
+// decimal below (Number's two significant digits wrote 889.5 s as "8.9e+02").
+std::string Seconds(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, std::abs(v) >= 10.0 ? "%.0f" : "%.1f", v);
+  return text;
+}
+
 void DrawFrame(Sheet& s, const Panel& p, const std::string& label) {
   const double step = NiceStep(p.hi - p.lo);
   for (double v = std::ceil(p.lo / step) * step; v <= p.hi + 1e-9; v += step) {
@@ -103,12 +111,12 @@ void DrawTimelineFigure(const analysis::TimelineSeries& ts, const std::string& t
       case analysis::PlausibilityVerdict::kWithin: line = "validity: within the range of human crowds (peak " + peak + ")"; break;
       case analysis::PlausibilityVerdict::kBeyondStatic:
         line = "validity: beyond Fruin's critical density of a static crowd (7.1 /m2) for " +
-               Number(std::round(v.time_beyond_static_s * 10.0) / 10.0) + " s, peak " + peak + ": within what crushes have reached";
+               Seconds(v.time_beyond_static_s) + " s, peak " + peak + ": within what crushes have reached";
         colour = Color::Hex(0xb35806);
         break;
       case analysis::PlausibilityVerdict::kBeyondMeasured:
         line = "validity: BEYOND what any human crowd has been measured to reach for " +
-               Number(std::round(v.time_beyond_measured_s * 10.0) / 10.0) + " s (peak " + peak +
+               Seconds(v.time_beyond_measured_s) + " s (peak " + peak +
                "): read its loads and counts as the model's in that state";
         colour = Color::Hex(0xb2182b);
         break;
