@@ -73,14 +73,13 @@ std::string DangerRatioText(const DangerRatio& r, const std::string& main_label,
   const std::string a = html ? Escape(main_label) : main_label, b = html ? Escape(other_label) : other_label;
   const std::string open = html ? "<b>" : "", close = html ? "</b>" : "";
   const std::string pairs = std::to_string(r.Pairs()) + (r.Pairs() == 1 ? " pair" : " pairs");
-  std::string s;
   if (r.finite.runs == 0 && r.main_none == 0)
     return open + "No ratio of the fractions in danger" + close + ": nobody reached the danger zone in " + a +
            " or " + b + ".";
   if (r.finite.runs == 0)
     return open + "No finite ratio of the fractions in danger" + close + ": nobody reached the danger zone in " + a +
            ", and someone did in " + b + " (in " + std::to_string(r.main_none) + " of " + pairs + " of runs).";
-  s = open + "Fraction of people in danger, " + b + " / " + a + ": " + Short(r.finite.median) + close + " (range " +
+  std::string s = open + "Fraction of people in danger, " + b + " / " + a + ": " + Short(r.finite.median) + close + " (range " +
       Short(r.finite.low) + "–" + Short(r.finite.high) + " over the " + std::to_string(r.finite.runs) + " of " + pairs +
       " of runs in which " + a + " had someone in danger)";
   if (r.main_none > 0)

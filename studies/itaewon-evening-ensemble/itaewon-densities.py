@@ -150,8 +150,8 @@ def main():
     args = p.parse_args()
     guard.refuse_repeated(args.runs, "run file")
     also = [evening_time(t.strip()) for t in args.also.split(",") if t.strip()]
-    times = sorted([(c, t, None, None) for c, t in also if t not in {r[1] for r in RECORDED}] + RECORDED,
-                   key=lambda r: r[1])
+    recorded_s = {r[1] for r in RECORDED}
+    times = sorted([(c, t, None, None) for c, t in also if t not in recorded_s] + RECORDED, key=lambda r: r[1])
     first = None
     for path in args.runs:
         names = venue_areas(path)

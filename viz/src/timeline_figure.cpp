@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "crowdrecon/common/error.hpp"
 #include "crowdrecon/viz/canvas.hpp"
 #include "crowdrecon/viz/chart.hpp"
 #include "ticks.hpp"
@@ -45,11 +46,7 @@ std::string Number(double v) {
 
 // A duration in seconds as people read it: whole seconds from 10 s on, one
 // decimal below (Number's two significant digits wrote 889.5 s as "8.9e+02").
-std::string Seconds(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, std::abs(v) >= 10.0 ? "%.0f" : "%.1f", v);
-  return text;
-}
+std::string Seconds(double v) { return FormatFixed(v, std::abs(v) >= 10.0 ? 0 : 1); }
 
 void DrawFrame(Sheet& s, const Panel& p, const std::string& label) {
   const double step = NiceStep(p.hi - p.lo);
