@@ -111,6 +111,9 @@ int RunSimulate(const SimulateArgs& args) {
   }
   if (const std::string steps = engine::StepLevelHistogram(p, s.time_step_s); !steps.empty())
     std::printf("adaptive step: %s\n", steps.c_str());
+  if (p.walking_person_steps > 0)  // (model.sleep_speed_m_per_s > 0)
+    std::printf("sleeping: %.1f %% of the walking people's steps asleep\n",
+                100.0 * static_cast<double>(p.sleeping_person_steps) / static_cast<double>(p.walking_person_steps));
   if (s.status != "complete") {
     std::fprintf(stderr, "crowdrecon: run interrupted at t = %.3f s; continue it with: crowdrecon simulate %s%s -o %s --resume\n",
                  s.simulated_s, args.scenario.c_str(), args.profile.empty() ? "" : (" --profile " + args.profile).c_str(),

@@ -239,6 +239,16 @@ std::string Simulation::SaveState() const {
     w.Put(approach_memory_m_per_s_);
     w.Put(approach_age_s_);
   }
+  // Only with sleeping (the parameters above say): who sleeps, how long the
+  // others have been still, the sleepers' frozen drive.
+  if (!in_->asleep.empty()) {
+    w.PutVector(in_->asleep);
+    w.PutVector(in_->still_s);
+    w.PutVector(in_->sleep_drive_force);
+    w.PutVector(in_->sleep_drive_torque);
+    w.PutVector(in_->sleep_anchor);
+    w.PutVector(in_->sleep_anchor_angle);
+  }
   return w.Finish();
 }
 
@@ -319,6 +329,26 @@ void Simulation::LoadState(const std::string& data) {
         throw InputError("checkpoint: damaged adaptive step (level " + std::to_string(level) + " at tick " +
                          std::to_string(tick_count_) + ")");
       level_ = next_level_ = level;
+    }
+    // Sleeping as the restored parameters say (off: nothing saved). A
+    // checkpoint from before sleeping existed ends here: everyone awake.
+    in_->asleep.clear();
+    SetUpSleeping();
+    if (!in_->asleep.empty() && r.remaining() > 0) {
+      r.GetVector(in_->asleep, n);
+      r.GetVector(in_->still_s, n);
+      r.GetVector(in_->sleep_drive_force, n);
+      r.GetVector(in_->sleep_drive_torque, n);
+      r.GetVector(in_->sleep_anchor, n);
+      r.GetVector(in_->sleep_anchor_angle, n);
+      for (std::size_t i = 0; i < n; ++i)
+        if (in_->asleep[i] > 1 || !(in_->still_s[i] >= 0.0))
+          throw InputError("checkpoint: damaged sleeping state of slot " + std::to_string(i));
+      RequireFinite(in_->still_s, "time still");
+      RequireFinite(in_->sleep_drive_force, "frozen drive");
+      RequireFinite(in_->sleep_drive_torque, "frozen drive torque");
+      RequireFinite(in_->sleep_anchor, "still spell's place");
+      RequireFinite(in_->sleep_anchor_angle, "still spell's angle");
     }
     in_->restitution_factor = RestitutionDampingFactor(p.restitution);
     in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);

@@ -305,6 +305,20 @@ auto MakeTable() {
            "anticipation_interval_s > 0", [](const P& p) {
              return p.anticipation == Anticipation::kTimeToCollision && p.anticipation_interval_s > 0.0;
            }),
+      // --- Sleeping (issue 66; off by default; appended: checkpoints read the table's first entries) ---
+      Number("sleep_speed_m_per_s", &P::sleep_speed_m_per_s, "m/s", 0.0, 1.0,
+             "issue 66 (Box2D's sleeping, per body; docs/model.md, \"Sleeping\")",
+             "0: every walking person is integrated at every step; > 0: a person still (speed and rim speed below "
+             "this) for sleep_time_s sleeps (not integrated, drive frozen to hold their mean load while still, "
+             "contacts with other sleepers and walls carried) until their load moves from it by more than "
+             "sleep_wake_force_n"),
+      When(Number("sleep_time_s", &P::sleep_time_s, "s", 0.0, 600.0, "issue 66",
+                  "how long a person must be still before sleeping"),
+           "sleep_speed_m_per_s > 0", [](const P& p) { return p.sleep_speed_m_per_s > 0.0; }),
+      When(Number("sleep_wake_force_n", &P::sleep_wake_force_n, "N", 0.0, 1e4, "issue 66",
+                  "how far a sleeper's load (contacts, external force) may move from the mean it held while still "
+                  "before it wakes (and that force at the body's farthest core point, as a torque)"),
+           "sleep_speed_m_per_s > 0", [](const P& p) { return p.sleep_speed_m_per_s > 0.0; }),
   };
 }
 
@@ -390,6 +404,10 @@ bool ModelParameters::IsValid(std::string* error) const {
   }
   if (time_step_mode == TimeStepMode::kAdaptive && integrator != Integrator::kVelocityVerlet) {
     if (error) *error = "time_step_mode = adaptive needs integrator = velocity_verlet (Gear's history assumes one step)";
+    return false;
+  }
+  if (sleep_speed_m_per_s > 0.0 && integrator != Integrator::kVelocityVerlet) {
+    if (error) *error = "sleep_speed_m_per_s > 0 needs integrator = velocity_verlet (Gear's history assumes every body moves)";
     return false;
   }
   if (gait_jitter_band_high_hz < gait_jitter_band_low_hz) {

@@ -91,6 +91,7 @@ Simulation::Simulation(WorldDef def) : def_(std::move(def)), in_(std::make_uniqu
   tick_s_ = dt_s_;
   next_dt_s_ = dt_s_;
   SetUpAdaptiveStep();
+  SetUpSleeping();
 
   if (def_.device == ComputeDevice::kCuda)
     in_->cuda = std::make_unique<cuda::Collider>(in_->family_geometry, in_->shape_family, in_->shape_scale,
@@ -286,6 +287,7 @@ void Simulation::Step() {
   level_ = next_level_;
   dt_s_ = next_dt_s_;
   Check();
+  Sleep();
 }
 
 void Simulation::AdvanceTo(double end_time_s) {
@@ -297,11 +299,13 @@ void Simulation::Quench() {
   std::fill(bodies_.angular_velocity_rad_per_s.begin(), bodies_.angular_velocity_rad_per_s.end(), 0.0);
   for (BehaviourTerm* t : in_->terms.stateful) t->Quench();
   in_->gear_initialised = false;
+  WakeAll();
 }
 
 void Simulation::SetExternalForce(std::uint32_t person, Vec2 force_n) {
   if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
   bodies_.external_force_n[person] = force_n;
+  Wake(person);
   Drive();  // the force enters the current evaluation too
 }
 
@@ -309,6 +313,7 @@ void Simulation::SetPersonState(std::uint32_t person, PersonState state) {
   if (person >= bodies_.size()) throw InputError("person index " + std::to_string(person) + " out of range");
   const PersonState before = bodies_.state[person];
   bodies_.state[person] = state;
+  Wake(person);
   if (state != PersonState::kWalking) {
     bodies_.velocity_m_per_s[person] = {};
     bodies_.angular_velocity_rad_per_s[person] = 0.0;
@@ -374,6 +379,7 @@ void Simulation::Spawn(std::uint32_t slot, const PersonDef& p, std::uint32_t id)
                        FormatNumber(LargestStep()) + " s (choose the step for every arrival)");
   }
   LoadPerson(slot, p, id);
+  Wake(slot);
   bodies_.force_n[slot] = {};
   bodies_.torque_n_m[slot] = 0.0;
   bodies_.contact_force_n[slot] = {};
@@ -431,6 +437,7 @@ void Simulation::SetTarget(std::uint32_t person, std::uint32_t target) {
   if (person >= bodies_.size() || target >= def_.targets.size())
     throw InputError("person " + std::to_string(person) + " or target " + std::to_string(target) + " out of range");
   bodies_.target[person] = target;
+  Wake(person);
   Drive();
 }
 
@@ -439,6 +446,7 @@ void Simulation::SetDesiredSpeed(std::uint32_t person, double speed_m_per_s) {
     throw InputError("person " + std::to_string(person) + ": desired speed " + FormatNumber(speed_m_per_s) +
                      " m/s; expected a person in range and a finite speed >= 0");
   bodies_.desired_speed_m_per_s[person] = speed_m_per_s;
+  Wake(person);
   Drive();
 }
 
@@ -466,6 +474,8 @@ void Simulation::SetParameters(const ModelParameters& parameters) {
   in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
   if (max_level_ > 0)  // the restitution errors at each level for the new parameters (the levels stay)
     level_speed_ = AdaptiveLevelSpeeds(def_, tick_s_, max_level_, reference_speed_m_per_s_);
+  WakeAll();  // (everyone's drive is another now)
+  SetUpSleeping();
   Drive();
 }
 
@@ -474,6 +484,7 @@ void Simulation::SetWallEnabled(std::uint32_t wall, bool enabled) {
   if (WallEnabled(wall) == enabled) return;
   if (wall_enabled_.empty()) wall_enabled_.assign(def_.walls.size(), 1);
   wall_enabled_[wall] = enabled ? 1 : 0;
+  WakeAll();  // (a sleeper's contacts with walls are carried)
   if (!enabled) std::erase_if(contacts_, [wall](const Contact& c) { return c.wall && c.b == wall; });
   in_->pairs_valid = false;
   if (step_count_ == 0) {  // the forces at t = 0 as the constructor computes them, with this wall as it is now
@@ -495,6 +506,8 @@ void Simulation::SetGroupDrive(std::uint32_t group, double back_force_gamma, dou
   }
   in.group_gamma[group] = back_force_gamma;
   in.group_lambda[group] = torsion_stiffness_lambda;
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.group[i] == group) Wake(i);
   if (!std::isnan(torsion_stiffness_lambda)) {
     ModelParameters p = def_.parameters;
     p.torsion_stiffness_lambda = torsion_stiffness_lambda;

@@ -156,6 +156,22 @@ class PreviousContacts {
     return nullptr;
   }
 
+  // Every contact of the pair `key` in the previous evaluation, appended to
+  // `out` in their order (a pair of sleepers: carried unchanged). The same
+  // cursor as Find: lookups in increasing order move it forward.
+  void AppendPair(std::uint64_t key, std::vector<Contact>& out) {
+    const auto before = [&](const Contact& c) { return PairKey(c) < key; };
+    if (!started_ || key < last_key_) {
+      pos_ = static_cast<std::size_t>(std::partition_point(previous_.begin(), previous_.end(), before) - previous_.begin());
+      started_ = true;
+    } else {
+      while (pos_ < previous_.size() && before(previous_[pos_])) ++pos_;
+    }
+    last_key_ = key;
+    last_feature_ = 0;
+    for (; pos_ < previous_.size() && PairKey(previous_[pos_]) == key; ++pos_) out.push_back(previous_[pos_]);
+  }
+
  private:
   const std::vector<Contact>& previous_;
   std::size_t pos_ = 0;
@@ -266,6 +282,19 @@ struct Simulation::Internals {
   // Contact-law constants.
   double restitution_factor = 0.0;       // 2 L / sqrt(pi^2 + L^2), L = -ln(eps)
   double wall_restitution_factor = 0.0;  // same for walls
+
+  // Sleeping (ModelParameters::sleep_speed_m_per_s > 0; docs/model.md,
+  // "Sleeping"; stage_sleep.cpp): per slot, whether the person sleeps, how
+  // long their still spell has lasted (0: none), where it began, and the
+  // frozen drive (the mean load of the spell turned round; while awake, its
+  // running value). Empty when sleeping is off. Checkpointed.
+  std::vector<std::uint8_t> asleep;
+  std::vector<double> still_s;
+  std::vector<Vec2> sleep_drive_force;
+  std::vector<double> sleep_drive_torque;
+  std::vector<Vec2> sleep_anchor;
+  std::vector<double> sleep_anchor_angle;
+  bool Asleep(std::size_t i) const { return !asleep.empty() && asleep[i] != 0; }
 
   // Gear predictor-corrector: scaled derivatives r2..r5 for x, y, theta.
   std::vector<std::array<Vec2, 4>> gear_xy;     // r2, r3, r4, r5

@@ -121,6 +121,10 @@ class PairCollider {
     const std::size_t end = std::min(in_.pairs.size(), (chunk + 1) * kChunk);
     for (std::size_t k = chunk * kChunk; k < end; ++k) {
       const auto [a, b] = in_.pairs[k];
+      if (in_.Asleep(a) && in_.Asleep(b)) {  // two sleepers: their contacts as they were (docs/model.md, "Sleeping")
+        previous.AppendPair(PairKey(false, a, b), out);
+        continue;
+      }
       Simulation::Internals::PairMotion& motion = in_.pair_motion[k];
       const double travel = in_.travel_m[a] + in_.travel_m[b];
       if (in_.pair_memory && motion.travel_offset + travel < in_.pair_clear.pair_m[k]) continue;  // still apart
@@ -158,6 +162,10 @@ class PairCollider {
     const std::size_t end = std::min(in_.wall_pairs.size(), (wchunk + 1) * kChunk);
     for (std::size_t k = wchunk * kChunk; k < end; ++k) {
       const auto [a, w] = in_.wall_pairs[k];
+      if (in_.Asleep(a)) {  // a sleeper against a wall: as it was
+        previous.AppendPair(PairKey(true, a, w), out);
+        continue;
+      }
       const double moved = in_.travel_m[a];
       if (in_.pair_memory && moved < in_.wall_pair_clear.pair_m[k]) continue;  // still apart (see Internals)
       if (bodies_.state[a] == PersonState::kRemoved) continue;
@@ -207,7 +215,7 @@ void Simulation::Collide() {
   ContactLaw wall_law = law;
   wall_law.damping_factor = in.wall_restitution_factor;
   const PairCollider collider(bodies_, in, def_.periodic, law, wall_law);
-  if (in.cuda && CollideOnDevice(collider)) return;
+  if (in.cuda && in.asleep.empty() && CollideOnDevice(collider)) return;  // (sleeping: on the processor)
   if (def_.threads == 1 || collider.chunks() < 4) {
     // On one thread the chunks come in order: straight into the contact list,
     // which is then what the concatenation of CollideOnThreads would make.

@@ -88,7 +88,8 @@ void Simulation::Drive() {
     // the forces of the contacts and the external force.
     for (std::size_t k = 0; k < b.count; ++k) {
       const std::size_t i = b.first + k;
-      b.driven[k] = bodies_.state[i] == PersonState::kWalking && mp.ground_reaction;
+      // (A sleeper's drive is frozen: added below, docs/model.md "Sleeping".)
+      b.driven[k] = bodies_.state[i] == PersonState::kWalking && mp.ground_reaction && !in.Asleep(i);
       b.force[k] = bodies_.contact_force_n[i] + bodies_.external_force_n[i];
       b.torque[k] = bodies_.contact_torque_n_m[i];
       b.facing[k] = Vec2{};
@@ -124,6 +125,10 @@ void Simulation::Drive() {
       if (bodies_.state[i] == PersonState::kRemoved) continue;  // no forces (zeroed when removed)
       bodies_.force_n[i] = b.force[k];
       bodies_.torque_n_m[i] = b.torque[k];
+      if (in.Asleep(i)) {
+        bodies_.force_n[i] += in.sleep_drive_force[i];
+        bodies_.torque_n_m[i] += in.sleep_drive_torque[i];
+      }
     }
   }
 }

@@ -62,7 +62,7 @@ void Simulation::VerletKickDrift() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
   for (std::int64_t ii = 0; ii < count; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
-    if (bodies_.state[i] != PersonState::kWalking) {
+    if (bodies_.state[i] != PersonState::kWalking || in.Asleep(i)) {  // (a sleeper stays: docs/model.md, "Sleeping")
       v[i] = {};
       w[i] = 0.0;
       in.v_half[i] = {};
@@ -89,7 +89,7 @@ void Simulation::VerletKick() {
 #pragma omp parallel for schedule(static) num_threads(def_.threads) if (count >= kParallelBodies)
   for (std::int64_t ii = 0; ii < count; ++ii) {
     const std::size_t i = static_cast<std::size_t>(ii);
-    if (bodies_.state[i] != PersonState::kWalking) continue;
+    if (bodies_.state[i] != PersonState::kWalking || in.Asleep(i)) continue;
     bodies_.velocity_m_per_s[i] =
         in.v_half[i] + (bodies_.force_n[i] + in.trailing_force[i]) / bodies_.mass_kg[i] * (h / 2.0);
     bodies_.angular_velocity_rad_per_s[i] =

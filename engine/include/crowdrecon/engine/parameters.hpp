@@ -334,6 +334,19 @@ struct ModelParameters {
   TimeStepMode time_step_mode = TimeStepMode::kFixed;
   double adaptive_max_safety = 0.32;
   double adaptive_reference_speed_m_per_s = 0.0;
+  // Sleeping (issue 66; off by default: 0): a walking person who has been
+  // still (speed and rim speed below sleep_speed_m_per_s) for sleep_time_s
+  // falls asleep: not integrated, the contacts with other sleepers and walls
+  // carried unchanged from step to step, the drive frozen at the force that
+  // holds the mean load (contacts, external force) the person bore while
+  // still. A sleeper wakes when its load moves from that mean by more than
+  // sleep_wake_force_n (or its torque by that force at the body's farthest
+  // core point), or when anything about it changes (target, desired speed,
+  // external force, state, its group's drive, the model's parameters, a wall
+  // switched). docs/model.md, "Sleeping"; engine/src/stage_sleep.cpp.
+  double sleep_speed_m_per_s = 0.0;
+  double sleep_time_s = 1.0;
+  double sleep_wake_force_n = 20.0;
 
   // Returns false and fills *error with "name = value, expected in [min,
   // max]" if a value is outside its range in the parameter table

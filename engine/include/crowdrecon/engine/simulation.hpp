@@ -210,6 +210,12 @@ class Simulation {
   // every evaluation. The results are the same, bit for bit; for tests.
   void SetPairMemory(bool enabled);
 
+  // Sleeping (ModelParameters::sleep_speed_m_per_s > 0; docs/model.md,
+  // "Sleeping"): how many people sleep now (0 with it off), and whether
+  // slot `person` does.
+  std::size_t asleep_count() const;
+  bool asleep(std::uint32_t person) const;
+
   // Diagnostics for tests and reports.
   Vec2 LinearMomentum() const;
   double AngularMomentum() const;  // about the origin (z component)
@@ -247,6 +253,13 @@ class Simulation {
   void GearPredict();
   void GearCorrect();
   void Check();
+  // Stage sleep (stage_sleep.cpp): who falls asleep and who wakes, after
+  // each step; the sleeping state made or dropped when the parameters say,
+  // and a sleeper woken by a change that concerns them.
+  void Sleep();
+  void SetUpSleeping();
+  void Wake(std::uint32_t person);
+  void WakeAll();
   // The adaptive step: its levels and the approach speed each allows (at
   // construction and when the parameters change), and the next step's level
   // (stage choose_step, after the drift: positions at the step's end).

@@ -13,9 +13,10 @@
 //   integrate      engine/src/stage_integrate.cpp     velocity Verlet or Gear 5th-order predictor-corrector
 //   check          engine/src/stage_check.cpp         non-finite state, cores interpenetrating -> SimulationError
 //   choose_step    engine/src/stage_choose_step.cpp   the next step (TimeStepMode::kAdaptive only)
+//   sleep          engine/src/stage_sleep.cpp         who falls asleep, who wakes (sleep_speed_m_per_s > 0 only)
 //
 // With the velocity Verlet integrator a step is: integrate (kick + drift),
-// [choose_step,] then the force stages 1-6, then integrate (kick), then check. With Gear:
+// [choose_step,] then the force stages 1-6, then integrate (kick), then check[, then sleep]. With Gear:
 // integrate (predict), force stages, integrate (correct), check.
 #pragma once
 
@@ -35,9 +36,10 @@ enum class Stage : std::uint8_t {
   kDrive,
   kIntegrate,
   kCheck,
-  kChooseStep
+  kChooseStep,
+  kSleep
 };
-inline constexpr std::size_t kStageCount = 9;
+inline constexpr std::size_t kStageCount = 10;
 
 struct StageInfo {
   Stage stage;
@@ -55,6 +57,7 @@ inline constexpr std::array<StageInfo, kStageCount> kStages{{
     {Stage::kIntegrate, "integrate", "velocity Verlet or Gear 5th-order predictor-corrector"},
     {Stage::kCheck, "check", "non-finite state or interpenetrating cores: SimulationError"},
     {Stage::kChooseStep, "choose_step", "the next step from the approach speeds of pairs that may touch (adaptive)"},
+    {Stage::kSleep, "sleep", "who falls asleep and who wakes (sleeping only)"},
 }};
 
 // The adaptive step's levels: a step of level l is 2^l times the fixed step.
@@ -72,6 +75,9 @@ struct Profile {
   // With the CUDA force computation: of the collide stage's time, the seconds
   // spent copying to and from the device and in its kernels (its events).
   double device_copy_s = 0, device_kernels_s = 0;
+  // Sleeping (stage sleep): over the steps, the walking people counted at
+  // each, and of them those asleep after it.
+  std::uint64_t walking_person_steps = 0, sleeping_person_steps = 0;
   // Steps taken at each level of the adaptive step (level 0 only, with the fixed step).
   std::array<std::uint64_t, kMaxStepLevels> steps_at_level{};
 
