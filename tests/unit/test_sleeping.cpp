@@ -60,6 +60,13 @@ std::string Sealed(std::string bytes) {
   return bytes;
 }
 
+// The first person asleep (40: nobody).
+std::uint32_t FirstSleeper(const Simulation& sim) {
+  for (std::uint32_t i = 0; i < 40; ++i)
+    if (sim.asleep(i)) return i;
+  return 40;
+}
+
 void MakeSleeping(WorldDef& def) {
   def.parameters.sleep_speed_m_per_s = 0.02;
   def.parameters.sleep_time_s = 0.5;
@@ -146,9 +153,7 @@ TEST(Sleeping, SleepersWakeWhenPushedWhenTheirTargetChangesAndWhenAWallGoes) {
   {
     Simulation sim(def);
     sim.AdvanceTo(12.0);
-    std::uint32_t sleeper = 40;
-    for (std::uint32_t i = 0; i < 40 && sleeper == 40; ++i)
-      if (sim.asleep(i)) sleeper = i;
+    const std::uint32_t sleeper = FirstSleeper(sim);
     ASSERT_LT(sleeper, 40u);
     const Vec2 before = sim.bodies().position_m[sleeper];
     for (std::uint32_t i = 0; i < 40; ++i) sim.SetTarget(i, 1);
@@ -174,9 +179,7 @@ TEST(Sleeping, SleepersWakeWhenPushedWhenTheirTargetChangesAndWhenAWallGoes) {
   {
     Simulation sim(def);
     sim.AdvanceTo(12.0);
-    std::uint32_t sleeper = 40;
-    for (std::uint32_t i = 0; i < 40 && sleeper == 40; ++i)
-      if (sim.asleep(i)) sleeper = i;
+    const std::uint32_t sleeper = FirstSleeper(sim);
     ASSERT_LT(sleeper, 40u);
     sim.SetExternalForce(sleeper, {0.0, 5.0});
     EXPECT_FALSE(sim.asleep(sleeper));
