@@ -38,14 +38,26 @@ def clock(t, start_h=2):
 
 def load(summaries_dir, results_csv):
     """seed -> {clog_s, danger, peak, avalanches, falls, wall_s}."""
+    guard.require_csv_columns(results_csv, ["seed", "status", "wall_s"], "a sweep's results.csv")
     walls = {}
     with open(results_csv, newline="") as f:
         for row in csv.DictReader(f):
             if row.get("status") == "complete":
-                walls[int(row["seed"])] = float(row["wall_s"])
+                try:
+                    walls[int(row["seed"])] = float(row["wall_s"])
+                except ValueError:
+                    raise guard.ScriptError(f"{results_csv}: a complete run with seed {row['seed']!r} and wall_s "
+                                            f"{row['wall_s']!r}; expected numbers") from None
     runs = {}
     for path in sorted(pathlib.Path(summaries_dir).glob("*.json")):
-        d = json.loads(path.read_text())
+        d = guard.read_json_file(path, "an ensemble summary of `crowdrecon timeline --summaries`")
+        if not isinstance(d, dict):
+            raise guard.ScriptError(f"{path}: not a JSON object; expected an ensemble summary of `crowdrecon timeline --summaries`")
+        missing = [k for k in ("seed", "clog_for_good_s", "end_s", "danger_peak", "peak_density_per_m2", "avalanche_s",
+                               "fall_s") if k not in d]
+        if missing:
+            raise guard.ScriptError(f"{path}: has no {', '.join(missing)}; expected an ensemble summary of "
+                                    "`crowdrecon timeline --summaries`")
         seed = int(d["seed"])
         runs[seed] = {
             "clog_s": d["clog_for_good_s"],

@@ -30,6 +30,7 @@ for f in ANSURIIMALEPublic.csv ANSURIIFEMALEPublic.csv; do
 done
 echo "my own notes" > notes/notes.txt
 echo "my own notes" > notes.txt
+mkdir jsonfolder && cp scenario.json jsonfolder/
 # A copy of the scripts without the data folder ../shared/data beside it.
 mkdir -p norepo/main/studies && cp -r "$root/scripts" norepo/main/ && cp -r "$root/studies/wuppertal-bottleneck" norepo/main/studies/
 
@@ -118,6 +119,12 @@ refused "scenario-with: a change that is not JSON" "is not JSON" -- \
 refused "area-stops: no run file" "required" -- "$py" "$D/local-avalanche-reading/results/area-stops.py"
 refused "releases: a sweep's results as a run" "has no run, .*tables" -- \
   "$py" "$D/night-full-ensemble/results/releases.py" hallway-sweep/results.sqlite
+refused "compare-nights: -o the sweep's results.csv" "is an input" -- \
+  "$py" "$D/sleeping/compare-nights.py" notes hallway-sweep/results.csv notes hallway-sweep/results.csv -o hallway-sweep/results.csv
+refused "compare-nights: a folder without summaries" "no summaries" -- \
+  "$py" "$D/sleeping/compare-nights.py" notes hallway-sweep/results.csv notes hallway-sweep/results.csv -o nights.md
+refused "compare-nights: a scenario as a summary" "has no seed" -- \
+  "$py" "$D/sleeping/compare-nights.py" jsonfolder hallway-sweep/results.csv jsonfolder hallway-sweep/results.csv -o nights.md
 
 # --- good input still works; a rerun replaces its previous outputs
 accepted "itaewon-densities: a table" d.md -- "$py" "$dens" run.sqlite -o d.md --csv d.csv
