@@ -332,7 +332,6 @@ void Simulation::LoadState(const std::string& data) {
     }
     // Sleeping as the restored parameters say (off: nothing saved). A
     // checkpoint from before sleeping existed ends here: everyone awake.
-    in_->asleep.clear();
     SetUpSleeping();
     if (!in_->asleep.empty() && r.remaining() > 0) {
       r.GetVector(in_->asleep, n);

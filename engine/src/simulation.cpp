@@ -474,8 +474,7 @@ void Simulation::SetParameters(const ModelParameters& parameters) {
   in_->wall_restitution_factor = RestitutionDampingFactor(p.wall_restitution);
   if (max_level_ > 0)  // the restitution errors at each level for the new parameters (the levels stay)
     level_speed_ = AdaptiveLevelSpeeds(def_, tick_s_, max_level_, reference_speed_m_per_s_);
-  WakeAll();  // (everyone's drive is another now)
-  SetUpSleeping();
+  SetUpSleeping();  // (everyone awake: everyone's drive is another now)
   Drive();
 }
 

@@ -27,29 +27,21 @@ namespace crowdrecon::engine {
 
 using namespace detail;  // the stages' shared helpers (simulation_internals.hpp)
 
+// Everyone awake with no still spell; nothing at all with sleeping off.
 void Simulation::SetUpSleeping() {
   Internals& in = *in_;
-  if (!(def_.parameters.sleep_speed_m_per_s > 0.0)) {
-    in.asleep.clear();
-    in.still_s.clear();
-    in.sleep_drive_force.clear();
-    in.sleep_drive_torque.clear();
-    in.sleep_anchor.clear();
-    in.sleep_anchor_angle.clear();
-    return;
-  }
-  const std::size_t n = bodies_.size();
-  in.asleep.resize(n, 0);
-  in.still_s.resize(n, 0.0);
-  in.sleep_drive_force.resize(n);
-  in.sleep_drive_torque.resize(n, 0.0);
-  in.sleep_anchor.resize(n);
-  in.sleep_anchor_angle.resize(n, 0.0);
+  const std::size_t n = def_.parameters.sleep_speed_m_per_s > 0.0 ? bodies_.size() : 0;
+  in.asleep.assign(n, 0);
+  in.still_s.assign(n, 0.0);
+  in.sleep_drive_force.assign(n, Vec2{});
+  in.sleep_drive_torque.assign(n, 0.0);
+  in.sleep_anchor.assign(n, Vec2{});
+  in.sleep_anchor_angle.assign(n, 0.0);
 }
 
 void Simulation::Wake(std::uint32_t person) {  // (a new still spell begins at its next Sleep)
   Internals& in = *in_;
-  if (in.asleep.empty() || person >= in.asleep.size()) return;
+  if (in.asleep.empty()) return;
   in.asleep[person] = 0;
   in.still_s[person] = 0.0;
 }
