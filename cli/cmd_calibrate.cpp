@@ -14,6 +14,7 @@
 #include "crowdrecon/calibrate/calibrate.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/common/scoped_signals.hpp"
+#include "crowdrecon/sweep/sweep_runner.hpp"
 
 namespace crowdrecon::cli {
 
@@ -28,8 +29,12 @@ struct CalibrateArgs {
 };
 
 int RunCalibrateCommand(const CalibrateArgs& args) {
-  CheckOutputs({{"-o", args.output, calibrate::CalibrationFolderOutput()}}, {{"the calibration file", args.calibration_file}},
-               args.force);
+  // Under mpirun rank 0 alone checks, and every rank follows it (sweep::CheckedOnRankZero).
+  if (!sweep::CheckedOnRankZero([&] {
+        CheckOutputs({{"-o", args.output, calibrate::CalibrationFolderOutput()}},
+                     {{"the calibration file", args.calibration_file}}, args.force);
+      }))
+    return 2;  // rank 0 said why
   calibrate::Options options;
   options.calibration_file = args.calibration_file;
   options.output_dir = args.output;

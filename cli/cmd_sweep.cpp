@@ -29,7 +29,11 @@ struct SweepArgs {
 };
 
 int RunSweepCommand(const SweepArgs& args) {
-  CheckOutputs({{"-o", args.output, sweep::SweepFolderOutput()}}, {{"the sweep file", args.sweep_file}}, args.force);
+  // Under mpirun rank 0 alone checks, and every rank follows it (sweep::CheckedOnRankZero).
+  if (!sweep::CheckedOnRankZero([&] {
+        CheckOutputs({{"-o", args.output, sweep::SweepFolderOutput()}}, {{"the sweep file", args.sweep_file}}, args.force);
+      }))
+    return 2;  // rank 0 said why
   sweep::SweepOptions options;
   options.sweep_file = args.sweep_file;
   options.output_dir = args.output;

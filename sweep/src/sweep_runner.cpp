@@ -563,4 +563,20 @@ SweepSummary RunSweep(const SweepOptions& options) {
 }
 
 
+bool CheckedOnRankZero(const std::function<void()>& check) {
+  if (!LaunchedAsMpiRank()) {
+    check();
+    return true;
+  }
+  MpiTransport mpi;
+  if (mpi.rank() != 0) return mpi.RootOk(true);
+  try {
+    check();
+  } catch (...) {
+    mpi.RootOk(false);
+    throw;
+  }
+  return mpi.RootOk(true);
+}
+
 }  // namespace crowdrecon::sweep

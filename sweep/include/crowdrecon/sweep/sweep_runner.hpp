@@ -106,4 +106,12 @@ SweepSummary RunSweep(const SweepOptions& options);
 // run files (or lone sidecars) removed.
 std::vector<std::filesystem::path> RemovePartialRuns(const std::filesystem::path& sweep_dir);
 
+// A check made once per job (of the outputs, before anything is written):
+// started by mpirun, rank 0 alone runs `check` and every rank follows its
+// verdict (a worker rank that checked too could find rank 0's output folder
+// half made and refuse it). Returns true to go on; what `check` throws on
+// rank 0 passes on there, and the other ranks return false (rank 0 says
+// why). Not under mpirun: `check` runs here and true is returned.
+bool CheckedOnRankZero(const std::function<void()>& check);
+
 }  // namespace crowdrecon::sweep
