@@ -319,6 +319,12 @@ auto MakeTable() {
                   "how far a sleeper's load (contacts, external force) may move from the mean it held while still "
                   "before it wakes (and that force at the body's farthest core point, as a torque)"),
            "sleep_speed_m_per_s > 0", [](const P& p) { return p.sleep_speed_m_per_s > 0.0; }),
+      // --- Side preference (issue 64; off by default; appended: checkpoints read the table's first entries) ---
+      When(Number("anticipation_side_preference", &P::anticipation_side_preference, "", -1.0, 1.0,
+                  "issue 64 (Moussaid et al. 2009; Xiao et al. 2019: most people avoid to their right)",
+                  "the share of the braking part of a walker's anticipation force turned into a step to their right "
+                  "(negative: to their left); 0: none"),
+           "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
   };
 }
 

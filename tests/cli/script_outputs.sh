@@ -125,6 +125,12 @@ refused "compare-nights: a folder without summaries" "no summaries" -- \
   "$py" "$D/sleeping/compare-nights.py" notes hallway-sweep/results.csv notes hallway-sweep/results.csv -o nights.md
 refused "compare-nights: a scenario as a summary" "has no seed" -- \
   "$py" "$D/sleeping/compare-nights.py" jsonfolder hallway-sweep/results.csv jsonfolder hallway-sweep/results.csv -o nights.md
+refused "passing-side: -o the sweep's results.csv" "is an input" -- \
+  "$py" "$D/side-preference/passing-side.py" hallway-sweep -o hallway-sweep/results.csv
+refused "passing-side: -o someone's notes" "expected another name, or --force" -- \
+  "$py" "$D/side-preference/passing-side.py" hallway-sweep -o notes.txt
+refused "passing-side: not a sweep folder" "expected a crowdrecon sweep folder" -- \
+  "$py" "$D/side-preference/passing-side.py" notes -o sides.md
 
 # --- good input still works; a rerun replaces its previous outputs
 accepted "itaewon-densities: a table" d.md -- "$py" "$dens" run.sqlite -o d.md --csv d.csv

@@ -613,6 +613,83 @@ TEST(KeepingDistance, TwoWalkersMeetingHeadOnPassWithTheCentrifugalForceOrAntici
   }
 }
 
+// The side preference (issue 64): the braking part of the anticipation
+// force, -F.e_i, turned by the share s into a step to the right of e_i: on a
+// walker heading +x for a person at rest on its line, F = (-m a, -s m a)
+// exactly (a the force per unit mass of one collision course, the same as
+// without it); a negative share steps to the left; nothing where nothing
+// brakes (moving away, beyond the radius).
+TEST(Anticipation, TheSidePreferenceTurnsTheBrakingPartToTheRight) {
+  ModelParameters p;
+  p.anticipation = Anticipation::kTimeToCollision;
+  for (const double d : {1.5, 2.5, 4.0}) {
+    double m = 0.0;
+    const Vec2 straight = TermForceOnAWalker(p, 1.0, 1.0, d, &m);
+    ASSERT_LT(straight.x, 0.0);
+    for (const double side : {0.4, -0.25, 1.0}) {
+      ModelParameters q = p;
+      q.anticipation_side_preference = side;
+      const Vec2 f = TermForceOnAWalker(q, 1.0, 1.0, d);
+      EXPECT_EQ(f.x, straight.x) << "d " << d << ", side " << side;
+      EXPECT_NEAR(f.y, side * straight.x, 1e-12 * m) << "d " << d << ", side " << side;  // -s m a: to the right of +x
+    }
+  }
+  ModelParameters q = p;
+  q.anticipation_side_preference = 0.5;
+  EXPECT_EQ(Length(TermForceOnAWalker(q, 1.0, 1.0, -2.0)), 0.0);                             // moving away
+  EXPECT_EQ(Length(TermForceOnAWalker(q, 1.0, 1.0, q.anticipation_radius_m + 0.1)), 0.0);  // beyond the radius
+}
+
+// Two walkers meeting head on exactly on one line (no jitter): without a
+// side preference nothing tells them apart sideways, they brake and stand
+// face to face, neither passing; with it each steps to its own right (the
+// one heading +x to -y, the one heading -x to +y) and they pass without
+// touching; with a negative share each to its left. Whichever way, the same on any thread
+// count and after a resume.
+TEST(KeepingDistance, TwoWalkersHeadOnOnOneLineEachStepToTheirOwnRight) {
+  for (const double side : {0.0, 0.3, -0.3}) {
+    ModelParameters p;
+    p.anticipation = Anticipation::kTimeToCollision;
+    p.anticipation_side_preference = side;
+    WorldDef def = File(1, 10.0, 1.2, p);
+    def.periodic = PeriodicBox{};
+    def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+    def.people[0].position_m = {0.0, 0.0};
+    def.people[0].velocity_m_per_s = {1.2, 0.0};
+    PersonDef other = def.people[0];
+    other.position_m = {8.0, 0.0};
+    other.velocity_m_per_s = {-1.2, 0.0};
+    other.angle_rad = 3.14159265358979;
+    other.target = 1;
+    def.people.push_back(other);
+    Simulation sim(def);
+    bool touched = false;
+    double y0_at_passing = 0.0, y1_at_passing = 0.0;
+    while (sim.time_s() < 12.0) {
+      sim.Step();
+      touched = touched || !sim.contacts().empty();
+      const BodyState& b = sim.bodies();
+      if (b.position_m[0].x < b.position_m[1].x) y0_at_passing = b.position_m[0].y, y1_at_passing = b.position_m[1].y;
+    }
+    const BodyState& b = sim.bodies();
+    const bool passed = b.position_m[0].x > 8.0 && b.position_m[1].x < 0.0;
+    if (side == 0.0) {
+      EXPECT_FALSE(passed) << "no side preference: a standoff";
+      EXPECT_EQ(b.position_m[0].y, 0.0) << "no side preference: nobody steps aside";
+    } else {
+      EXPECT_FALSE(touched) << "side " << side;
+      EXPECT_TRUE(passed) << "side " << side;
+      const double right = side > 0.0 ? 1.0 : -1.0;
+      EXPECT_LT(right * y0_at_passing, -0.1) << "the walker heading +x: to its right (-y) for side > 0";
+      EXPECT_GT(right * y1_at_passing, 0.1) << "the walker heading -x: to its right (+y) for side > 0";
+    }
+  }
+  ModelParameters p;
+  p.anticipation = Anticipation::kTimeToCollision;
+  p.anticipation_side_preference = 0.3;
+  ExpectTheSameOnAnyThreadCountAndAfterAResume(p, 0.1, "side preference");
+}
+
 TEST(KeepingDistance, TheCentrifugalForceAndAnticipationOffAreThePapersModelAndOnTheSameOnAnyThreadCountAndAfterAResume) {
   WorldDef paper = testing::RandomGas(6, 0.45, 5, true), numbers = paper;
   paper.parameters.ground_reaction = numbers.parameters.ground_reaction = true;

@@ -302,6 +302,15 @@ struct ModelParameters {
   // evaluated at every step (a smooth switch over its last 0.5 m), only the
   // rest on the clock; 0: every pair on the clock.
   double anticipation_near_m = 0.0;
+  // A side preference in avoiding (issue 64; 0 off): a walking person turns
+  // this share of the braking part of their anticipation force (the part
+  // against their own direction e_i, -F.e_i where positive) into a step to
+  // their right, (e_y, -e_x) (ERRATA 9's frame, the floor's normal up); a
+  // negative value steps to the left. Two people meeting head on both step
+  // to their own right and pass left shoulder to left shoulder, as most
+  // people do where traffic keeps right (Moussaid et al. 2009; Xiao et al.
+  // 2019, about 70 % to the right in circle-antipode experiments).
+  double anticipation_side_preference = 0.0;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
