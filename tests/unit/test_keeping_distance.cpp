@@ -580,24 +580,30 @@ TEST(Anticipation, PeopleWhoStandByChoiceDoNotDodge) {
 
 // Two walkers meeting head on, their lines 0.1 m apart: with the paper's
 // model they collide; with either term they pass each other.
+// Two walkers 8 m apart heading for each other at 1.2 m/s (their desired
+// speed), the second `offset_m` to the side (+y) of the first's line.
+WorldDef HeadOn(const ModelParameters& p, double offset_m) {
+  WorldDef def = File(1, 10.0, 1.2, p);
+  def.periodic = PeriodicBox{};
+  def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
+  def.people[0].position_m = {0.0, 0.0};
+  def.people[0].velocity_m_per_s = {1.2, 0.0};
+  PersonDef other = def.people[0];
+  other.position_m = {8.0, offset_m};
+  other.velocity_m_per_s = {-1.2, 0.0};
+  other.angle_rad = 3.14159265358979;
+  other.target = 1;
+  def.people.push_back(other);
+  return def;
+}
+
 TEST(KeepingDistance, TwoWalkersMeetingHeadOnPassWithTheCentrifugalForceOrAnticipation) {
   ModelParameters centrifugal, anticipation;
   centrifugal.centrifugal = Centrifugal::kGeneralized;
   anticipation.anticipation = Anticipation::kTimeToCollision;
   const std::vector<const ModelParameters*> cases{nullptr, &centrifugal, &anticipation};
   for (const ModelParameters* p : cases) {
-    WorldDef def = File(1, 10.0, 1.2, p != nullptr ? *p : ModelParameters{});
-    def.periodic = PeriodicBox{};
-    def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
-    def.people[0].position_m = {0.0, 0.0};
-    def.people[0].velocity_m_per_s = {1.2, 0.0};
-    PersonDef other = def.people[0];
-    other.position_m = {8.0, 0.1};
-    other.velocity_m_per_s = {-1.2, 0.0};
-    other.angle_rad = 3.14159265358979;
-    other.target = 1;
-    def.people.push_back(other);
-    Simulation sim(def);
+    Simulation sim(HeadOn(p != nullptr ? *p : ModelParameters{}, 0.1));
     bool touched = false;
     while (sim.time_s() < 12.0) {
       sim.Step();
@@ -651,18 +657,7 @@ TEST(KeepingDistance, TwoWalkersHeadOnOnOneLineEachStepToTheirOwnRight) {
     ModelParameters p;
     p.anticipation = Anticipation::kTimeToCollision;
     p.anticipation_side_preference = side;
-    WorldDef def = File(1, 10.0, 1.2, p);
-    def.periodic = PeriodicBox{};
-    def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
-    def.people[0].position_m = {0.0, 0.0};
-    def.people[0].velocity_m_per_s = {1.2, 0.0};
-    PersonDef other = def.people[0];
-    other.position_m = {8.0, 0.0};
-    other.velocity_m_per_s = {-1.2, 0.0};
-    other.angle_rad = 3.14159265358979;
-    other.target = 1;
-    def.people.push_back(other);
-    Simulation sim(def);
+    Simulation sim(HeadOn(p, 0.0));
     bool touched = false;
     double y0_at_passing = 0.0, y1_at_passing = 0.0;
     while (sim.time_s() < 12.0) {
