@@ -31,6 +31,7 @@ constexpr const char* kHeadwayChoices[] = {"none", "time_gap"};
 constexpr const char* kSocialForceChoices[] = {"none", "circular"};
 constexpr const char* kCentrifugalChoices[] = {"none", "generalized"};
 constexpr const char* kAnticipationChoices[] = {"none", "time_to_collision"};
+constexpr const char* kSidePreferenceGateChoices[] = {"always", "slowed"};
 
 ParameterInfo Number(const char* name, double P::*field, const char* unit, double min, double max, const char* source,
                      const char* meaning, const char* default_from = nullptr) {
@@ -325,6 +326,13 @@ auto MakeTable() {
                   "the share of the braking part of a walker's anticipation force turned into a step to their right "
                   "(negative: to their left); 0: none"),
            "anticipation = time_to_collision", [](const P& p) { return p.anticipation == Anticipation::kTimeToCollision; }),
+      When(Choice<&P::anticipation_side_gate>("anticipation_side_gate", kSidePreferenceGateChoices,
+                                               "issue 64 (studies/side-preference/)",
+                                               "always: the side step is s times the braking part; slowed: also times "
+                                               "max(0, 1 - v.e / v0), only as far as the walker is slowed"),
+           "anticipation_side_preference != 0", [](const P& p) {
+             return p.anticipation == Anticipation::kTimeToCollision && p.anticipation_side_preference != 0.0;
+           }),
   };
 }
 

@@ -40,7 +40,8 @@ namespace {
 // CRWORLDC: the anticipation's clock (issue 66: its interval and near radius) at the table's end.
 // CRWORLDD: sleeping (issue 66: its speed, time and wake force) at the table's end.
 // CRWORLDE: the anticipation's side preference (issue 64) at the table's end.
-constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', 'E'};
+// CRWORLDF: and when it acts (anticipation_side_gate, a choice) after it.
+constexpr char kWorldMagic[8] = {'C', 'R', 'W', 'O', 'R', 'L', 'D', 'F'};
 
 // The bytes are the machine's; the development machine and the GPU machines
 // are little-endian, so a file moves between them unchanged. A big-endian
@@ -51,7 +52,7 @@ static_assert(sizeof(Vec2) == 2 * sizeof(double));
 // Tripwires for the definition structs. A new field changes their size and
 // stops the build here: add it to the Fields function below and change the
 // magic (the old files would be read wrongly otherwise).
-static_assert(sizeof(ModelParameters) == 536, "ModelParameters changed: update the parameter table (parameter_table.cpp) and the magic");
+static_assert(sizeof(ModelParameters) == 544, "ModelParameters changed: update the parameter table (parameter_table.cpp) and the magic");
 static_assert(sizeof(PersonDef) == 96, "PersonDef changed: update PersonFields and the magic");
 static_assert(sizeof(PeriodicBox) == 40, "PeriodicBox changed: update the world file and the magic");
 static_assert(sizeof(FloorSlope) == 48, "FloorSlope changed: update the world file and the magic");

@@ -640,6 +640,20 @@ TEST(Anticipation, TheSidePreferenceTurnsTheBrakingPartToTheRight) {
       EXPECT_NEAR(f.y, side * straight.x, 1e-12 * m) << "d " << d << ", side " << side;  // -s m a: to the right of +x
     }
   }
+  // Gated (slowed): times max(0, 1 - v.e / v0): none at the desired speed,
+  // 0.5 of it at half of it (a walker at 0.6 m/s wanting 1.2).
+  ModelParameters gated = p;
+  gated.anticipation_side_preference = 0.4;
+  gated.anticipation_side_gate = SidePreferenceGate::kSlowed;
+  for (const double d : {1.5, 2.5}) {
+    const Vec2 at_pace = TermForceOnAWalker(gated, 1.0, 1.0, d), ungated_at_pace = TermForceOnAWalker(p, 1.0, 1.0, d);
+    EXPECT_EQ(at_pace.x, ungated_at_pace.x);
+    EXPECT_EQ(at_pace.y, 0.0) << "d " << d;
+    double m = 0.0;
+    const Vec2 slowed = TermForceOnAWalker(gated, 0.6, 1.2, d, &m), straight = TermForceOnAWalker(p, 0.6, 1.2, d);
+    EXPECT_EQ(slowed.x, straight.x);
+    EXPECT_NEAR(slowed.y, 0.4 * 0.5 * straight.x, 1e-12 * m) << "d " << d;
+  }
   ModelParameters q = p;
   q.anticipation_side_preference = 0.5;
   EXPECT_EQ(Length(TermForceOnAWalker(q, 1.0, 1.0, -2.0)), 0.0);                             // moving away

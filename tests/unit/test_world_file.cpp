@@ -139,7 +139,7 @@ std::string LoadError(const std::string& data, const std::string& origin) {
 TEST(WorldFile, RoundTripGivesTheSameBytes) {
   const WorldDef def = EveryKindOfWorld();
   const std::string bytes = SaveWorld(def);
-  ASSERT_EQ(bytes.substr(0, 8), "CRWORLDE");
+  ASSERT_EQ(bytes.substr(0, 8), "CRWORLDF");
   const WorldDef loaded = LoadWorld(bytes, "memory");
   EXPECT_EQ(SaveWorld(loaded), bytes);
 
@@ -307,10 +307,10 @@ TEST(WorldFile, DamagedDataIsRefusedWithItsOrigin) {
   // gait_jitter, 4 doubles, yielding, 2 doubles, shoulder_turn, a double,
   // give_way, 4 doubles, drive_reaction, a double, headway, 4 doubles,
   // social_force, 3 doubles, centrifugal, 8 doubles, anticipation, 6
-  // doubles, 3 doubles (sleeping), 1 double (side preference); then the shape count.
+  // doubles, 3 doubles (sleeping), 1 double (side preference), its gate (a choice); then the shape count.
   const std::size_t integrator_at = 8 + 5 * 8 + 1 + 8 + 1 + 2 + 2 * 8 + 1 + 3 * 8 + 1 + 1 * 8 + 1;
   const std::size_t shape_count_at =
-      integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 3 * 8 + 1 + 8 * 8 + 1 + 6 * 8 + 3 * 8 + 8;
+      integrator_at + 1 + 2 * 8 + 1 + 2 * 8 + 1 + 4 * 8 + 1 + 2 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 8 + 1 + 4 * 8 + 1 + 3 * 8 + 1 + 8 * 8 + 1 + 6 * 8 + 3 * 8 + 8 + 1;
   ASSERT_EQ(static_cast<unsigned char>(good[integrator_at]), static_cast<unsigned>(Integrator::kGear5));
   std::string bad_enum = good;
   bad_enum[integrator_at] = 7;

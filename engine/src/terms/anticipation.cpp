@@ -298,6 +298,7 @@ class AnticipationTerm final : public BehaviourTerm {
     const double tick = clocked_ ? std::floor(in.time_s / in.def.parameters.anticipation_interval_s) : 0.0;
     const bool split = near_m_ > 0.0;
     const double side = in.def.parameters.anticipation_side_preference;
+    const bool gate_slowed = in.def.parameters.anticipation_side_gate == SidePreferenceGate::kSlowed;
     for (std::size_t n = 0; n < b.count; ++n) {
       const std::size_t i = b.first + n;
       if (!b.driven[n] || !WantsToWalk(in.bodies, i)) continue;
@@ -320,7 +321,9 @@ class AnticipationTerm final : public BehaviourTerm {
       if (side != 0.0) {
         const Vec2 e = b.direction[n];
         const double braking = -Dot(push, e);
-        if (braking > 0.0) push += Vec2{e.y, -e.x} * (side * braking);
+        double share = side;
+        if (gate_slowed && b.pace[n] > 0.0) share *= std::max(0.0, 1.0 - Dot(vi, e) / b.pace[n]);
+        if (braking > 0.0) push += Vec2{e.y, -e.x} * (share * braking);
       }
       b.force[n] += push * in.bodies.mass_kg[i];
     }

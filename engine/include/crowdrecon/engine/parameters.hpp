@@ -120,6 +120,13 @@ enum class SocialForce {
 // form, a repulsion that grows with the speed at which a person closes in on
 // another's speed-dependent ellipse (Chraibi, Seyfried and Schadschneider,
 // Phys. Rev. E 82:046111, 2010).
+// When the anticipation's side preference acts (issue 64): always, or in the
+// share a walker is slowed below their desired speed.
+enum class SidePreferenceGate {
+  kAlways,  // s B (default)
+  kSlowed,  // s B max(0, 1 - v.e / v0): a walker at their desired speed does not step aside
+};
+
 enum class Centrifugal {
   kNone,         // the paper's model (default)
   kGeneralized,  // -m K_ij (eta v0_i + v_ij)^2 / dist_ij e_ij from each person j ahead, interpolated near 0 and r_c
@@ -311,6 +318,10 @@ struct ModelParameters {
   // people do where traffic keeps right (Moussaid et al. 2009; Xiao et al.
   // 2019, about 70 % to the right in circle-antipode experiments).
   double anticipation_side_preference = 0.0;
+  // When it acts: always (s B), or scaled by how much the walker is slowed,
+  // max(0, 1 - v_i.e_i / v0_i): people walking at their desired speed keep
+  // their line, people held up by someone coming the other way step aside.
+  SidePreferenceGate anticipation_side_gate = SidePreferenceGate::kAlways;
 
   // (Bodies: masses in 40-70 kg and rho = 1000 kg/m^2 are the population's,
   // geometry::PopulationOptions; PersonDef holds each person's mass and inertia.)
