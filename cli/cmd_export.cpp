@@ -27,7 +27,42 @@ struct ExportArgs {
   std::string output;
   bool force = false;
   bool tables = false;  // --tables: the run as one run file with tables
+  bool segment_head = false;  // --segment-head: the segment's head and its checkpoint
 };
+
+// --segment-head: RUN (a segment stopped at its checkpoint) as its head
+// beside a copy of its checkpoint (runfile::WriteSegmentHead).
+void WriteHead(const ExportArgs& args) {
+  const runfile::RunFileReader one = runfile::RunFileReader::OneSegment(args.run_file);
+  const std::string status = one.RunValue("status");
+  if (status != "interrupted")
+    throw InputError(args.run_file + ": its status is \"" + status + "\"; a segment's head is made of a segment stopped "
+                     "at its checkpoint (status \"interrupted\": simulate --stop-after, Ctrl-C or SIGTERM), the one "
+                     "a run continues from");
+  if (!one.RunValue("segment_head").empty())
+    throw InputError(args.run_file + ": is a segment's head already; copy it with its checkpoint instead");
+  const std::filesystem::path from_checkpoint = scenario::CheckpointPath(args.run_file);
+  std::error_code ec;
+  if (!std::filesystem::exists(from_checkpoint, ec))
+    throw InputError(args.run_file + ": has no checkpoint to continue from (" + from_checkpoint.string() + ")");
+  const std::vector<runfile::FrameTime> times = one.FrameTimes();
+  runfile::WriteSegmentHead(args.run_file, args.output);
+  const std::filesystem::path to_checkpoint = scenario::CheckpointPath(args.output);
+  const std::filesystem::path partial = PartialPath(to_checkpoint);
+  std::filesystem::copy_file(from_checkpoint, partial, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) {
+    std::filesystem::remove(partial, ec);
+    throw InputError(to_checkpoint.string() + ": cannot write the checkpoint's copy (" + ec.message() + ")");
+  }
+  std::filesystem::rename(partial, to_checkpoint);
+  std::printf("segment head: %s at t = %s s (frame %lld), %lld bytes, and its checkpoint %s, %lld bytes\n",
+              args.output.c_str(), times.empty() ? "?" : FormatNumber(times.back().time_s).c_str(),
+              static_cast<long long>(times.empty() ? -1 : times.back().frame),
+              static_cast<long long>(std::filesystem::file_size(args.output, ec)), to_checkpoint.c_str(),
+              static_cast<long long>(std::filesystem::file_size(to_checkpoint, ec)));
+  std::printf("continue it anywhere: crowdrecon simulate SCENARIO -o NEXT.sqlite --continue-from %s\n",
+              args.output.c_str());
+}
 
 // "x in [0, 12) m" for the periodic axes of `box`.
 std::string DescribeSeams(const PeriodicBox& box) {
@@ -39,8 +74,11 @@ std::string DescribeSeams(const PeriodicBox& box) {
 }
 
 void RunExport(const ExportArgs& args) {
-  CheckOutputs({{"-o", args.output, args.tables ? runfile::RunFileOutput() : runfile::TrajectoryExportOutput()}},
-               {{"the run file", args.run_file}}, args.force);
+  if (args.tables && args.segment_head) throw InputError("--tables and --segment-head: give one of them");
+  CheckOutputs({{"-o", args.output,
+                 args.tables || args.segment_head ? runfile::RunFileOutput() : runfile::TrajectoryExportOutput()}},
+               {{"the run file", args.run_file}, {"the run's checkpoint", scenario::CheckpointPath(args.run_file)}},
+               args.force);
   // Said here rather than as SQLite's "file is not a database".
   std::error_code ec;
   if (!std::filesystem::exists(args.run_file, ec))
@@ -48,6 +86,7 @@ void RunExport(const ExportArgs& args) {
   if (!runfile::IsRunFile(args.run_file))
     throw InputError(args.run_file + ": is " + runfile::DescribeNonRunFile(args.run_file) +
                      ", not a crowdrecon run file; expected a run file (.sqlite) written by `crowdrecon simulate`");
+  if (args.segment_head) return WriteHead(args);
   const runfile::RunFileReader run(args.run_file);
   if (args.tables) {
     const runfile::TablesExportSummary t = runfile::WriteRunTables(run, args.output);
@@ -95,6 +134,11 @@ void RegisterExportCommand(CLI::App& app) {
                 "Write instead the whole run as one run file with tables (run.frames \"tables\"): packed frames "
                 "unpacked, a run in segments joined; for scripts that read the tables (docs/scenarios.md, "
                 "\"Packed frames\"); -o must not exist or be a run file");
+  cmd->add_flag("--segment-head", args->segment_head,
+                "Write instead RUN's head: the segment (stopped at its checkpoint) without its frames, with a copy "
+                "of its checkpoint beside it (-o's name + .checkpoint): small enough to keep in a repository, and "
+                "what `simulate --continue-from` needs to continue the run on another machine; no command reads "
+                "a head as a run (docs/scenarios.md, \"Runs in segments\")");
   AddForceFlag(cmd, &args->force);
   cmd->callback([args] { RunExport(*args); });
 }

@@ -183,6 +183,10 @@ struct ChainAccess {
         throw InputError(after.file() + ": its chain of segments comes back to " + path.string() +
                          " (run values continues; the run file is damaged)");
       auto segment = std::unique_ptr<RunFileReader>(new RunFileReader(path, false));
+      if (!segment->RunValue("segment_head").empty())
+        throw InputError(after.file() + ": continues " + path.string() + ", which is a segment's head (" +
+                         segment->RunValue("segment_head") + "): its frames are not there; a run in segments is read "
+                         "whole: put the whole segment in its place");
       const std::vector<FrameTime> times = segment->FrameTimes();
       if (times.empty() || times.back().frame != at)
         throw InputError(after.file() + ": continues " + path.string() + " after its frame " + std::to_string(at) +
@@ -252,6 +256,12 @@ RunFileReader::RunFileReader(const std::filesystem::path& file, bool follow_segm
     if (people.Next() && people.Type(0) == SQLITE_INTEGER)
       impl_->people = static_cast<std::size_t>(std::clamp<std::int64_t>(people.Int(0), 0, run_limits::kPersonId));
   }
+  // A segment's head (WriteSegmentHead) holds no frames: it continues, it
+  // is not read.
+  if (follow_segments && !RunValue("segment_head").empty())
+    throw InputError(impl_->file + ": is a segment's head (" + RunValue("segment_head") +
+                     "): a run can be continued from it (simulate --continue-from), not read; put the whole segment "
+                     "in its place");
   if (follow_segments && !RunValue("continues").empty()) ChainAccess::Open(*this, file);
 }
 

@@ -363,7 +363,7 @@ void RunFileWriter::StartSegment(const std::filesystem::path& file, const std::f
     db.Exec("BEGIN");
     Statement put(db, "INSERT OR REPLACE INTO run VALUES(?, ?)");
     for (const auto& [key, value] : values)
-      if (key != "status") put.Bind(1, key).Bind(2, value).Run();
+      if (key != "status" && key != "segment_head") put.Bind(1, key).Bind(2, value).Run();  // (a head's mark is its own)
     ForgetDerived(db);  // (what an analysis stored describes the segment before)
     put.Bind(1, std::string("continues")).Bind(2, from).Run();
     put.Bind(1, std::string("continues_at_frame")).Bind(2, std::to_string(at_frame)).Run();

@@ -130,4 +130,38 @@ TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesyst
   return summary;
 }
 
+void WriteSegmentHead(const std::filesystem::path& segment, const std::filesystem::path& file) {
+  const std::filesystem::path partial = PartialPath(file);
+  std::error_code ec;
+  std::filesystem::remove(partial, ec);
+  sqlite::RemoveSidecars(partial);
+  try {
+    CopyRunFile(segment, partial);
+    {
+      Database db(partial.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX);
+      db.Exec("BEGIN");
+      for (const char* table : kCopied) {
+        if (!sqlite::HasTable(db, table)) continue;
+        db.Exec(std::string(table) == "frame_time"
+                    ? std::string("DELETE FROM frame_time WHERE frame <> (SELECT MAX(frame) FROM frame_time)")
+                    : std::string("DELETE FROM ") + table);
+      }
+      // (The tables stay, empty: a packed segment's head is packed too.)
+      for (const char* table : {"frame_pack", "contact_dropped"})
+        if (sqlite::HasTable(db, table)) db.Exec(std::string("DELETE FROM ") + table);
+      Statement put(db, "INSERT OR REPLACE INTO run VALUES('segment_head', ?)");
+      put.Bind(1, "its frames left out to carry the run to another machine (crowdrecon export --segment-head of " +
+                      segment.filename().string() + ")")
+          .Run();
+      db.Exec("COMMIT");
+      db.Exec("VACUUM");
+    }
+  } catch (...) {
+    std::filesystem::remove(partial, ec);
+    sqlite::RemoveSidecars(partial);
+    throw;
+  }
+  std::filesystem::rename(partial, file);
+}
+
 }  // namespace crowdrecon::runfile

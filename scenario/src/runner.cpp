@@ -170,7 +170,9 @@ std::string NothingToResume(const std::filesystem::path& run_file, const Scenari
     return file + ": nothing to resume: the run file does not exist; start the run without --resume";
   if (!runfile::IsRunFile(run_file))
     return file + ": nothing to resume: it is " + runfile::DescribeNonRunFile(run_file) + ", not a crowdrecon run file";
-  const runfile::RunFileReader reader(run_file);
+  // (This segment's own values: the chain before it is not read, and may be
+  // a segment's head, runfile::WriteSegmentHead.)
+  const runfile::RunFileReader reader = runfile::RunFileReader::OneSegment(run_file);
   if (reader.RunValue("scenario") != scenario.json_text)
     return file + ": nothing to resume: the run file was written for a different scenario (" +
            reader.RunValue("scenario_file") + ", or the scenario file changed); start the run without --resume";
@@ -189,7 +191,7 @@ std::filesystem::path CheckpointPath(const std::filesystem::path& run_file) {
 }
 
 double RecordedWallSeconds(const std::filesystem::path& run_file) {
-  const double s = std::strtod(runfile::RunFileReader(run_file).RunValue(kWallSecondsKey).c_str(), nullptr);
+  const double s = std::strtod(runfile::RunFileReader::OneSegment(run_file).RunValue(kWallSecondsKey).c_str(), nullptr);
   return std::isfinite(s) ? std::max(0.0, s) : 0.0;
 }
 

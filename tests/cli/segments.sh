@@ -60,6 +60,32 @@ refused "the segment as its own continuation" 'an input is never overwritten' \
 if [[ -n $other ]]; then
   refused "another scenario" 'scenario' "$cr" simulate "$other" -o "$tmp/y.sqlite" -q --continue-from "$tmp/chain/b/seg2.sqlite"
 fi
+# A segment's head (export --segment-head): the segment without its frames
+# and a copy of its checkpoint, all another machine needs to go on. Carried
+# alone to a new folder, continued there twice: the chain is refused while
+# the head stands in for the segment, and is the whole run once the whole
+# segment is put in its place.
+mkdir -p "$tmp/heads" "$tmp/far/b"
+"$cr" export "$tmp/chain/seg1.sqlite" -o "$tmp/heads/seg1.sqlite" --segment-head > "$tmp/head.txt"
+grep -q "segment head: $tmp/heads/seg1.sqlite at t = " "$tmp/head.txt" || fail "the head's line: $(cat "$tmp/head.txt")"
+[[ -s "$tmp/heads/seg1.sqlite.checkpoint" ]] || fail "no checkpoint beside the head"
+cmp -s "$tmp/heads/seg1.sqlite.checkpoint" "$tmp/chain/seg1.sqlite.checkpoint" || fail "the head's checkpoint is not the segment's"
+[[ $(stat -c %s "$tmp/heads/seg1.sqlite") -lt $(stat -c %s "$tmp/chain/seg1.sqlite") ]] || fail "the head is not smaller"
+[[ $(sqlite3 "$tmp/heads/seg1.sqlite" "SELECT COUNT(*) FROM frame_time") == 1 ]] || fail "the head keeps more than its last frame's time"
+cp "$tmp/heads/seg1.sqlite" "$tmp/heads/seg1.sqlite.checkpoint" "$tmp/far/"
+(cd "$tmp/far"
+ "$cr" simulate "$scenario" -o b/seg2.sqlite -q --continue-from seg1.sqlite --stop-after 3.05 --threads 1 > /dev/null 2>&1 || true
+ [[ $(sqlite3 b/seg2.sqlite "SELECT value FROM run WHERE key = 'status'") == interrupted ]] || fail "the head's continuation not stopped"
+ "$cr" simulate "$scenario" -o run.sqlite -q --continue-from b/seg2.sqlite > /dev/null 2>&1)
+refused "a chain through a head" "which is a segment's head" "$cr" analyze "$tmp/far/run.sqlite"
+refused "a head read as a run" "is a segment's head" "$cr" analyze "$tmp/far/seg1.sqlite"
+refused "a head of a head" "a segment's head already" "$cr" export "$tmp/far/seg1.sqlite" -o "$tmp/far/again.sqlite" --segment-head
+refused "a head of a complete run" 'made of a segment stopped' \
+  "$cr" export "$tmp/whole/run.sqlite" -o "$tmp/whole-head.sqlite" --segment-head
+cp "$tmp/chain/seg1.sqlite" "$tmp/far/seg1.sqlite"
+[[ $("$cr" analyze "$tmp/far/run.sqlite" --digest) == "$whole" ]] || fail "continued from a head, then made whole: not the whole run"
+echo "a segment's head: continued elsewhere, the whole run once the segment is back"
+
 mv "$tmp/chain/seg1.sqlite" "$tmp/seg1-moved.sqlite"
 refused "a missing segment" 'which is not there' "$cr" analyze "$tmp/chain/run.sqlite"
 echo "segments: the run made in one go"

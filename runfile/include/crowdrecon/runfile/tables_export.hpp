@@ -24,4 +24,16 @@ struct TablesExportSummary {
 // caller has checked that `file` may be written: CheckOutputs).
 TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesystem::path& file);
 
+// A segment's head (issue 66: a long run carried to another machine): the
+// run file `segment` (a segment stopped at its checkpoint) with its header
+// (scenario, venue, shapes, people, walls, storage, run values) and only its
+// last frame's time, every per-frame row left out, marked with the run
+// value segment_head: what `simulate --continue-from` needs beside the
+// checkpoint to write the next segment anywhere, small enough to keep in a
+// repository. No tool reads a head as a run (RunFileReader refuses it: its
+// frames are not there); put the whole segment in its place to read the
+// chain. Written through a partial file renamed when whole (the caller has
+// checked that `file` may be written).
+void WriteSegmentHead(const std::filesystem::path& segment, const std::filesystem::path& file);
+
 }  // namespace crowdrecon::runfile
