@@ -2,6 +2,7 @@
 #include "crowdrecon/runfile/tables_export.hpp"
 
 #include <cmath>
+#include <functional>
 #include <set>
 #include <string>
 #include <vector>
@@ -30,17 +31,30 @@ constexpr const char* kCopied[] = {"trajectory_data", "person_state", "person_lo
                                    "contact",         "event",        "census",      "contact_summary",
                                    "contact_kept",    "contact_forces"};
 
+// Writes `file` through its partial file: `write` fills the partial (absent
+// when it starts), renamed over `file` when it returns, removed if it throws.
+void WriteThroughPartial(const std::filesystem::path& file, const std::function<void(const std::filesystem::path&)>& write) {
+  const std::filesystem::path partial = PartialPath(file);
+  std::error_code ec;
+  std::filesystem::remove(partial, ec);
+  sqlite::RemoveSidecars(partial);
+  try {
+    write(partial);
+  } catch (...) {
+    std::filesystem::remove(partial, ec);
+    sqlite::RemoveSidecars(partial);
+    throw;
+  }
+  std::filesystem::rename(partial, file);
+}
+
 }  // namespace
 
 TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesystem::path& file) {
   TablesExportSummary summary;
   const std::vector<std::string> segments = run.SegmentFiles();
   summary.segments = static_cast<std::int64_t>(segments.size());
-  const std::filesystem::path partial = PartialPath(file);
-  std::error_code ec;
-  std::filesystem::remove(partial, ec);
-  sqlite::RemoveSidecars(partial);
-  try {
+  WriteThroughPartial(file, [&](const std::filesystem::path& partial) {
     {  // The header as the run's, no frame.
       const RunFileReader last = RunFileReader::OneSegment(segments.back());
       RunHeader header = last.Header();
@@ -121,21 +135,12 @@ TablesExportSummary WriteRunTables(const RunFileReader& run, const std::filesyst
               column + ")) FROM trajectory_data WHERE EXISTS (SELECT 1 FROM trajectory_data)");
     }
     db.Exec("COMMIT");
-  } catch (...) {
-    std::filesystem::remove(partial, ec);
-    sqlite::RemoveSidecars(partial);
-    throw;
-  }
-  std::filesystem::rename(partial, file);
+  });
   return summary;
 }
 
 void WriteSegmentHead(const std::filesystem::path& segment, const std::filesystem::path& file) {
-  const std::filesystem::path partial = PartialPath(file);
-  std::error_code ec;
-  std::filesystem::remove(partial, ec);
-  sqlite::RemoveSidecars(partial);
-  try {
+  WriteThroughPartial(file, [&](const std::filesystem::path& partial) {
     CopyRunFile(segment, partial);
     {
       Database db(partial.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX);
@@ -156,12 +161,7 @@ void WriteSegmentHead(const std::filesystem::path& segment, const std::filesyste
       db.Exec("COMMIT");
       db.Exec("VACUUM");
     }
-  } catch (...) {
-    std::filesystem::remove(partial, ec);
-    sqlite::RemoveSidecars(partial);
-    throw;
-  }
-  std::filesystem::rename(partial, file);
+  });
 }
 
 }  // namespace crowdrecon::runfile
