@@ -80,13 +80,19 @@ def main():
     ap.add_argument("sweep_dir", type=guard.sweep_dir_csv)
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--csv")
-    ap.add_argument("--crowdrecon", type=guard.executable, default=str(HERE.parents[1] / "build/release/cli/crowdrecon"))
+    ap.add_argument("--crowdrecon", type=guard.executable,
+                    help="the crowdrecon executable (default: build/release/cli/crowdrecon of this repository)")
     guard.add_force(ap)
     a = ap.parse_args()
     outputs = [guard.Output("-o", a.out, "a table of passing-side.py", guard.first_line_has(FIRST_LINE))]
     if a.csv:
         outputs.append(guard.Output("--csv", a.csv, "a table of passing-side.py", guard.csv_starting(*CSV_HEADER)))
     guard.check_outputs(outputs, guard.sweep_inputs(a.sweep_dir), a.force)
+    if a.crowdrecon is None:  # (checked here, after the outputs: the default is looked for only when needed)
+        try:
+            a.crowdrecon = guard.executable(str(HERE.parents[1] / "build/release/cli/crowdrecon"))
+        except argparse.ArgumentTypeError as e:
+            raise guard.ScriptError(f"--crowdrecon not given and {e}") from None
     results = os.path.join(a.sweep_dir, "results.csv")
     with open(results, newline="") as f:
         table = list(csv.DictReader(f))
