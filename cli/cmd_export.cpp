@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "crowdrecon/common/error.hpp"
+#include "crowdrecon/common/input_file.hpp"
 #include "crowdrecon/common/output_path.hpp"
 #include "crowdrecon/runfile/run_file.hpp"
 #include "crowdrecon/runfile/tables_export.hpp"
@@ -45,16 +46,11 @@ void WriteHead(const ExportArgs& args) {
   std::error_code ec;
   if (!std::filesystem::exists(from_checkpoint, ec))
     throw InputError(args.run_file + ": has no checkpoint to continue from (" + from_checkpoint.string() + ")");
+  const std::string checkpoint = ReadInputFile(from_checkpoint, "checkpoint");
   const std::vector<runfile::FrameTime> times = one.FrameTimes();
   runfile::WriteSegmentHead(args.run_file, args.output);
   const std::filesystem::path to_checkpoint = scenario::CheckpointPath(args.output);
-  const std::filesystem::path partial = PartialPath(to_checkpoint);
-  std::filesystem::copy_file(from_checkpoint, partial, std::filesystem::copy_options::overwrite_existing, ec);
-  if (ec) {
-    std::filesystem::remove(partial, ec);
-    throw InputError(to_checkpoint.string() + ": cannot write the checkpoint's copy (" + ec.message() + ")");
-  }
-  std::filesystem::rename(partial, to_checkpoint);
+  WriteFileAtomically(to_checkpoint, checkpoint);
   std::printf("segment head: %s at t = %s s (frame %lld), %lld bytes, and its checkpoint %s, %lld bytes\n",
               args.output.c_str(), times.empty() ? "?" : FormatNumber(times.back().time_s).c_str(),
               static_cast<long long>(times.empty() ? -1 : times.back().frame),

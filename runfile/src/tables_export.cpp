@@ -145,15 +145,13 @@ void WriteSegmentHead(const std::filesystem::path& segment, const std::filesyste
     {
       Database db(partial.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX);
       db.Exec("BEGIN");
-      for (const char* table : kCopied) {
-        if (!sqlite::HasTable(db, table)) continue;
-        db.Exec(std::string(table) == "frame_time"
-                    ? std::string("DELETE FROM frame_time WHERE frame <> (SELECT MAX(frame) FROM frame_time)")
-                    : std::string("DELETE FROM ") + table);
-      }
-      // (The tables stay, empty: a packed segment's head is packed too.)
-      for (const char* table : {"frame_pack", "contact_dropped"})
-        if (sqlite::HasTable(db, table)) db.Exec(std::string("DELETE FROM ") + table);
+      // Every per-frame row but the last frame's time; the tables stay, empty
+      // (a packed segment's head is packed too).
+      std::vector<std::string> per_frame(std::begin(kCopied), std::end(kCopied));
+      per_frame.insert(per_frame.end(), {"frame_pack", "contact_dropped"});
+      for (const std::string& table : per_frame)
+        if (sqlite::HasTable(db, table))
+          db.Exec("DELETE FROM " + table + (table == "frame_time" ? " WHERE frame <> (SELECT MAX(frame) FROM frame_time)" : ""));
       Statement put(db, "INSERT OR REPLACE INTO run VALUES('segment_head', ?)");
       put.Bind(1, "its frames left out to carry the run to another machine (crowdrecon export --segment-head of " +
                       segment.filename().string() + ")")
