@@ -316,6 +316,20 @@ void RegisterAll() {
                                    [w, threads](benchmark::State& s) { Step(s, w, threads, kDevelopedSeconds); })
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
+  // The validated crowd at 5 /m2 (issue 66): its anticipation visiting each
+  // pair once against each person's whole list (the same run, bit for bit).
+  for (const bool once : {false, true})
+    for (int threads : {1, 2})
+      benchmark::RegisterBenchmark(("Step/box-2000-validated/pairs:" + std::string(once ? "once" : "whole") +
+                                    "/threads:" + std::to_string(threads))
+                                       .c_str(),
+                                   [once, threads](benchmark::State& s) {
+                                     engine::UseHalfPairs(once);
+                                     Step(s, "box-2000-validated", threads);
+                                     engine::UseHalfPairs(true);
+                                   })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
 }
 
 // Writes the worlds of the Step benchmarks, and their states after the

@@ -48,6 +48,10 @@
 namespace crowdrecon::engine::detail {
 
 inline constexpr std::size_t kDriveBlock = 64;
+// Below this many people the per-body stages (and a term's own loops over
+// everyone) run on one thread (the results are the same either way; only the
+// overhead differs).
+inline constexpr std::int64_t kParallelBodies = 512;
 
 // The minimum-image difference a - b under the periodic box (the stages and
 // the terms that look at their neighbours).

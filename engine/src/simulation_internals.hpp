@@ -35,9 +35,6 @@ namespace detail {
 // Pairs per work chunk. Chunks are fixed by the pair list, not by the thread
 // count, and their outputs are concatenated in order: determinism by construction.
 constexpr std::size_t kChunk = 64;
-// Below this many people the per-body stages run on one thread (the results
-// are the same either way; only the overhead differs).
-constexpr std::int64_t kParallelBodies = 512;
 
 using Clock = std::chrono::steady_clock;
 

@@ -370,14 +370,14 @@ TEST(Anticipation, ACrowdsForceIsTheSumOfEachPersonsInTheirOrder) {
 
 // The anticipation's clock (anticipation_interval_s, issue 66). A periodic
 // crowd of 64 walkers, half heading +x, half -x, at 1.2 m/s, anticipating.
-WorldDef CrossingCrowd(double interval_s, unsigned seed = 7) {
-  WorldDef def = testing::RandomGas(8, 1.3, seed, true);
+WorldDef CrossingCrowd(double interval_s, unsigned seed = 7, int per_side = 8, double spacing_m = 1.3) {
+  WorldDef def = testing::RandomGas(per_side, spacing_m, seed, true);
   def.parameters = ModelParameters{};
   def.parameters.anticipation = Anticipation::kTimeToCollision;
   def.parameters.anticipation_interval_s = interval_s;
   def.targets.push_back(geometry::NavigationField::Constant({-1.0, 0.0}));
   for (std::size_t i = 0; i < def.people.size(); ++i) {  // (a checkerboard: head on along each row)
-    const bool east = (i + i / 8) % 2 == 0;
+    const bool east = (i + i / static_cast<std::size_t>(per_side)) % 2 == 0;
     def.people[i].desired_speed_m_per_s = 1.2;
     def.people[i].target = east ? 0 : 1;
     def.people[i].velocity_m_per_s = {east ? 1.0 : -1.0, 0.2 * def.people[i].velocity_m_per_s.y};
@@ -425,6 +425,40 @@ TEST(Anticipation, TheWideInstructionsPickTheSameCollisionCoursesBitForBit) {
     UseWideInstructions(true);
     EXPECT_TRUE(SameBodies(wide, narrow)) << (periodic ? "periodic" : "open");
     EXPECT_FALSE(SameBodies(wide, none));
+  }
+}
+
+// Each pair once (issue 66; the term's head): the run that walks each
+// person's whole list, bit for bit — a crowd of 576 crossing at 1.2 /m2
+// (enough for the drive's threads), periodic (minimum images across the
+// box) and in the open, with people fallen, gone and standing by choice
+// (each only the partner of a pair), on 1 to 3 threads; and a run where
+// the term acts (without it, another).
+TEST(Anticipation, EachPairOnceIsTheRunOfEachPersonsWholeListBitForBit) {
+  for (const bool periodic : {true, false}) {
+    WorldDef def = CrossingCrowd(0.0, 11, 24, 0.9);
+    if (!periodic) def.periodic = PeriodicBox{};
+    for (std::size_t i = 3; i < def.people.size(); i += 37) def.people[i].state = PersonState::kFallen;
+    for (std::size_t i = 5; i < def.people.size(); i += 53) def.people[i].state = PersonState::kRemoved;
+    for (std::size_t i = 7; i < def.people.size(); i += 41) def.people[i].desired_speed_m_per_s = 0.0;
+    WorldDef without = def;
+    without.parameters.anticipation = Anticipation::kNone;
+    Simulation whole(def), none(without);
+    std::vector<Simulation> halves;
+    for (const int threads : {1, 2, 3}) {
+      def.threads = threads;
+      halves.emplace_back(def);
+    }
+    for (int n = 0; n < 300; ++n) {
+      UseHalfPairs(false);
+      whole.Step();
+      UseHalfPairs(true);
+      for (Simulation& half : halves) half.Step();
+      none.Step();
+    }
+    for (const Simulation& half : halves)
+      EXPECT_TRUE(SameBodies(whole, half)) << (periodic ? "periodic, " : "open, ") << half.definition().threads;
+    EXPECT_FALSE(SameBodies(whole, none));
   }
 }
 

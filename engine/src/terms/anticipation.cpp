@@ -28,6 +28,27 @@
 // and the contact forces act as ever (as the gait jitter, gait_jitter.cpp).
 // Summed in the neighbour list's order: the same on any thread count.
 //
+// Each pair once (issue 66; evaluated at every step, without the clock):
+// the force per unit mass of j on i is exactly minus that of i on j, bit for
+// bit (x, v and x + v tau change sign exactly in IEEE arithmetic, the
+// minimum image too; a, b, c, D, tau, the size and the ceiling are the same
+// numbers), and the pick of collision courses is the same test from either
+// side. So before the blocks, each in-venue person i visits only the
+// candidates j > i of their list (a suffix: the list is in increasing
+// index; a pair within the radius is on both lists) and records the
+// colliding pairs with their force, by blocks of people on the threads;
+// then each pair, in the blocks' order, adds its force to i and takes it
+// from j (on the threads, each owning a part of the people). A person's sum
+// so gets their partners k < i (each from k's visit, in increasing k)
+// before their own j > i (in increasing j): in increasing partner index,
+// each term the very number the whole list gave, so the run is the one that
+// walked each person's whole list, bit for bit (UseHalfPairs switches back,
+// for tests and benchmarks), at half the pair tests. Pairs where neither
+// person is a walker who wants to walk are not recorded. Where most people
+// stand (an evacuation before its pre-movement times), the walkers' whole
+// lists are fewer tests: each evaluation takes the cheaper of the two
+// (EachPairOnceIsCheaper), which changes no result.
+//
 // Its side preference (anticipation_side_preference s, 0 off): with e_i the
 // direction the person wants to go and F the summed force per unit mass,
 // the braking part B = -F.e_i (where positive) gives F + s B (e_y, -e_x),
@@ -77,6 +98,7 @@ namespace crowdrecon::engine::detail {
 namespace {
 
 bool wide_allowed = true;
+bool half_pairs_allowed = true;
 
 // A person as the pair loops read them: position, velocity and bounding
 // radius in one cache line (a copy made for each evaluation; x NaN for an
@@ -206,6 +228,26 @@ class AnticipationTerm final : public BehaviourTerm {
       copy_[j] = Candidate{empty ? std::numeric_limits<double>::quiet_NaN() : x.x, x.y, v.x, v.y,
                            bound_m_[in.bodies.shape[j]], {}};
     }
+    halved_ = !clocked_ && half_pairs_allowed && EachPairOnceIsCheaper(in);
+    if (halved_) SumEachPairOnce(in);
+  }
+
+  // Whether visiting each pair once tests fewer candidates than the walkers'
+  // whole lists: everyone in the venue visits their later candidates, while
+  // the whole lists are visited by walkers who want to walk only (where
+  // most people stand, waiting to set off, the whole lists are cheaper).
+  // Either way the same run, bit for bit: this chooses the cost alone.
+  bool EachPairOnceIsCheaper(const DriveInputs& in) const {
+    const NeighbourList& list = in.neighbours;
+    const BodyState& bodies = in.bodies;
+    std::size_t whole = 0, once = 0;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (bodies.state[i] == PersonState::kRemoved) continue;
+      const std::size_t listed = list.start[i + 1] - list.start[i];
+      if (bodies.state[i] == PersonState::kWalking && WantsToWalk(bodies, i)) whole += listed;
+      once += listed / 2;
+    }
+    return once < whole;
   }
 
   // A candidate j of person i (at xi, moving at vi, bounding radius ri): the
@@ -245,14 +287,15 @@ class AnticipationTerm final : public BehaviourTerm {
   // With kAll, step one takes four candidates at a time where the processor
   // has AVX2 (PickCollidingWide: the same picks). With kAll, the same
   // arithmetic as one loop over the candidates, so the same sums.
-  template <Pairs which>
-  Vec2 Sum(const DriveInputs& in, const std::vector<std::uint32_t>& items, std::uint32_t begin, std::uint32_t end,
-           Vec2 xi, Vec2 vi, double ri) const {
+  // Calls visit(j, a) for each of them that collides, a the force per unit
+  // mass of j on i (its share, split), in the list's order.
+  template <Pairs which, class Visit>
+  void ForEachCollision(const DriveInputs& in, const std::vector<std::uint32_t>& items, std::uint32_t begin,
+                        std::uint32_t end, Vec2 xi, Vec2 vi, double ri, Visit&& visit) const {
     const ModelParameters& mp = in.def.parameters;
     const double k = mp.anticipation_strength_m2, inverse_horizon = 1.0 / mp.anticipation_horizon_s;
     const double ceiling = mp.anticipation_max_acceleration_m_per_s2;
     const double inner = near_m_ - switch_m_;  // S = 1 within it
-    Vec2 push{};
     for (std::uint32_t m = begin; m < end;) {
       const std::uint32_t chunk_end = std::min<std::uint32_t>(end, m + kChunk);
       std::uint32_t hits[kChunk + 3];
@@ -286,10 +329,63 @@ class AnticipationTerm final : public BehaviourTerm {
           const double near_share = std::clamp((near_m_ - std::sqrt(p.xx)) / switch_m_, 0.0, 1.0);
           acceleration *= which == Pairs::kNear ? near_share : 1.0 - near_share;
         }
-        push += at_contact * (acceleration / p.reach);
+        visit(hits[h], at_contact * (acceleration / p.reach));
       }
     }
+  }
+  template <Pairs which>
+  Vec2 Sum(const DriveInputs& in, const std::vector<std::uint32_t>& items, std::uint32_t begin, std::uint32_t end,
+           Vec2 xi, Vec2 vi, double ri) const {
+    Vec2 push{};
+    ForEachCollision<which>(in, items, begin, end, xi, vi, ri, [&push](std::uint32_t, Vec2 a) { push += a; });
     return push;
+  }
+
+  // Each pair once (the file's head): every person's sum of the whole
+  // list's pairs into summed_.
+  void SumEachPairOnce(const DriveInputs& in) const {
+    const BodyState& bodies = in.bodies;
+    const NeighbourList& list = in.neighbours;
+    const auto n = static_cast<std::int64_t>(bodies.size());
+    acts_.resize(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      acts_[i] =
+          bodies.state[i] == PersonState::kWalking && in.def.parameters.ground_reaction && WantsToWalk(bodies, i);
+    const std::int64_t blocks = (n + kPairBlock - 1) / kPairBlock;
+    if (pairs_.size() < static_cast<std::size_t>(blocks)) pairs_.resize(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(dynamic) num_threads(in.def.threads) if (n >= kParallelBodies)
+    for (std::int64_t block = 0; block < blocks; ++block) {
+      std::vector<Pair>& found = pairs_[static_cast<std::size_t>(block)];
+      found.clear();
+      const std::int64_t last = std::min(n, (block + 1) * kPairBlock);
+      for (auto i = static_cast<std::uint32_t>(block * kPairBlock); i < last; ++i) {
+        if (bodies.state[i] == PersonState::kRemoved) continue;
+        const std::uint32_t* first = list.items.data() + list.start[i];
+        const std::uint32_t* end = list.items.data() + list.start[i + 1];
+        const auto later = static_cast<std::uint32_t>(std::upper_bound(first, end, i) - list.items.data());
+        ForEachCollision<Pairs::kAll>(in, list.items, later, list.start[i + 1], bodies.position_m[i],
+                                      bodies.velocity_m_per_s[i], bound_m_[bodies.shape[i]],
+                                      [&](std::uint32_t j, Vec2 a) {
+                                        if (acts_[i] || acts_[j]) found.push_back(Pair{i, j, a});
+                                      });
+      }
+    }
+    // The sums: each thread owns a contiguous part of the people and goes
+    // through the pairs in their order, adding those that touch its own
+    // (each person's in the order of the serial pass); pairs are in
+    // increasing i, so a part is done at the first pair past it.
+    summed_.assign(bodies.size(), Vec2{});
+    const int parts = n >= kParallelBodies ? std::max(1, in.def.threads) : 1;
+#pragma omp parallel for schedule(static) num_threads(parts)
+    for (int part = 0; part < parts; ++part) {
+      const auto low = static_cast<std::uint32_t>(n * part / parts);
+      const auto high = static_cast<std::uint32_t>(n * (part + 1) / parts);
+      for (std::int64_t block = 0; block < blocks && block * kPairBlock < high; ++block)
+        for (const Pair& p : pairs_[static_cast<std::size_t>(block)]) {
+          if (p.i >= low && p.i < high) summed_[p.i] += p.a;
+          if (p.j >= low && p.j < high) summed_[p.j] -= p.a;
+        }
+    }
   }
 
   void Force(const DriveInputs& in, DriveBlock& b) const override {
@@ -305,7 +401,9 @@ class AnticipationTerm final : public BehaviourTerm {
       const Vec2 xi = in.bodies.position_m[i], vi = in.bodies.velocity_m_per_s[i];
       const double ri = bound_m_[in.bodies.shape[i]];
       Vec2 push;
-      if (!clocked_) {
+      if (halved_) {
+        push = summed_[i];
+      } else if (!clocked_) {
         push = Sum<Pairs::kAll>(in, list.items, list.start[i], list.start[i + 1], xi, vi, ri);
       } else {
         if (evaluated_in_[i] != tick) {
@@ -370,6 +468,19 @@ class AnticipationTerm final : public BehaviourTerm {
   // filter is in use.
   mutable std::vector<Candidate> copy_;
   mutable bool wide_ = false;
+  // Each pair once (SumEachPairOnce): in use for this evaluation; per person
+  // whether the force acts on them (a walker who wants to walk); per block
+  // of kPairBlock people the colliding pairs (i, j > i) and the force of j
+  // on i per unit mass; per person the sum.
+  struct Pair {
+    std::uint32_t i, j;
+    Vec2 a;
+  };
+  static constexpr std::int64_t kPairBlock = 64;
+  mutable bool halved_ = false;
+  mutable std::vector<std::uint8_t> acts_;
+  mutable std::vector<std::vector<Pair>> pairs_;
+  mutable std::vector<Vec2> summed_;
 };
 
 }  // namespace
@@ -379,6 +490,7 @@ class AnticipationTerm final : public BehaviourTerm {
 namespace crowdrecon::engine {
 
 void UseWideInstructions(bool use) { detail::wide_allowed = use; }
+void UseHalfPairs(bool use) { detail::half_pairs_allowed = use; }
 bool WideInstructions() {
 #ifdef CROWDRECON_WIDE_FILTER
   static const bool has = __builtin_cpu_supports("avx2");

@@ -81,11 +81,20 @@ class PairCollider;  // engine/src/stage_collide.cpp
 }  // namespace detail
 
 // Whether the engine may use the processor's wide (AVX2) instructions where
-// it has them (default: yes; the anticipation's pick of collision courses).
+// it has them (default: yes; the anticipation's pick of collision courses,
+// the gait jitter's cosines).
 // The results are the same either way, bit for bit: a switch for tests and
 // benchmarks. WideInstructions: allowed, and the processor has them.
 void UseWideInstructions(bool use);
 bool WideInstructions();
+
+// Whether the anticipation (time to collision, evaluated at every step)
+// visits each pair once, from its lower index, and gives the partner the
+// opposite force (default: yes), or each person's whole list. The results
+// are the same either way, bit for bit (each person's sum is still taken
+// over their partners in increasing index, each term the same number):
+// a switch for tests and benchmarks.
+void UseHalfPairs(bool use);
 
 class Simulation {
  public:
