@@ -400,11 +400,11 @@ void StepEach(int steps, std::initializer_list<Simulation*> simulations) {
     for (Simulation* sim : simulations) sim->Step();
 }
 
-// The wide instructions (AVX2) pick the same collision courses as the scalar
-// loop: a crowd crossing in a periodic box (minimum images across it) and
-// in the open, with someone fallen and an empty slot, is the same run bit
-// for bit either way (and it is a run where the term acts: without it,
-// another).
+// The wide instructions (AVX2) pick the same collision courses, and give
+// them the same forces, as the scalar loop: a crowd crossing in a periodic
+// box (minimum images across it) and in the open, with someone fallen and
+// an empty slot, is the same run bit for bit either way (and it is a run
+// where the term acts: without it, another).
 TEST(Anticipation, TheWideInstructionsPickTheSameCollisionCoursesBitForBit) {
   if (!WideInstructions()) GTEST_SKIP() << "this processor has no AVX2";
   for (const bool periodic : {true, false}) {

@@ -190,6 +190,63 @@ __attribute__((target("avx2"))) std::uint32_t PickCollidingWide(const Candidate*
   }
   return count;
 }
+
+// The forces per unit mass of the picks hits[0, count) on person i, four at
+// a time while four are left (AVX2): Approaching's terms and the force of
+// AnticipationTerm::ForEachCollision with the same IEEE operations in the
+// same order (no fused multiply-add; the square root and the divisions are
+// correctly rounded either way), exp from the library lane by lane; the
+// force of hits[h] into (ax[h], ay[h]). Returns how many were done (a
+// multiple of four: the caller does the rest one at a time).
+__attribute__((target("avx2"))) std::uint32_t CollisionForcesWide(const Candidate* q, const PeriodicBox& box,
+                                                                   const std::uint32_t* hits, std::uint32_t count,
+                                                                   Vec2 xi, Vec2 vi, double ri, double k,
+                                                                   double inverse_horizon, double ceiling, double* ax,
+                                                                   double* ay) {
+  const __m256d xix = _mm256_set1_pd(xi.x), xiy = _mm256_set1_pd(xi.y);
+  const __m256d vix = _mm256_set1_pd(vi.x), viy = _mm256_set1_pd(vi.y);
+  const __m256d rib = _mm256_set1_pd(ri), kb = _mm256_set1_pd(k), ih = _mm256_set1_pd(inverse_horizon);
+  const __m256d ceilingb = _mm256_set1_pd(ceiling), two = _mm256_set1_pd(2.0);
+  const double period_x = box.max_m.x - box.min_m.x, period_y = box.max_m.y - box.min_m.y;
+  const __m256d px = _mm256_set1_pd(period_x), hx = _mm256_set1_pd(period_x / 2.0);
+  const __m256d py = _mm256_set1_pd(period_y), hy = _mm256_set1_pd(period_y / 2.0);
+  std::uint32_t h = 0;
+  for (; h + 4 <= count; h += 4) {
+    const std::uint32_t j0 = hits[h], j1 = hits[h + 1], j2 = hits[h + 2], j3 = hits[h + 3];
+    const __m256d r0 = _mm256_load_pd(&q[j0].x), r1 = _mm256_load_pd(&q[j1].x);
+    const __m256d r2 = _mm256_load_pd(&q[j2].x), r3 = _mm256_load_pd(&q[j3].x);
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    const __m256d x4 = _mm256_permute2f128_pd(t0, t2, 0x20), y4 = _mm256_permute2f128_pd(t1, t3, 0x20);
+    const __m256d vx4 = _mm256_permute2f128_pd(t0, t2, 0x31), vy4 = _mm256_permute2f128_pd(t1, t3, 0x31);
+    __m256d dx = _mm256_sub_pd(xix, x4);
+    __m256d dy = _mm256_sub_pd(xiy, y4);
+    if (box.x) dx = MinimumImageWide(dx, px, hx);
+    if (box.y) dy = MinimumImageWide(dy, py, hy);
+    const __m256d wx = _mm256_sub_pd(vix, vx4);
+    const __m256d wy = _mm256_sub_pd(viy, vy4);
+    const __m256d reach = _mm256_add_pd(rib, _mm256_set_pd(q[j3].bound, q[j2].bound, q[j1].bound, q[j0].bound));
+    const __m256d xx = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+    const __m256d a = _mm256_add_pd(_mm256_mul_pd(wx, wx), _mm256_mul_pd(wy, wy));
+    const __m256d bb = _mm256_add_pd(_mm256_mul_pd(dx, wx), _mm256_mul_pd(dy, wy));
+    const __m256d c = _mm256_sub_pd(xx, _mm256_mul_pd(reach, reach));
+    const __m256d discriminant = _mm256_sub_pd(_mm256_mul_pd(bb, bb), _mm256_mul_pd(a, c));
+    const __m256d root = _mm256_sqrt_pd(discriminant);
+    const __m256d tau = _mm256_div_pd(c, _mm256_sub_pd(root, bb));
+    alignas(32) double exponent[4];
+    _mm256_store_pd(exponent, _mm256_mul_pd(_mm256_xor_pd(tau, _mm256_set1_pd(-0.0)), ih));  // -tau * 1/tau0
+    for (double& e : exponent) e = std::exp(e);
+    const __m256d size = _mm256_div_pd(
+        _mm256_mul_pd(_mm256_div_pd(_mm256_mul_pd(kb, _mm256_load_pd(exponent)), _mm256_mul_pd(tau, tau)),
+                      _mm256_add_pd(_mm256_div_pd(two, tau), ih)),
+        root);
+    const __m256d acceleration = _mm256_min_pd(ceilingb, _mm256_mul_pd(size, reach));  // std::min(size reach, ceiling)
+    const __m256d factor = _mm256_div_pd(acceleration, reach);
+    _mm256_storeu_pd(ax + h, _mm256_mul_pd(_mm256_add_pd(dx, _mm256_mul_pd(wx, tau)), factor));
+    _mm256_storeu_pd(ay + h, _mm256_mul_pd(_mm256_add_pd(dy, _mm256_mul_pd(wy, tau)), factor));
+  }
+  return h;
+}
 #endif
 
 }  // namespace
@@ -318,7 +375,17 @@ class AnticipationTerm final : public BehaviourTerm {
         hits[count] = j;
         count += static_cast<std::uint32_t>(counts);
       }
-      for (std::uint32_t h = 0; h < count; ++h) {
+      std::uint32_t h = 0;
+#ifdef CROWDRECON_WIDE_FILTER
+      if constexpr (which == Pairs::kAll)
+        if (wide_) {
+          double ax[kChunk + 3], ay[kChunk + 3];
+          h = CollisionForcesWide(copy_.data(), in.def.periodic, hits, count, xi, vi, ri, k, inverse_horizon, ceiling,
+                                  ax, ay);
+          for (std::uint32_t w = 0; w < h; ++w) visit(hits[w], Vec2{ax[w], ay[w]});
+        }
+#endif
+      for (; h < count; ++h) {
         const Approach p = Approaching(in, xi, vi, ri, hits[h]);
         const double root = std::sqrt(p.discriminant);
         const double tau = p.c / (root - p.bb);
