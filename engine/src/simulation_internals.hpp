@@ -314,6 +314,9 @@ struct Simulation::Internals {
   detail::NeighbourList neighbours;
   std::vector<Vec2> neighbours_position_at_build;
   std::vector<std::uint8_t> neighbours_listed;
+  // The build's work space: per chunk of people, their candidates and near
+  // candidates (stage_neighbours.cpp), kept between builds.
+  std::vector<std::vector<std::uint32_t>> neighbour_chunks, near_chunks;
   double requested_neighbour_radius_m = 0.0;  // Simulation::RequestNeighbours
   // The time at which Drive evaluates the forces (s): within a step, the end
   // of the step (the integrators evaluate there), between steps time_s_.

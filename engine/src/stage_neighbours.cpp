@@ -21,8 +21,9 @@
 // newcomer's slot moves far, which rebuilds the list at the next step.
 // Candidates are a superset of the people within the radius whenever the
 // list is used by a step, so when it is rebuilt changes no result; the list
-// is built in one serial pass in a fixed order (the same on any thread
-// count) and is not in the checkpoint. When a term asks
+// is built in a fixed order (the same on any thread
+// count: each chunk of people's rows on a thread, the chunks end to end in
+// their order) and is not in the checkpoint. When a term asks
 // for a near list (a shorter radius it needs at every step), the list's
 // candidates within the near radius + skin are kept as a second list, built
 // and kept valid with the first.
@@ -84,11 +85,18 @@ GridAxis Axis(bool periodic, double box_min, double box_max, double low, double 
   return a;
 }
 
+// People per chunk of the build (each chunk's rows made on one thread, the
+// chunks then put end to end in their order: the same list on any thread
+// count).
+constexpr std::size_t kBuildChunk = 256;
+
 // The list of every slot's candidates: the slots `eligible` within `radius`
 // + the skin of it at the positions `at` (each slot has a list, eligible or
-// not; the candidates of each in increasing index), and the near list.
+// not; the candidates of each in increasing index), and the near list; the
+// rows on `threads` threads, in `chunks` and `near_chunks` (work space).
 void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, const std::vector<std::uint8_t>& eligible,
-                        double radius, double near_radius, NeighbourList& list) {
+                        double radius, double near_radius, int threads, std::vector<std::vector<std::uint32_t>>& chunks,
+                        std::vector<std::vector<std::uint32_t>>& near_chunks, NeighbourList& list) {
   const std::size_t n = at.size();
   const double reach = radius + kNeighbourSkin_m;
   Vec2 low{0.0, 0.0}, high{0.0, 0.0};
@@ -123,31 +131,64 @@ void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, con
   list.near_items.clear();
   const double reach2 = reach * reach;
   const double near_reach2 = (near_radius + kNeighbourSkin_m) * (near_radius + kNeighbourSkin_m);
-  std::vector<std::uint32_t> mine;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 x = at[i];
-    std::int64_t cx[3], cy[3];
-    const int mx = ax.Around(ax.Cell(x.x), cx), my = ay.Around(ay.Cell(x.y), cy);
-    mine.clear();
-    for (int a = 0; a < my; ++a)
-      for (int b = 0; b < mx; ++b) {
-        const auto c = static_cast<std::size_t>(cy[a] * ax.count + cx[b]);
-        for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
-          const std::uint32_t j = cell_items[k];
-          if (j == i) continue;
-          const Vec2 d = detail::Separation(box, x, at[j]);
-          if (Dot(d, d) <= reach2) mine.push_back(j);
+  const bool near = near_radius > 0.0;
+  // Each chunk's rows: its people's candidates end to end, and each one's
+  // count in start[i + 1] (near_start) until the counts are summed below.
+  const auto chunk_count = static_cast<std::int64_t>((n + kBuildChunk - 1) / kBuildChunk);
+  if (chunks.size() < static_cast<std::size_t>(chunk_count)) chunks.resize(static_cast<std::size_t>(chunk_count));
+  if (near && near_chunks.size() < static_cast<std::size_t>(chunk_count))
+    near_chunks.resize(static_cast<std::size_t>(chunk_count));
+#pragma omp parallel for schedule(dynamic) num_threads(threads) if (static_cast<std::int64_t>(n) >= kParallelBodies)
+  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
+    std::vector<std::uint32_t>& rows = chunks[static_cast<std::size_t>(chunk)];
+    rows.clear();
+    if (near) near_chunks[static_cast<std::size_t>(chunk)].clear();
+    std::vector<std::uint32_t> mine;
+    const std::size_t first = static_cast<std::size_t>(chunk) * kBuildChunk, last = std::min(n, first + kBuildChunk);
+    for (std::size_t i = first; i < last; ++i) {
+      const Vec2 x = at[i];
+      std::int64_t cx[3], cy[3];
+      const int mx = ax.Around(ax.Cell(x.x), cx), my = ay.Around(ay.Cell(x.y), cy);
+      mine.clear();
+      for (int a = 0; a < my; ++a)
+        for (int b = 0; b < mx; ++b) {
+          const auto c = static_cast<std::size_t>(cy[a] * ax.count + cx[b]);
+          for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) {
+            const std::uint32_t j = cell_items[k];
+            if (j == i) continue;
+            const Vec2 d = detail::Separation(box, x, at[j]);
+            if (Dot(d, d) <= reach2) mine.push_back(j);
+          }
         }
+      std::sort(mine.begin(), mine.end());
+      rows.insert(rows.end(), mine.begin(), mine.end());
+      list.start[i + 1] = static_cast<std::uint32_t>(mine.size());
+      if (near) {
+        std::vector<std::uint32_t>& near_rows = near_chunks[static_cast<std::size_t>(chunk)];
+        const std::size_t before = near_rows.size();
+        for (const std::uint32_t j : mine) {
+          const Vec2 d = detail::Separation(box, x, at[j]);
+          if (Dot(d, d) <= near_reach2) near_rows.push_back(j);
+        }
+        list.near_start[i + 1] = static_cast<std::uint32_t>(near_rows.size() - before);
       }
-    std::sort(mine.begin(), mine.end());
-    list.items.insert(list.items.end(), mine.begin(), mine.end());
-    list.start[i + 1] = static_cast<std::uint32_t>(list.items.size());
-    if (near_radius > 0.0) {
-      for (const std::uint32_t j : mine) {
-        const Vec2 d = detail::Separation(box, x, at[j]);
-        if (Dot(d, d) <= near_reach2) list.near_items.push_back(j);
-      }
-      list.near_start[i + 1] = static_cast<std::uint32_t>(list.near_items.size());
+    }
+  }
+  // The counts summed into starts, the chunks put end to end.
+  for (std::size_t i = 0; i < n; ++i) list.start[i + 1] += list.start[i];
+  list.items.resize(list.start[n]);
+  if (near) {
+    for (std::size_t i = 0; i < n; ++i) list.near_start[i + 1] += list.near_start[i];
+    list.near_items.resize(list.near_start[n]);
+  }
+#pragma omp parallel for schedule(static) num_threads(threads) if (static_cast<std::int64_t>(n) >= kParallelBodies)
+  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
+    const std::size_t first = static_cast<std::size_t>(chunk) * kBuildChunk;
+    const std::vector<std::uint32_t>& rows = chunks[static_cast<std::size_t>(chunk)];
+    std::copy(rows.begin(), rows.end(), list.items.begin() + list.start[first]);
+    if (near) {
+      const std::vector<std::uint32_t>& near_rows = near_chunks[static_cast<std::size_t>(chunk)];
+      std::copy(near_rows.begin(), near_rows.end(), list.near_items.begin() + list.near_start[first]);
     }
   }
 }
@@ -179,7 +220,8 @@ void Simulation::Neighbours() {
   }
   in.neighbours_listed.resize(n);
   for (std::size_t i = 0; i < n; ++i) in.neighbours_listed[i] = bodies_.state[i] != PersonState::kRemoved;
-  BuildNeighbourList(def_.periodic, bodies_.position_m, in.neighbours_listed, radius, near_radius, in.neighbours);
+  BuildNeighbourList(def_.periodic, bodies_.position_m, in.neighbours_listed, radius, near_radius, def_.threads,
+                     in.neighbour_chunks, in.near_chunks, in.neighbours);
   in.neighbours_position_at_build = bodies_.position_m;
 }
 
@@ -196,7 +238,7 @@ void Simulation::ListComebacks() {
   if (!any) return;
   ScopedTimer timer(profile_.stage_s[Index(Stage::kNeighbours)]);
   BuildNeighbourList(def_.periodic, in.neighbours_position_at_build, in.neighbours_listed, in.neighbours.radius_m,
-                     in.neighbours.near_radius_m, in.neighbours);
+                     in.neighbours.near_radius_m, def_.threads, in.neighbour_chunks, in.near_chunks, in.neighbours);
 }
 
 void Simulation::RequestNeighbours(double radius_m) {

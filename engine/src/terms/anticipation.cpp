@@ -419,39 +419,58 @@ class AnticipationTerm final : public BehaviourTerm {
       acts_[i] =
           bodies.state[i] == PersonState::kWalking && in.def.parameters.ground_reaction && WantsToWalk(bodies, i);
     const std::int64_t blocks = (n + kPairBlock - 1) / kPairBlock;
-    if (pairs_.size() < static_cast<std::size_t>(blocks)) pairs_.resize(static_cast<std::size_t>(blocks));
+    if (pairs_.size() < static_cast<std::size_t>(blocks)) {
+      pairs_.resize(static_cast<std::size_t>(blocks));
+      crossing_.resize(static_cast<std::size_t>(blocks));
+    }
+    // The parts of the people the threads sum for (below): part q is
+    // [n q / parts, n (q + 1) / parts).
+    const int parts = n >= kParallelBodies ? std::max(1, in.def.threads) : 1;
+    const auto part_end = [n, parts](std::uint32_t i) {  // the end of i's part
+      int q = static_cast<int>(static_cast<std::int64_t>(i) * parts / n);
+      while (n * (q + 1) / parts <= i) ++q;  // (rounding: at most once)
+      return static_cast<std::uint32_t>(n * (q + 1) / parts);
+    };
 #pragma omp parallel for schedule(dynamic) num_threads(in.def.threads) if (n >= kParallelBodies)
     for (std::int64_t block = 0; block < blocks; ++block) {
       std::vector<Pair>& found = pairs_[static_cast<std::size_t>(block)];
+      std::vector<Pair>& crossing = crossing_[static_cast<std::size_t>(block)];
       found.clear();
+      crossing.clear();
       const std::int64_t last = std::min(n, (block + 1) * kPairBlock);
       for (auto i = static_cast<std::uint32_t>(block * kPairBlock); i < last; ++i) {
         if (bodies.state[i] == PersonState::kRemoved) continue;
         const std::uint32_t* first = list.items.data() + list.start[i];
         const std::uint32_t* end = list.items.data() + list.start[i + 1];
         const auto later = static_cast<std::uint32_t>(std::upper_bound(first, end, i) - list.items.data());
+        const std::uint32_t own_part_end = part_end(i);
         ForEachCollision<Pairs::kAll>(in, list.items, later, list.start[i + 1], bodies.position_m[i],
                                       bodies.velocity_m_per_s[i], bound_m_[bodies.shape[i]],
                                       [&](std::uint32_t j, Vec2 a) {
-                                        if (acts_[i] || acts_[j]) found.push_back(Pair{i, j, a});
+                                        if (!(acts_[i] || acts_[j])) return;
+                                        found.push_back(Pair{i, j, a});
+                                        if (j >= own_part_end) crossing.push_back(Pair{i, j, a});
                                       });
       }
     }
-    // The sums: each thread owns a contiguous part of the people and goes
-    // through the pairs in their order, adding those that touch its own
-    // (each person's in the order of the serial pass); pairs are in
-    // increasing i, so a part is done at the first pair past it.
+    // The sums: each thread owns a part of the people and goes through the
+    // pairs in their order, adding those that touch its own (each person's
+    // in the order of the serial pass). A block of people wholly before the
+    // part touches it only by its pairs that cross into a later part (kept
+    // apart, in their order); pairs are in increasing i, so a part is done
+    // at the first block past it.
     summed_.assign(bodies.size(), Vec2{});
-    const int parts = n >= kParallelBodies ? std::max(1, in.def.threads) : 1;
 #pragma omp parallel for schedule(static) num_threads(parts)
     for (int part = 0; part < parts; ++part) {
       const auto low = static_cast<std::uint32_t>(n * part / parts);
       const auto high = static_cast<std::uint32_t>(n * (part + 1) / parts);
-      for (std::int64_t block = 0; block < blocks && block * kPairBlock < high; ++block)
-        for (const Pair& p : pairs_[static_cast<std::size_t>(block)]) {
+      for (std::int64_t block = 0; block < blocks && block * kPairBlock < high; ++block) {
+        const bool before = (block + 1) * kPairBlock <= low;
+        for (const Pair& p : (before ? crossing_ : pairs_)[static_cast<std::size_t>(block)]) {
           if (p.i >= low && p.i < high) summed_[p.i] += p.a;
           if (p.j >= low && p.j < high) summed_[p.j] -= p.a;
         }
+      }
     }
   }
 
@@ -547,6 +566,7 @@ class AnticipationTerm final : public BehaviourTerm {
   mutable bool halved_ = false;
   mutable std::vector<std::uint8_t> acts_;
   mutable std::vector<std::vector<Pair>> pairs_;
+  mutable std::vector<std::vector<Pair>> crossing_;  // per block, its pairs whose j is in a later part
   mutable std::vector<Vec2> summed_;
 };
 
