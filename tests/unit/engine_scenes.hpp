@@ -118,4 +118,18 @@ inline WorldDef RandomGas(int per_side, double spacing_m, unsigned seed, bool pe
   return def;
 }
 
+// Steps `wide` with the engine's wide instructions and `narrow` and `none`
+// without them, in turn, `steps` times (leaving them allowed): the tests
+// that the wide instructions give the scalar results bit for bit.
+inline void StepWideAndNarrow(int steps, Simulation& wide, Simulation& narrow, Simulation& none) {
+  for (int n = 0; n < steps; ++n) {
+    UseWideInstructions(true);
+    wide.Step();
+    UseWideInstructions(false);
+    narrow.Step();
+    none.Step();
+  }
+  UseWideInstructions(true);
+}
+
 }  // namespace crowdrecon::engine::testing

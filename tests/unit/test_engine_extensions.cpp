@@ -188,14 +188,7 @@ TEST(GaitJitter, TheWideInstructionsGiveTheScalarCosinesBitForBit) {
   WorldDef still = def;
   still.parameters.gait_jitter_velocity_m_per_s = 0.0;
   Simulation wide(def), narrow(def), none(still);
-  while (wide.time_s() < 40.0) {
-    UseWideInstructions(true);
-    wide.Step();
-    UseWideInstructions(false);
-    narrow.Step();
-    none.Step();
-  }
-  UseWideInstructions(true);
+  testing::StepWideAndNarrow(static_cast<int>(40.0 / wide.time_step_s()), wide, narrow, none);
   const std::size_t bytes = def.people.size() * sizeof(Vec2);
   EXPECT_EQ(std::memcmp(wide.bodies().velocity_m_per_s.data(), narrow.bodies().velocity_m_per_s.data(), bytes), 0);
   EXPECT_NE(std::memcmp(wide.bodies().velocity_m_per_s.data(), none.bodies().velocity_m_per_s.data(), bytes), 0);

@@ -415,14 +415,7 @@ TEST(Anticipation, TheWideInstructionsPickTheSameCollisionCoursesBitForBit) {
     WorldDef without = def;
     without.parameters.anticipation = Anticipation::kNone;
     Simulation wide(def), narrow(def), none(without);
-    for (int n = 0; n < 600; ++n) {
-      UseWideInstructions(true);
-      wide.Step();
-      UseWideInstructions(false);
-      narrow.Step();
-      none.Step();
-    }
-    UseWideInstructions(true);
+    testing::StepWideAndNarrow(600, wide, narrow, none);
     EXPECT_TRUE(SameBodies(wide, narrow)) << (periodic ? "periodic" : "open");
     EXPECT_FALSE(SameBodies(wide, none));
   }

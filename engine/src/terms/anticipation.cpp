@@ -116,6 +116,54 @@ __attribute__((target("avx2"), always_inline)) inline __m256d MinimumImageWide(_
   return _mm256_blendv_pd(d, _mm256_sub_pd(d, _mm256_mul_pd(p, k)), far);
 }
 
+// Person i (at xi, moving at vi, bounding radius ri) and the box, broadcast
+// to four lanes for the loops below.
+struct WideFrame {
+  __m256d xix, xiy, vix, viy, rib, px, hx, py, hy;
+  bool periodic_x, periodic_y;
+};
+__attribute__((target("avx2"), always_inline)) inline WideFrame MakeWideFrame(const PeriodicBox& box, Vec2 xi,
+                                                                                Vec2 vi, double ri) {
+  const double period_x = box.max_m.x - box.min_m.x, period_y = box.max_m.y - box.min_m.y;
+  return WideFrame{_mm256_set1_pd(xi.x),          _mm256_set1_pd(xi.y),
+                   _mm256_set1_pd(vi.x),          _mm256_set1_pd(vi.y),
+                   _mm256_set1_pd(ri),            _mm256_set1_pd(period_x),
+                   _mm256_set1_pd(period_x / 2.0), _mm256_set1_pd(period_y),
+                   _mm256_set1_pd(period_y / 2.0), box.x,
+                   box.y};
+}
+
+// Approaching's terms for four candidates j0..j3 of person i, with the same
+// IEEE operations in the same order (no fused multiply-add).
+struct WideTerms {
+  __m256d dx, dy, wx, wy, reach, xx, bb, c, discriminant;
+};
+__attribute__((target("avx2"), always_inline)) inline WideTerms ApproachWide(const Candidate* q, const WideFrame& f,
+                                                                               std::uint32_t j0, std::uint32_t j1,
+                                                                               std::uint32_t j2, std::uint32_t j3) {
+  WideTerms t;
+  const __m256d r0 = _mm256_load_pd(&q[j0].x), r1 = _mm256_load_pd(&q[j1].x);
+  const __m256d r2 = _mm256_load_pd(&q[j2].x), r3 = _mm256_load_pd(&q[j3].x);
+  // (x, y, vx, vy) of four people transposed to x4, y4, vx4, vy4
+  const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+  const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+  const __m256d x4 = _mm256_permute2f128_pd(t0, t2, 0x20), y4 = _mm256_permute2f128_pd(t1, t3, 0x20);
+  const __m256d vx4 = _mm256_permute2f128_pd(t0, t2, 0x31), vy4 = _mm256_permute2f128_pd(t1, t3, 0x31);
+  t.dx = _mm256_sub_pd(f.xix, x4);
+  t.dy = _mm256_sub_pd(f.xiy, y4);
+  if (f.periodic_x) t.dx = MinimumImageWide(t.dx, f.px, f.hx);
+  if (f.periodic_y) t.dy = MinimumImageWide(t.dy, f.py, f.hy);
+  t.wx = _mm256_sub_pd(f.vix, vx4);
+  t.wy = _mm256_sub_pd(f.viy, vy4);
+  t.reach = _mm256_add_pd(f.rib, _mm256_set_pd(q[j3].bound, q[j2].bound, q[j1].bound, q[j0].bound));
+  t.xx = _mm256_add_pd(_mm256_mul_pd(t.dx, t.dx), _mm256_mul_pd(t.dy, t.dy));
+  const __m256d a = _mm256_add_pd(_mm256_mul_pd(t.wx, t.wx), _mm256_mul_pd(t.wy, t.wy));
+  t.bb = _mm256_add_pd(_mm256_mul_pd(t.dx, t.wx), _mm256_mul_pd(t.dy, t.wy));
+  t.c = _mm256_sub_pd(t.xx, _mm256_mul_pd(t.reach, t.reach));
+  t.discriminant = _mm256_sub_pd(_mm256_mul_pd(t.bb, t.bb), _mm256_mul_pd(a, t.c));
+  return t;
+}
+
 // For each mask of four lanes, the bytes that move the chosen lanes' 32-bit
 // values to the front (in order), and how many there are.
 alignas(16) constexpr std::uint8_t kPack[16][16] = {
@@ -149,33 +197,11 @@ __attribute__((target("avx2"))) std::uint32_t PickCollidingWide(const Candidate*
                                                                  std::uint32_t end, Vec2 xi, Vec2 vi, double ri,
                                                                  double radius, std::uint32_t* hits,
                                                                  std::uint32_t count) {
-  const __m256d xix = _mm256_set1_pd(xi.x), xiy = _mm256_set1_pd(xi.y);
-  const __m256d vix = _mm256_set1_pd(vi.x), viy = _mm256_set1_pd(vi.y);
-  const __m256d rib = _mm256_set1_pd(ri), radius2 = _mm256_set1_pd(radius * radius), zero = _mm256_setzero_pd();
-  const double period_x = box.max_m.x - box.min_m.x, period_y = box.max_m.y - box.min_m.y;
-  const __m256d px = _mm256_set1_pd(period_x), hx = _mm256_set1_pd(period_x / 2.0);
-  const __m256d py = _mm256_set1_pd(period_y), hy = _mm256_set1_pd(period_y / 2.0);
+  const WideFrame f = MakeWideFrame(box, xi, vi, ri);
+  const __m256d radius2 = _mm256_set1_pd(radius * radius), zero = _mm256_setzero_pd();
   for (; m + 4 <= end; m += 4) {
-    const std::uint32_t j0 = items[m], j1 = items[m + 1], j2 = items[m + 2], j3 = items[m + 3];
-    const __m256d r0 = _mm256_load_pd(&q[j0].x), r1 = _mm256_load_pd(&q[j1].x);
-    const __m256d r2 = _mm256_load_pd(&q[j2].x), r3 = _mm256_load_pd(&q[j3].x);
-    // (x, y, vx, vy) of four people transposed to x4, y4, vx4, vy4
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    const __m256d x4 = _mm256_permute2f128_pd(t0, t2, 0x20), y4 = _mm256_permute2f128_pd(t1, t3, 0x20);
-    const __m256d vx4 = _mm256_permute2f128_pd(t0, t2, 0x31), vy4 = _mm256_permute2f128_pd(t1, t3, 0x31);
-    __m256d dx = _mm256_sub_pd(xix, x4);
-    __m256d dy = _mm256_sub_pd(xiy, y4);
-    if (box.x) dx = MinimumImageWide(dx, px, hx);
-    if (box.y) dy = MinimumImageWide(dy, py, hy);
-    const __m256d wx = _mm256_sub_pd(vix, vx4);
-    const __m256d wy = _mm256_sub_pd(viy, vy4);
-    const __m256d reach = _mm256_add_pd(rib, _mm256_set_pd(q[j3].bound, q[j2].bound, q[j1].bound, q[j0].bound));
-    const __m256d xx = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-    const __m256d a = _mm256_add_pd(_mm256_mul_pd(wx, wx), _mm256_mul_pd(wy, wy));
-    const __m256d bb = _mm256_add_pd(_mm256_mul_pd(dx, wx), _mm256_mul_pd(dy, wy));
-    const __m256d c = _mm256_sub_pd(xx, _mm256_mul_pd(reach, reach));
-    const __m256d discriminant = _mm256_sub_pd(_mm256_mul_pd(bb, bb), _mm256_mul_pd(a, c));
+    const WideTerms t = ApproachWide(q, f, items[m], items[m + 1], items[m + 2], items[m + 3]);
+    const __m256d xx = t.xx, c = t.c, bb = t.bb, discriminant = t.discriminant;
     __m256d collides = _mm256_cmp_pd(xx, radius2, _CMP_NGT_UQ);  // !(xx > radius^2)
     collides = _mm256_and_pd(collides, _mm256_cmp_pd(c, zero, _CMP_GT_OQ));
     collides = _mm256_and_pd(collides, _mm256_cmp_pd(bb, zero, _CMP_LT_OQ));
@@ -203,34 +229,14 @@ __attribute__((target("avx2"))) std::uint32_t CollisionForcesWide(const Candidat
                                                                    Vec2 xi, Vec2 vi, double ri, double k,
                                                                    double inverse_horizon, double ceiling, double* ax,
                                                                    double* ay) {
-  const __m256d xix = _mm256_set1_pd(xi.x), xiy = _mm256_set1_pd(xi.y);
-  const __m256d vix = _mm256_set1_pd(vi.x), viy = _mm256_set1_pd(vi.y);
-  const __m256d rib = _mm256_set1_pd(ri), kb = _mm256_set1_pd(k), ih = _mm256_set1_pd(inverse_horizon);
+  const WideFrame f = MakeWideFrame(box, xi, vi, ri);
+  const __m256d kb = _mm256_set1_pd(k), ih = _mm256_set1_pd(inverse_horizon);
   const __m256d ceilingb = _mm256_set1_pd(ceiling), two = _mm256_set1_pd(2.0);
-  const double period_x = box.max_m.x - box.min_m.x, period_y = box.max_m.y - box.min_m.y;
-  const __m256d px = _mm256_set1_pd(period_x), hx = _mm256_set1_pd(period_x / 2.0);
-  const __m256d py = _mm256_set1_pd(period_y), hy = _mm256_set1_pd(period_y / 2.0);
   std::uint32_t h = 0;
   for (; h + 4 <= count; h += 4) {
-    const std::uint32_t j0 = hits[h], j1 = hits[h + 1], j2 = hits[h + 2], j3 = hits[h + 3];
-    const __m256d r0 = _mm256_load_pd(&q[j0].x), r1 = _mm256_load_pd(&q[j1].x);
-    const __m256d r2 = _mm256_load_pd(&q[j2].x), r3 = _mm256_load_pd(&q[j3].x);
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    const __m256d x4 = _mm256_permute2f128_pd(t0, t2, 0x20), y4 = _mm256_permute2f128_pd(t1, t3, 0x20);
-    const __m256d vx4 = _mm256_permute2f128_pd(t0, t2, 0x31), vy4 = _mm256_permute2f128_pd(t1, t3, 0x31);
-    __m256d dx = _mm256_sub_pd(xix, x4);
-    __m256d dy = _mm256_sub_pd(xiy, y4);
-    if (box.x) dx = MinimumImageWide(dx, px, hx);
-    if (box.y) dy = MinimumImageWide(dy, py, hy);
-    const __m256d wx = _mm256_sub_pd(vix, vx4);
-    const __m256d wy = _mm256_sub_pd(viy, vy4);
-    const __m256d reach = _mm256_add_pd(rib, _mm256_set_pd(q[j3].bound, q[j2].bound, q[j1].bound, q[j0].bound));
-    const __m256d xx = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-    const __m256d a = _mm256_add_pd(_mm256_mul_pd(wx, wx), _mm256_mul_pd(wy, wy));
-    const __m256d bb = _mm256_add_pd(_mm256_mul_pd(dx, wx), _mm256_mul_pd(dy, wy));
-    const __m256d c = _mm256_sub_pd(xx, _mm256_mul_pd(reach, reach));
-    const __m256d discriminant = _mm256_sub_pd(_mm256_mul_pd(bb, bb), _mm256_mul_pd(a, c));
+    const WideTerms t = ApproachWide(q, f, hits[h], hits[h + 1], hits[h + 2], hits[h + 3]);
+    const __m256d dx = t.dx, dy = t.dy, wx = t.wx, wy = t.wy, reach = t.reach, bb = t.bb, c = t.c;
+    const __m256d discriminant = t.discriminant;
     const __m256d root = _mm256_sqrt_pd(discriminant);
     const __m256d tau = _mm256_div_pd(c, _mm256_sub_pd(root, bb));
     alignas(32) double exponent[4];

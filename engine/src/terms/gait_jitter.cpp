@@ -99,23 +99,11 @@ __attribute__((target("avx2"))) double AxisCosinesWide(const double* frequency_u
                                                 _mm256_mul_pd(k, _mm256_set1_pd(kPiOver2Mid))),
                                   _mm256_mul_pd(k, _mm256_set1_pd(kPiOver2Lo)));
   const __m256d s = _mm256_mul_pd(r, r);
-  __m256d ps = _mm256_set1_pd(2.8114572543455207632e-15);
-  ps = HornerStep(ps, s, -7.6471637318198164759e-13);
-  ps = HornerStep(ps, s, 1.6059043836821614599e-10);
-  ps = HornerStep(ps, s, -2.5052108385441718775e-08);
-  ps = HornerStep(ps, s, 2.7557319223985890653e-06);
-  ps = HornerStep(ps, s, -1.9841269841269841270e-04);
-  ps = HornerStep(ps, s, 8.3333333333333333333e-03);
-  ps = HornerStep(ps, s, -1.6666666666666666667e-01);
+  __m256d ps = _mm256_set1_pd(kSinSeries[0]);
+  for (int term = 1; term < kSeriesTerms; ++term) ps = HornerStep(ps, s, kSinSeries[term]);
   const __m256d sin_r = _mm256_add_pd(r, _mm256_mul_pd(_mm256_mul_pd(r, s), ps));
-  __m256d pc = _mm256_set1_pd(4.7794773323873852974e-14);
-  pc = HornerStep(pc, s, -1.1470745597729724714e-11);
-  pc = HornerStep(pc, s, 2.0876756987868098979e-09);
-  pc = HornerStep(pc, s, -2.7557319223985890653e-07);
-  pc = HornerStep(pc, s, 2.4801587301587301587e-05);
-  pc = HornerStep(pc, s, -1.3888888888888888889e-03);
-  pc = HornerStep(pc, s, 4.1666666666666666667e-02);
-  pc = HornerStep(pc, s, -0.5);
+  __m256d pc = _mm256_set1_pd(kCosSeries[0]);
+  for (int term = 1; term < kSeriesTerms; ++term) pc = HornerStep(pc, s, kCosSeries[term]);
   const __m256d cos_r = _mm256_add_pd(_mm256_set1_pd(1.0), _mm256_mul_pd(s, pc));
   const __m256i q = _mm256_castpd_si256(rounding);
   const __m256d one = _mm256_set1_pd(1.0);

@@ -39,6 +39,32 @@ inline constexpr double kReduceLimit = 1e6;
 // the nearest integer (ties to even) in the default rounding mode.
 inline constexpr double kRoundMagic = 0x1.8p52;
 
+// The Taylor series of SinCos, highest power first (Horner): sin r = r (1 +
+// s P(s)), P = -1/3! + s/5! - ... + s^7/17!; cos r = 1 + s Q(s), Q = -1/2! +
+// s/4! - ... + s^7/16!; s = r^2. (Also read by the engine's four-lane copy
+// of SinCos, engine/src/terms/gait_jitter.cpp.)
+inline constexpr int kSeriesTerms = 8;
+inline constexpr double kSinSeries[kSeriesTerms] = {
+    2.8114572543455207632e-15,   // 1/17!
+    -7.6471637318198164759e-13,  // -1/15!
+    1.6059043836821614599e-10,   // 1/13!
+    -2.5052108385441718775e-08,  // -1/11!
+    2.7557319223985890653e-06,   // 1/9!
+    -1.9841269841269841270e-04,  // -1/7!
+    8.3333333333333333333e-03,   // 1/5!
+    -1.6666666666666666667e-01,  // -1/3!
+};
+inline constexpr double kCosSeries[kSeriesTerms] = {
+    4.7794773323873852974e-14,   // 1/16!
+    -1.1470745597729724714e-11,  // -1/14!
+    2.0876756987868098979e-09,   // 1/12!
+    -2.7557319223985890653e-07,  // -1/10!
+    2.4801587301587301587e-05,   // 1/8!
+    -1.3888888888888888889e-03,  // -1/6!
+    4.1666666666666666667e-02,   // 1/4!
+    -0.5,                        // -1/2!
+};
+
 // Branch-free selection (the engine's arguments fall in any quadrant or
 // octant, so branches would be mispredicted half of the time): with f = 0 or
 // 1, f a + (1 - f) b and the like are exact, and stay in the floating-point
@@ -58,25 +84,11 @@ inline void SinCos(double x, double& sin_x, double& cos_x) {
   const double k = (x * kTwoOverPi + kRoundMagic) - kRoundMagic;
   const double r = ((x - k * kPiOver2Hi) - k * kPiOver2Mid) - k * kPiOver2Lo;
   const double s = r * r;
-  // sin r = r (1 - s/3! + s^2/5! - ... + s^8/17!)
-  double ps = 2.8114572543455207632e-15;  // 1/17!
-  ps = ps * s - 7.6471637318198164759e-13;  // 1/15!
-  ps = ps * s + 1.6059043836821614599e-10;  // 1/13!
-  ps = ps * s - 2.5052108385441718775e-08;  // 1/11!
-  ps = ps * s + 2.7557319223985890653e-06;  // 1/9!
-  ps = ps * s - 1.9841269841269841270e-04;  // 1/7!
-  ps = ps * s + 8.3333333333333333333e-03;  // 1/5!
-  ps = ps * s - 1.6666666666666666667e-01;  // 1/3!
+  double ps = kSinSeries[0];
+  for (int term = 1; term < kSeriesTerms; ++term) ps = ps * s + kSinSeries[term];
   const double sin_r = r + r * s * ps;
-  // cos r = 1 - s/2! + s^2/4! - ... + s^8/16!
-  double pc = 4.7794773323873852974e-14;  // 1/16!
-  pc = pc * s - 1.1470745597729724714e-11;  // 1/14!
-  pc = pc * s + 2.0876756987868098979e-09;  // 1/12!
-  pc = pc * s - 2.7557319223985890653e-07;  // 1/10!
-  pc = pc * s + 2.4801587301587301587e-05;  // 1/8!
-  pc = pc * s - 1.3888888888888888889e-03;  // 1/6!
-  pc = pc * s + 4.1666666666666666667e-02;  // 1/4!
-  pc = pc * s - 0.5;                        // 1/2!
+  double pc = kCosSeries[0];
+  for (int term = 1; term < kSeriesTerms; ++term) pc = pc * s + kCosSeries[term];
   const double cos_r = 1.0 + s * pc;
   // Quadrant q = k mod 4: (sin, cos) = (s, c), (c, -s), (-s, -c), (-c, s).
   const auto q = static_cast<std::uint64_t>(static_cast<std::int64_t>(k));
