@@ -75,6 +75,9 @@ inline Vec2 Separation(const PeriodicBox& box, Vec2 a, Vec2 b) {
 struct NeighbourList {
   double radius_m = 0.0;
   std::vector<std::uint32_t> start, items;
+  // Where person i's candidates after i begin: items[later[i]] .. items[start[i + 1] - 1]
+  // are those of index > i (the list's rows are in increasing index).
+  std::vector<std::uint32_t> later;
   double near_radius_m = 0.0;
   std::vector<std::uint32_t> near_start, near_items;
   bool empty() const { return start.empty(); }

@@ -126,6 +126,7 @@ void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, con
   list.radius_m = radius;
   list.start.assign(n + 1, 0);
   list.items.clear();
+  list.later.assign(n, 0);
   list.near_radius_m = near_radius;
   list.near_start.assign(near_radius > 0.0 ? n + 1 : 0, 0);
   list.near_items.clear();
@@ -163,6 +164,8 @@ void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, con
       std::sort(mine.begin(), mine.end());
       rows.insert(rows.end(), mine.begin(), mine.end());
       list.start[i + 1] = static_cast<std::uint32_t>(mine.size());
+      // (how many come before i: made an index below)
+      list.later[i] = static_cast<std::uint32_t>(std::upper_bound(mine.begin(), mine.end(), i) - mine.begin());
       if (near) {
         std::vector<std::uint32_t>& near_rows = near_chunks[static_cast<std::size_t>(chunk)];
         const std::size_t before = near_rows.size();
@@ -175,7 +178,10 @@ void BuildNeighbourList(const PeriodicBox& box, const std::vector<Vec2>& at, con
     }
   }
   // The counts summed into starts, the chunks put end to end.
-  for (std::size_t i = 0; i < n; ++i) list.start[i + 1] += list.start[i];
+  for (std::size_t i = 0; i < n; ++i) {
+    list.start[i + 1] += list.start[i];
+    list.later[i] += list.start[i];
+  }
   list.items.resize(list.start[n]);
   if (near) {
     for (std::size_t i = 0; i < n; ++i) list.near_start[i + 1] += list.near_start[i];

@@ -446,11 +446,8 @@ class AnticipationTerm final : public BehaviourTerm {
       const std::int64_t last = std::min(n, (block + 1) * kPairBlock);
       for (auto i = static_cast<std::uint32_t>(block * kPairBlock); i < last; ++i) {
         if (bodies.state[i] == PersonState::kRemoved) continue;
-        const std::uint32_t* first = list.items.data() + list.start[i];
-        const std::uint32_t* end = list.items.data() + list.start[i + 1];
-        const auto later = static_cast<std::uint32_t>(std::upper_bound(first, end, i) - list.items.data());
         const std::uint32_t own_part_end = part_end(i);
-        ForEachCollision<Pairs::kAll>(in, list.items, later, list.start[i + 1], bodies.position_m[i],
+        ForEachCollision<Pairs::kAll>(in, list.items, list.later[i], list.start[i + 1], bodies.position_m[i],
                                       bodies.velocity_m_per_s[i], bound_m_[bodies.shape[i]],
                                       [&](std::uint32_t j, Vec2 a) {
                                         if (!(acts_[i] || acts_[j])) return;
