@@ -21,10 +21,10 @@
 // newcomer's slot moves far, which rebuilds the list at the next step.
 // Candidates are a superset of the people within the radius whenever the
 // list is used by a step, so when it is rebuilt changes no result; the list
-// is built in a fixed order (the same on any thread
-// count: each chunk of people's rows on a thread, the chunks end to end in
-// their order) and is not in the checkpoint. When a term asks
-// for a near list (a shorter radius it needs at every step), the list's
+// is built in a fixed order, the same on any thread count (each chunk of
+// people's rows on a thread, the chunks put end to end in their order), and
+// is not in the checkpoint. When a term asks for a near list (a shorter
+// radius it needs at every step), the list's
 // candidates within the near radius + skin are kept as a second list, built
 // and kept valid with the first.
 #include "simulation_internals.hpp"
