@@ -285,11 +285,14 @@ class AnticipationTerm final : public BehaviourTerm {
     wide_ = WideInstructions();
     const std::size_t n = in.bodies.size();
     copy_.resize(n);
+    acts_.resize(n);
     for (std::size_t j = 0; j < n; ++j) {
       const Vec2 x = in.bodies.position_m[j], v = in.bodies.velocity_m_per_s[j];
       const bool empty = in.bodies.state[j] == PersonState::kRemoved;
       copy_[j] = Candidate{empty ? std::numeric_limits<double>::quiet_NaN() : x.x, x.y, v.x, v.y,
                            bound_m_[in.bodies.shape[j]], {}};
+      acts_[j] = in.bodies.state[j] == PersonState::kWalking && in.def.parameters.ground_reaction &&
+                 WantsToWalk(in.bodies, j);
     }
     halved_ = !clocked_ && half_pairs_allowed && EachPairOnceIsCheaper(in);
     if (halved_) SumEachPairOnce(in);
@@ -307,7 +310,7 @@ class AnticipationTerm final : public BehaviourTerm {
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       if (bodies.state[i] == PersonState::kRemoved) continue;
       const std::size_t listed = list.start[i + 1] - list.start[i];
-      if (bodies.state[i] == PersonState::kWalking && WantsToWalk(bodies, i)) whole += listed;
+      if (acts_[i]) whole += listed;
       once += listed / 2;
     }
     return once < whole;
@@ -420,10 +423,6 @@ class AnticipationTerm final : public BehaviourTerm {
     const BodyState& bodies = in.bodies;
     const NeighbourList& list = in.neighbours;
     const auto n = static_cast<std::int64_t>(bodies.size());
-    acts_.resize(bodies.size());
-    for (std::size_t i = 0; i < bodies.size(); ++i)
-      acts_[i] =
-          bodies.state[i] == PersonState::kWalking && in.def.parameters.ground_reaction && WantsToWalk(bodies, i);
     const std::int64_t blocks = (n + kPairBlock - 1) / kPairBlock;
     if (pairs_.size() < static_cast<std::size_t>(blocks)) {
       pairs_.resize(static_cast<std::size_t>(blocks));
@@ -558,7 +557,7 @@ class AnticipationTerm final : public BehaviourTerm {
   mutable std::vector<Candidate> copy_;
   mutable bool wide_ = false;
   // Each pair once (SumEachPairOnce): in use for this evaluation; per person
-  // whether the force acts on them (a walker who wants to walk); per block
+  // whether the force acts on them (a walker who wants to walk; Prepare); per block
   // of kPairBlock people the colliding pairs (i, j > i) and the force of j
   // on i per unit mass; per person the sum.
   struct Pair {
