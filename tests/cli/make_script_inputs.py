@@ -11,6 +11,11 @@
         timeline fall event (the recorded-falls sweeps).
     make_script_inputs.py run FILE VENUE.json
         one such run file.
+    make_script_inputs.py nights DIR VENUE.json
+        DIR/paths.csv (night-path.py's columns) and DIR/summaries/RUN.json
+        (ensemble run summaries) of six whole nights at inflow scales 1-1.5,
+        four of which jam (one of them stopped before its end, without a
+        summary): for studies/night-validated-calibration/night-hazard.py.
 
 The people stand and walk at fixed, seeded places inside the venue's first
 measurement area (or at the origin), so that the numbers are not all zero.
@@ -107,7 +112,36 @@ def make_sweep(folder, venue, runs, fall=False):
         w.writerows(rows)
 
 
+def make_nights(folder, venue):
+    """(run, scale, first jam or None, clog for good or None, finished)."""
+    nights = [("n1", 1.0, None, None, True), ("n2", 1.2, None, None, True), ("n3", 1.4, 4790.0, 4790.0, True),
+              ("n4", 1.45, 2400.0, 2460.0, True), ("n5", 1.45, 2900.0, 3700.0, True), ("n6", 1.5, 2750.0, None, False)]
+    os.makedirs(os.path.join(folder, "summaries"), exist_ok=True)
+    with open(os.path.join(folder, "paths.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "time_s", "inside", "main", "counter", "density_per_m2", "counter_flow_share",
+                    "counter_share_raw", "mean_speed_m_per_s"])
+        for run, scale, jam, clog, finished in nights:
+            end = 5700 if finished else 3100
+            for t in range(0, end + 1, 10):
+                moving = jam is None or t < jam or (clog is not None and jam + 200 < t < clog)
+                w.writerow([run, t, 60, 40, 20, 1.7, 0.33, 0.33, 1.0 if moving else 0.02])
+    for run, scale, jam, clog, finished in nights:
+        if not finished:
+            continue
+        summary = {"format": "crowdrecon-ensemble-run", "version": 1, "label": run, "seed": 1, "end_s": 5700.0,
+                   "clog_for_good_s": clog, "avalanche_s": [], "fall_s": [],
+                   "scenario": {"venue": venue.get("metadata", {}).get("name", "venue"),
+                                "timeline": {"rate_scale": scale}, "model": {}}}
+        with open(os.path.join(folder, "summaries", run + ".json"), "w") as f:
+            json.dump(summary, f)
+
+
 def main(argv):
+    if len(argv) >= 4 and argv[1] == "nights":
+        with open(argv[3]) as f:
+            make_nights(argv[2], json.load(f))
+        return
     if len(argv) < 4 or argv[1] not in ("sweep", "run"):
         sys.exit(__doc__)
     with open(argv[3]) as f:

@@ -20,6 +20,7 @@ mkdir "$s" && cd "$s" || exit 1
 make() { "$py" "$here/make_script_inputs.py" "$@" || { echo "script_outputs.sh: cannot make the inputs ($*)"; exit 1; }; }
 make run run.sqlite "$root/venues/itaewon/alley.json"
 make sweep hallway-sweep "$root/venues/madrid-arena/hallway-open.json" --runs 6
+make nights nights "$root/venues/madrid-arena/hallway-open.json"
 ln -s run.sqlite link.sqlite
 ln run.sqlite hard.sqlite
 cp "$root/tests/data/scenarios/hallway-short.json" scenario.json
@@ -131,6 +132,17 @@ refused "passing-side: -o someone's notes" "expected another name, or --force" -
   "$py" "$D/side-preference/passing-side.py" hallway-sweep -o notes.txt
 refused "passing-side: not a sweep folder" "expected a crowdrecon sweep folder" -- \
   "$py" "$D/side-preference/passing-side.py" notes -o sides.md
+hz=$D/night-validated-calibration/night-hazard.py
+refused "night-hazard: -o the summaries folder" "is an input|deletes nothing" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o nights/summaries --coverage 0
+refused "night-hazard: a night neither summarised nor unfinished" "night n6 has no summary" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries -o hz --coverage 0
+refused "night-hazard: --unfinished without its scale" "expected RUN:SCALE" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6 -o hz --coverage 0
+refused "night-hazard: scenarios as summaries" "expected an ensemble run summary" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries jsonfolder --unfinished n6:1.5 -o hz --coverage 0
+refused "night-hazard: a run file as the paths CSV" "expected night-path.py's CSV" -- \
+  "$py" "$hz" --paths run.sqlite --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 0
 
 # --- good input still works; a rerun replaces its previous outputs
 accepted "itaewon-densities: a table" d.md -- "$py" "$dens" run.sqlite -o d.md --csv d.csv
@@ -139,6 +151,10 @@ accepted "sweep-ensembles: two variants" cmp.md -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
 accepted "sweep-ensembles: run again" cmp.csv -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
+accepted "night-hazard: six nights, coverage 3" hz/hazard.md -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 3
+accepted "night-hazard: run again" hz/nights.csv -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 0
 leftovers=$(find "$s" -name '.*partial-*')
 [[ -z $leftovers ]] || { echo "FAIL partial files left: $leftovers"; fails=$((fails + 1)); }
 
