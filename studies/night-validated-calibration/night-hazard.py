@@ -106,6 +106,18 @@ def density(beta, s, t):
     return math.exp(a + b * t - cumulative(beta, s, t))
 
 
+def time_of(beta, s, target):
+    """The time t in the night where H(t) = target (H increases: bisection)."""
+    lo, hi = START_S, END_S
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if cumulative(beta, s, mid) < target:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 def draw_time(beta, s, rng, within=False):
     """An event time from S (None: not by the night's end); within: conditioned on happening by the end."""
     h_end = cumulative(beta, s, END_S)
@@ -117,14 +129,7 @@ def draw_time(beta, s, rng, within=False):
         e = rng.expovariate(1.0)
         if e >= h_end:
             return None
-    lo, hi = START_S, END_S  # H is increasing: bisection
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if cumulative(beta, s, mid) < e:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    return time_of(beta, s, e)
 
 
 def pieces(nights, event):
@@ -162,14 +167,7 @@ def quantile(beta, s, q):
     h = -math.log(1.0 - q)
     if cumulative(beta, s, END_S) < h:
         return None
-    lo, hi = START_S, END_S
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if cumulative(beta, s, mid) < h:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    return time_of(beta, s, h)
 
 
 def coverage(nights, event, beta, cov, target_scales, reps, seed):
