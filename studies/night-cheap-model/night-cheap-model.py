@@ -435,19 +435,24 @@ def fitted_check(beta, use, delta, nights_at):
     return out
 
 
+def night_pieces(scale, t, stop):
+    """A whole night's 10-s pieces from NIGHT_AFTER_S to `stop` (its event at t, or censored there when t is None),
+    each with the rates of its middle: the exposures fit_hazard takes."""
+    pieces = []
+    u = NIGHT_AFTER_S
+    while u < stop - 1e-9:
+        dt = min(SAMPLE_S, stop - u)
+        m, c = night_rates(u + dt / 2, scale)
+        pieces.append({"jammed": 1 if t is not None and u + dt >= stop - 1e-9 else 0, "exposure_s": dt,
+                       "x": covariates(m, c, GAMMA0, LAMBDA0)})
+        u += dt
+    return pieces
+
+
 def own_hazard_section(nights_at, cheap_fits):
     """The whole nights' own first-jam hazard, the cheap model's form fitted to them directly (10-s pieces of each night
     from 300 s to its first jam or its end, the rates of each piece's middle), beside the cheap fits."""
-    pieces = []
-    for scale, t, end in nights_at:
-        stop = t if t is not None else end
-        u = NIGHT_AFTER_S
-        while u < stop - 1e-9:
-            dt = min(SAMPLE_S, stop - u)
-            m, c = night_rates(u + dt / 2, scale)
-            pieces.append({"jammed": 1 if t is not None and u + dt >= stop - 1e-9 else 0, "exposure_s": dt,
-                           "x": covariates(m, c, GAMMA0, LAMBDA0)})
-            u += dt
+    pieces = [p for scale, t, end in nights_at for p in night_pieces(scale, t, t if t is not None else end)]
     use = [0, 1, 2]
     beta, cov, _ = fit_hazard(pieces, use)
     scales = sorted({n[0] for n in nights_at})

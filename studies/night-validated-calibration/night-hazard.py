@@ -132,23 +132,9 @@ def draw_time(beta, s, rng, within=False):
     return time_of(beta, s, e)
 
 
-def pieces(nights, event):
-    """10-s pieces of each night from START_S to its event or censoring (the cheap model's fitting form)."""
-    out = []
-    for n in nights:
-        t, stop = n[event]
-        u = START_S
-        while u < stop - 1e-9:
-            dt = min(cheap.SAMPLE_S, stop - u)
-            m, c = cheap.night_rates(u + dt / 2, n["scale"])
-            out.append({"jammed": 1 if t is not None and u + dt >= stop - 1e-9 else 0, "exposure_s": dt,
-                        "x": cheap.covariates(m, c, cheap.GAMMA0, cheap.LAMBDA0)})
-            u += dt
-    return out
-
-
 def fit(nights, event):
-    return cheap.fit_hazard(pieces(nights, event), USE)
+    """The hazard of `event` fitted to the nights (each night's 10-s pieces to its event or censoring)."""
+    return cheap.fit_hazard([p for n in nights for p in cheap.night_pieces(n["scale"], *n[event])], USE)
 
 
 def scale_interval(draws, target, threshold=3.84):
@@ -244,17 +230,16 @@ def read_nights(args):
             end = float(d["end_s"])
             if end < END_S - 1.0:
                 raise guard.ScriptError(f"{run}: its summary ends at {end:g} s; expected a whole night (to {END_S:g} s)")
-            gamma = d["scenario"].get("model", {}).get("back_force_gamma", cheap.GAMMA0)
             finished = True
             avalanches = [float(a) for a in d.get("avalanche_s", [])]
             falls = [float(f) for f in d.get("fall_s", [])]
         elif run in unfinished:
-            scale, clog, end, gamma, finished, avalanches, falls = unfinished[run], None, last, cheap.GAMMA0, False, None, None
+            scale, clog, end, finished, avalanches, falls = unfinished[run], None, last, False, None, None
         else:
             raise guard.ScriptError(f"{args.paths}: night {run} has no summary in {', '.join(args.summaries)} and is not "
                                     "named with --unfinished RUN:SCALE; expected every night of the CSV accounted for")
         nights.append({
-            "run": run, "scale": scale, "finished": finished, "gamma": gamma,
+            "run": run, "scale": scale, "finished": finished,
             "first jam": (onset, onset if onset is not None else end),
             # an unfinished night's clog for good is no earlier than its first jam (censored there), or than its end
             "clog for good": ((clog, clog) if clog is not None else (None, end if finished or onset is None else onset)),
