@@ -156,13 +156,19 @@ def ks_distance(places):
     return max(max((i + 1) / n - u, u - i / n) for i, u in enumerate(places)) if places else float("nan")
 
 
+def profile_over(likelihood, scales, threshold=3.84):
+    """The profile of -2 ln L over `scales` (likelihood: scale -> L): the best scale, the first and last scales
+    within Δ(-2 ln L) < threshold, and every (scale, -2 ln L) row."""
+    rows = [(sc, -2.0 * math.log(max(likelihood(sc), 1e-300))) for sc in scales]
+    top = min(v for _, v in rows)
+    inside = [sc for sc, v in rows if v - top < threshold]
+    return min(rows, key=lambda r: r[1])[0], inside[0], inside[-1], rows
+
+
 def profile_scale(likelihood):
     """The inflow scale over 0.50-1.50 (steps of 0.01) for one recorded time: its best value and the values within
     Δ(-2 ln L) < 3.84. likelihood: scale -> L."""
-    rows = [(k / 100.0, -2.0 * math.log(max(likelihood(k / 100.0), 1e-300))) for k in range(50, 151)]
-    top = min(v for _, v in rows)
-    inside = [sc for sc, v in rows if v - top < 3.84]
-    return min(rows, key=lambda r: r[1])[0], inside[0], inside[-1]
+    return profile_over(likelihood, [k / 100.0 for k in range(50, 151)])[:3]
 
 
 def fit_hazard(runs, use):

@@ -139,13 +139,7 @@ def fit(nights, event):
 
 def scale_interval(draws, target, threshold=3.84):
     """Best scale and the scales within Δ(-2 ln L) < threshold, the coefficients' uncertainty averaged over."""
-    rows = []
-    for s in SCALES:
-        like = sum(density(b, s, target) for b in draws) / len(draws)
-        rows.append((s, -2.0 * math.log(max(like, 1e-300))))
-    top = min(v for _, v in rows)
-    inside = [s for s, v in rows if v - top < threshold]
-    return min(rows, key=lambda r: r[1])[0], inside[0], inside[-1], rows
+    return cheap.profile_over(lambda s: sum(density(b, s, target) for b in draws) / len(draws), SCALES, threshold)
 
 
 def quantile(beta, s, q):
