@@ -441,16 +441,16 @@ def fitted_check(beta, use, delta, nights_at):
     return out
 
 
-def night_pieces(scale, t, stop):
+def night_pieces(scale, t, stop, gamma=GAMMA0):
     """A whole night's 10-s pieces from NIGHT_AFTER_S to `stop` (its event at t, or censored there when t is None),
-    each with the rates of its middle: the exposures fit_hazard takes."""
+    each with the rates of its middle (and the entering group's back force gamma): the exposures fit_hazard takes."""
     pieces = []
     u = NIGHT_AFTER_S
     while u < stop - 1e-9:
         dt = min(SAMPLE_S, stop - u)
         m, c = night_rates(u + dt / 2, scale)
         pieces.append({"jammed": 1 if t is not None and u + dt >= stop - 1e-9 else 0, "exposure_s": dt,
-                       "x": covariates(m, c, GAMMA0, LAMBDA0)})
+                       "x": covariates(m, c, gamma, LAMBDA0)})
         u += dt
     return pieces
 

@@ -40,12 +40,24 @@ a known scale (conditioned on happening within the night, as the record's
 did), its interval computed as above; the share of intervals that contain
 the known scale, with its binomial standard error.
 
+The entering crowd's push (issue 67 point 2): each night's entering group's
+back force Γ is read from its summary's scenario (an event at the start
+setting the group "counter"'s back_force_gamma, else the model's). Where the
+nights' Γ differ, both hazards get the cheap model's term b3 ln(Γ/1.2), the
+single-reading intervals above are those at the profile's Γ 1.2, and both
+readings together give the record's (s, Γ): their likelihoods multiplied
+(the two events independent given s and Γ) on a grid of s (0.5-3) and Γ
+(0.3-4.8, the calibration file's ranges), the region within Δ(-2 ln L) <
+5.99, its threshold calibrated and checked by simulation as above (known
+points (1.3, 1.2), (1.45, 1.2), (1.45, 4.8); a coarser grid).
+
 Usage:
   night-hazard.py --paths paths.csv --summaries DIR [--summaries DIR ...]
-                  [--unfinished RUN:SCALE ...] -o OUT [--coverage N]
+                  [--unfinished RUN:SCALE[:GAMMA] ...] -o OUT [--coverage N]
 
 Writes OUT/hazard.md (the tables), OUT/nights.csv (each night's events and
-exposure), OUT/hazard.svg and .png (with chromium).
+exposure), OUT/hazard.svg and .png (with chromium), and where the nights' Γ
+differ OUT/joint.svg and .png (the record's (s, Γ)).
 
 Before any work (scripts/script_guard.py): the CSV must be night-path.py's,
 each --summaries a folder of ensemble summaries, every night of the CSV
@@ -72,7 +84,8 @@ _spec = importlib.util.spec_from_file_location("cheap", os.path.join(ROOT, "stud
 cheap = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(cheap)
 
-USE = [0, 1, 2]  # the cheap model's covariates: 1, m - 2.25, c - 1.6
+USE = [0, 1, 2]  # the cheap model's covariates: 1, m - 2.25, c - 1.6 (and 3, ln(Γ/1.2), when the nights' Γ differ)
+GAMMA0 = cheap.GAMMA0
 START_S = cheap.NIGHT_AFTER_S
 END_S = cheap.NIGHT_END_S
 SCALES = [k / 100.0 for k in range(50, 301)]  # the calibration file's range of the scale, 0.5-3
@@ -84,43 +97,46 @@ DRAWS = 100
 KNOWN_SCALES = (1.3, 1.45, 1.6)
 
 
-def line(beta, s):
-    """ln h(t) = a + b t along the night at scale s (m and c are linear in t)."""
-    b0, b1, b2 = beta
+def line(beta, s, g=GAMMA0):
+    """ln h(t) = a + b t along the night at scale s and the entering group's back force g (m and c are linear
+    in t)."""
+    b0, b1, b2 = beta[:3]
     a = b0 + b1 * (3.0 * s - cheap.M0) + b2 * (0.2 * s - cheap.C0)
+    if len(beta) > 3:
+        a += beta[3] * math.log(g / GAMMA0)
     b = s * (-2.0 * b1 + 3.8 * b2) / END_S
     return a, b
 
 
-def cumulative(beta, s, t):
+def cumulative(beta, s, t, g=GAMMA0):
     """H(t) = ∫ h from START_S to t."""
-    a, b = line(beta, s)
+    a, b = line(beta, s, g)
     if abs(b) * (t - START_S) < 1e-9:
         return math.exp(a + b * START_S) * (t - START_S)
     return (math.exp(a + b * t) - math.exp(a + b * START_S)) / b
 
 
-def density(beta, s, t):
+def density(beta, s, t, g=GAMMA0):
     """h(t) S(t): the likelihood of an event at t."""
-    a, b = line(beta, s)
-    return math.exp(a + b * t - cumulative(beta, s, t))
+    a, b = line(beta, s, g)
+    return math.exp(a + b * t - cumulative(beta, s, t, g))
 
 
-def time_of(beta, s, target):
+def time_of(beta, s, target, g=GAMMA0):
     """The time t in the night where H(t) = target (H increases: bisection)."""
     lo, hi = START_S, END_S
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if cumulative(beta, s, mid) < target:
+        if cumulative(beta, s, mid, g) < target:
             lo = mid
         else:
             hi = mid
     return 0.5 * (lo + hi)
 
 
-def draw_time(beta, s, rng, within=False):
+def draw_time(beta, s, rng, within=False, g=GAMMA0):
     """An event time from S (None: not by the night's end); within: conditioned on happening by the end."""
-    h_end = cumulative(beta, s, END_S)
+    h_end = cumulative(beta, s, END_S, g)
     if within:
         if h_end < 1e-12:
             return None
@@ -129,12 +145,13 @@ def draw_time(beta, s, rng, within=False):
         e = rng.expovariate(1.0)
         if e >= h_end:
             return None
-    return time_of(beta, s, e)
+    return time_of(beta, s, e, g)
 
 
 def fit(nights, event):
     """The hazard of `event` fitted to the nights (each night's 10-s pieces to its event or censoring)."""
-    return cheap.fit_hazard([p for n in nights for p in cheap.night_pieces(n["scale"], *n[event])], USE)
+    return cheap.fit_hazard([p for n in nights for p in cheap.night_pieces(n["scale"], *n[event], gamma=n["gamma"])],
+                            USE)
 
 
 def scale_interval(draws, target, threshold=3.84):
@@ -142,12 +159,12 @@ def scale_interval(draws, target, threshold=3.84):
     return cheap.profile_over(lambda s: sum(density(b, s, target) for b in draws) / len(draws), SCALES, threshold)
 
 
-def quantile(beta, s, q):
+def quantile(beta, s, q, g=GAMMA0):
     """The time by which a share q of nights have had the event (None: not within the night)."""
     h = -math.log(1.0 - q)
-    if cumulative(beta, s, END_S) < h:
+    if cumulative(beta, s, END_S, g) < h:
         return None
-    return time_of(beta, s, h)
+    return time_of(beta, s, h, g)
 
 
 def coverage(nights, event, beta, cov, target_scales, reps, seed):
@@ -160,8 +177,8 @@ def coverage(nights, event, beta, cov, target_scales, reps, seed):
         for _ in range(reps):
             fake = []
             for n in nights:
-                t = draw_time(beta, n["scale"], rng)
-                fake.append({"scale": n["scale"], event: (t, t if t is not None else END_S)})
+                t = draw_time(beta, n["scale"], rng, g=n["gamma"])
+                fake.append({"scale": n["scale"], "gamma": n["gamma"], event: (t, t if t is not None else END_S)})
             if sum(1 for f in fake if f[event][0] is not None) < 3:
                 failed += 1
                 continue
@@ -186,6 +203,75 @@ def coverage(nights, event, beta, cov, target_scales, reps, seed):
     return out
 
 
+GAMMAS = [0.3 * 2.0 ** (k / 4.0) for k in range(17)]  # the calibration file's range of the entering Γ, 0.3-4.8
+JOINT_KNOWN = ((1.3, 1.2), (1.45, 1.2), (1.45, 4.8))
+COARSE_SCALES = [k / 50.0 for k in range(25, 151)]  # the coverage studies' grid: s by 0.02, Γ by half octaves
+COARSE_GAMMAS = GAMMAS[::2]
+
+
+def joint_likelihood(draws_by_event, targets, s, g):
+    """The recorded times' joint likelihood at (s, Γ): the product over the readings of h(t) S(t), each averaged
+    over its hazard's coefficient draws (the readings' events taken as independent given s and Γ)."""
+    out = 1.0
+    for event, target in targets.items():
+        draws = draws_by_event[event]
+        out *= sum(density(b, s, target, g) for b in draws) / len(draws)
+    return out
+
+
+def joint_profile(draws_by_event, targets, scales=None, gammas=None):
+    """-2 ln L of the joint likelihood on the (s, Γ) grid: {(s, Γ): value}."""
+    return {(s, g): -2.0 * math.log(max(joint_likelihood(draws_by_event, targets, s, g), 1e-300))
+            for s in (scales or SCALES) for g in (gammas or GAMMAS)}
+
+
+def joint_region(grid, threshold):
+    """The best (s, Γ) and the ranges of s and Γ over the cells within Δ(-2 ln L) < threshold."""
+    best = min(grid, key=grid.get)
+    inside = [k for k, v in grid.items() if v - grid[best] < threshold]
+    return best, (min(k[0] for k in inside), max(k[0] for k in inside)), (min(k[1] for k in inside),
+                                                                           max(k[1] for k in inside))
+
+
+def joint_coverage(nights, fits, targets, reps, seed):
+    """Per known (s, Γ): Δ(-2 ln L) of the joint likelihood at the known point against the coarse grid's least, over
+    synthetic studies (each event's nights drawn from its fitted hazard at the design's scales and Γ, both hazards
+    refitted, a record drawn at the known point, each event within the night), and the studies without a fit."""
+    rng = random.Random(seed)
+    out = {}
+    for known in JOINT_KNOWN:
+        deltas, failed = [], 0
+        for _ in range(reps):
+            draws_by_event, record, ok = {}, {}, True
+            for event in targets:
+                beta, cov, _ = fits[event]
+                fake = []
+                for n in nights:
+                    t = draw_time(beta, n["scale"], rng, g=n["gamma"])
+                    fake.append({"scale": n["scale"], "gamma": n["gamma"], event: (t, t if t is not None else END_S)})
+                try:
+                    if sum(1 for f in fake if f[event][0] is not None) < len(USE):
+                        raise ZeroDivisionError
+                    b_rep, c_rep, _ = fit(fake, event)
+                except ZeroDivisionError:
+                    ok = False
+                    break
+                t_rec = draw_time(beta, known[0], rng, within=True, g=known[1])
+                if (t_rec is None or any(not math.isfinite(x) for x in b_rep) or max(abs(x) for x in b_rep) > 50):
+                    ok = False
+                    break
+                draws_by_event[event] = cheap.coefficient_draws(b_rep, c_rep, 20, rng.randrange(1 << 30))
+                record[event] = t_rec
+            if not ok:
+                failed += 1
+                continue
+            grid = joint_profile(draws_by_event, record, COARSE_SCALES, COARSE_GAMMAS)
+            at_known = -2.0 * math.log(max(joint_likelihood(draws_by_event, record, *known), 1e-300))
+            deltas.append(at_known - min(grid.values()))
+        out[known] = (deltas, failed)
+    return out
+
+
 def percentile(values, q):
     v = sorted(values)
     if not v:
@@ -193,6 +279,23 @@ def percentile(values, q):
     k = (len(v) - 1) * q
     i = int(math.floor(k))
     return v[i] if i + 1 >= len(v) else v[i] + (v[i + 1] - v[i]) * (k - i)
+
+
+def entering_gamma(scenario, where):
+    """The entering group's back force of a night: an event at the start setting the group "counter"'s
+    back_force_gamma, else the model's (the profile's)."""
+    gamma = float(scenario.get("model", {}).get("back_force_gamma", GAMMA0))
+    for k, e in enumerate(scenario.get("timeline", {}).get("events") or []):
+        if "back_force_gamma" not in (e.get("set") or {}):
+            continue
+        if e.get("group") not in (None, "counter") or float(e.get("time_s", 0.0)) > 0.0:
+            raise guard.ScriptError(f"{where}: scenario.timeline.events[{k}] sets back_force_gamma "
+                                    f"{'at ' + str(e.get('time_s')) + ' s' if e.get('group') in (None, 'counter') else 'of the group ' + repr(e.get('group'))}; "
+                                    "expected only the entering group's (\"counter\"), set at the start (time_s 0)")
+        gamma = float(e["set"]["back_force_gamma"])
+    if not gamma > 0.0:
+        raise guard.ScriptError(f"{where}: the entering group's back_force_gamma {gamma:g}; expected a positive number")
+    return gamma
 
 
 def read_nights(args):
@@ -205,14 +308,23 @@ def read_nights(args):
                 if d.get("format") != "crowdrecon-ensemble-run":
                     raise guard.ScriptError(f"{os.path.join(folder, name)}: format {d.get('format')!r}; "
                                             "expected an ensemble run summary (crowdrecon-ensemble-run)")
+                d["_path"] = os.path.join(folder, name)
                 summaries[os.path.splitext(name)[0]] = d
     unfinished = {}
     for item in args.unfinished:
-        run, _, scale = item.rpartition(":")
+        parts = item.split(":")
         try:
-            unfinished[run] = float(scale)
+            if len(parts) == 2:
+                unfinished[parts[0]] = (float(parts[1]), GAMMA0)
+            elif len(parts) == 3:
+                unfinished[parts[0]] = (float(parts[1]), float(parts[2]))
+            else:
+                raise ValueError
+            if not unfinished[parts[0]][1] > 0.0:
+                raise ValueError
         except ValueError:
-            raise guard.ScriptError(f"--unfinished {item}: expected RUN:SCALE (a run of the paths CSV and its inflow scale)")
+            raise guard.ScriptError(f"--unfinished {item}: expected RUN:SCALE or RUN:SCALE:GAMMA (a run of the paths CSV, "
+                                    f"its inflow scale and its entering group's positive back force, default {GAMMA0:g})")
     nights = []
     for run, rows in paths.items():
         onset = cheap.first_jam([(t, v) for t, v, _, _ in rows], START_S)
@@ -220,6 +332,7 @@ def read_nights(args):
         if run in summaries:
             d = summaries[run]
             scale = float(d["scenario"]["timeline"].get("rate_scale", 1.0))
+            gamma = entering_gamma(d["scenario"], d["_path"])
             clog = d.get("clog_for_good_s")
             end = float(d["end_s"])
             if end < END_S - 1.0:
@@ -228,12 +341,12 @@ def read_nights(args):
             avalanches = [float(a) for a in d.get("avalanche_s", [])]
             falls = [float(f) for f in d.get("fall_s", [])]
         elif run in unfinished:
-            scale, clog, end, finished, avalanches, falls = unfinished[run], None, last, False, None, None
+            (scale, gamma), clog, end, finished, avalanches, falls = unfinished[run], None, last, False, None, None
         else:
             raise guard.ScriptError(f"{args.paths}: night {run} has no summary in {', '.join(args.summaries)} and is not "
                                     "named with --unfinished RUN:SCALE; expected every night of the CSV accounted for")
         nights.append({
-            "run": run, "scale": scale, "finished": finished,
+            "run": run, "scale": scale, "gamma": gamma, "finished": finished,
             "first jam": (onset, onset if onset is not None else end),
             # an unfinished night's clog for good is no earlier than its first jam (censored there), or than its end
             "clog for good": ((clog, clog) if clog is not None else (None, end if finished or onset is None else onset)),
@@ -335,8 +448,57 @@ def draw_figure(path, nights, fits, intervals):
         f.write("\n".join(out))
 
 
+def draw_joint(path, joint):
+    """The joint Δ(−2 ln L) over (s, Γ): cells shaded by Δ, the region's cells outlined, the best marked."""
+    w, h, x0, top, pw, ph = 700, 540, 80, 50, 580, 380
+    grid = joint["grid"]
+    low = min(grid.values())
+    smin, smax = SCALES[0], SCALES[-1]
+    lg0, lg1 = math.log(GAMMAS[0]), math.log(GAMMAS[-1])
+    thr = joint["threshold"] or 5.99
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
+           f'<rect width="{w}" height="{h}" fill="white"/>',
+           f'<text x="{x0}" y="{top - 20}" font-weight="bold">The recorded night: Δ(−2 ln L) of the inflow scale and the '
+           'entering group\'s push</text>',
+           f'<clipPath id="plot"><rect x="{x0}" y="{top}" width="{pw}" height="{ph}"/></clipPath>', '<g clip-path="url(#plot)">']
+    ds = (SCALES[1] - SCALES[0]) / (smax - smin) * pw
+    dg = ph / (len(GAMMAS) - 1)
+    for (sc, g), v in grid.items():
+        d = v - low
+        x = x0 + (sc - smin) / (smax - smin) * pw - ds / 2
+        y = top + ph - (math.log(g) - lg0) / (lg1 - lg0) * ph - dg / 2
+        shade = max(0.0, min(1.0, d / 30.0))
+        grey = int(40 + 215 * shade)
+        fill = f"rgb({grey},{grey},255)" if d < thr else f"rgb({grey},{grey},{grey})"
+        out.append(f'<rect x="{x:.1f}" y="{y:.1f}" width="{ds + 0.6:.1f}" height="{dg + 0.6:.1f}" fill="{fill}" '
+                   'shape-rendering="crispEdges"/>')
+    out.append('</g>')
+    (bs, bg), _, _ = joint.get("calibrated") or joint["region"]
+    out.append(f'<circle cx="{x0 + (bs - smin) / (smax - smin) * pw:.1f}" '
+               f'cy="{top + ph - (math.log(bg) - lg0) / (lg1 - lg0) * ph:.1f}" r="6" fill="#d95f02" stroke="black"/>')
+    out.append(f'<rect x="{x0}" y="{top}" width="{pw}" height="{ph}" fill="none" stroke="#999"/>')
+    for sc in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0):
+        out.append(f'<text x="{x0 + (sc - smin) / (smax - smin) * pw}" y="{top + ph + 16}" text-anchor="middle">{sc:g}</text>')
+    out.append(f'<text x="{x0 + pw / 2}" y="{top + ph + 34}" text-anchor="middle">inflow scale s</text>')
+    for g in GAMMAS[::4]:
+        out.append(f'<text x="{x0 - 6}" y="{top + ph - (math.log(g) - lg0) / (lg1 - lg0) * ph + 4:.1f}" '
+                   f'text-anchor="end">{g:g}</text>')
+    out.append(f'<text x="18" y="{top + ph / 2}" transform="rotate(-90 18 {top + ph / 2})" text-anchor="middle">'
+               'entering group\'s back force Γ</text>')
+    out.append(f'<text x="20" y="{h - 48}" fill="#444">Blue: within Δ &lt; {thr:.2f}'
+               f'{" (calibrated by simulation)" if joint["threshold"] else " (two parameters, uncalibrated)"}; '
+               'darker: more likely. Dot: the best (s, Γ).</text>')
+    out.append(f'<text x="20" y="{h - 30}" fill="#444">Both readings of the record at once: the first stop before 02:18 '
+               'as the first jam,</text>')
+    out.append(f'<text x="20" y="{h - 12}" fill="#444">the fatal clog at 03:33 as the clog for good (hazards fitted to '
+               'the validated nights).</text>')
+    out.append("</svg>")
+    with guard.whole_file(path) as f:
+        f.write("\n".join(out))
+
+
 OUTPUTS = {"hazard.md": "# The Madrid night's inflow scale with the validated crowd", "nights.csv": "run,scale,",
-           "hazard.svg": None, "hazard.png": None}
+           "hazard.svg": None, "hazard.png": None, "joint.svg": None, "joint.png": None}
 
 
 def main():
@@ -358,20 +520,25 @@ def main():
            for name, check in checks.items()],
         [("the --paths CSV", args.paths)] + [("a --summaries folder", d) for d in args.summaries], args.force)
     nights = read_nights(args)
+    global USE
+    gammas_run = sorted({n["gamma"] for n in nights})
+    if len(gammas_run) > 1:
+        USE = [0, 1, 2, 3]  # the nights' entering Γ differ: its term can be fitted
+    targets = {event: target for event, _, target in READINGS}
 
     # The closed form against the cheap model's numerical integral (its survival_curve), at the first fit.
     fits = {}
     for event, _, _ in READINGS:
-        if sum(1 for n in nights if n[event][0] is not None) < 3:
-            raise guard.ScriptError(f"{args.paths}: fewer than 3 nights with a {event}; expected nights at inflow scales "
-                                    f"where some jam (three coefficients need at least three events)")
+        if sum(1 for n in nights if n[event][0] is not None) < len(USE):
+            raise guard.ScriptError(f"{args.paths}: fewer than {len(USE)} nights with a {event}; expected nights at inflow "
+                                    f"scales where some jam ({len(USE)} coefficients need at least as many events)")
         fits[event] = fit(nights, event)
     beta = fits["first jam"][0]
-    for s in (1.0, 1.45):
-        numeric = cheap.survival_curve(beta, USE, scale=s, dt=1.0)[-1][1]
-        closed = math.exp(-cumulative(beta, s, END_S))
+    for s, g in ((1.0, GAMMA0), (1.45, GAMMA0)) + (((1.45, 4.8),) if len(USE) > 3 else ()):
+        numeric = cheap.survival_curve(beta, USE, gamma=g, scale=s, dt=1.0)[-1][1]
+        closed = math.exp(-cumulative(beta, s, END_S, g))
         if abs(numeric - closed) > 1e-4 * max(closed, 1e-3):
-            raise RuntimeError(f"internal error: survival {closed} against the numerical {numeric} at s = {s}")
+            raise RuntimeError(f"internal error: survival {closed} against the numerical {numeric} at s = {s}, Γ = {g}")
 
     intervals = {}
     for event, _, target in READINGS:
@@ -389,48 +556,73 @@ def main():
             checks[event] = coverage(nights, event, b, cv, KNOWN_SCALES, args.coverage, 20261208)
             calibrated[event] = scale_interval(cheap.coefficient_draws(b, cv, DRAWS, 11), target, thresholds[event])
 
+    # The entering group's push beside the scale, where the nights' Γ differ: both readings at once over (s, Γ).
+    joint = None
+    if len(USE) > 3:
+        draws_by_event = {event: cheap.coefficient_draws(fits[event][0], fits[event][1], DRAWS, 11) for event in targets}
+        grid = joint_profile(draws_by_event, targets)
+        joint = {"grid": grid, "region": joint_region(grid, 5.99), "threshold": None, "check": None}
+        if args.coverage:
+            reps = max(1, args.coverage // 2)
+            calibration = joint_coverage(nights, fits, targets, reps, 20261209)
+            joint["threshold"] = max(5.99, percentile([d for ds, _ in calibration.values() for d in ds], 0.95))
+            joint["check"] = joint_coverage(nights, fits, targets, reps, 20261210)
+            joint["calibrated"] = joint_region(grid, joint["threshold"])
+
     os.makedirs(args.out, exist_ok=True)
     with guard.whole_file(os.path.join(args.out, "nights.csv"), "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["run", "scale", "finished", "first_jam_s", "first_jam_exposure_end_s", "clog_for_good_s",
+        w.writerow(["run", "scale", "gamma", "finished", "first_jam_s", "first_jam_exposure_end_s", "clog_for_good_s",
                     "clog_exposure_end_s", "avalanches", "falls"])
         for n in nights:
-            w.writerow([n["run"], n["scale"], int(n["finished"]), n["first jam"][0] or "", n["first jam"][1],
+            w.writerow([n["run"], n["scale"], n["gamma"], int(n["finished"]), n["first jam"][0] or "", n["first jam"][1],
                         n["clog for good"][0] or "", n["clog for good"][1],
                         "" if n["avalanches"] is None else len(n["avalanches"]), "" if n["falls"] is None else len(n["falls"])])
 
     md = ["# The Madrid night's inflow scale with the validated crowd (its whole nights' own hazards)", "",
-          f"{len(nights)} whole nights of `madrid-night.json` with the profile `validated` (the entering group's back force "
-          f"{cheap.GAMMA0:g}, the profile's), at the inflow scales "
+          f"{len(nights)} whole nights of `madrid-night.json` with the profile `validated` ("
+          + (f"the entering group's back force {GAMMA0:g}, the profile's" if len(USE) == 3 else
+             "the entering group's back force Γ " + ", ".join(f"{g:g} ({sum(1 for n in nights if n['gamma'] == g)})"
+                                                             for g in gammas_run))
+          + "), at the inflow scales "
           + ", ".join(f"{s:g} ({sum(1 for n in nights if n['scale'] == s)})" for s in sorted({n['scale'] for n in nights}))
           + ". Written by `night-hazard.py` (its header says the model and the checks).", "",
           "## The nights", "",
-          "| night | scale | first jam | clog for good | avalanches | falls |", "| --- | --- | --- | --- | --- | --- |"]
+          "| night | scale | " + ("Γ entering | " if len(USE) > 3 else "") + "first jam | clog for good | avalanches | falls |",
+          "| --- | --- | " + ("--- | " if len(USE) > 3 else "") + "--- | --- | --- | --- |"]
     for n in sorted(nights, key=lambda n: (n["scale"], n["run"])):
         cl = n["clog for good"]
         clog = fmt_time(cl[0]) if cl[0] is not None else (
             "none" if n["finished"] else f"not known (stopped at {fmt_time(n['end_s'])}; no earlier than {fmt_time(cl[1])})")
-        md.append(f"| {n['run']} | {n['scale']:g} | {fmt_time(n['first jam'][0]) if n['first jam'][0] is not None else 'none'} | "
+        md.append(f"| {n['run']} | {n['scale']:g} | " + (f"{n['gamma']:g} | " if len(USE) > 3 else "")
+                  + f"{fmt_time(n['first jam'][0]) if n['first jam'][0] is not None else 'none'} | "
                   f"{clog} | {'—' if n['avalanches'] is None else len(n['avalanches'])} | "
                   f"{'—' if n['falls'] is None else len(n['falls'])} |")
     md += ["", "## The fitted hazards", "",
-           "ln h = b0 + b1 (m − 2.25) + b2 (c − 1.6), h per s; maximum likelihood over each night's 10-s pieces from 02:05.", "",
-           "| event | events / nights | b0 | b1 (per leaving person/s) | b2 (per entering person/s) |", "| --- | --- | --- | --- | --- |"]
+           "ln h = b0 + b1 (m − 2.25) + b2 (c − 1.6)" + (" + b3 ln(Γ/1.2)" if len(USE) > 3 else "")
+           + ", h per s; maximum likelihood over each night's 10-s pieces from 02:05.", "",
+           "| event | events / nights | b0 | b1 (per leaving person/s) | b2 (per entering person/s) |"
+           + (" b3 (per ln(Γ/1.2) of the entering group) |" if len(USE) > 3 else ""),
+           "| --- | --- | --- | --- | --- |" + (" --- |" if len(USE) > 3 else "")]
     for event, _, _ in READINGS:
         b, cv, _ = fits[event]
         k = sum(1 for n in nights if n[event][0] is not None)
-        md.append(f"| {event} | {k} / {len(nights)} | " + " | ".join(f"{b[i]:.2f} ± {math.sqrt(cv[i][i]):.2f}" for i in range(3)) + " |")
-    md += ["", "Predicted from the fits (10 % / median / 90 % of nights; — : fewer by the night's end):", "",
-           "| scale | first jam | clog for good |", "| --- | --- | --- |"]
-    for s in (1.0, 1.2, 1.3, 1.4, 1.45, 1.5, 1.6, 1.8, 2.0):
-        cells = []
-        for event, _, _ in READINGS:
-            b = fits[event][0]
-            cells.append(" / ".join(fmt_time(quantile(b, s, q)) for q in (0.1, 0.5, 0.9)))
-        md.append(f"| {s:g} | " + " | ".join(cells) + " |")
+        md.append(f"| {event} | {k} / {len(nights)} | " + " | ".join(f"{b[i]:.2f} ± {math.sqrt(cv[i][i]):.2f}" for i in range(len(USE))) + " |")
+    for g in (gammas_run if len(USE) > 3 else [GAMMA0]):
+        md += ["", "Predicted from the fits (10 % / median / 90 % of nights; — : fewer by the night's end)"
+               + (f", the entering group's Γ {g:g}" if len(USE) > 3 else "") + ":", "",
+               "| scale | first jam | clog for good |", "| --- | --- | --- |"]
+        for s in (1.0, 1.2, 1.3, 1.4, 1.45, 1.5, 1.6, 1.8, 2.0):
+            cells = []
+            for event, _, _ in READINGS:
+                b = fits[event][0]
+                cells.append(" / ".join(fmt_time(quantile(b, s, q, g)) for q in (0.1, 0.5, 0.9)))
+            md.append(f"| {s:g} | " + " | ".join(cells) + " |")
     md += ["", "## The recorded night's scale", "",
            f"Likelihood h(t) S(t) of the recorded time, averaged over {DRAWS} draws of the coefficients; s on a grid of 0.01 "
-           "over 0.5–3 (the calibration file's range).", "",
+           "over 0.5–3 (the calibration file's range)"
+           + (f"; the entering group's Γ at the profile's {GAMMA0:g} (both together over s and Γ: the next section)"
+              if len(USE) > 3 else "") + ".", "",
            "| reading | best s | s within Δ(−2 ln L) < 3.84 | at the best s: 10 % / median / 90 % |", "| --- | --- | --- | --- |"]
     for event, label, _ in READINGS:
         best, lo, hi, _ = intervals[event]
@@ -462,6 +654,50 @@ def main():
         for event, label, _ in READINGS:
             best, lo, hi, _ = calibrated[event]
             md.append(f"| {label}, as the {event} | {thresholds[event]:.2f} | {best:.2f} | {lo:.2f}–{hi:.2f} |")
+    if joint:
+        (bs, bg), (s_lo, s_hi), (g_lo, g_hi) = joint["region"]
+        md += ["", "## The recorded night's scale and push together", "",
+               "Both readings at once (the first stop before 02:18 as the first jam, the fatal clog at 03:33 as the clog "
+               "for good), their likelihoods multiplied (the two events taken as independent given s and Γ), each "
+               f"averaged over {DRAWS} draws of its hazard's coefficients; s by 0.01 over 0.5–3, the entering group's Γ "
+               "by quarter octaves over 0.3–4.8 (the calibration file's ranges). The region: the grid's cells within "
+               "Δ(−2 ln L) < 5.99 (two parameters), its extent in s and in Γ.", "",
+               "| | best s | best Γ | s in the region | Γ in the region | at the best: first jam 10 % / median / 90 % "
+               "| clog for good 10 % / median / 90 % |", "| --- | --- | --- | --- | --- | --- | --- |"]
+        rows = [("Δ < 5.99", joint["region"])]
+        if joint.get("calibrated"):
+            rows.append((f"Δ < {joint['threshold']:.2f} (calibrated)", joint["calibrated"]))
+        for name, ((bs, bg), (s_lo, s_hi), (g_lo, g_hi)) in rows:
+            md.append(f"| {name} | {bs:.2f} | {bg:.2f} | {s_lo:.2f}–{s_hi:.2f} | {g_lo:.2f}–{g_hi:.2f} | "
+                      + " | ".join(" / ".join(fmt_time(quantile(fits[e][0], bs, q, bg)) for q in (0.1, 0.5, 0.9))
+                                   for e in targets) + " |")
+        md += ["", "The least −2 ln L over s at each Γ (the scale's interval there: Δ < 3.84 from that Γ's own least):", "",
+               "| Γ entering | best s | s within | Δ(−2 ln L) from the overall least |", "| --- | --- | --- | --- |"]
+        low = min(joint["grid"].values())
+        for g in GAMMAS[::2]:
+            col = {sc: v for (sc, gg), v in joint["grid"].items() if gg == g}
+            best_s = min(col, key=col.get)
+            inside = [sc for sc, v in col.items() if v - col[best_s] < 3.84]
+            md.append(f"| {g:.2f} | {best_s:.2f} | {min(inside):.2f}–{max(inside):.2f} | {col[best_s] - low:.2f} |")
+        if joint["check"]:
+            md += ["", "Coverage of the region (simulated; the coarse grid s by 0.02, Γ by half octaves, 20 coefficient "
+                   f"draws; {max(1, args.coverage // 2)} synthetic studies per known point, each event's nights drawn "
+                   "from its fitted hazard at the design's scales and Γ, both hazards refitted, a record of both events "
+                   "drawn at the known point within the night; the threshold calibrated on a first set, checked on an "
+                   "independent second):", "",
+                   "| known (s, Γ) | Δ < 5.99 contains it | Δ < calibrated threshold contains it | no fit |",
+                   "| --- | --- | --- | --- |"]
+            for known, (deltas, failed) in joint["check"].items():
+                cells = []
+                for thr in (5.99, joint["threshold"]):
+                    n = len(deltas)
+                    hits = sum(1 for d in deltas if d < thr)
+                    share = hits / n if n else float("nan")
+                    se = math.sqrt(share * (1 - share) / n) if n else float("nan")
+                    cells.append(f"{hits} of {n}: {100 * share:.1f} % ± {100 * se:.1f}")
+                md.append(f"| ({known[0]:g}, {known[1]:g}) | " + " | ".join(cells) + f" | {failed} |")
+        draw_joint(os.path.join(args.out, "joint.svg"), joint)
+        svg_to_png(os.path.join(args.out, "joint.svg"), os.path.join(args.out, "joint.png"), 700, 540)
     with guard.whole_file(os.path.join(args.out, "hazard.md")) as f:
         f.write("\n".join(md) + "\n")
     svg = os.path.join(args.out, "hazard.svg")

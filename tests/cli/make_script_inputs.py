@@ -13,9 +13,12 @@
         one such run file.
     make_script_inputs.py nights DIR VENUE.json
         DIR/paths.csv (night-path.py's columns) and DIR/summaries/RUN.json
-        (ensemble run summaries) of six whole nights at inflow scales 1-1.5,
-        four of which jam (one of them stopped before its end, without a
+        (ensemble run summaries) of seven whole nights at inflow scales 1-1.5,
+        five of which jam (one of them stopped before its end, without a
         summary): for studies/night-validated-calibration/night-hazard.py.
+        DIR/summaries-push/: the same nights, three of them with the entering
+        group's back force raised (4.8) at the start; DIR/summaries-late/:
+        one raised at 100 s (which night-hazard.py refuses).
 
 The people stand and walk at fixed, seeded places inside the venue's first
 measurement area (or at the origin), so that the numbers are not all zero.
@@ -115,8 +118,11 @@ def make_sweep(folder, venue, runs, fall=False):
 def make_nights(folder, venue):
     """(run, scale, first jam or None, clog for good or None, finished)."""
     nights = [("n1", 1.0, None, None, True), ("n2", 1.2, None, None, True), ("n3", 1.4, 4790.0, 4790.0, True),
-              ("n4", 1.45, 2400.0, 2460.0, True), ("n5", 1.45, 2900.0, 3700.0, True), ("n6", 1.5, 2750.0, None, False)]
-    os.makedirs(os.path.join(folder, "summaries"), exist_ok=True)
+              ("n4", 1.45, 2400.0, 2460.0, True), ("n5", 1.45, 2900.0, 3700.0, True), ("n6", 1.5, 2750.0, None, False),
+              ("n7", 1.5, 2600.0, 3300.0, True)]
+    pushed = {"n4", "n5", "n7"}
+    for sub in ("summaries", "summaries-push", "summaries-late"):
+        os.makedirs(os.path.join(folder, sub), exist_ok=True)
     with open(os.path.join(folder, "paths.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "time_s", "inside", "main", "counter", "density_per_m2", "counter_flow_share",
@@ -135,6 +141,13 @@ def make_nights(folder, venue):
                                 "timeline": {"rate_scale": scale}, "model": {}}}
         with open(os.path.join(folder, "summaries", run + ".json"), "w") as f:
             json.dump(summary, f)
+        for sub, at in (("summaries-push", 0.0), ("summaries-late", 100.0)):
+            if run in pushed:
+                summary["scenario"]["timeline"]["events"] = [{"time_s": at, "group": "counter",
+                                                              "set": {"back_force_gamma": 4.8}}]
+            with open(os.path.join(folder, sub, run + ".json"), "w") as f:
+                json.dump(summary, f)
+            summary["scenario"]["timeline"].pop("events", None)
 
 
 def main(argv):

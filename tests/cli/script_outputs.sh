@@ -141,6 +141,10 @@ refused "night-hazard: --unfinished without its scale" "expected RUN:SCALE" -- \
   "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6 -o hz --coverage 0
 refused "night-hazard: scenarios as summaries" "expected an ensemble run summary" -- \
   "$py" "$hz" --paths nights/paths.csv --summaries jsonfolder --unfinished n6:1.5 -o hz --coverage 0
+refused "night-hazard: the entering group's push raised during the night" "expected only the entering group's" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries-late --unfinished n6:1.5 -o hz --coverage 0
+refused "night-hazard: --unfinished with a push of 0" "expected RUN:SCALE or RUN:SCALE:GAMMA" -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries-push --unfinished n6:1.5:0 -o hz --coverage 0
 refused "night-hazard: a run file as the paths CSV" "expected night-path.py's CSV" -- \
   "$py" "$hz" --paths run.sqlite --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 0
 
@@ -151,10 +155,12 @@ accepted "sweep-ensembles: two variants" cmp.md -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
 accepted "sweep-ensembles: run again" cmp.csv -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
-accepted "night-hazard: six nights, coverage 3" hz/hazard.md -- \
+accepted "night-hazard: seven nights, coverage 3" hz/hazard.md -- \
   "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 3
 accepted "night-hazard: run again" hz/nights.csv -- \
   "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 0
+accepted "night-hazard: three nights pushing harder (the scale and the push together)" hzp/joint.png -- \
+  "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries-push --unfinished n6:1.5:4.8 -o hzp --coverage 2
 leftovers=$(find "$s" -name '.*partial-*')
 [[ -z $leftovers ]] || { echo "FAIL partial files left: $leftovers"; fails=$((fails + 1)); }
 
