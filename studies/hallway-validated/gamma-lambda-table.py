@@ -4,7 +4,7 @@ the two seeds' regimes, and per variant the counts of runs in each regime, the m
 counter-flow group, the mean speed and the mean lane order, beside the bodies sweep's thorax runs at the same
 points (the profile's Γ 1.2, λ 27).
 
-Usage: gamma-lambda-table.py GAMMA-LAMBDA-RESULTS.csv BODIES-RESULTS.csv -o TABLE.md
+Usage: gamma-lambda-table.py GAMMA-LAMBDA-RESULTS.csv BODIES-RESULTS.csv -o TABLE.md [--base-variant thorax]
 
 Both CSVs are crowdrecon sweep results (results.csv); -o must not be one of them. Written whole.
 """
@@ -27,6 +27,7 @@ def main():
     ap.add_argument("sweep", type=guard.existing_file)
     ap.add_argument("base", type=guard.existing_file)
     ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--base-variant", default="thorax", help="the base's variant in BODIES-RESULTS.csv (default thorax)")
     guard.add_force(ap)
     args = ap.parse_args()
     for path in (args.sweep, args.base):
@@ -37,8 +38,11 @@ def main():
     rows = list(csv.DictReader(open(args.sweep)))
     points = sorted({(float(r[DENS]), float(r[CF])) for r in rows})
     base = [dict(r, variant="base (Γ 1.2, λ 27)") for r in csv.DictReader(open(args.base))
-            if r["variant"] == "thorax" and (float(r[DENS]), float(r[CF])) in points]
-    variants = ["base (Γ 1.2, λ 27)"] + sorted({r["variant"] for r in rows}, key=lambda v: (v.split("-")[0] != "gamma", float(v.split("-")[1])))
+            if r["variant"] == args.base_variant and (float(r[DENS]), float(r[CF])) in points]
+    if not base:
+        raise guard.ScriptError(f"{args.base}: no runs of the variant {args.base_variant!r} at the sweep's points; "
+                                "expected the base's runs at the same densities and counter-flows (--base-variant)")
+    variants = ["base (Γ 1.2, λ 27)"] + sorted({r["variant"] for r in rows})
     allrows = base + rows
     dens = sorted({p[0] for p in points})
     cfs = sorted({p[1] for p in points}, reverse=True)

@@ -132,6 +132,13 @@ refused "passing-side: -o someone's notes" "expected another name, or --force" -
   "$py" "$D/side-preference/passing-side.py" hallway-sweep -o notes.txt
 refused "passing-side: not a sweep folder" "expected a crowdrecon sweep folder" -- \
   "$py" "$D/side-preference/passing-side.py" notes -o sides.md
+gl=$D/hallway-validated/gamma-lambda-table.py
+refused "gamma-lambda-table: -o the sweep's results" "is an input" -- \
+  "$py" "$gl" hallway-sweep/results.csv hallway-sweep/results.csv -o hallway-sweep/results.csv --base-variant two-way
+refused "gamma-lambda-table: a base without its variant" "no runs of the variant 'thorax'" -- \
+  "$py" "$gl" hallway-sweep/results.csv hallway-sweep/results.csv -o gl.md
+refused "gamma-lambda-table: a paths CSV as the sweep" "expected a crowdrecon sweep's results.csv" -- \
+  "$py" "$gl" nights/paths.csv hallway-sweep/results.csv -o gl.md
 hz=$D/night-validated-calibration/night-hazard.py
 refused "night-hazard: -o the summaries folder" "is an input|deletes nothing" -- \
   "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o nights/summaries --coverage 0
@@ -155,6 +162,8 @@ accepted "sweep-ensembles: two variants" cmp.md -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
 accepted "sweep-ensembles: run again" cmp.csv -- \
   "$py" "$S/sweep-ensembles.py" hallway-sweep two-way one-way -o cmp --metrics mean_speed_m_per_s,max_load_n
+accepted "gamma-lambda-table: a sweep against its own base" gl.md -- \
+  "$py" "$gl" hallway-sweep/results.csv hallway-sweep/results.csv -o gl.md --base-variant two-way
 accepted "night-hazard: seven nights, coverage 3" hz/hazard.md -- \
   "$py" "$hz" --paths nights/paths.csv --summaries nights/summaries --unfinished n6:1.5 -o hz --coverage 3
 accepted "night-hazard: run again" hz/nights.csv -- \
