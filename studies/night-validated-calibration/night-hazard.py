@@ -272,6 +272,16 @@ def joint_coverage(nights, fits, targets, reps, seed):
     return out
 
 
+def contains_cell(deltas, threshold):
+    """A coverage table's cell: how many synthetic studies' Δ(-2 ln L) at the known point fall below the threshold,
+    and that share with its binomial standard error."""
+    n = len(deltas)
+    hits = sum(1 for d in deltas if d < threshold)
+    share = hits / n if n else float("nan")
+    se = math.sqrt(share * (1 - share) / n) if n else float("nan")
+    return f"{hits} of {n}: {100 * share:.1f} % ± {100 * se:.1f}"
+
+
 def percentile(values, q):
     v = sorted(values)
     if not v:
@@ -439,10 +449,17 @@ def draw_figure(path, nights, fits, intervals):
         lx = 150 + 90 * i
         out.append(f'<line x1="{lx}" y1="{legend_y}" x2="{lx + 20}" y2="{legend_y}" stroke="{col}" stroke-width="2"/>')
         out.append(f'<text x="{lx + 24}" y="{legend_y + 4}">{s:g}</text>')
-    out.append(f'<text x="20" y="{h - 30}" fill="#444">Curves: the hazard fitted to the validated nights, ln h = b0 + b1 (m − 2.25) + b2 (c − 1.6), '
-               'at each inflow scale; dots: the nights\' own events, at their scale.</text>')
-    out.append(f'<text x="20" y="{h - 12}" fill="#444">Right: the recorded time\'s −2 ln L over the scale, less its least, '
-               'averaged over the coefficients\' uncertainty; 3.84 marks the uncalibrated 95 % interval (table: the calibrated ones).</text>')
+    finish_svg(path, out, h, ["Curves: the hazard fitted to the validated nights, ln h = b0 + b1 (m − 2.25) + b2 (c − 1.6), "
+                              "at each inflow scale; dots: the nights' own events, at their scale.",
+                              "Right: the recorded time's −2 ln L over the scale, less its least, averaged over the "
+                              "coefficients' uncertainty; 3.84 marks the uncalibrated 95 % interval (table: the calibrated ones)."])
+
+
+def finish_svg(path, out, h, captions):
+    """The figure's captions, one line each from 18 px apart up to the bottom edge, and the figure written whole."""
+    for k, text in enumerate(captions):
+        y = h - 12 - 18 * (len(captions) - 1 - k)
+        out.append(f'<text x="20" y="{y}" fill="#444">{text.replace("<", "&lt;")}</text>')
     out.append("</svg>")
     with guard.whole_file(path) as f:
         f.write("\n".join(out))
@@ -485,16 +502,11 @@ def draw_joint(path, joint):
                    f'text-anchor="end">{g:g}</text>')
     out.append(f'<text x="18" y="{top + ph / 2}" transform="rotate(-90 18 {top + ph / 2})" text-anchor="middle">'
                'entering group\'s back force Γ</text>')
-    out.append(f'<text x="20" y="{h - 48}" fill="#444">Blue: within Δ &lt; {thr:.2f}'
-               f'{" (calibrated by simulation)" if joint["threshold"] else " (two parameters, uncalibrated)"}; '
-               'darker: more likely. Dot: the best (s, Γ).</text>')
-    out.append(f'<text x="20" y="{h - 30}" fill="#444">Both readings of the record at once: the first stop before 02:18 '
-               'as the first jam,</text>')
-    out.append(f'<text x="20" y="{h - 12}" fill="#444">the fatal clog at 03:33 as the clog for good (hazards fitted to '
-               'the validated nights).</text>')
-    out.append("</svg>")
-    with guard.whole_file(path) as f:
-        f.write("\n".join(out))
+    finish_svg(path, out, h, [f"Blue: within Δ < {thr:.2f}"
+                              + (" (calibrated by simulation)" if joint["threshold"] else " (two parameters, uncalibrated)")
+                              + "; darker: more likely. Dot: the best (s, Γ).",
+                              "Both readings of the record at once: the first stop before 02:18 as the first jam,",
+                              "the fatal clog at 03:33 as the clog for good (hazards fitted to the validated nights)."])
 
 
 OUTPUTS = {"hazard.md": "# The Madrid night's inflow scale with the validated crowd", "nights.csv": "run,scale,",
@@ -641,14 +653,8 @@ def main():
         for event, _, _ in READINGS:
             q = thresholds[event]
             for s, (deltas, failed) in checks[event].items():
-                cells = []
-                for thr in (3.84, q):
-                    n = len(deltas)
-                    hits = sum(1 for d in deltas if d < thr)
-                    share = hits / n if n else float("nan")
-                    se = math.sqrt(share * (1 - share) / n) if n else float("nan")
-                    cells.append(f"{hits} of {n}: {100 * share:.1f} % ± {100 * se:.1f}")
-                md.append(f"| {event} | {s:g} | " + " | ".join(cells) + f" | {failed} |")
+                md.append(f"| {event} | {s:g} | " + " | ".join(contains_cell(deltas, thr) for thr in (3.84, q))
+                          + f" | {failed} |")
         md += ["", "The recorded night's scale with the calibrated thresholds:", "",
                "| reading | threshold | best s | s within it |", "| --- | --- | --- | --- |"]
         for event, label, _ in READINGS:
@@ -688,14 +694,8 @@ def main():
                    "| known (s, Γ) | Δ < 5.99 contains it | Δ < calibrated threshold contains it | no fit |",
                    "| --- | --- | --- | --- |"]
             for known, (deltas, failed) in joint["check"].items():
-                cells = []
-                for thr in (5.99, joint["threshold"]):
-                    n = len(deltas)
-                    hits = sum(1 for d in deltas if d < thr)
-                    share = hits / n if n else float("nan")
-                    se = math.sqrt(share * (1 - share) / n) if n else float("nan")
-                    cells.append(f"{hits} of {n}: {100 * share:.1f} % ± {100 * se:.1f}")
-                md.append(f"| ({known[0]:g}, {known[1]:g}) | " + " | ".join(cells) + f" | {failed} |")
+                md.append(f"| ({known[0]:g}, {known[1]:g}) | "
+                          + " | ".join(contains_cell(deltas, thr) for thr in (5.99, joint["threshold"])) + f" | {failed} |")
         draw_joint(os.path.join(args.out, "joint.svg"), joint)
         svg_to_png(os.path.join(args.out, "joint.svg"), os.path.join(args.out, "joint.png"), 700, 540)
     with guard.whole_file(os.path.join(args.out, "hazard.md")) as f:
