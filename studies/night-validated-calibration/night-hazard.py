@@ -167,6 +167,27 @@ def quantile(beta, s, q, g=GAMMA0):
     return time_of(beta, s, h, g)
 
 
+def synthetic_refit(nights, event, beta, rng, min_events):
+    """A synthetic study: the design's nights (their scales and Γ) drawn from the hazard `beta` of `event`, the hazard
+    refitted to them; (coefficients, covariance), or None with fewer than min_events events or no fit."""
+    fake = []
+    for n in nights:
+        t = draw_time(beta, n["scale"], rng, g=n["gamma"])
+        fake.append({"scale": n["scale"], "gamma": n["gamma"], event: (t, t if t is not None else END_S)})
+    if sum(1 for f in fake if f[event][0] is not None) < min_events:
+        return None
+    try:
+        b_rep, c_rep, _ = fit(fake, event)
+    except ZeroDivisionError:
+        return None
+    return b_rep, c_rep
+
+
+def finite_fit(b_rep):
+    """A refit with a finite maximum (not every synthetic event at one end of the night)."""
+    return all(math.isfinite(x) for x in b_rep) and max(abs(x) for x in b_rep) <= 50
+
+
 def coverage(nights, event, beta, cov, target_scales, reps, seed):
     """Per known scale, the synthetic studies' Δ(-2 ln L) at the known scale (an interval at threshold q contains it
     when Δ < q), and the count of studies without a fit."""
@@ -175,21 +196,11 @@ def coverage(nights, event, beta, cov, target_scales, reps, seed):
     for true_s in target_scales:
         deltas, failed = [], 0
         for _ in range(reps):
-            fake = []
-            for n in nights:
-                t = draw_time(beta, n["scale"], rng, g=n["gamma"])
-                fake.append({"scale": n["scale"], "gamma": n["gamma"], event: (t, t if t is not None else END_S)})
-            if sum(1 for f in fake if f[event][0] is not None) < 3:
+            refit = synthetic_refit(nights, event, beta, rng, 3)
+            if refit is None or not finite_fit(refit[0]):
                 failed += 1
                 continue
-            try:
-                b_rep, c_rep, _ = fit(fake, event)
-            except ZeroDivisionError:
-                failed += 1
-                continue
-            if any(not math.isfinite(x) for x in b_rep) or max(abs(x) for x in b_rep) > 50:
-                failed += 1  # no finite maximum (every synthetic event at one end): not an estimate
-                continue
+            b_rep, c_rep = refit
             record = draw_time(beta, true_s, rng, within=True)
             if record is None:
                 failed += 1
@@ -244,20 +255,14 @@ def joint_coverage(nights, fits, targets, reps, seed):
         for _ in range(reps):
             draws_by_event, record, ok = {}, {}, True
             for event in targets:
-                beta, cov, _ = fits[event]
-                fake = []
-                for n in nights:
-                    t = draw_time(beta, n["scale"], rng, g=n["gamma"])
-                    fake.append({"scale": n["scale"], "gamma": n["gamma"], event: (t, t if t is not None else END_S)})
-                try:
-                    if sum(1 for f in fake if f[event][0] is not None) < len(USE):
-                        raise ZeroDivisionError
-                    b_rep, c_rep, _ = fit(fake, event)
-                except ZeroDivisionError:
+                beta = fits[event][0]
+                refit = synthetic_refit(nights, event, beta, rng, len(USE))
+                if refit is None:
                     ok = False
                     break
+                b_rep, c_rep = refit
                 t_rec = draw_time(beta, known[0], rng, within=True, g=known[1])
-                if (t_rec is None or any(not math.isfinite(x) for x in b_rep) or max(abs(x) for x in b_rep) > 50):
+                if t_rec is None or not finite_fit(b_rep):
                     ok = False
                     break
                 draws_by_event[event] = cheap.coefficient_draws(b_rep, c_rep, 20, rng.randrange(1 << 30))
@@ -298,9 +303,14 @@ def entering_gamma(scenario, where):
     for k, e in enumerate(scenario.get("timeline", {}).get("events") or []):
         if "back_force_gamma" not in (e.get("set") or {}):
             continue
-        if e.get("group") not in (None, "counter") or float(e.get("time_s", 0.0)) > 0.0:
-            raise guard.ScriptError(f"{where}: scenario.timeline.events[{k}] sets back_force_gamma "
-                                    f"{'at ' + str(e.get('time_s')) + ' s' if e.get('group') in (None, 'counter') else 'of the group ' + repr(e.get('group'))}; "
+        if e.get("group") not in (None, "counter"):
+            what = f"of the group {e.get('group')!r}"
+        elif float(e.get("time_s", 0.0)) > 0.0:
+            what = f"at {e.get('time_s')} s"
+        else:
+            what = None
+        if what:
+            raise guard.ScriptError(f"{where}: scenario.timeline.events[{k}] sets back_force_gamma {what}; "
                                     "expected only the entering group's (\"counter\"), set at the start (time_s 0)")
         gamma = float(e["set"]["back_force_gamma"])
     if not gamma > 0.0:
